@@ -1,0 +1,41 @@
+// lodrefine: refine coarse LoD2 building models with MLS point clouds.
+#include <cstdio>
+#include <exception>
+#include <new>
+
+#include "commands.h"
+#include "lodrefine/types.h"
+
+namespace lodrefine::app {
+int& exit_code() {
+  static int code = 0;
+  return code;
+}
+}  // namespace lodrefine::app
+
+int main(int argc, char** argv) {
+  using namespace lodrefine;
+  CLI::App app{"lodrefine: refine coarse LoD2 building models with mobile laser scanning point clouds"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "lodrefine 0.1.0");
+  app::add_refine_command(app);
+  app::add_synth_command(app);
+  app::add_eval_command(app);
+  app::add_crop_command(app);
+  app::add_params_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "lodrefine: error: %s\n", e.what());
+    return 2;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "lodrefine: error: out of memory\n");
+    return 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "lodrefine: error: %s\n", e.what());
+    return 1;
+  }
+  return app::exit_code();
+}

@@ -1,0 +1,32 @@
+// Method parameters as CLI options, generated from the one table in params.h.
+#pragma once
+#include <algorithm>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "lodrefine/params.h"
+
+namespace lodrefine::app {
+
+inline std::string option_name(const std::string& field) {
+  std::string s = "--" + field;
+  std::replace(s.begin(), s.end(), '_', '-');
+  return s;
+}
+
+// Adds one option per parameter to `cmd`, bound to `params` (which must outlive parsing).
+inline void add_param_options(CLI::App* cmd, Params& params) {
+  const auto& table = param_table();
+  std::size_t i = 0;
+#define LODREFINE_PARAM_OPTION(type, name, def, lo, hi, help)                                            \
+  cmd->add_option(option_name(#name), params.name, table[i].description)                                  \
+      ->capture_default_str()                                                                             \
+      ->check(CLI::Range(type(lo), type(hi)))                                                             \
+      ->group("Method parameters");                                                                       \
+  ++i;
+  LODREFINE_PARAMS(LODREFINE_PARAM_OPTION)
+#undef LODREFINE_PARAM_OPTION
+}
+
+}  // namespace lodrefine::app

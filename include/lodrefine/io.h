@@ -1,0 +1,39 @@
+// Reading and writing building models (OBJ) and point clouds (PLY).
+// Every reader throws InputError with a one-line message on malformed input; every writer
+// writes to a temporary file beside the target and renames it, so no partial file is left.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "lodrefine/types.h"
+
+namespace lodrefine {
+
+// Reads an OBJ polygon soup as exported per building from CityGML: `g WallSurface` /
+// `g RoofSurface` / `g GroundSurface` groups (also `usemtl`), polygons of 3+ vertices,
+// georeferenced doubles. Building id from `o NAME`, else a `# id: X` comment, else the file
+// stem. Faces are kept as given (no welding); Face::source is the face's index in the file.
+Mesh read_obj(const std::string& path);
+
+// Writes polygons grouped by semantic (`g WallSurface` ...), `o <id>`, vertices offset by
+// `origin` (the local frame's origin) and printed with enough digits for < 0.1 mm at 7-digit
+// magnitudes. Atomic (temp + rename). Throws std::runtime_error if the target is not writable.
+void write_obj(const std::string& path, const Mesh& mesh, const Vec3& origin = Vec3::Zero());
+
+// Reads x/y/z of a PLY (ascii, binary little- or big-endian; float or double or any integer
+// type; extra properties and elements skipped). Rejects NaN/Inf and header/data mismatches.
+PointCloud read_ply(const std::string& path);
+
+// Streams the vertices of a PLY in chunks without holding the whole file; the callback gets
+// each point in file order. Same validation as read_ply.
+void stream_ply(const std::string& path, const std::function<void(const Vec3&)>& on_point);
+
+// Writes x/y/z as binary little-endian doubles (plus an optional per-point float property).
+void write_ply(const std::string& path, const PointCloud& cloud, const Vec3& origin = Vec3::Zero(),
+               const std::vector<float>* scalar = nullptr, const std::string& scalar_name = "scalar");
+
+// Writes `content` to `path` atomically (temp file in the same directory + rename).
+void write_file_atomic(const std::string& path, const std::string& content);
+
+}  // namespace lodrefine

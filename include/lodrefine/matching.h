@@ -1,0 +1,44 @@
+// Stage 2: model-to-surface matching. Groups the model's faces into planar surfaces, matches
+// scan planes to wall surfaces (normal + centroid-distance hard filters, OBB IoU, S_match),
+// scores the model by Q_model.
+#pragma once
+#include <vector>
+
+#include "lodrefine/geometry.h"
+#include "lodrefine/params.h"
+#include "lodrefine/planes.h"
+#include "lodrefine/types.h"
+
+namespace lodrefine {
+
+// Edge-connected coplanar faces of one semantic: one supporting plane of the model.
+struct ModelSurface {
+  Plane plane;             // PCA plane of all its vertices, oriented outward
+  std::vector<int> faces;  // indices into Mesh::faces
+  Semantic sem = Semantic::Other;
+  double area = 0.0;
+  Vec3 centroid = Vec3::Zero();
+};
+
+std::vector<ModelSurface> model_surfaces(const Mesh& mesh, double angle_deg = 1.0, double distance = 0.02);
+
+struct Match {
+  int scan_plane = -1;   // index into the scan planes
+  int surface = -1;      // index into the model surfaces
+  double s_normal = 0, d_centroid = 0, c_bbox = 0, s_match = 0;
+};
+
+struct MatchResult {
+  std::vector<Match> matches;   // the accepted one-to-one matches (one scan plane per surface)
+  double q_model = 0.0;         // sum of S_match
+};
+
+MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
+                           const PointCloud& cloud, const std::vector<ScanPlane>& planes,
+                           const Params& params);
+
+// The facade points of a cloud for evaluation: inliers of scan planes matched to the model's
+// walls (no ground, clutter or neighbours). Mesh and cloud in the same (local) frame.
+std::vector<int> select_facade_points(const Mesh& mesh, const PointCloud& cloud, const Params& params);
+
+}  // namespace lodrefine

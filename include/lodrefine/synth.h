@@ -1,0 +1,46 @@
+// Generator of test buildings with known ground truth: the true building, a coarse LoD2-like
+// model of it (facades shifted/rotated, export defects) and a simulated MLS crop.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "lodrefine/types.h"
+
+namespace lodrefine {
+
+enum class BuildingType { Flat, Gable, Hip, Shed, Stepped, LShape, TShape, Polygon };
+const char* building_type_name(BuildingType t);          // "flat", "gable", ...
+BuildingType building_type_from_name(const std::string&); // throws InputError
+std::vector<BuildingType> all_building_types();
+
+struct SynthOptions {
+  double max_shift = 0.8;        // facade offset, uniform in [min_shift, max_shift] with random sign (m)
+  double min_shift = 0.2;
+  double max_rotation_deg = 3.0; // facade rotation about a vertical axis
+  double global_shift = 0.03;    // whole coarse model shifted by up to this (m)
+  int scanned_facades = 0;       // 0: random 1..3
+  double noise = 0.01;           // MLS range noise sigma (m)
+  int target_points = 30000;     // points on scanned facades, before nuisances
+  bool defects = true;           // missing ground / mm gaps / flipped face / duplicate face
+  bool nuisances = true;         // windows, recesses, occlusion holes, trees, cars, ground, neighbours
+  Vec3 origin{85000.0, 447000.0, 0.0};  // georeferenced offset (RD New-like by default)
+};
+
+struct SynthBuilding {
+  std::string id;
+  BuildingType type;
+  Mesh truth;    // closed, oriented, shared vertices, georeferenced
+  Mesh coarse;   // polygon soup as exported from CityGML (defects included), georeferenced
+  PointCloud cloud;                // georeferenced MLS crop
+  std::vector<int> scanned_truth_faces;  // indices into truth.faces of the scanned walls
+  std::vector<int> point_label;    // per cloud point: truth face index for facade points, -1 window recess, -2 clutter, -3 ground, -4 neighbour
+};
+
+// Deterministic for (type, seed, options).
+SynthBuilding make_building(BuildingType type, std::uint64_t seed, const SynthOptions& opt = {});
+
+// Writes DIR/<id>/{truth.obj, coarse.obj, cloud.ply, meta.json}.
+void write_synth_building(const std::string& dir, const SynthBuilding& b);
+
+}  // namespace lodrefine

@@ -1,0 +1,43 @@
+// Core value types shared by every pipeline stage.
+#pragma once
+#include <Eigen/Core>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace lodrefine {
+
+using Vec3 = Eigen::Vector3d;
+using Vec2 = Eigen::Vector2d;
+
+// CityGML thematic surface of a face; Other for groups we do not recognise.
+enum class Semantic { Wall, Roof, Ground, Other };
+const char* semantic_name(Semantic s);       // "WallSurface", "RoofSurface", ...
+Semantic semantic_from_name(const std::string& group);  // case-insensitive substring match
+
+// One planar polygon of a building, vertices indexing Mesh::vertices (counter-clockwise seen
+// from outside once the mesh is oriented).
+struct Face {
+  std::vector<int> v;
+  Semantic sem = Semantic::Other;
+  int source = -1;  // index of the input face this one descends from (-1: new)
+};
+
+// A polygonal building model. Coordinates are in whatever frame the caller uses: readers
+// return the file's (georeferenced) frame, the pipeline works in a local frame.
+struct Mesh {
+  std::vector<Vec3> vertices;
+  std::vector<Face> faces;
+  std::string id;  // building id (OBJ `o` name or `# id:` comment)
+};
+
+struct PointCloud {
+  std::vector<Vec3> points;
+};
+
+// Input that cannot be used; what() is a one-line message naming the file and the fault.
+struct InputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace lodrefine
