@@ -1,4 +1,60 @@
+// `lodrefine refine`: one coarse building + its MLS crop -> the refined building.
+#include <cstdio>
+
 #include "commands.h"
+#include "lodrefine/io.h"
+#include "lodrefine/refine.h"
+#include "options.h"
+
 namespace lodrefine::app {
-void add_refine_command(CLI::App& app) { app.add_subcommand("refine", "(not yet available)"); }
+namespace {
+
+struct RefineArgs {
+  std::string model, cloud, out, report;
+  Params params;
+};
+
+nlohmann::json params_json(const Params& p) {
+  nlohmann::json j;
+#define LODREFINE_PARAM_JSON(type, name, def, lo, hi, help) j[#name] = p.name;
+  LODREFINE_PARAMS(LODREFINE_PARAM_JSON)
+#undef LODREFINE_PARAM_JSON
+  return j;
+}
+
+void run(const RefineArgs& a) {
+  a.params.validate();
+  const Mesh model = read_obj(a.model);
+  const PointCloud cloud = read_ply(a.cloud);
+  if (cloud.points.empty()) throw InputError(a.cloud + ": the cloud has no points");
+  RefineResult r = refine_building(model, cloud, a.params);
+  r.report["model"] = a.model;
+  r.report["cloud"]["path"] = a.cloud;
+  r.report["params"] = params_json(a.params);
+  r.report["written"] = r.valid ? a.out : "";
+  if (r.valid) write_obj(a.out, r.mesh);
+  if (!a.report.empty()) write_file_atomic(a.report, r.report.dump(2) + "\n");
+  if (!r.valid) {
+    std::fprintf(stderr, "lodrefine: error: %s: no valid building to write: %s\n", model.id.c_str(),
+                 r.report["output_validation"].value("problem", std::string("invalid")).c_str());
+    exit_code() = 3;
+    return;
+  }
+  std::printf("%s: %s -> %s (%.2f s)\n", model.id.c_str(), r.outcome.c_str(), a.out.c_str(),
+              r.report["seconds"].value("total", 0.0));
+}
+
+}  // namespace
+
+void add_refine_command(CLI::App& app) {
+  static RefineArgs args;
+  auto* cmd = app.add_subcommand("refine", "Refine one building model with an MLS point cloud");
+  cmd->add_option("--model", args.model, "Coarse building model (OBJ, CityGML fan-out export)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--cloud", args.cloud, "MLS point cloud crop around the building (PLY)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--out", args.out, "Refined model (OBJ), written atomically")->required();
+  cmd->add_option("--report", args.report, "JSON report: matches, planes, candidates, MIP, timings, validation");
+  add_param_options(cmd, args.params);
+  cmd->callback([] { run(args); });
+}
+
 }  // namespace lodrefine::app

@@ -17,6 +17,8 @@ namespace lodrefine {
   X(int, normal_neighbors, 12, 3, 200, "neighbours for PCA normal estimation")                           \
   X(double, min_plane_area, 1.0, 0.0, 1e6, "scan planes whose inlier hull is smaller are ignored (m^2)") \
   X(double, facade_max_tilt_deg, 10.0, 0.0, 45.0, "scan plane counts as facade if its normal is within this of horizontal (deg)") \
+  X(double, vertical_snap_deg, 1.5, 0.0, 10.0, "facade planes tilted less than this are refitted exactly vertical (deg)") \
+  X(double, change_tolerance, 0.02, 0.0, 1.0, "a matched wall within this of its scan plane everywhere is kept as is (m)") \
   X(double, match_angle_deg, 10.0, 0.0, 90.0, "matching hard filter: max angle between normals (deg)")    \
   X(double, match_distance, 2.0, 0.0, 100.0, "matching hard filter: max centroid-to-plane distance (m)")  \
   X(double, match_min_overlap, 0.2, 0.0, 1.0, "matching: min OBB overlap (share of the scan box inside the face box)") \

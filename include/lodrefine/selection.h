@@ -1,0 +1,28 @@
+// Stage 4b: face selection as a binary program in GLPK (paper Sec. 3.4): sigmoid coverage
+// cost, PolyFit complexity (sharp edges), and per edge "selected incident faces = 2 x used",
+// with the region's outside surface as a constant incident face on boundary edges.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "lodrefine/candidates.h"
+#include "lodrefine/params.h"
+
+namespace lodrefine {
+
+struct SelectionResult {
+  bool ok = false;             // a feasible selection satisfying every edge constraint
+  std::vector<char> selected;  // per candidate
+  std::string status;          // "optimal", "feasible (time limit)", "infeasible", "time limit", ...
+  int variables = 0, constraints = 0, nonzeros = 0;
+  double objective = 0.0;
+  double seconds = 0.0;
+};
+
+// `cost[f]`: coverage cost of candidate f (already weighted); `outside[e]`: 1 where the kept
+// surface outside the region continues across edge e (counts as a selected face), else 0;
+// `start`: optional feasible selection handed to GLPK as its first incumbent.
+SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& cost, const std::vector<int>& outside,
+                             const Params& params, const std::vector<char>* start = nullptr);
+
+}  // namespace lodrefine

@@ -1,0 +1,154 @@
+// Stage 2: model-to-surface matching (paper Sec. 3.1).
+#include "lodrefine/matching.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace lodrefine {
+namespace {
+
+std::vector<Vec3> face_points(const Mesh& mesh, const Face& f) {
+  std::vector<Vec3> pts;
+  pts.reserve(f.v.size());
+  for (int i : f.v) pts.push_back(mesh.vertices[i]);
+  return pts;
+}
+
+// In-plane extent [min u, max u] x [min v, max v] of points in a surface's frame.
+struct Rect {
+  double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
+  void add(double u, double v) {
+    u0 = std::min(u0, u); u1 = std::max(u1, u);
+    v0 = std::min(v0, v); v1 = std::max(v1, v);
+  }
+  double area() const { return std::max(0.0, u1 - u0) * std::max(0.0, v1 - v0); }
+};
+
+double overlap_area(const Rect& a, const Rect& b) {
+  const double du = std::min(a.u1, b.u1) - std::max(a.u0, b.u0);
+  const double dv = std::min(a.v1, b.v1) - std::max(a.v0, b.v0);
+  return du > 0 && dv > 0 ? du * dv : 0.0;
+}
+
+}  // namespace
+
+std::vector<ModelSurface> model_surfaces(const Mesh& mesh, double angle_deg, double distance) {
+  const int nf = int(mesh.faces.size());
+  std::map<std::pair<int, int>, std::vector<int>> edge_faces;
+  for (int f = 0; f < nf; ++f) {
+    const auto& v = mesh.faces[f].v;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const int a = v[i], b = v[(i + 1) % v.size()];
+      edge_faces[{std::min(a, b), std::max(a, b)}].push_back(f);
+    }
+  }
+  std::vector<Plane> face_plane(nf);
+  for (int f = 0; f < nf; ++f) face_plane[f] = polygon_plane(face_points(mesh, mesh.faces[f]));
+
+  std::vector<int> group(nf, -1);
+  std::vector<ModelSurface> surfaces;
+  for (int seed = 0; seed < nf; ++seed) {
+    if (group[seed] >= 0) continue;
+    const int gid = int(surfaces.size());
+    std::vector<int> stack{seed}, members;
+    group[seed] = gid;
+    while (!stack.empty()) {
+      const int f = stack.back();
+      stack.pop_back();
+      members.push_back(f);
+      const auto& v = mesh.faces[f].v;
+      for (std::size_t i = 0; i < v.size(); ++i) {
+        const int a = v[i], b = v[(i + 1) % v.size()];
+        for (int g : edge_faces[{std::min(a, b), std::max(a, b)}]) {
+          if (group[g] >= 0 || mesh.faces[g].sem != mesh.faces[seed].sem) continue;
+          if (face_plane[g].n.dot(face_plane[seed].n) < std::cos(angle_deg * M_PI / 180.0)) continue;
+          bool on_plane = true;
+          for (int vi : mesh.faces[g].v)
+            on_plane = on_plane && std::abs(face_plane[seed].distance(mesh.vertices[vi])) <= distance;
+          if (!on_plane) continue;
+          group[g] = gid;
+          stack.push_back(g);
+        }
+      }
+    }
+    ModelSurface s;
+    s.faces = members;
+    s.sem = mesh.faces[seed].sem;
+    std::vector<Vec3> pts;
+    Vec3 nsum = Vec3::Zero(), csum = Vec3::Zero();
+    for (int f : members) {
+      const auto poly = face_points(mesh, mesh.faces[f]);
+      pts.insert(pts.end(), poly.begin(), poly.end());
+      const double a = polygon_area(poly);
+      s.area += a;
+      nsum += newell_normal(poly);
+      csum += a * polygon_centroid(poly);
+    }
+    s.plane = fit_plane(pts);
+    if (s.plane.n.dot(nsum) < 0) s.plane = s.plane.flipped();
+    s.centroid = s.area > 0 ? Vec3(csum / s.area) : pts.front();
+    surfaces.push_back(std::move(s));
+  }
+  return surfaces;
+}
+
+MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& surfaces, const PointCloud& cloud,
+                           const std::vector<ScanPlane>& planes, const Params& prm) {
+  MatchResult result;
+  const double cos_max = std::cos(prm.match_angle_deg * M_PI / 180.0);
+  for (int s = 0; s < int(surfaces.size()); ++s) {
+    const ModelSurface& surf = surfaces[s];
+    if (surf.sem != Semantic::Wall) continue;
+    const auto [u, v] = surf.plane.basis();
+    Rect model_box;
+    for (int f : surf.faces)
+      for (int vi : mesh.faces[f].v) {
+        const Vec3 q = mesh.vertices[vi] - surf.centroid;
+        model_box.add(q.dot(u), q.dot(v));
+      }
+    Match best;
+    for (int p = 0; p < int(planes.size()); ++p) {
+      const ScanPlane& sp = planes[p];
+      if (!sp.facade) continue;
+      const double s_normal = sp.plane.n.dot(surf.plane.n);
+      const double d_c = std::abs(surf.plane.distance(sp.centroid));
+      if (std::abs(s_normal) < cos_max || d_c > prm.match_distance) continue;  // hard filters
+      // Both OBBs in the surface's frame, sharing the slab that spans both planes along the
+      // normal: the volume IoU of two flat boxes would vanish at any offset.
+      Rect scan_box;
+      for (int i : sp.inliers) {
+        const Vec3 q = cloud.points[i] - surf.centroid;
+        scan_box.add(q.dot(u), q.dot(v));
+      }
+      const double inter = overlap_area(model_box, scan_box);
+      const double uni = model_box.area() + scan_box.area() - inter;
+      const double iou = uni > 0 ? inter / uni : 0.0;
+      const double coverage = std::max({iou, inter / std::max(1e-12, scan_box.area()),
+                                        inter / std::max(1e-12, model_box.area())});
+      if (coverage < prm.match_min_overlap) continue;
+      const double score = prm.w_normal * std::abs(s_normal) + prm.w_coverage * iou;
+      if (score > best.s_match) best = Match{p, s, s_normal, d_c, iou, score};
+    }
+    if (best.scan_plane >= 0) {
+      result.matches.push_back(best);
+      result.q_model += best.s_match;
+    }
+  }
+  return result;
+}
+
+std::vector<int> select_facade_points(const Mesh& mesh, const PointCloud& cloud, const Params& prm) {
+  const auto planes = detect_planes(cloud, prm);
+  const auto surfaces = model_surfaces(mesh);
+  const auto m = match_surfaces(mesh, surfaces, cloud, planes, prm);
+  std::vector<char> take(cloud.points.size(), 0);
+  for (const auto& match : m.matches)
+    for (int i : planes[match.scan_plane].inliers) take[i] = 1;
+  std::vector<int> idx;
+  for (int i = 0; i < int(take.size()); ++i)
+    if (take[i]) idx.push_back(i);
+  return idx;
+}
+
+}  // namespace lodrefine

@@ -1,0 +1,106 @@
+// Stage 1. The only translation unit with CGAL's shape detection: keep it that way, it is the
+// slowest to compile.
+#include "lodrefine/planes.h"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Random.h>
+#include <CGAL/Shape_detection/Efficient_RANSAC.h>
+#include <CGAL/pca_estimate_normals.h>
+#include <CGAL/property_map.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+namespace lodrefine {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = Kernel::Point_3;
+using Vector = Kernel::Vector_3;
+using PointWithNormal = std::pair<Point, Vector>;
+using PointList = std::vector<PointWithNormal>;
+using PointMap = CGAL::First_of_pair_property_map<PointWithNormal>;
+using NormalMap = CGAL::Second_of_pair_property_map<PointWithNormal>;
+using Traits = CGAL::Shape_detection::Efficient_RANSAC_traits<Kernel, PointList, PointMap, NormalMap>;
+using Ransac = CGAL::Shape_detection::Efficient_RANSAC<Traits>;
+using RansacPlane = CGAL::Shape_detection::Plane<Traits>;
+
+// Vertical least-squares plane: PCA of the horizontal coordinates only.
+Plane fit_vertical_plane(const std::vector<Vec3>& pts) {
+  Vec2 c = Vec2::Zero();
+  for (const auto& p : pts) c += p.head<2>();
+  c /= double(pts.size());
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+  for (const auto& p : pts) {
+    const Vec2 q = p.head<2>() - c;
+    cov += q * q.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(cov);
+  const Vec2 n2 = es.eigenvectors().col(0);
+  return Plane::through(Vec3(c.x(), c.y(), 0.0), Vec3(n2.x(), n2.y(), 0.0));
+}
+
+ScanPlane describe(const std::vector<Vec3>& all, std::vector<int> inliers, const Params& prm) {
+  ScanPlane sp;
+  sp.inliers = std::move(inliers);
+  std::vector<Vec3> pts;
+  pts.reserve(sp.inliers.size());
+  for (int i : sp.inliers) pts.push_back(all[i]);
+  sp.plane = fit_plane(pts);
+  const double tilt = 90.0 - unoriented_angle_deg(sp.plane.n, Vec3::UnitZ());
+  sp.facade = tilt <= prm.facade_max_tilt_deg;
+  if (tilt <= prm.vertical_snap_deg) sp.plane = fit_vertical_plane(pts);
+  double ss = 0.0;
+  for (const auto& p : pts) {
+    sp.centroid += p;
+    ss += sp.plane.distance(p) * sp.plane.distance(p);
+  }
+  sp.centroid /= double(pts.size());
+  sp.rms = std::sqrt(ss / double(pts.size()));
+  const auto [u, v] = sp.plane.basis();
+  std::vector<Vec2> uv;
+  uv.reserve(pts.size());
+  for (const auto& p : pts) uv.emplace_back((p - sp.centroid).dot(u), (p - sp.centroid).dot(v));
+  sp.hull_area = std::abs(signed_area_2d(convex_hull_2d(std::move(uv))));
+  return sp;
+}
+
+}  // namespace
+
+std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm) {
+  std::vector<ScanPlane> result;
+  const std::size_t n = cloud.points.size();
+  if (n < std::size_t(std::max(prm.ransac_min_points, prm.normal_neighbors + 1))) return result;
+
+  PointList pts;
+  pts.reserve(n);
+  for (const auto& p : cloud.points) pts.emplace_back(Point(p.x(), p.y(), p.z()), Vector(0, 0, 0));
+  CGAL::pca_estimate_normals<CGAL::Sequential_tag>(
+      pts, prm.normal_neighbors, CGAL::parameters::point_map(PointMap()).normal_map(NormalMap()));
+
+  // Efficient RANSAC draws from CGAL's default generator: seed it for reproducible runs.
+  CGAL::get_default_random() = CGAL::Random(static_cast<unsigned>(prm.seed));
+  Ransac ransac;
+  ransac.set_input(pts);
+  ransac.add_shape_factory<RansacPlane>();
+  Ransac::Parameters rp;
+  rp.probability = prm.ransac_probability;
+  rp.min_points = std::size_t(prm.ransac_min_points);
+  rp.epsilon = prm.ransac_epsilon;
+  rp.cluster_epsilon = prm.ransac_cluster_epsilon;
+  rp.normal_threshold = std::cos(prm.ransac_normal_deg * M_PI / 180.0);
+  ransac.detect(rp);
+
+  for (const auto& shape : ransac.shapes()) {
+    std::vector<int> inl(shape->indices_of_assigned_points().begin(), shape->indices_of_assigned_points().end());
+    if (inl.size() < 3) continue;
+    ScanPlane sp = describe(cloud.points, std::move(inl), prm);
+    if (sp.hull_area >= prm.min_plane_area) result.push_back(std::move(sp));
+  }
+  // Largest first: later stages prefer well-supported planes on ties.
+  std::stable_sort(result.begin(), result.end(),
+                   [](const ScanPlane& a, const ScanPlane& b) { return a.inliers.size() > b.inliers.size(); });
+  return result;
+}
+
+}  // namespace lodrefine

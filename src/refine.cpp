@@ -1,0 +1,506 @@
+// The pipeline (paper Sec. 3): repair -> planes -> matching -> per outdated wall a local
+// candidate arrangement, confidence and GLPK selection -> validated closed shell.
+#include "lodrefine/refine.h"
+
+#include <boost/geometry.hpp>
+#include <boost/geometry/geometries/point_xy.hpp>
+#include <boost/geometry/geometries/polygon.hpp>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <set>
+
+#include "lodrefine/candidates.h"
+#include "lodrefine/confidence.h"
+#include "lodrefine/matching.h"
+#include "lodrefine/planes.h"
+#include "lodrefine/repair.h"
+#include "lodrefine/selection.h"
+#include "lodrefine/validate.h"
+
+namespace lodrefine {
+namespace {
+
+namespace bg = boost::geometry;
+using BPoint = bg::model::d2::point_xy<double>;
+using BPolygon = bg::model::polygon<BPoint, false, false>;  // CCW, open
+using BMulti = bg::model::multi_polygon<BPolygon>;
+using json = nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+Mesh translated(Mesh m, const Vec3& d) {
+  for (auto& v : m.vertices) v += d;
+  return m;
+}
+
+std::vector<Vec3> face_polygon(const Mesh& m, int f) {
+  std::vector<Vec3> pts;
+  for (int i : m.faces[f].v) pts.push_back(m.vertices[i]);
+  return pts;
+}
+
+// Moves each vertex onto the meet of the planes of its surfaces (least squares), so that the
+// model is exactly consistent with the planes the arrangement uses. Moves beyond `max_move`
+// (a warped input face) are not made.
+void snap_to_surfaces(Mesh& mesh, const std::vector<ModelSurface>& surfaces, double max_move) {
+  std::vector<std::vector<int>> vertex_surfaces(mesh.vertices.size());
+  for (int s = 0; s < int(surfaces.size()); ++s)
+    for (int f : surfaces[s].faces)
+      for (int v : mesh.faces[f].v)
+        if (vertex_surfaces[v].empty() || vertex_surfaces[v].back() != s) vertex_surfaces[v].push_back(s);
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+    auto& ss = vertex_surfaces[v];
+    std::sort(ss.begin(), ss.end());
+    ss.erase(std::unique(ss.begin(), ss.end()), ss.end());
+    if (ss.empty()) continue;
+    // Minimise |x - p|^2 * eps + sum (n.x + d)^2: the small regulariser picks the nearest
+    // point when fewer than three independent planes meet here.
+    Eigen::Matrix3d a = 1e-9 * Eigen::Matrix3d::Identity();
+    Vec3 b = 1e-9 * mesh.vertices[v];
+    for (int s : ss) {
+      const Plane& pl = surfaces[s].plane;
+      a += pl.n * pl.n.transpose();
+      b -= pl.d * pl.n;
+    }
+    const Vec3 x = a.fullPivLu().solve(b);
+    if (x.allFinite() && (x - mesh.vertices[v]).norm() <= max_move) mesh.vertices[v] = x;
+  }
+}
+
+// Sutherland–Hodgman of a 3D polygon against the region (area test only).
+double area_inside(std::vector<Vec3> poly, const Region& r) {
+  for (const auto& pl : r.planes()) {
+    std::vector<Vec3> out;
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+      const Vec3& p = poly[i];
+      const Vec3& q = poly[(i + 1) % poly.size()];
+      const double dp = pl.distance(p), dq = pl.distance(q);
+      if (dp <= 0) out.push_back(p);
+      if ((dp < 0) != (dq < 0) && dp != dq) out.push_back(p + (q - p) * (dp / (dp - dq)));
+    }
+    poly.swap(out);
+    if (poly.size() < 3) return 0.0;
+  }
+  return polygon_area(poly);
+}
+
+// Everything one wall replacement needs and produces.
+struct Replacement {
+  std::vector<int> surfaces;  // model surfaces replaced by the scan plane
+  Plane plane;                // the scan plane, oriented like the wall (outward)
+  std::vector<Vec3> points;   // its inliers
+};
+
+Region replacement_region(const Mesh& mesh, const std::vector<ModelSurface>& surfaces, const Replacement& rep,
+                          const Params& prm) {
+  const auto [u, v] = rep.plane.basis();
+  Eigen::Matrix3d axes;
+  axes.col(0) = u;
+  axes.col(1) = v;
+  axes.col(2) = rep.plane.n;
+  std::vector<Vec3> pts;
+  for (int s : rep.surfaces)
+    for (int f : surfaces[s].faces)
+      for (int vi : mesh.faces[f].v) {
+        pts.push_back(mesh.vertices[vi]);
+        pts.push_back(rep.plane.project(mesh.vertices[vi]));
+      }
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  for (const auto& p : pts) {
+    const Vec3 q = axes.transpose() * p;
+    lo = lo.cwiseMin(q);
+    hi = hi.cwiseMax(q);
+  }
+  const Vec3 ext = hi - lo;
+  Vec3 margin;
+  margin.x() = std::max(prm.bbox_margin, prm.bbox_expand * ext.x());
+  margin.y() = std::max(prm.bbox_margin, prm.bbox_expand * ext.y());
+  margin.z() = prm.bbox_margin;
+  Region r;
+  r.axes = axes;
+  Vec3 qlo = lo - margin, qhi = hi + margin;
+  // Keep every model vertex well off the region's faces, so no model edge runs along them
+  // and the outside surface is unambiguous at the boundary.
+  for (int iter = 0; iter < 40; ++iter) {
+    bool moved = false;
+    for (int k = 0; k < 3; ++k)
+      for (const auto& p : mesh.vertices) {
+        const double q = axes.col(k).dot(p);
+        if (std::abs(q - qlo[k]) < 0.02) { qlo[k] -= 0.05; moved = true; }
+        if (std::abs(q - qhi[k]) < 0.02) { qhi[k] += 0.05; moved = true; }
+      }
+    if (!moved) break;
+  }
+  r.center = axes * (0.5 * (qlo + qhi));
+  r.half = 0.5 * (qhi - qlo);
+  return r;
+}
+
+struct StepResult {
+  bool ok = false;
+  std::string reason;
+  Mesh mesh;
+  json info;
+};
+
+// Polygon minus the region's section, in the polygon's plane; false if a hole would appear.
+bool subtract_region(const std::vector<Vec3>& poly, const Plane& plane, const Region& r,
+                     std::vector<std::vector<Vec3>>& pieces) {
+  const auto section = region_section(plane, r);
+  if (section.size() < 3) {
+    pieces.push_back(poly);
+    return true;
+  }
+  const auto [u, v] = plane.basis();
+  const Vec3 o = plane.project(poly.front());
+  auto to2 = [&](const std::vector<Vec3>& pts) {
+    BPolygon bp;
+    for (const auto& p : pts) bp.outer().emplace_back((p - o).dot(u), (p - o).dot(v));
+    bg::correct(bp);
+    return bp;
+  };
+  BMulti out;
+  bg::difference(to2(poly), to2(section), out);
+  for (const auto& bp : out) {
+    if (!bp.inners().empty()) return false;
+    std::vector<Vec3> piece;
+    for (const auto& q : bp.outer()) piece.push_back(o + q.x() * u + q.y() * v);
+    if (piece.size() >= 3 && polygon_area(piece) > 1e-8) pieces.push_back(std::move(piece));
+  }
+  return true;
+}
+
+StepResult replace_walls(const Mesh& mesh, const std::vector<ModelSurface>& surfaces, Replacement rep,
+                         const Params& prm) {
+  StepResult res;
+  const auto t0 = Clock::now();
+
+  // Model walls that the scan plane makes coplanar with it are replaced together.
+  Region region = replacement_region(mesh, surfaces, rep, prm);
+  for (int iter = 0; iter < 3; ++iter) {
+    bool grew = false;
+    for (int s = 0; s < int(surfaces.size()); ++s) {
+      if (surfaces[s].sem != Semantic::Wall ||
+          std::find(rep.surfaces.begin(), rep.surfaces.end(), s) != rep.surfaces.end())
+        continue;
+      if (unoriented_angle_deg(surfaces[s].plane.n, rep.plane.n) > prm.merge_angle_deg) continue;
+      bool near = true, inside = false;
+      for (int f : surfaces[s].faces) {
+        for (int vi : mesh.faces[f].v) near = near && std::abs(rep.plane.distance(mesh.vertices[vi])) <= prm.merge_distance;
+        inside = inside || area_inside(face_polygon(mesh, f), region) > 1e-8;
+      }
+      if (near && inside) {
+        rep.surfaces.push_back(s);
+        grew = true;
+      }
+    }
+    if (!grew) break;
+    region = replacement_region(mesh, surfaces, rep, prm);
+  }
+  const std::set<int> replaced(rep.surfaces.begin(), rep.surfaces.end());
+  std::set<int> replaced_faces;
+  for (int s : rep.surfaces) replaced_faces.insert(surfaces[s].faces.begin(), surfaces[s].faces.end());
+
+  // Supporting planes: the scan plane and every kept surface reaching into the region.
+  std::vector<SupportPlane> planes{{rep.plane, Semantic::Wall, true, -1}};
+  std::vector<int> face_plane(mesh.faces.size(), -1);
+  std::vector<char> face_in_region(mesh.faces.size(), 0);
+  for (int f = 0; f < int(mesh.faces.size()); ++f)
+    face_in_region[f] = !replaced_faces.count(f) && area_inside(face_polygon(mesh, f), region) > 1e-8;
+  for (int s = 0; s < int(surfaces.size()); ++s) {
+    if (replaced.count(s)) continue;
+    bool in = false;
+    for (int f : surfaces[s].faces) in = in || face_in_region[f];
+    if (!in) continue;
+    // Surfaces on the very same plane (split by other faces) share one supporting plane.
+    int idx = -1;
+    for (int k = 1; k < int(planes.size()) && idx < 0; ++k)
+      if (planes[k].sem == surfaces[s].sem && planes[k].plane.n.dot(surfaces[s].plane.n) > 1.0 - 1e-9 &&
+          std::abs(planes[k].plane.d - surfaces[s].plane.d) < 1e-6)
+        idx = k;
+    if (idx < 0) {
+      idx = int(planes.size());
+      planes.push_back({surfaces[s].plane, surfaces[s].sem, false, s});
+    }
+    for (int f : surfaces[s].faces) face_plane[f] = idx;
+  }
+
+  const CandidateSet cs = build_candidates(planes, region);
+  res.info["supporting_planes"] = planes.size();
+  res.info["candidates"] = cs.faces.size();
+  res.info["edges"] = cs.edges.size();
+
+  // Boundary edges: does the kept surface continue outside the region across them?
+  std::vector<int> outside(cs.edges.size(), 0);
+  const auto box = region.planes();
+  for (int e = 0; e < int(cs.edges.size()); ++e) {
+    const auto& edge = cs.edges[e];
+    if (edge.box_plane < 0) continue;
+    std::set<int> edge_planes;
+    for (int f : edge.faces) edge_planes.insert(cs.faces[f].plane);
+    const Vec3 a = cs.vertices[edge.a], b = cs.vertices[edge.b];
+    for (int pi : edge_planes) {
+      const Plane& pl = cs.planes[pi].plane;
+      Vec3 t = pl.n.cross(b - a);
+      if (t.norm() < 1e-12) continue;
+      t.normalize();
+      const double along = t.dot(box[edge.box_plane].n);
+      if (std::abs(along) < 1e-3) continue;
+      if (along < 0) t = -t;
+      const Vec3 q = 0.5 * (a + b) + 0.01 * t;
+      const auto [u, v] = pl.basis();
+      const Vec2 q2((q - a).dot(u), (q - a).dot(v));
+      for (int f = 0; f < int(mesh.faces.size()); ++f) {
+        if (face_plane[f] != pi) continue;
+        std::vector<Vec2> poly2;
+        for (int vi : mesh.faces[f].v) poly2.emplace_back((mesh.vertices[vi] - a).dot(u), (mesh.vertices[vi] - a).dot(v));
+        if (point_in_polygon_2d(q2, poly2)) {
+          ++outside[e];
+          break;
+        }
+      }
+    }
+  }
+
+  // Confidence against the kept model faces near the region and the scan plane's points.
+  std::vector<ModelReference> model_refs;
+  Region near_region = region;
+  near_region.half += Vec3::Constant(prm.conf_model_distance);
+  for (int f = 0; f < int(mesh.faces.size()); ++f)
+    if (!replaced_faces.count(f) && area_inside(face_polygon(mesh, f), near_region) > 1e-8)
+      model_refs.push_back({face_polygon(mesh, f)});
+  CloudReference cloud_ref;
+  for (const auto& p : rep.points)
+    if (region.contains(p)) cloud_ref.points.push_back(p);
+  const auto conf = candidate_confidence(cs, model_refs, {cloud_ref}, prm);
+  std::vector<double> cost(cs.faces.size());
+  for (std::size_t f = 0; f < cs.faces.size(); ++f) cost[f] = coverage_cost(cs.faces[f].area, conf[f].value, prm.tau_cov);
+
+  const SelectionResult sel = select_faces(cs, cost, outside, prm);
+  res.info["mip"] = {{"variables", sel.variables}, {"constraints", sel.constraints}, {"nonzeros", sel.nonzeros},
+                     {"status", sel.status},       {"objective", sel.objective},     {"seconds", sel.seconds}};
+  if (!sel.ok) {
+    res.reason = "face selection " + sel.status;
+    return res;
+  }
+
+  // Assemble: kept faces (clipped to outside the region) + selected candidates.
+  Mesh soup;
+  soup.id = mesh.id;
+  auto add_polygon = [&soup](const std::vector<Vec3>& poly, Semantic sem, int source) {
+    Face f;
+    for (const auto& p : poly) {
+      f.v.push_back(int(soup.vertices.size()));
+      soup.vertices.push_back(p);
+    }
+    f.sem = sem;
+    f.source = source;
+    soup.faces.push_back(std::move(f));
+  };
+  for (int f = 0; f < int(mesh.faces.size()); ++f) {
+    if (replaced_faces.count(f)) continue;
+    const auto poly = face_polygon(mesh, f);
+    if (!face_in_region[f]) {
+      add_polygon(poly, mesh.faces[f].sem, mesh.faces[f].source);
+      continue;
+    }
+    std::vector<std::vector<Vec3>> pieces;
+    if (!subtract_region(poly, cs.planes[face_plane[f]].plane, region, pieces)) {
+      res.reason = "the change region lies inside a kept face";
+      return res;
+    }
+    for (const auto& piece : pieces) add_polygon(piece, mesh.faces[f].sem, mesh.faces[f].source);
+  }
+  int selected = 0;
+  for (int f = 0; f < int(cs.faces.size()); ++f) {
+    if (!sel.selected[f]) continue;
+    ++selected;
+    add_polygon(cs.polygon(f), cs.planes[cs.faces[f].plane].sem, -1);
+  }
+  res.info["selected"] = selected;
+
+  RepairReport rr;
+  Mesh closed;
+  try {
+    closed = repair_model(soup, 1e-3, &rr);
+  } catch (const InputError& e) {
+    res.reason = std::string("assembled shell is not closed: ") + e.what();
+    return res;
+  }
+  if (rr.filled_holes > 0) {
+    res.reason = "assembled shell had " + std::to_string(rr.filled_holes) + " hole(s)";
+    return res;
+  }
+  res.mesh = merge_coplanar_faces(closed);
+  const Validation val = validate_mesh(res.mesh, prm.planarity_tolerance);
+  if (!val.valid()) {
+    res.reason = "refined shell invalid: " + val.problem;
+    return res;
+  }
+  res.ok = true;
+  res.info["seconds"] = seconds_since(t0);
+  return res;
+}
+
+// Largest deviation of a surface's vertices from a plane.
+double deviation(const Mesh& mesh, const ModelSurface& s, const Plane& pl) {
+  double d = 0.0;
+  for (int f : s.faces)
+    for (int v : mesh.faces[f].v) d = std::max(d, std::abs(pl.distance(mesh.vertices[v])));
+  return d;
+}
+
+json validation_json(const Validation& v) {
+  return {{"watertight", v.watertight()}, {"valid", v.valid()}, {"problem", v.problem},
+          {"boundary_edges", v.boundary_edges}, {"nonmanifold_edges", v.nonmanifold_edges},
+          {"outward", v.outward}, {"volume", v.volume}, {"max_planarity_error", v.max_planarity_error},
+          {"self_intersecting", v.self_intersecting}};
+}
+
+}  // namespace
+
+Vec3 local_origin(const Mesh& model) {
+  Vec3 lo = Vec3::Constant(1e300);
+  for (const auto& v : model.vertices) lo = lo.cwiseMin(v);
+  if (!lo.allFinite() || model.vertices.empty()) return Vec3::Zero();
+  return Vec3(std::floor(lo.x() / 100.0) * 100.0, std::floor(lo.y() / 100.0) * 100.0, std::floor(lo.z() / 100.0) * 100.0);
+}
+
+RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const Params& prm) {
+  prm.validate();
+  const auto t_start = Clock::now();
+  RefineResult out;
+  json& rep = out.report;
+  rep["id"] = model.id;
+  json timing;
+
+  const Vec3 origin = local_origin(model);
+  rep["origin"] = {origin.x(), origin.y(), origin.z()};
+
+  // Repair the exported soup into a closed shell (this may throw: nothing valid to write).
+  auto t = Clock::now();
+  RepairReport rr;
+  Mesh current = merge_coplanar_faces(repair_model(translated(model, -origin), prm.weld_tolerance, &rr));
+  current.id = model.id;
+  snap_to_surfaces(current, model_surfaces(current), 0.05);
+  rep["repair"] = {{"welded_vertices", rr.welded_vertices},
+                   {"removed_degenerate_faces", rr.removed_degenerate_faces},
+                   {"removed_duplicate_faces", rr.removed_duplicate_faces},
+                   {"split_t_junctions", rr.split_t_junctions},
+                   {"flipped_faces", rr.flipped_faces},
+                   {"filled_holes", rr.filled_holes},
+                   {"notes", rr.notes}};
+  const Validation v0 = validate_mesh(current, prm.planarity_tolerance);
+  rep["input_validation"] = validation_json(v0);
+  timing["repair"] = seconds_since(t);
+  const Mesh repaired = current;
+
+  auto finish = [&](const std::string& outcome) {
+    out.outcome = outcome;
+    const Validation vf = validate_mesh(current, prm.planarity_tolerance);
+    out.valid = vf.valid();
+    rep["outcome"] = outcome;
+    rep["refined"] = out.refined;
+    rep["output_validation"] = validation_json(vf);
+    rep["faces"] = current.faces.size();
+    timing["total"] = seconds_since(t_start);
+    rep["seconds"] = timing;
+    out.mesh = translated(current, origin);
+    out.mesh.id = model.id;
+    return out;
+  };
+
+  // Only the cloud near the model matters (crops may carry whole streets).
+  t = Clock::now();
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  for (const auto& v : current.vertices) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  const Vec3 pad = Vec3::Constant(prm.match_distance + prm.bbox_margin) + prm.bbox_expand * (hi - lo);
+  PointCloud local;
+  for (const auto& p : cloud.points) {
+    const Vec3 q = p - origin;
+    if ((q.array() >= (lo - pad).array()).all() && (q.array() <= (hi + pad).array()).all()) local.points.push_back(q);
+  }
+  rep["cloud"] = {{"points", cloud.points.size()}, {"points_near_model", local.points.size()}};
+  const auto planes = detect_planes(local, prm);
+  timing["planes"] = seconds_since(t);
+  json jplanes = json::array();
+  for (const auto& p : planes)
+    jplanes.push_back({{"normal", {p.plane.n.x(), p.plane.n.y(), p.plane.n.z()}}, {"d", p.plane.d},
+                       {"inliers", p.inliers.size()}, {"rms", p.rms}, {"area", p.hull_area}, {"facade", p.facade}});
+  rep["planes"] = jplanes;
+  if (planes.empty()) return finish("original (no planes found in the cloud near the model)");
+
+  // Match, replace the most confident outdated wall, re-match on the new model, repeat.
+  t = Clock::now();
+  json steps = json::array();
+  std::set<std::pair<int, long long>> tried;  // (scan plane, rounded wall position)
+  double t_match = 0.0;
+  for (int iter = 0; iter < 4 * int(planes.size()) + 4; ++iter) {
+    const auto tm = Clock::now();
+    const auto surfaces = model_surfaces(current);
+    const MatchResult mr = match_surfaces(current, surfaces, local, planes, prm);
+    if (iter == 0) {
+      json jm = json::array();
+      for (const auto& m : mr.matches)
+        jm.push_back({{"scan_plane", m.scan_plane}, {"surface", m.surface}, {"s_normal", m.s_normal},
+                      {"d_centroid", m.d_centroid}, {"c_bbox", m.c_bbox}, {"s_match", m.s_match},
+                      {"deviation", deviation(current, surfaces[m.surface], planes[m.scan_plane].plane)},
+                      {"faces", surfaces[m.surface].faces}});
+      rep["matches"] = jm;
+      rep["q_model"] = mr.q_model;
+    }
+    t_match += seconds_since(tm);
+    const Match* next = nullptr;
+    for (const auto& m : mr.matches) {
+      const auto key = std::make_pair(m.scan_plane, (long long)std::llround(surfaces[m.surface].centroid.squaredNorm() * 100));
+      if (tried.count(key) || deviation(current, surfaces[m.surface], planes[m.scan_plane].plane) <= prm.change_tolerance)
+        continue;
+      if (next == nullptr || m.s_match > next->s_match) next = &m;
+    }
+    if (next == nullptr) break;
+    const auto& surf = surfaces[next->surface];
+    tried.insert({next->scan_plane, (long long)std::llround(surf.centroid.squaredNorm() * 100)});
+    Replacement r;
+    r.surfaces = {next->surface};
+    r.plane = planes[next->scan_plane].plane;
+    if (r.plane.n.dot(surf.plane.n) < 0) r.plane = r.plane.flipped();
+    for (int i : planes[next->scan_plane].inliers) r.points.push_back(local.points[i]);
+    StepResult sr = replace_walls(current, surfaces, r, prm);
+    json js = sr.info;
+    js["scan_plane"] = next->scan_plane;
+    js["wall_faces"] = surf.faces;
+    js["moved_by"] = deviation(current, surf, r.plane);
+    js["ok"] = sr.ok;
+    if (!sr.ok) js["reason"] = sr.reason;
+    steps.push_back(js);
+    if (sr.ok) {
+      current = std::move(sr.mesh);
+      current.id = model.id;
+      out.refined = true;
+    }
+  }
+  timing["matching"] = t_match;
+  timing["replacement"] = seconds_since(t) - t_match;
+  rep["replacements"] = steps;
+  if (!out.refined) {
+    if (steps.empty()) return finish(rep["matches"].empty() ? "original (no wall matched a scan plane)"
+                                                            : "original (every matched wall agrees with the scan)");
+    return finish("original (" + steps.back().value("reason", std::string("no replacement succeeded")) + ")");
+  }
+  const Validation vf = validate_mesh(current, prm.planarity_tolerance);
+  if (!vf.valid()) {  // never written as refined
+    current = repaired;
+    out.refined = false;
+    return finish("original (refined shell failed validation: " + vf.problem + ")");
+  }
+  return finish("refined");
+}
+
+}  // namespace lodrefine
