@@ -15,6 +15,10 @@ namespace lodrefine {
 // georeferenced doubles. Building id from `o NAME`, else a `# id: X` comment, else the file
 // stem. Faces are kept as given (no welding); Face::source is the face's index in the file.
 Mesh read_obj(const std::string& path);
+// Same, also reporting how many `f` statements with fewer than 3 vertices were skipped (they
+// are no polygons; the file is rejected only when no face remains). Positive indices may refer
+// to vertices defined later in the file; negative ones are relative to the vertices so far.
+Mesh read_obj(const std::string& path, int* skipped_faces);
 
 // Writes polygons grouped by semantic (`g WallSurface` ...), `o <id>`, vertices offset by
 // `origin` (the local frame's origin) and printed with enough digits for < 0.1 mm at 7-digit
