@@ -16,8 +16,9 @@ namespace lodrefine {
 // stem. Faces are kept as given (no welding); Face::source is the face's index in the file.
 Mesh read_obj(const std::string& path);
 // Same, also reporting how many `f` statements with fewer than 3 vertices were skipped (they
-// are no polygons; the file is rejected only when no face remains). Positive indices may refer
-// to vertices defined later in the file; negative ones are relative to the vertices so far.
+// are no polygons and get no Face::source number; the file is rejected only when no face
+// remains). Positive indices may refer to vertices defined later in the file; negative ones
+// are relative to the vertices so far.
 Mesh read_obj(const std::string& path, int* skipped_faces);
 
 // Writes polygons grouped by semantic (`g WallSurface` ...), `o <id>`, vertices offset by

@@ -22,8 +22,10 @@ struct RepairReport {
 
 // Repairs `soup` (any frame; use a local one for georeferenced data). Throws InputError when
 // nothing usable remains (e.g. < 4 faces, or a non-closable shape). Face::sem and Face::source
-// are carried over; filled holes get Semantic::Ground if they are horizontal at the bottom,
-// else the semantic of their neighbours.
+// are carried over; filled holes get Semantic::Ground if they are horizontal facing down,
+// Semantic::Roof if horizontal facing up, else the semantic of their neighbours (by shared edge
+// length). A hole planar within 2 cm becomes one face, a non-planar one is triangulated (noted).
+// Welding clusters around seed vertices, so it never chains across more than `weld_tolerance`.
 Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report = nullptr);
 
 // Merges edge-adjacent coplanar faces of the same semantic into single polygons (within

@@ -1,6 +1,9 @@
 // The project's own validator: every model is checked before it is written as refined.
 #pragma once
+#include <map>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "lodrefine/types.h"
 
@@ -27,5 +30,18 @@ struct Validation {
 // triangulated faces). Expects shared vertices.
 Validation validate_mesh(const Mesh& mesh, double planarity_tolerance = 0.01,
                          bool check_self_intersections = true);
+
+// Edge topology, shared with repair: each undirected edge (lower vertex index first) with the
+// faces using it, `forward` when the face runs from the lower to the higher vertex.
+struct EdgeUse {
+  int face;
+  bool forward;
+};
+using EdgeUses = std::map<std::pair<int, int>, std::vector<EdgeUse>>;
+EdgeUses edge_uses(const std::vector<Face>& faces);
+
+// Enclosed volume of `faces` (all indices valid), positive when they point outward; exact for
+// closed meshes of planar faces.
+double signed_volume(const std::vector<Vec3>& vertices, const std::vector<Face>& faces);
 
 }  // namespace lodrefine
