@@ -1,0 +1,459 @@
+// The paper's evaluation metrics. The only CGAL-heavy translation unit of the evaluation (AABB tree).
+#include "lodrefine/eval.h"
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Simple_cartesian.h>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "lodrefine/geometry.h"
+#include "lodrefine/matching.h"
+#include "lodrefine/repair.h"
+#include "lodrefine/validate.h"
+
+namespace lodrefine {
+
+namespace {
+
+using K = CGAL::Simple_cartesian<double>;
+using CgalTriangles = std::vector<K::Triangle_3>;
+using Primitive = CGAL::AABB_triangle_primitive<K, CgalTriangles::const_iterator>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
+
+constexpr double kPi = 3.14159265358979323846;
+// Triangles whose nearest point is this much farther than the nearest one still count as
+// touching it (double rounding in a local frame is ~1e-13 m).
+constexpr double kTieTolerance = 1e-7;
+constexpr double kMinTriangleArea = 1e-12;
+
+K::Point_3 to_cgal(const Vec3& p) { return {p.x(), p.y(), p.z()}; }
+
+// Calls fn(a, b, c, face) for every triangle of every face (ear clipping, face orientation kept).
+template <class Fn>
+void for_each_triangle(const Mesh& mesh, Fn&& fn) {
+  std::vector<Vec3> poly;
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    poly.clear();
+    for (int v : mesh.faces[f].v) poly.push_back(mesh.vertices.at(v));
+    for (const auto& t : triangulate_polygon(poly)) fn(poly[t[0]], poly[t[1]], poly[t[2]], int(f));
+  }
+}
+
+// Nearest point of a triangle to p (Ericson, Real-Time Collision Detection 5.1.5) and the angle
+// the triangle subtends around it: 2π inside, π on an edge, the corner angle at a vertex.
+struct Closest {
+  Vec3 q;
+  double angle;
+};
+
+double corner_angle(const Vec3& at, const Vec3& u, const Vec3& w) {
+  const Vec3 e1 = (u - at).normalized(), e2 = (w - at).normalized();
+  return std::acos(std::clamp(e1.dot(e2), -1.0, 1.0));
+}
+
+Closest closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return {a, corner_angle(a, b, c)};
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return {b, corner_angle(b, c, a)};
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return {a + ab * (d1 / (d1 - d3)), kPi};
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return {c, corner_angle(c, a, b)};
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return {a + ac * (d2 / (d2 - d6)), kPi};
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return {b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))), kPi};
+  const double denom = 1.0 / (va + vb + vc);
+  return {a + ab * (vb * denom) + ac * (vc * denom), 2 * kPi};
+}
+
+// AABB tree over a mesh's triangles, in a frame shifted to the mesh's first vertex so that
+// georeferenced inputs keep their precision.
+class SurfaceIndex {
+ public:
+  explicit SurfaceIndex(const Mesh& mesh) {
+    if (!mesh.vertices.empty()) origin_ = mesh.vertices.front().array().floor().matrix();
+    for_each_triangle(mesh, [&](const Vec3& a, const Vec3& b, const Vec3& c, int face) {
+      Tri t{a - origin_, b - origin_, c - origin_, Vec3::Zero(), face};
+      const Vec3 n = (t.b - t.a).cross(t.c - t.a);
+      if (0.5 * n.norm() < kMinTriangleArea) return;
+      t.n = n.normalized();
+      tris_.push_back(t);
+      cgal_.emplace_back(to_cgal(t.a), to_cgal(t.b), to_cgal(t.c));
+    });
+    if (tris_.empty()) throw InputError("mesh '" + mesh.id + "' has no non-degenerate face");
+    tree_.insert(cgal_.cbegin(), cgal_.cend());
+    tree_.build();
+    tree_.accelerate_distance_queries();
+  }
+  SurfaceIndex(const SurfaceIndex&) = delete;  // the tree points into cgal_
+  SurfaceIndex& operator=(const SurfaceIndex&) = delete;
+
+  struct Nearest {
+    double distance;  // signed if asked for, else >= 0
+    int face;
+  };
+
+  Nearest nearest(const Vec3& world, bool want_sign) const {
+    const Vec3 p = world - origin_;
+    const auto hit = tree_.closest_point_and_primitive(to_cgal(p));
+    const std::size_t i = std::size_t(hit.second - cgal_.cbegin());
+    const Closest c = closest_on_triangle(p, tris_[i].a, tris_[i].b, tris_[i].c);
+    const double d = (p - c.q).norm();
+    if (!want_sign || d == 0.0) return {d, tris_[i].face};
+    return {sign_at(p, c, i) * d, tris_[i].face};
+  }
+
+ private:
+  struct Tri {
+    Vec3 a, b, c, n;
+    int face;
+  };
+
+  // Inside a face the face normal decides. On an edge or vertex, the angle-weighted pseudonormal
+  // of every triangle touching the nearest point decides (Bærentzen & Aanæs 2005): correct on a
+  // closed surface whatever the triangulation, where a single adjacent normal can be wrong.
+  double sign_at(const Vec3& p, const Closest& c, std::size_t i) const {
+    const double own = tris_[i].n.dot(p - c.q);
+    if (c.angle == 2 * kPi) return own >= 0 ? 1.0 : -1.0;
+    const double r = (p - c.q).norm() + kTieTolerance;
+    std::vector<Primitive::Id> touching;
+    tree_.all_intersected_primitives(K::Sphere_3(to_cgal(p), r * r), std::back_inserter(touching));
+    double s = 0.0;
+    for (const auto& id : touching) {
+      const Tri& t = tris_[std::size_t(id - cgal_.cbegin())];
+      const Closest ct = closest_on_triangle(p, t.a, t.b, t.c);
+      if ((p - ct.q).norm() <= r) s += ct.angle * t.n.dot(p - ct.q);
+    }
+    if (s == 0.0) s = own;
+    return s >= 0 ? 1.0 : -1.0;
+  }
+
+  Vec3 origin_ = Vec3::Zero();
+  std::vector<Tri> tris_;
+  CgalTriangles cgal_;
+  Tree tree_;
+};
+
+// Shared vertices for identical coordinates; consecutive repeats and collapsed faces dropped.
+Mesh weld_identical(const Mesh& mesh) {
+  Mesh out;
+  out.id = mesh.id;
+  std::map<std::array<double, 3>, int> index;
+  std::vector<int> remap(mesh.vertices.size());
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Vec3& v = mesh.vertices[i];
+    const auto [it, inserted] = index.emplace(std::array<double, 3>{v.x(), v.y(), v.z()}, int(out.vertices.size()));
+    if (inserted) out.vertices.push_back(v);
+    remap[i] = it->second;
+  }
+  for (const Face& f : mesh.faces) {
+    Face g = f;
+    g.v.clear();
+    for (int v : f.v)
+      if (g.v.empty() || g.v.back() != remap.at(v)) g.v.push_back(remap.at(v));
+    while (g.v.size() > 1 && g.v.front() == g.v.back()) g.v.pop_back();
+    if (g.v.size() >= 3) out.faces.push_back(std::move(g));
+  }
+  return out;
+}
+
+Vec3 area_centroid(const Mesh& mesh) {
+  Vec3 acc = Vec3::Zero();
+  double area = 0.0;
+  const Vec3 o = mesh.vertices.empty() ? Vec3::Zero() : mesh.vertices.front();
+  for_each_triangle(mesh, [&](const Vec3& a, const Vec3& b, const Vec3& c, int) {
+    const double w = 0.5 * (b - a).cross(c - a).norm();
+    acc += w * ((a - o) + (b - o) + (c - o)) / 3.0;
+    area += w;
+  });
+  return area > 0 ? Vec3(o + acc / area) : o;
+}
+
+// Signed tetrahedra against the first vertex; orientation-independent as long as it is
+// consistent. nullopt for a (near) zero volume.
+std::optional<Vec3> volume_centroid(const Mesh& mesh) {
+  if (mesh.vertices.empty()) return std::nullopt;
+  const Vec3 o = mesh.vertices.front();
+  Vec3 acc = Vec3::Zero();
+  double vol = 0.0;
+  for_each_triangle(mesh, [&](const Vec3& a, const Vec3& b, const Vec3& c, int) {
+    const double v = (a - o).dot((b - o).cross(c - o)) / 6.0;
+    acc += v * ((a - o) + (b - o) + (c - o)) / 4.0;
+    vol += v;
+  });
+  if (std::abs(vol) < 1e-9) return std::nullopt;
+  return Vec3(o + acc / vol);
+}
+
+// c_init / c_ref: the volume centroid; an open model (typical for exported originals) is
+// measured as the volume it describes, i.e. after repair, before falling back to its area.
+Vec3 model_centroid(const Mesh& mesh, const Params& params) {
+  if (is_watertight(mesh))
+    if (auto c = volume_centroid(mesh)) return *c;
+  try {
+    const Mesh repaired = repair_model(mesh, params.weld_tolerance);
+    if (is_watertight(repaired))
+      if (auto c = volume_centroid(repaired)) return *c;
+  } catch (const InputError&) {
+  }
+  return area_centroid(mesh);
+}
+
+std::vector<double> unsigned_distances(const Mesh& mesh, const std::vector<Vec3>& pts) {
+  if (pts.empty()) return {};
+  const SurfaceIndex index(mesh);
+  std::vector<double> d(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) d[i] = index.nearest(pts[i], false).distance;
+  return d;
+}
+
+Vec3 mean_point(const std::vector<Vec3>& pts) {
+  Vec3 c = Vec3::Zero();
+  for (const auto& p : pts) c += p;
+  return pts.empty() ? c : Vec3(c / double(pts.size()));
+}
+
+std::vector<int> faces_with(const Mesh& mesh, Semantic sem) {
+  std::vector<int> out;
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+    if (mesh.faces[f].sem == sem) out.push_back(int(f));
+  return out;
+}
+
+// Points sampled on the truth's scanned walls and on its roofs.
+struct TruthSamples {
+  std::vector<Vec3> facade, roof;
+};
+
+TruthSamples truth_samples(const Mesh& truth, const std::vector<Vec3>& facade_pts,
+                           const std::vector<int>* scanned, std::vector<int>& scanned_out) {
+  scanned_out = scanned ? *scanned : scanned_walls(truth, facade_pts);
+  for (int f : scanned_out)
+    if (f < 0 || std::size_t(f) >= truth.faces.size())
+      throw InputError("scanned truth face " + std::to_string(f) + " is not a face of the truth model");
+  constexpr double kSpacing = 0.1;  // 100 samples per m²: dense enough for cm-level statistics
+  return {sample_faces(truth, scanned_out, kSpacing), sample_faces(truth, faces_with(truth, Semantic::Roof), kSpacing)};
+}
+
+std::optional<DistanceStats> stats_if_any(const std::vector<double>& d) {
+  if (d.empty()) return std::nullopt;
+  return summarize_distances(d);
+}
+
+// Fills the "after" side: C2M, watertightness, centroid and truth distances of the refined model.
+void evaluate_refined(BuildingEval& e, const Mesh& refined, const std::vector<Vec3>& pts,
+                      const TruthSamples* samples, const Params& params) {
+  if (refined.faces.empty()) throw InputError("refined model has no faces");
+  if (!pts.empty()) e.c2m_after = cloud_to_mesh(refined, pts);
+  e.after = summarize_distances(e.c2m_after);
+  e.watertight_after = is_watertight(refined);
+  e.c_ref = model_centroid(refined, params);
+  if (!pts.empty()) e.delta_d = (e.c_mls - e.c_init).norm() - (e.c_mls - e.c_ref).norm();
+  if (!samples) return;
+  e.truth_facade_d_after = unsigned_distances(refined, samples->facade);
+  e.truth_roof_d_after = unsigned_distances(refined, samples->roof);
+  e.truth_facade_after = stats_if_any(e.truth_facade_d_after);
+  e.truth_roof_after = stats_if_any(e.truth_roof_d_after);
+}
+
+DistanceStats average_stats(const std::vector<const DistanceStats*>& all) {
+  DistanceStats m;
+  if (all.empty()) return m;
+  for (const auto* s : all) {
+    m.count += s->count;
+    m.rmse += s->rmse, m.mae += s->mae, m.mean += s->mean, m.std += s->std;
+    m.median += s->median, m.p95 += s->p95, m.max_abs += s->max_abs;
+  }
+  const double n = double(all.size());
+  m.rmse /= n, m.mae /= n, m.mean /= n, m.std /= n, m.median /= n, m.p95 /= n, m.max_abs /= n;
+  return m;
+}
+
+void append(std::vector<double>& to, const std::vector<double>& from) { to.insert(to.end(), from.begin(), from.end()); }
+
+}  // namespace
+
+double percentile_sorted(const std::vector<double>& s, double q) {
+  if (s.empty()) return 0.0;
+  const double pos = q * double(s.size() - 1);
+  const std::size_t lo = std::size_t(std::floor(pos));
+  const std::size_t hi = std::min(lo + 1, s.size() - 1);
+  return s[lo] + (pos - double(lo)) * (s[hi] - s[lo]);
+}
+
+DistanceStats summarize_distances(const std::vector<double>& d) {
+  DistanceStats s;
+  s.count = d.size();
+  if (d.empty()) return s;
+  double sum = 0, sum_abs = 0, sum_sq = 0;
+  std::vector<double> abs_d(d.size());
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    sum += d[i];
+    sum_abs += std::abs(d[i]);
+    sum_sq += d[i] * d[i];
+    abs_d[i] = std::abs(d[i]);
+  }
+  const double n = double(d.size());
+  s.mean = sum / n;
+  s.mae = sum_abs / n;
+  s.rmse = std::sqrt(sum_sq / n);
+  double var = 0;  // two-pass: stable for small spreads around a large mean
+  for (double x : d) var += (x - s.mean) * (x - s.mean);
+  s.std = std::sqrt(var / n);
+  std::vector<double> sorted = d;
+  std::sort(sorted.begin(), sorted.end());
+  std::sort(abs_d.begin(), abs_d.end());
+  s.median = percentile_sorted(sorted, 0.5);
+  s.p95 = percentile_sorted(abs_d, 0.95);
+  s.max_abs = abs_d.back();
+  return s;
+}
+
+std::vector<double> cloud_to_mesh(const Mesh& mesh, const std::vector<Vec3>& points) {
+  const SurfaceIndex index(mesh);
+  std::vector<double> d(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) d[i] = index.nearest(points[i], true).distance;
+  return d;
+}
+
+Vec3 mesh_centroid(const Mesh& mesh) {
+  if (is_watertight(mesh))
+    if (auto c = volume_centroid(mesh)) return *c;
+  return area_centroid(mesh);
+}
+
+bool is_watertight(const Mesh& mesh) {
+  const Mesh welded = weld_identical(mesh);
+  if (welded.faces.size() < 4) return false;
+  // Planarity and self-intersections are not part of the paper's definition.
+  const Validation v = validate_mesh(welded, std::numeric_limits<double>::max(), false);
+  return v.watertight() && v.inconsistent_edges == 0;
+}
+
+std::vector<Vec3> sample_faces(const Mesh& mesh, const std::vector<int>& faces, double spacing) {
+  std::vector<Vec3> out;
+  for (int f : faces) {
+    std::vector<Vec3> poly;
+    for (int v : mesh.faces.at(f).v) poly.push_back(mesh.vertices.at(v));
+    if (poly.size() < 3 || polygon_area(poly) <= 0) continue;
+    const auto [u, v] = polygon_plane(poly).basis();
+    std::vector<Vec2> p2;
+    Vec2 lo = Vec2::Constant(std::numeric_limits<double>::max()), hi = -lo;
+    for (const auto& p : poly) {
+      p2.emplace_back((p - poly[0]).dot(u), (p - poly[0]).dot(v));
+      lo = lo.cwiseMin(p2.back()), hi = hi.cwiseMax(p2.back());
+    }
+    const std::size_t before = out.size();
+    for (double x = lo.x() + 0.5 * spacing; x < hi.x(); x += spacing)
+      for (double y = lo.y() + 0.5 * spacing; y < hi.y(); y += spacing)
+        if (point_in_polygon_2d(Vec2(x, y), p2)) out.push_back(poly[0] + x * u + y * v);
+    if (out.size() == before) out.push_back(polygon_centroid(poly));
+  }
+  return out;
+}
+
+std::vector<int> scanned_walls(const Mesh& truth, const std::vector<Vec3>& points, double distance, int min_points) {
+  if (points.empty()) return {};
+  const SurfaceIndex index(truth);
+  std::vector<int> count(truth.faces.size(), 0);
+  for (const auto& p : points) {
+    const auto hit = index.nearest(p, false);
+    if (hit.distance <= distance) ++count[std::size_t(hit.face)];
+  }
+  std::vector<int> out;
+  for (std::size_t f = 0; f < truth.faces.size(); ++f)
+    if (truth.faces[f].sem == Semantic::Wall && count[f] >= min_points) out.push_back(int(f));
+  return out;
+}
+
+BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const PointCloud& cloud,
+                               const Mesh* truth, const Params& params) {
+  return evaluate_building(original, refined, cloud, truth, params, nullptr);
+}
+
+BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const PointCloud& cloud,
+                               const Mesh* truth, const Params& params,
+                               const std::vector<int>* scanned_truth_faces) {
+  BuildingEval e;
+  e.id = original.id.empty() ? refined.id : original.id;
+  e.facade_index = select_facade_points(original, cloud, params);
+  std::vector<Vec3> pts;
+  pts.reserve(e.facade_index.size());
+  for (int i : e.facade_index) pts.push_back(cloud.points.at(std::size_t(i)));
+  e.facade_points = pts.size();
+  e.c_mls = mean_point(pts);
+  e.delta_d = std::numeric_limits<double>::quiet_NaN();
+
+  if (!pts.empty()) e.c2m_before = cloud_to_mesh(original, pts);
+  e.before = summarize_distances(e.c2m_before);
+  e.watertight_before = is_watertight(original);
+  e.c_init = model_centroid(original, params);
+
+  std::optional<TruthSamples> samples;
+  if (truth) {
+    samples = truth_samples(*truth, pts, scanned_truth_faces, e.scanned_truth_faces);
+    e.truth_facade_d_before = unsigned_distances(original, samples->facade);
+    e.truth_roof_d_before = unsigned_distances(original, samples->roof);
+    e.truth_facade_before = stats_if_any(e.truth_facade_d_before);
+    e.truth_roof_before = stats_if_any(e.truth_roof_d_before);
+  }
+  try {
+    evaluate_refined(e, refined, pts, samples ? &*samples : nullptr, params);
+  } catch (const InputError& err) {
+    e.error = err.what();
+    e.watertight_after = false;
+  }
+  return e;
+}
+
+PooledEval pool_evaluations(const std::vector<BuildingEval>& buildings) {
+  PooledEval p;
+  p.buildings = buildings.size();
+  std::vector<double> before, after, delta, tf_before, tf_after, tr_before, tr_after;
+  std::vector<const DistanceStats*> per_before, per_after;
+  std::size_t wt_before = 0, wt_after = 0;
+  for (const auto& b : buildings) {
+    wt_before += b.watertight_before;
+    wt_after += b.ok() && b.watertight_after;
+    if (!b.ok()) {
+      ++p.failed;
+      continue;
+    }
+    if (b.truth_facade_before || b.truth_roof_before) ++p.truth_buildings;
+    append(tf_before, b.truth_facade_d_before), append(tf_after, b.truth_facade_d_after);
+    append(tr_before, b.truth_roof_d_before), append(tr_after, b.truth_roof_d_after);
+    if (b.facade_points == 0) continue;
+    ++p.evaluated;
+    append(before, b.c2m_before), append(after, b.c2m_after);
+    per_before.push_back(&b.before), per_after.push_back(&b.after);
+    if (std::isfinite(b.delta_d)) delta.push_back(b.delta_d);
+  }
+  p.before = summarize_distances(before), p.after = summarize_distances(after);
+  p.mean_before = average_stats(per_before), p.mean_after = average_stats(per_after);
+  if (!delta.empty()) {
+    const DistanceStats s = summarize_distances(delta);
+    p.delta_d_mean = s.mean, p.delta_d_median = s.median;
+  }
+  if (p.buildings > 0) {
+    p.watertight_rate_before = double(wt_before) / double(p.buildings);
+    p.watertight_rate_after = double(wt_after) / double(p.buildings);
+  }
+  p.truth_facade_before = stats_if_any(tf_before), p.truth_facade_after = stats_if_any(tf_after);
+  p.truth_roof_before = stats_if_any(tr_before), p.truth_roof_after = stats_if_any(tr_after);
+  return p;
+}
+
+}  // namespace lodrefine
