@@ -1,6 +1,74 @@
-// Placeholder registration; replaced by the real command.
+// `lodrefine crop`: one cloud per building from a large tile, in one streaming pass.
+#include <cstdio>
+#include <filesystem>
+
 #include "commands.h"
+#include "lodrefine/crop.h"
+#include "lodrefine/io.h"
 
 namespace lodrefine::app {
-void add_crop_command(CLI::App& app) { app.add_subcommand("crop", "(not yet available)"); }
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CropArgs {
+  std::string tile, models, out;
+  double expand = 0.1, margin = 3.0;
+};
+
+// Models: DIR/*.obj (id = stem) or DIR/<id>/coarse.obj.
+std::vector<std::pair<std::string, fs::path>> find_models(const fs::path& dir) {
+  std::vector<std::pair<std::string, fs::path>> found;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (e.is_regular_file() && e.path().extension() == ".obj") found.emplace_back(e.path().stem().string(), e.path());
+    if (e.is_directory() && fs::exists(e.path() / "coarse.obj"))
+      found.emplace_back(e.path().filename().string(), e.path() / "coarse.obj");
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+void run(const CropArgs& a) {
+  if (!fs::is_directory(a.models)) throw InputError(a.models + ": not a directory");
+  const auto models = find_models(a.models);
+  if (models.empty()) throw InputError(a.models + ": no *.obj or */coarse.obj models");
+  std::vector<CropTarget> targets;
+  std::vector<std::string> ids;
+  int skipped = 0;
+  for (const auto& [id, path] : models) {
+    try {
+      targets.push_back(crop_target(read_obj(path.string()), a.expand, a.margin));
+      ids.push_back(id);
+    } catch (const InputError& e) {  // one broken model must not stop the tile
+      std::fprintf(stderr, "lodrefine: warning: skipping %s: %s\n", id.c_str(), e.what());
+      ++skipped;
+    }
+  }
+  const std::size_t n = crop_tile(a.tile, targets);
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    const fs::path dir = fs::path(a.out) / ids[i];
+    fs::create_directories(dir);
+    write_ply((dir / "cloud.ply").string(), targets[i].cloud);
+    const fs::path model = models[i].second;
+    if (fs::absolute(model) != fs::absolute(dir / "coarse.obj"))
+      fs::copy_file(model, dir / "coarse.obj", fs::copy_options::overwrite_existing);
+    std::printf("%s: %zu points\n", ids[i].c_str(), targets[i].cloud.points.size());
+  }
+  std::printf("%zu tile points, %zu buildings cropped, %d skipped\n", n, targets.size(), skipped);
+  if (skipped) exit_code() = 1;
+}
+
+}  // namespace
+
+void add_crop_command(CLI::App& app) {
+  static CropArgs args;
+  auto* cmd = app.add_subcommand("crop", "Cut one cloud per building from a large PLY tile (streaming)");
+  cmd->add_option("--tile", args.tile, "Large point cloud tile (PLY)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--models", args.models, "Folder of models: *.obj or <id>/coarse.obj")->required();
+  cmd->add_option("--out", args.out, "Run folder: writes <id>/cloud.ply and <id>/coarse.obj")->required();
+  cmd->add_option("--expand", args.expand, "Relative box growth on each side")->capture_default_str()->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--margin", args.margin, "Absolute box growth on each side (m)")->capture_default_str()->check(CLI::Range(0.0, 1000.0));
+  cmd->callback([] { run(args); });
+}
+
 }  // namespace lodrefine::app

@@ -17,10 +17,11 @@ namespace {
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
 using Vector = Kernel::Vector_3;
-using PointWithNormal = std::pair<Point, Vector>;
+// Efficient RANSAC reorders its input: each point carries its index in the cloud.
+using PointWithNormal = std::tuple<Point, Vector, int>;
 using PointList = std::vector<PointWithNormal>;
-using PointMap = CGAL::First_of_pair_property_map<PointWithNormal>;
-using NormalMap = CGAL::Second_of_pair_property_map<PointWithNormal>;
+using PointMap = CGAL::Nth_of_tuple_property_map<0, PointWithNormal>;
+using NormalMap = CGAL::Nth_of_tuple_property_map<1, PointWithNormal>;
 using Traits = CGAL::Shape_detection::Efficient_RANSAC_traits<Kernel, PointList, PointMap, NormalMap>;
 using Ransac = CGAL::Shape_detection::Efficient_RANSAC<Traits>;
 using RansacPlane = CGAL::Shape_detection::Plane<Traits>;
@@ -74,7 +75,10 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm)
 
   PointList pts;
   pts.reserve(n);
-  for (const auto& p : cloud.points) pts.emplace_back(Point(p.x(), p.y(), p.z()), Vector(0, 0, 0));
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& p = cloud.points[i];
+    pts.emplace_back(Point(p.x(), p.y(), p.z()), Vector(0, 0, 0), int(i));
+  }
   CGAL::pca_estimate_normals<CGAL::Sequential_tag>(
       pts, prm.normal_neighbors, CGAL::parameters::point_map(PointMap()).normal_map(NormalMap()));
 
@@ -92,7 +96,8 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm)
   ransac.detect(rp);
 
   for (const auto& shape : ransac.shapes()) {
-    std::vector<int> inl(shape->indices_of_assigned_points().begin(), shape->indices_of_assigned_points().end());
+    std::vector<int> inl;
+    for (std::size_t k : shape->indices_of_assigned_points()) inl.push_back(std::get<2>(pts[k]));
     if (inl.size() < 3) continue;
     ScanPlane sp = describe(cloud.points, std::move(inl), prm);
     if (sp.hull_area >= prm.min_plane_area) result.push_back(std::move(sp));

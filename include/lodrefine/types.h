@@ -1,6 +1,7 @@
 // Core value types shared by every pipeline stage.
 #pragma once
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross products on Vec3 everywhere
 #include <stdexcept>
 #include <string>
 #include <vector>

@@ -1,0 +1,24 @@
+// Cutting one MLS crop per building out of a large tile, in one streaming pass.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "lodrefine/types.h"
+
+namespace lodrefine {
+
+struct CropTarget {
+  std::string id;
+  Vec3 lo, hi;        // expanded bounding box (georeferenced)
+  PointCloud cloud;   // filled by crop_tile
+};
+
+// The model's bounding box grown by `relative` of its size and `absolute` metres on each side
+// (vertically by `absolute` only).
+CropTarget crop_target(const Mesh& model, double relative, double absolute);
+
+// Streams `tile_ply` once and appends each point to every target whose box holds it (a 2D
+// grid over the targets keeps this O(points)). Returns the number of points read.
+std::size_t crop_tile(const std::string& tile_ply, std::vector<CropTarget>& targets);
+
+}  // namespace lodrefine
