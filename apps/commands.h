@@ -14,5 +14,6 @@ void add_synth_command(CLI::App& app);
 void add_eval_command(CLI::App& app);
 void add_crop_command(CLI::App& app);
 void add_params_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
 
 }  // namespace lodrefine::app
