@@ -27,9 +27,25 @@ struct SynthOptions {
   Vec3 origin{85000.0, 447000.0, 0.0};  // georeferenced offset (RD New-like by default)
 };
 
+// A facade of the coarse model that differs from the truth.
+struct MovedWall {
+  std::vector<int> truth_faces;  // truth walls on the moved facade plane (first: the pivot wall)
+  double offset = 0.0;           // perpendicular shift (m), positive = outward
+  double rotation_deg = 0.0;     // about a vertical axis through the pivot wall's midpoint, CCW seen from above
+  bool scanned = false;          // one of scanned_truth_faces
+};
+
 struct SynthBuilding {
   std::string id;
   BuildingType type;
+  std::uint64_t seed = 0;
+  SynthOptions options;
+  Vec3 frame_origin = Vec3::Zero();  // georeferenced origin of the building's own frame
+  double frame_rotation_deg = 0.0;   // rotation of the building's own frame about z
+  std::vector<MovedWall> moved_walls;
+  Vec3 coarse_shift = Vec3::Zero();  // global shift applied to the whole coarse model
+  std::vector<std::string> defects;  // export defects of the coarse soup, e.g. "reversed_face:7"
+  double point_spacing = 0.0;        // facade sampling grid step (m)
   Mesh truth;    // closed, oriented, shared vertices, georeferenced
   Mesh coarse;   // polygon soup as exported from CityGML (defects included), georeferenced
   PointCloud cloud;                // georeferenced MLS crop
