@@ -65,7 +65,8 @@ void run(const BenchArgs& a) {
       PointCloud local_cloud = b.cloud;
       for (auto& p : local_cloud.points) p -= o;
       const Mesh truth = shifted(b.truth, -o);
-      const BuildingEval ev = evaluate_building(shifted(b.coarse, -o), shifted(r.mesh, -o), local_cloud, &truth, a.params);
+      const BuildingEval ev = evaluate_building(shifted(b.coarse, -o), shifted(r.mesh, -o), local_cloud, &truth, a.params,
+                                                &b.scanned_truth_faces);
       const double f0 = ev.truth_facade_before ? ev.truth_facade_before->rmse : -1;
       const double f1 = ev.truth_facade_after ? ev.truth_facade_after->rmse : -1;
       if (ev.truth_facade_after) {
@@ -99,7 +100,7 @@ void add_bench_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("bench", "Benchmark: refine a generated tile, print time per stage and accuracy");
   cmd->add_option("--type", args.types, "Building types (or all)")->capture_default_str();
   cmd->add_option("--count", args.count, "Buildings per type")->capture_default_str()->check(CLI::Range(1, 100000));
-  cmd->add_option("--seed", args.seed, "First seed")->capture_default_str();
+  cmd->add_option("--first-seed", args.seed, "First building seed (the RANSAC seed is --seed)")->capture_default_str();
   cmd->add_option("--points", args.points, "Target facade points per building")->capture_default_str()->check(CLI::Range(100, 10000000));
   add_param_options(cmd, args.params);
   cmd->callback([] { run(args); });

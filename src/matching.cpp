@@ -31,6 +31,38 @@ double overlap_area(const Rect& a, const Rect& b) {
   return du > 0 && dv > 0 ? du * dv : 0.0;
 }
 
+// Two surfaces are adjacent when they share a vertex.
+bool adjacent(const Mesh& mesh, const ModelSurface& a, const ModelSurface& b) {
+  std::vector<int> va, vb;
+  for (int f : a.faces) va.insert(va.end(), mesh.faces[f].v.begin(), mesh.faces[f].v.end());
+  for (int f : b.faces) vb.insert(vb.end(), mesh.faces[f].v.begin(), mesh.faces[f].v.end());
+  std::sort(va.begin(), va.end());
+  std::sort(vb.begin(), vb.end());
+  std::vector<int> common;
+  std::set_intersection(va.begin(), va.end(), vb.begin(), vb.end(), std::back_inserter(common));
+  return !common.empty();
+}
+
+// How far the corner where `plane` meets the adjacent facade's scan plane lies beyond the end
+// of that facade's points (0 when the points reach it). A wall moved onto a neighbour's wall
+// across a gap leaves the adjacent facade's scan ending well short of the new corner.
+double corner_gap(const Plane& plane, const ScanPlane& adjacent_scan, const PointCloud& cloud) {
+  const auto [u, v] = adjacent_scan.plane.basis();
+  const Vec3 dir = plane.n.cross(adjacent_scan.plane.n);
+  if (dir.norm() < 0.5) return 0.0;  // not a corner (near-parallel walls)
+  // A point on the corner line, at the height of the adjacent scan's centroid.
+  const auto corner = meet(plane, adjacent_scan.plane, Plane::through(adjacent_scan.centroid, v));
+  if (!corner) return 0.0;
+  const double uc = (*corner - adjacent_scan.centroid).dot(u);
+  double lo = 1e300, hi = -1e300;
+  for (int i : adjacent_scan.inliers) {
+    const double q = (cloud.points[i] - adjacent_scan.centroid).dot(u);
+    lo = std::min(lo, q);
+    hi = std::max(hi, q);
+  }
+  return std::max({0.0, uc - hi, lo - uc});
+}
+
 }  // namespace
 
 std::vector<ModelSurface> model_surfaces(const Mesh& mesh, double angle_deg, double distance) {
@@ -130,11 +162,25 @@ MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& su
       const double score = prm.w_normal * std::abs(s_normal) + prm.w_coverage * iou;
       if (score > best.s_match) best = Match{p, s, s_normal, d_c, iou, score};
     }
-    if (best.scan_plane >= 0) {
-      result.matches.push_back(best);
-      result.q_model += best.s_match;
-    }
+    if (best.scan_plane >= 0) result.matches.push_back(best);
   }
+  // Corner consistency with the adjacent matched facades (beyond the paper: rejects walls of
+  // neighbouring buildings seen across a gap).
+  std::vector<Match> kept;
+  for (const auto& m : result.matches) {
+    bool ok = true;
+    for (const auto& a : result.matches) {
+      if (&a == &m || a.scan_plane == m.scan_plane) continue;
+      if (unoriented_angle_deg(surfaces[a.surface].plane.n, surfaces[m.surface].plane.n) < 30.0) continue;
+      if (!adjacent(mesh, surfaces[a.surface], surfaces[m.surface])) continue;
+      const double g = corner_gap(planes[m.scan_plane].plane, planes[a.scan_plane], cloud);
+      if (g > prm.corner_gap) ok = false;
+    }
+    if (!ok) continue;
+    kept.push_back(m);
+    result.q_model += m.s_match;
+  }
+  result.matches = kept;
   return result;
 }
 
