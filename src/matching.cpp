@@ -165,21 +165,39 @@ MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& su
     if (best.scan_plane >= 0) result.matches.push_back(best);
   }
   // Corner consistency with the adjacent matched facades (beyond the paper: rejects walls of
-  // neighbouring buildings seen across a gap).
-  std::vector<Match> kept;
-  for (const auto& m : result.matches) {
-    bool ok = true;
-    for (const auto& a : result.matches) {
-      if (&a == &m || a.scan_plane == m.scan_plane) continue;
+  // neighbouring buildings seen across a gap). A wrong match also makes its correct
+  // neighbours look inconsistent, so the match with the most conflicts goes first.
+  const int nm = int(result.matches.size());
+  std::vector<std::vector<char>> conflict(nm, std::vector<char>(nm, 0));
+  for (int i = 0; i < nm; ++i)
+    for (int j = 0; j < nm; ++j) {
+      const Match &m = result.matches[i], &a = result.matches[j];
+      if (i == j || a.scan_plane == m.scan_plane) continue;
       if (unoriented_angle_deg(surfaces[a.surface].plane.n, surfaces[m.surface].plane.n) < 30.0) continue;
       if (!adjacent(mesh, surfaces[a.surface], surfaces[m.surface])) continue;
-      const double g = corner_gap(planes[m.scan_plane].plane, planes[a.scan_plane], cloud);
-      if (g > prm.corner_gap) ok = false;
+      if (corner_gap(planes[m.scan_plane].plane, planes[a.scan_plane], cloud) > prm.corner_gap) conflict[i][j] = conflict[j][i] = 1;
     }
-    if (!ok) continue;
-    kept.push_back(m);
-    result.q_model += m.s_match;
+  std::vector<char> alive(nm, 1);
+  for (;;) {
+    int worst = -1, worst_count = 0;
+    for (int i = 0; i < nm; ++i) {
+      if (!alive[i]) continue;
+      int c = 0;
+      for (int j = 0; j < nm; ++j) c += alive[j] && conflict[i][j];
+      if (c > worst_count || (c == worst_count && c > 0 && result.matches[i].s_match < result.matches[worst].s_match)) {
+        worst = i;
+        worst_count = c;
+      }
+    }
+    if (worst < 0) break;
+    alive[worst] = 0;
   }
+  std::vector<Match> kept;
+  for (int i = 0; i < nm; ++i)
+    if (alive[i]) {
+      kept.push_back(result.matches[i]);
+      result.q_model += result.matches[i].s_match;
+    }
   result.matches = kept;
   return result;
 }

@@ -123,15 +123,30 @@ Region replacement_region(const Mesh& mesh, const std::vector<ModelSurface>& sur
   Region r;
   r.axes = axes;
   Vec3 qlo = lo - margin, qhi = hi + margin;
-  // Keep every model vertex well off the region's faces, so no model edge runs along them
-  // and the outside surface is unambiguous at the boundary.
-  for (int iter = 0; iter < 40; ++iter) {
+  // Keep the model's vertices off the region's faces, and the points where its edges cross a
+  // face off the region's edges: no model feature may run (almost) along the boundary, or
+  // slivers make the outside surface ambiguous there.
+  std::vector<std::pair<Vec3, Vec3>> edges;
+  for (const auto& f : mesh.faces)
+    for (std::size_t k = 0; k < f.v.size(); ++k)
+      edges.emplace_back(axes.transpose() * mesh.vertices[f.v[k]], axes.transpose() * mesh.vertices[f.v[(k + 1) % f.v.size()]]);
+  constexpr double kClear = 0.02, kStep = 0.05;
+  auto near_bound = [&](const Vec3& q, int k) {  // pushes the bound of axis k that q is close to
+    if (std::abs(q[k] - qlo[k]) < kClear) { qlo[k] -= kStep; return true; }
+    if (std::abs(q[k] - qhi[k]) < kClear) { qhi[k] += kStep; return true; }
+    return false;
+  };
+  for (int iter = 0; iter < 60; ++iter) {
     bool moved = false;
-    for (int k = 0; k < 3; ++k)
-      for (const auto& p : mesh.vertices) {
-        const double q = axes.col(k).dot(p);
-        if (std::abs(q - qlo[k]) < 0.02) { qlo[k] -= 0.05; moved = true; }
-        if (std::abs(q - qhi[k]) < 0.02) { qhi[k] += 0.05; moved = true; }
+    for (const auto& [a, b] : edges)
+      for (int k = 0; k < 3; ++k) {
+        moved = near_bound(a, k) || moved;
+        for (double bound : {qlo[k], qhi[k]}) {
+          if ((a[k] - bound) * (b[k] - bound) >= 0) continue;
+          const Vec3 x = a + (b - a) * ((bound - a[k]) / (b[k] - a[k]));
+          for (int j = 0; j < 3; ++j)
+            if (j != k) moved = near_bound(x, j) || moved;
+        }
       }
     if (!moved) break;
   }
