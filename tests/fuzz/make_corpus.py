@@ -1,0 +1,96 @@
+#!/usr/bin/env python3
+"""Writes the small seed corpus of the fuzz targets into corpus/<target>/ (deterministic).
+Run from anywhere: python3 tests/fuzz/make_corpus.py"""
+import os
+import random
+import struct
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def put(target, name, data):
+    d = os.path.join(HERE, "corpus", target)
+    os.makedirs(d, exist_ok=True)
+    with open(os.path.join(d, name), "wb") as f:
+        f.write(data if isinstance(data, bytes) else data.encode())
+
+
+def box_obj(x0, x1, y0, y1, h, ox=0.0, oy=0.0, name="box"):
+    c = [(x0, y0, 0), (x1, y0, 0), (x1, y1, 0), (x0, y1, 0), (x0, y0, h), (x1, y0, h), (x1, y1, h), (x0, y1, h)]
+    quads = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
+    groups = ["GroundSurface", "RoofSurface", "WallSurface", "WallSurface", "WallSurface", "WallSurface"]
+    out = [f"o {name}"]
+    n = 0
+    for q, g in zip(quads, groups):
+        out.append(f"g {g}")
+        for k in q:
+            x, y, z = c[k]
+            out.append(f"v {x + ox:.3f} {y + oy:.3f} {z:.3f}")
+        out.append("f " + " ".join(str(n + i + 1) for i in range(4)))
+        n += 4
+    return "\n".join(out) + "\n"
+
+
+def wall_points(n_u, n_v, x0, x1, z1, y, rng, noise=0.005):
+    pts = []
+    for i in range(n_u):
+        for j in range(n_v):
+            x = x0 + (x1 - x0) * (i + 0.5) / n_u
+            z = 0.2 + (z1 - 0.2) * (j + 0.5) / n_v
+            pts.append((x, y + rng.gauss(0, noise), z))
+    return pts
+
+
+def ply(points, fmt="binary_little_endian", typ="float", extra=""):
+    head = f"ply\nformat {fmt} 1.0\nelement vertex {len(points)}\n"
+    head += "".join(f"property {typ} {a}\n" for a in "xyz") + extra + "end_header\n"
+    if fmt == "ascii":
+        return (head + "".join(f"{x:.3f} {y:.3f} {z:.3f}\n" for x, y, z in points)).encode()
+    code = {"float": "f", "double": "d", "uchar": "B", "short": "h", "int": "i"}[typ]
+    endian = "<" if fmt == "binary_little_endian" else ">"
+    body = b"".join(struct.pack(endian + code * 3, *p) for p in points)
+    return head.encode() + body
+
+
+def main():
+    rng = random.Random(7)
+    # --- OBJ reader seeds
+    put("fuzz_obj", "box.obj", box_obj(0, 6, 0, 4, 3, 85000.0, 447000.0))
+    put("fuzz_obj", "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    put("fuzz_obj", "negative.obj", "# id: neg\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\nf 1 2\n")
+    put("fuzz_obj", "slashes.obj",
+        "mtllib x.mtl\nv 0 0 0\nv 1 0 0 1\nv 0 1 0 0.5 0.5 0.5\nvt 0 0\nvn 0 0 1\ns off\n"
+        "usemtl RoofSurface\nf 1/1/1 2/1/1 3/1/1\nf 1//1 2//1 3//1\nf 1/1 2/1 3/1\n")
+    put("fuzz_obj", "forward.obj", "f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\r\n")
+    put("fuzz_obj", "exp.obj", "v 1e3 -2.5E-2 +7\nv 0x1 0 0\nv 1 1 1\nf 1 2 3\n")
+    # --- PLY reader seeds
+    pts = wall_points(4, 3, 0, 6, 3, 0.0, rng)
+    put("fuzz_ply", "ascii.ply", ply(pts, "ascii"))
+    put("fuzz_ply", "le_float.ply", ply(pts))
+    put("fuzz_ply", "be_double.ply", ply(pts[:4], "binary_big_endian", "double"))
+    put("fuzz_ply", "uchar.ply", ply([(1, 2, 3), (4, 5, 6)], typ="uchar"))
+    put("fuzz_ply", "short.ply", ply([(1, -2, 3), (400, 5, -6)], typ="short"))
+    face_ply = ("ply\nformat ascii 1.0\ncomment made by hand\nelement vertex 3\nproperty float x\nproperty float y\n"
+                "property float z\nproperty uchar red\nelement face 1\nproperty list uchar int vertex_indices\n"
+                "end_header\n0 0 0 255\n1 0 0 0\n0 1 0 7\n3 0 1 2\n")
+    put("fuzz_ply", "faces.ply", face_ply)
+    pre = (b"ply\nformat binary_little_endian 1.0\nelement camera 1\nproperty list uchar float m\n"
+           b"element vertex 1\nproperty double z\nproperty double y\nproperty double x\nend_header\n"
+           + struct.pack("<B2f", 2, 1.0, 2.0) + struct.pack("<3d", 3.0, 2.0, 1.0))
+    put("fuzz_ply", "list_first.ply", pre)
+    # --- whole refine: [len lo, len hi, flags] + OBJ + PLY
+    for name, flags, cloud in [
+        ("moved_wall_tiny", 1, wall_points(10, 6, 0.3, 5.7, 2.8, 0.0, rng)),   # model wall at y = -0.4
+        ("moved_wall_ascii", 1, None),
+        ("few_points", 0, wall_points(2, 2, 1, 5, 2, 0.0, rng)),
+    ]:
+        obj = box_obj(0, 6, -0.4, 4, 3).encode()
+        if cloud is None:
+            data = ply(wall_points(8, 5, 0.3, 5.7, 2.8, 0.0, rng), "ascii")
+        else:
+            data = ply(cloud)
+        put("fuzz_refine", name, struct.pack("<HB", len(obj), flags) + obj + data)
+
+
+if __name__ == "__main__":
+    main()
