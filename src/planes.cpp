@@ -66,6 +66,31 @@ ScanPlane describe(const std::vector<Vec3>& all, std::vector<int> inliers, const
   return sp;
 }
 
+// RANSAC's connectivity split one facade into pieces wherever a gap (a window column, an
+// occluding tree) is wider than the cluster epsilon: the pieces of one plane are one surface.
+std::vector<ScanPlane> merge_coplanar(std::vector<ScanPlane> planes, const std::vector<Vec3>& all, const Params& prm) {
+  const double tol = 2.0 * prm.ransac_epsilon;
+  auto mean_distance = [&](const ScanPlane& a, const Plane& b) {
+    double s = 0.0;
+    for (int i : a.inliers) s += std::abs(b.distance(all[i]));
+    return s / double(a.inliers.size());
+  };
+  for (bool merged = true; merged;) {
+    merged = false;
+    for (std::size_t i = 0; i < planes.size() && !merged; ++i)
+      for (std::size_t j = i + 1; j < planes.size() && !merged; ++j) {
+        if (unoriented_angle_deg(planes[i].plane.n, planes[j].plane.n) > 2.0) continue;
+        if (mean_distance(planes[j], planes[i].plane) > tol || mean_distance(planes[i], planes[j].plane) > tol) continue;
+        std::vector<int> inl = planes[i].inliers;
+        inl.insert(inl.end(), planes[j].inliers.begin(), planes[j].inliers.end());
+        planes[i] = describe(all, std::move(inl), prm);
+        planes.erase(planes.begin() + long(j));
+        merged = true;
+      }
+  }
+  return planes;
+}
+
 }  // namespace
 
 std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm) {
@@ -102,6 +127,7 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm)
     ScanPlane sp = describe(cloud.points, std::move(inl), prm);
     if (sp.hull_area >= prm.min_plane_area) result.push_back(std::move(sp));
   }
+  result = merge_coplanar(std::move(result), cloud.points, prm);
   // Largest first: later stages prefer well-supported planes on ties.
   std::stable_sort(result.begin(), result.end(),
                    [](const ScanPlane& a, const ScanPlane& b) { return a.inliers.size() > b.inliers.size(); });
