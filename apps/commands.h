@@ -15,5 +15,6 @@ void add_eval_command(CLI::App& app);
 void add_crop_command(CLI::App& app);
 void add_params_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_convert_command(CLI::App& app);
 
 }  // namespace lodrefine::app

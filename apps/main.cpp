@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   app::add_crop_command(app);
   app::add_params_command(app);
   app::add_bench_command(app);
+  app::add_convert_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

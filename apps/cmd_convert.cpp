@@ -1,0 +1,57 @@
+// `lodrefine convert`: a CityJSON / CityJSONSeq file -> one OBJ per LoD2 building, as an FME
+// fan-out export writes them (polygon soup, `o <id>`, WallSurface/RoofSurface/GroundSurface
+// groups, georeferenced coordinates), ready for `lodrefine refine` / `crop`.
+#include <cstdio>
+#include <filesystem>
+#include <set>
+
+#include "commands.h"
+#include "lodrefine/cityjson.h"
+#include "lodrefine/io.h"
+
+namespace lodrefine::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ConvertArgs {
+  std::string cityjson, out_dir;
+  std::vector<std::string> ids;
+};
+
+void run(const ConvertArgs& a) {
+  const CityJsonFile file = read_cityjson(a.cityjson);
+  const std::set<std::string> wanted(a.ids.begin(), a.ids.end());
+  std::set<std::string> found, stems;
+  fs::create_directories(a.out_dir);
+  int written = 0;
+  for (const auto& b : file.buildings) {
+    if (!wanted.empty() && !wanted.count(b.mesh.id)) continue;
+    found.insert(b.mesh.id);
+    std::string stem = file_stem_for_id(b.mesh.id);
+    for (int k = 2; !stems.insert(stem).second; ++k) stem = file_stem_for_id(b.mesh.id) + "_" + std::to_string(k);
+    write_obj((fs::path(a.out_dir) / (stem + ".obj")).string(), b.mesh);
+    ++written;
+  }
+  for (const auto& id : wanted)
+    if (!found.count(id)) throw InputError(a.cityjson + ": no Building/BuildingPart '" + id + "' with an LoD 2.x geometry");
+  for (const auto& note : file.notes) std::fprintf(stderr, "lodrefine: note: %s\n", note.c_str());
+  std::printf("%d building(s) written to %s (CityJSON %s%s, %s; %d object(s) without LoD 2.x skipped)\n", written,
+              a.out_dir.c_str(), file.version.c_str(), file.sequence ? " sequence" : "",
+              file.crs.empty() ? "no CRS" : file.crs.c_str(), file.objects_without_lod2);
+}
+
+}  // namespace
+
+void add_convert_command(CLI::App& app) {
+  static ConvertArgs args;
+  auto* cmd = app.add_subcommand("convert", "Write each LoD2 building of a CityJSON (Seq) file as its own OBJ");
+  cmd->add_option("--cityjson", args.cityjson, "CityJSON 1.0/1.1/2.0 file or CityJSONSeq (.jsonl)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--id", args.ids, "Only these CityObject ids (repeatable; default: every building)");
+  cmd->add_option("--out-dir", args.out_dir, "Directory for <id>.obj (created if missing)")->required();
+  cmd->callback([] { run(args); });
+}
+
+}  // namespace lodrefine::app
