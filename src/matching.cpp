@@ -5,6 +5,8 @@
 #include <cmath>
 #include <map>
 
+#include "lodrefine/repair.h"
+
 namespace lodrefine {
 namespace {
 
@@ -202,7 +204,13 @@ MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& su
   return result;
 }
 
-std::vector<int> select_facade_points(const Mesh& mesh, const PointCloud& cloud, const Params& prm) {
+std::vector<int> select_facade_points(const Mesh& input, const PointCloud& cloud, const Params& prm) {
+  // Matching needs the walls' adjacency (corner checks), which a soup lacks: weld it first.
+  Mesh mesh = input;
+  try {
+    mesh = repair_model(input, prm.weld_tolerance);
+  } catch (const InputError&) {
+  }
   const auto planes = detect_planes(cloud, prm);
   const auto surfaces = model_surfaces(mesh);
   const auto m = match_surfaces(mesh, surfaces, cloud, planes, prm);
