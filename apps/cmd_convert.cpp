@@ -22,21 +22,23 @@ struct ConvertArgs {
 void run(const ConvertArgs& a) {
   const CityJsonFile file = read_cityjson(a.cityjson);
   const std::set<std::string> wanted(a.ids.begin(), a.ids.end());
-  std::set<std::string> found, stems;
-  fs::create_directories(a.out_dir);
-  int written = 0;
-  for (const auto& b : file.buildings) {
-    if (!wanted.empty() && !wanted.count(b.mesh.id)) continue;
-    found.insert(b.mesh.id);
-    std::string stem = file_stem_for_id(b.mesh.id);
-    for (int k = 2; !stems.insert(stem).second; ++k) stem = file_stem_for_id(b.mesh.id) + "_" + std::to_string(k);
-    write_obj((fs::path(a.out_dir) / (stem + ".obj")).string(), b.mesh);
-    ++written;
-  }
+  std::vector<const CityJsonBuilding*> chosen;
+  std::set<std::string> found;
+  for (const auto& b : file.buildings)
+    if (wanted.empty() || wanted.count(b.mesh.id)) chosen.push_back(&b), found.insert(b.mesh.id);
   for (const auto& id : wanted)
     if (!found.count(id)) throw InputError(a.cityjson + ": no Building/BuildingPart '" + id + "' with an LoD 2.x geometry");
-  for (const auto& note : file.notes) std::fprintf(stderr, "lodrefine: note: %s\n", note.c_str());
-  std::printf("%d building(s) written to %s (CityJSON %s%s, %s; %d object(s) without LoD 2.x skipped)\n", written,
+  fs::create_directories(a.out_dir);
+  std::set<std::string> stems;
+  for (const CityJsonBuilding* b : chosen) {
+    std::string stem = file_stem_for_id(b->mesh.id);
+    for (int k = 2; !stems.insert(stem).second; ++k) stem = file_stem_for_id(b->mesh.id) + "_" + std::to_string(k);
+    write_obj((fs::path(a.out_dir) / (stem + ".obj")).string(), b->mesh);
+    if (b->skipped_holes + b->skipped_rings + b->skipped_shells > 0)
+      std::fprintf(stderr, "lodrefine: note: %s: dropped %d inner ring(s), %d degenerate surface(s), %d interior shell(s)\n",
+                   b->mesh.id.c_str(), b->skipped_holes, b->skipped_rings, b->skipped_shells);
+  }
+  std::printf("%zu building(s) written to %s (CityJSON %s%s, %s; %d object(s) without LoD 2.x skipped)\n", chosen.size(),
               a.out_dir.c_str(), file.version.c_str(), file.sequence ? " sequence" : "",
               file.crs.empty() ? "no CRS" : file.crs.c_str(), file.objects_without_lod2);
 }
