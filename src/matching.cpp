@@ -214,9 +214,25 @@ std::vector<int> select_facade_points(const Mesh& input, const PointCloud& cloud
   const auto planes = detect_planes(cloud, prm);
   const auto surfaces = model_surfaces(mesh);
   const auto m = match_surfaces(mesh, surfaces, cloud, planes, prm);
+  // Only the part of each matched plane in front of its wall: a plane may run on along a
+  // flush neighbouring facade, whose points are not this building's.
   std::vector<char> take(cloud.points.size(), 0);
-  for (const auto& match : m.matches)
-    for (int i : planes[match.scan_plane].inliers) take[i] = 1;
+  for (const auto& match : m.matches) {
+    const ModelSurface& surf = surfaces[match.surface];
+    const auto [u, v] = surf.plane.basis();
+    Rect box;
+    for (int f : surf.faces)
+      for (int vi : mesh.faces[f].v) {
+        const Vec3 q = mesh.vertices[vi] - surf.centroid;
+        box.add(q.dot(u), q.dot(v));
+      }
+    const double margin = prm.corner_gap;
+    for (int i : planes[match.scan_plane].inliers) {
+      const Vec3 q = cloud.points[i] - surf.centroid;
+      const double qu = q.dot(u), qv = q.dot(v);
+      if (qu >= box.u0 - margin && qu <= box.u1 + margin && qv >= box.v0 - margin && qv <= box.v1 + margin) take[i] = 1;
+    }
+  }
   std::vector<int> idx;
   for (int i = 0; i < int(take.size()); ++i)
     if (take[i]) idx.push_back(i);
