@@ -55,19 +55,11 @@ std::vector<std::string_view> split_ws(std::string_view s) {
   return out;
 }
 
-// Whole-token number parsing; nullopt on any trailing junk.
-std::optional<double> parse_double(std::string_view t) {
+// Whole-token number parsing (double or integer); nullopt on any trailing junk or overflow.
+template <class T>
+std::optional<T> parse_number(std::string_view t) {
   if (t.size() > 1 && t[0] == '+') t.remove_prefix(1);
-  double v = 0;
-  const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
-  if (r.ec != std::errc() || r.ptr != t.data() + t.size()) return std::nullopt;
-  return v;
-}
-
-template <class Int>
-std::optional<Int> parse_int(std::string_view t) {
-  if (t.size() > 1 && t[0] == '+') t.remove_prefix(1);
-  Int v = 0;
+  T v = 0;
   const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
   if (r.ec != std::errc() || r.ptr != t.data() + t.size()) return std::nullopt;
   return v;
@@ -156,7 +148,7 @@ class ObjParser {
     if (tok.size() > 8) fail_line("vertex with too many values");
     Vec3 p;
     for (std::size_t i = 1; i < tok.size(); ++i) {
-      const auto v = parse_double(tok[i]);
+      const auto v = parse_number<double>(tok[i]);
       if (!v) fail_line("bad number " + quote(tok[i]));
       if (!std::isfinite(*v)) fail_line("non-finite coordinate " + quote(tok[i]));
       if (i <= 3) p[int(i - 1)] = *v;
@@ -183,7 +175,7 @@ class ObjParser {
     const std::string_view head = t.substr(0, t.find('/'));
     if (t.find_first_not_of("0123456789/-+", head.size()) != std::string_view::npos)
       fail_line("bad face vertex " + quote(t));
-    const auto idx = parse_int<long long>(head);
+    const auto idx = parse_number<long long>(head);
     if (!idx) fail_line("bad face vertex " + quote(t));
     if (*idx == 0) fail_line("face index 0 (OBJ indices start at 1)");
     const long long n = (long long)mesh_.vertices.size();
@@ -364,7 +356,7 @@ class PlyReader {
     std::string s;
     char c;
     while (in_.get(c) && c != '\n') {
-      if (s.size() > 4096) fail(path_, "header line too long (not a PLY header?)");
+      if (s.size() > 4096) fail(path_, "not a PLY file (header line over 4096 bytes)");
       s += c;
     }
     if (!in_ && s.empty()) fail(path_, "header ends before end_header (truncated)");
@@ -401,7 +393,7 @@ class PlyReader {
 
   void element_line(const std::vector<std::string_view>& tok) {
     if (tok.size() != 3) fail(path_, "bad element line");
-    const auto count = parse_int<std::uint64_t>(tok[2]);
+    const auto count = parse_number<std::uint64_t>(tok[2]);
     if (!count) fail(path_, "bad element count " + quote(tok[2]));
     elements_.push_back({std::string(tok[1]), *count, {}});
   }
@@ -467,7 +459,7 @@ class PlyReader {
       return true;
     }
     if (!data.token(tok_)) return false;
-    const auto v = parse_double(tok_);
+    const auto v = parse_number<double>(tok_);
     if (!v) fail(path_, "bad ASCII value " + quote(tok_));
     out = *v;
     return true;

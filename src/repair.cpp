@@ -165,6 +165,7 @@ int split_t_junctions(const std::vector<Vec3>& V, std::vector<Face>& faces, doub
     for (std::size_t i = 0; i < f.v.size(); ++i) {
       out.push_back(f.v[i]);
       for (int w : vertices_on_edge(V, used, f.v[i], f.v[(i + 1) % f.v.size()], f.v, tol)) {
+        if (std::find(out.begin(), out.end(), w) != out.end()) continue;  // already on another edge
         out.push_back(w);
         ++inserted;
       }
@@ -241,7 +242,8 @@ int pop(std::vector<int>& v) {
 }
 
 // Boundary loops, each traced against its faces' direction so that a polygon through it
-// continues the neighbours' orientation. Loops that do not close are left open.
+// continues the neighbours' orientation. Where boundaries touch at a vertex, the walk is cut
+// into simple loops; walks that do not close are left open.
 std::vector<std::vector<int>> hole_loops(const std::vector<Face>& faces) {
   std::map<int, std::vector<int>> next;
   for (const auto& [e, u] : edge_uses(faces))
@@ -250,19 +252,25 @@ std::vector<std::vector<int>> hole_loops(const std::vector<Face>& faces) {
       else next[e.first].push_back(e.second);
     }
   std::vector<std::vector<int>> loops;
+  const auto emit = [&loops](std::vector<int> loop) {
+    if (loop.size() >= 3) loops.push_back(std::move(loop));
+  };
   for (auto& [start, outs] : next)
     while (!outs.empty()) {
-      std::vector<int> loop{start};
-      for (int cur = pop(outs); cur != start;) {
-        const auto it = next.find(cur);
-        if (it == next.end() || it->second.empty()) {
-          loop.clear();
-          break;
+      std::vector<int> walk{start};
+      for (int cur = pop(outs);;) {
+        const auto seen = std::find(walk.begin(), walk.end(), cur);
+        if (seen != walk.end()) {  // closed a loop at cur: cut it off, keep walking from cur
+          emit(std::vector<int>(seen, walk.end()));
+          walk.erase(seen + 1, walk.end());
+          if (cur == start) break;
+        } else {
+          walk.push_back(cur);
         }
-        loop.push_back(cur);
+        const auto it = next.find(cur);
+        if (it == next.end() || it->second.empty()) break;
         cur = pop(it->second);
       }
-      if (loop.size() >= 3) loops.push_back(std::move(loop));
     }
   return loops;
 }
@@ -300,7 +308,9 @@ Semantic fill_semantic(const std::vector<Vec3>& V, const std::vector<Face>& face
   const auto& v = faces[f].v;
   for (std::size_t i = 0; i < v.size(); ++i) {
     const int a = v[i], b = v[(i + 1) % v.size()];
-    for (const EdgeUse& u : uses.at({std::min(a, b), std::max(a, b)}))
+    const auto it = uses.find({std::min(a, b), std::max(a, b)});
+    if (it == uses.end()) continue;
+    for (const EdgeUse& u : it->second)
       if (std::size_t(u.face) < first_new) weight[faces[u.face].sem] += (V[a] - V[b]).norm();
   }
   Semantic best = Semantic::Other;
@@ -384,7 +394,9 @@ std::optional<std::vector<int>> region_outline(const std::vector<Face>& faces, c
     const auto& v = faces[f].v;
     for (std::size_t i = 0; i < v.size(); ++i) {
       const int a = v[i], b = v[(i + 1) % v.size()];
-      const auto& u = uses.at({std::min(a, b), std::max(a, b)});
+      const auto it = uses.find({std::min(a, b), std::max(a, b)});
+      if (it == uses.end()) return std::nullopt;  // a repeated vertex: leave such faces alone
+      const auto& u = it->second;
       const bool interior = u.size() == 2 && region[u[0].face] == id && region[u[1].face] == id;
       if (!interior && !next.emplace(a, b).second) return std::nullopt;
     }
@@ -474,19 +486,23 @@ Mesh merge_coplanar_faces(const Mesh& mesh, double angle_deg, double distance) {
   const std::vector<int> region = coplanar_regions(mesh, adjacency(mesh.faces, uses), angle_deg, distance);
   std::map<int, std::vector<int>> members;
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) members[region[f]].push_back(int(f));
-  std::vector<Face> faces;
+  std::map<int, Face> merged;
   for (const auto& [id, fs] : members) {
     const auto outline = fs.size() > 1 ? region_outline(mesh.faces, fs, region, id, uses) : std::nullopt;
-    if (!outline) {
-      for (int f : fs) faces.push_back(mesh.faces[f]);
-      continue;
-    }
+    if (!outline) continue;
     // The merged polygon descends mostly from its largest face.
     const int largest = *std::max_element(fs.begin(), fs.end(), [&](int a, int b) {
       return polygon_area(positions(mesh.vertices, mesh.faces[a].v)) <
              polygon_area(positions(mesh.vertices, mesh.faces[b].v));
     });
-    faces.push_back({*outline, mesh.faces[largest].sem, mesh.faces[largest].source});
+    merged[id] = {*outline, mesh.faces[largest].sem, mesh.faces[largest].source};
+  }
+  // Input order is kept: a merged polygon takes the place of its region's first face.
+  std::vector<Face> faces;
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    const auto it = merged.find(region[f]);
+    if (it == merged.end()) faces.push_back(mesh.faces[f]);
+    else if (members[region[f]].front() == int(f)) faces.push_back(it->second);
   }
   drop_straight_vertices(mesh.vertices, faces, distance);
   return compact(mesh.vertices, std::move(faces), mesh.id);

@@ -2,6 +2,8 @@
 // self-intersection machinery (slow to compile); the topology helpers live here too.
 #include "lodrefine/validate.h"
 
+// Self-overlapping face outlines reach CDT_2 (and fall back, see face_triangles): no warning spam.
+#define CGAL_NO_CDT_2_WARNING
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_faces.h>
@@ -146,7 +148,8 @@ SurfaceMesh triangle_mesh(const Mesh& m, std::vector<int>& original) {
       std::array<SmVertex, 3> tri = {vid[f.v[t[0]]], vid[f.v[t[1]]], vid[f.v[t[2]]]};
       if (CGAL::Euler::can_add_face(tri, sm) && sm.add_face(tri) != SurfaceMesh::null_face()) continue;
       for (int k = 0; k < 3; ++k) {
-        tri[k] = sm.add_vertex(sm.point(tri[k]));
+        const Kernel::Point_3 p = sm.point(tri[k]);  // a copy: add_vertex may reallocate the points
+        tri[k] = sm.add_vertex(p);
         original.push_back(f.v[t[k]]);
       }
       sm.add_face(tri);

@@ -161,6 +161,8 @@ TEST(IoObj, MalformedInputsThrowOneLineInputErrors) {
   expect_obj_error("# only a comment\nv 1 2 3\n", "no faces");
   expect_obj_error("v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", "line 2: non-finite");
   expect_obj_error("v 0 0 0\nv 1 0 inf\nv 0 1 0\nf 1 2 3\n", "line 2: non-finite");
+  expect_obj_error("v 0 0 0\nv 1e999 0 0\nv 0 1 0\nf 1 2 3\n", "line 2: bad number '1e999'");
+  expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n", "bad face vertex");
   expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "line 4: face index 4 out of range");
   expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", "face index -4 out of range");
   expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "face index 0");
@@ -258,6 +260,7 @@ TEST(IoPly, MalformedInputsThrowOneLineInputErrors) {
   expect_ply_error("", "empty file");
   expect_ply_error("OFF\n3 1 0\n", "not a PLY file");
   expect_ply_error(std::string("\0\1\2\3junkjunk", 12), "not a PLY file");
+  expect_ply_error("ply\n" + std::string(5000, 'x'), "not a PLY file");
   expect_ply_error("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n", "truncated");
   expect_ply_error("ply\nformat binary_middle_endian 1.0\nelement vertex 0\nend_header\n", "unknown format");
   expect_ply_error("ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n1\n",
