@@ -95,7 +95,7 @@ std::vector<ModelSurface> model_surfaces(const Mesh& mesh, double angle_deg, dou
       for (std::size_t i = 0; i < v.size(); ++i) {
         const int a = v[i], b = v[(i + 1) % v.size()];
         for (int g : edge_faces[{std::min(a, b), std::max(a, b)}]) {
-          if (group[g] >= 0 || mesh.faces[g].sem != mesh.faces[seed].sem) continue;
+          if (group[g] >= 0) continue;
           if (face_plane[g].n.dot(face_plane[seed].n) < std::cos(angle_deg * M_PI / 180.0)) continue;
           bool on_plane = true;
           for (int vi : mesh.faces[g].v)
@@ -108,7 +108,7 @@ std::vector<ModelSurface> model_surfaces(const Mesh& mesh, double angle_deg, dou
     }
     ModelSurface s;
     s.faces = members;
-    s.sem = mesh.faces[seed].sem;
+    std::map<Semantic, double> sem_area;
     std::vector<Vec3> pts;
     Vec3 nsum = Vec3::Zero(), csum = Vec3::Zero();
     for (int f : members) {
@@ -116,9 +116,15 @@ std::vector<ModelSurface> model_surfaces(const Mesh& mesh, double angle_deg, dou
       pts.insert(pts.end(), poly.begin(), poly.end());
       const double a = polygon_area(poly);
       s.area += a;
+      sem_area[mesh.faces[f].sem] += a;
       nsum += newell_normal(poly);
       csum += a * polygon_centroid(poly);
     }
+    // One plane, one surface: a mislabelled piece (a repaired hole, say) takes the semantic
+    // that covers most of it.
+    s.sem = std::max_element(sem_area.begin(), sem_area.end(), [](const auto& a, const auto& b) {
+              return a.second < b.second;
+            })->first;
     s.plane = fit_plane(pts);
     if (s.plane.n.dot(nsum) < 0) s.plane = s.plane.flipped();
     s.centroid = s.area > 0 ? Vec3(csum / s.area) : pts.front();
@@ -133,7 +139,8 @@ MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& su
   const double cos_max = std::cos(prm.match_angle_deg * M_PI / 180.0);
   for (int s = 0; s < int(surfaces.size()); ++s) {
     const ModelSurface& surf = surfaces[s];
-    if (surf.sem != Semantic::Wall) continue;
+    // Slivers (e.g. hole fills) are no facades: a large scan box would "cover" them.
+    if (surf.sem != Semantic::Wall || surf.area < prm.min_plane_area) continue;
     const auto [u, v] = surf.plane.basis();
     Rect model_box;
     for (int f : surf.faces)
@@ -165,6 +172,18 @@ MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& su
       if (score > best.s_match) best = Match{p, s, s_normal, d_c, iou, score};
     }
     if (best.scan_plane >= 0) result.matches.push_back(best);
+  }
+  // A scan plane sees one side of a wall: the surfaces it replaces must all face the way of
+  // the surface it fits best (else a notch's opposite wall would be pulled onto it).
+  {
+    std::vector<Match> same_side;
+    for (const auto& m : result.matches) {
+      const Match* ref = &m;
+      for (const auto& o : result.matches)
+        if (o.scan_plane == m.scan_plane && o.d_centroid < ref->d_centroid) ref = &o;
+      if (surfaces[m.surface].plane.n.dot(surfaces[ref->surface].plane.n) > 0) same_side.push_back(m);
+    }
+    result.matches = same_side;
   }
   // Corner consistency with the adjacent matched facades (beyond the paper: rejects walls of
   // neighbouring buildings seen across a gap). A wrong match also makes its correct

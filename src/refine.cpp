@@ -231,15 +231,18 @@ StepResult replace_walls(const Mesh& mesh, const std::vector<ModelSurface>& surf
     bool in = false;
     for (int f : surfaces[s].faces) in = in || face_in_region[f];
     if (!in) continue;
-    // Surfaces on the very same plane (split by other faces) share one supporting plane.
+    // Surfaces on the very same plane (split by other faces, or a repaired hole labelled
+    // otherwise) share one supporting plane, named after the larger surface.
     int idx = -1;
     for (int k = 1; k < int(planes.size()) && idx < 0; ++k)
-      if (planes[k].sem == surfaces[s].sem && planes[k].plane.n.dot(surfaces[s].plane.n) > 1.0 - 1e-9 &&
-          std::abs(planes[k].plane.d - surfaces[s].plane.d) < 1e-6)
+      if (planes[k].plane.n.dot(surfaces[s].plane.n) > 1.0 - 1e-9 && std::abs(planes[k].plane.d - surfaces[s].plane.d) < 1e-6)
         idx = k;
     if (idx < 0) {
       idx = int(planes.size());
       planes.push_back({surfaces[s].plane, surfaces[s].sem, false, s});
+    } else if (surfaces[s].area > surfaces[planes[idx].source].area) {
+      planes[idx].sem = surfaces[s].sem;
+      planes[idx].source = s;
     }
     for (int f : surfaces[s].faces) face_plane[f] = idx;
   }
@@ -399,7 +402,18 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
   // Repair the exported soup into a closed shell (this may throw: nothing valid to write).
   auto t = Clock::now();
   RepairReport rr;
-  Mesh current = merge_coplanar_faces(repair_model(translated(model, -origin), prm.weld_tolerance, &rr));
+  // A coarse weld closes export gaps but collapses short edges of detailed models: retry finer.
+  Mesh current;
+  for (double tol = prm.weld_tolerance;; tol /= 10.0) {
+    try {
+      rr = RepairReport{};
+      current = merge_coplanar_faces(repair_model(translated(model, -origin), tol, &rr));
+      if (tol != prm.weld_tolerance) rr.notes.push_back("welded at " + std::to_string(tol) + " m");
+      break;
+    } catch (const InputError&) {
+      if (tol < 1e-4) throw;
+    }
+  }
   current.id = model.id;
   snap_to_surfaces(current, model_surfaces(current), 0.05);
   rep["repair"] = {{"welded_vertices", rr.welded_vertices},
@@ -456,7 +470,7 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
   t = Clock::now();
   json steps = json::array();
   std::set<std::pair<int, long long>> tried;  // (scan plane, rounded wall position)
-  double t_match = 0.0;
+  double t_match = 0.0, mip_seconds = 0.0;
   for (int iter = 0; iter < 4 * int(planes.size()) + 4; ++iter) {
     const auto tm = Clock::now();
     const auto surfaces = model_surfaces(current);
@@ -487,7 +501,15 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
     r.plane = planes[next->scan_plane].plane;
     if (r.plane.n.dot(surf.plane.n) < 0) r.plane = r.plane.flipped();
     for (int i : planes[next->scan_plane].inliers) r.points.push_back(local.points[i]);
-    StepResult sr = replace_walls(current, surfaces, r, prm);
+    // The MIP time limit holds for the whole building, over all its replacements.
+    Params step_prm = prm;
+    step_prm.mip_time_limit = prm.mip_time_limit - mip_seconds;
+    if (step_prm.mip_time_limit < 0.01) {
+      steps.push_back({{"scan_plane", next->scan_plane}, {"ok", false}, {"reason", "MIP time limit used up"}});
+      break;
+    }
+    StepResult sr = replace_walls(current, surfaces, r, step_prm);
+    if (sr.info.contains("mip")) mip_seconds += sr.info["mip"].value("seconds", 0.0);
     json js = sr.info;
     js["scan_plane"] = next->scan_plane;
     js["wall_faces"] = surf.faces;

@@ -287,12 +287,6 @@ const std::map<std::string, std::string> kKnownFailures = {
      "repair fills a 16-vertex hole that is 7.3 m out of plane with 14 triangles (vertical ones labelled "
      "GroundSurface, up-facing ground); the street wall's MIP is infeasible and only a 0.5 m2 back-facing fill "
      "sliver is 'refined'"},
-    {"NL.IMBAG.Pand.0503100000031927-0",
-     "the file lacks a roof triangle; repair fills it labelled WallSurface (fill_semantic by neighbour edges), so "
-     "it stays a separate supporting plane identical to the roof's and the assembled shell is not closed"},
-    {"GUID_7739B23D-DA96-4581-873D-AADDC97A4A87_1",
-     "matching takes |S_normal|: the scan plane also matches a back-facing wall 1.1 m behind it (the notch), "
-     "which is replaced too and the notch is filled"},
     {"08835", "GLPK stops at mip_time_limit with a suboptimal selection (scan RMS 5.4 cm)"},
 };
 

@@ -11,7 +11,8 @@
 
 namespace lodrefine {
 
-// Edge-connected coplanar faces of one semantic: one supporting plane of the model.
+// Edge-connected coplanar faces: one supporting plane of the model; its semantic is the one
+// covering most of its area.
 struct ModelSurface {
   Plane plane;             // PCA plane of all its vertices, oriented outward
   std::vector<int> faces;  // indices into Mesh::faces
