@@ -285,8 +285,8 @@ constexpr double kRoofTolerance = 0.01;
 const std::map<std::string, std::string> kKnownFailures = {
     {"{228D167B-09BF-4CF8-A381-A2D9242DECAC}",
      "repair fills a 16-vertex hole that is 7.3 m out of plane with 14 triangles (vertical ones labelled "
-     "GroundSurface, up-facing ground); the street wall's MIP is infeasible and only a 0.5 m2 back-facing fill "
-     "sliver is 'refined'"},
+     "GroundSurface, up-facing ground); the street wall's MIP is then infeasible, so the "
+     "repaired original is written with that reason"},
     {"08835", "GLPK stops at mip_time_limit with a suboptimal selection (scan RMS 5.4 cm)"},
 };
 
