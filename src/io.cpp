@@ -131,7 +131,8 @@ class ObjParser {
   }
 
   static bool ignored(std::string_view kw) {
-    static const std::array<std::string_view, 10> kws = {"vt", "vn", "vp", "s", "mtllib", "l", "p", "mg", "lod", "usemap"};
+    static const std::array<std::string_view, 10> kws = {"vt", "vn", "vp",  "s",  "mtllib",
+                                                         "l",  "p",  "mg", "lod", "usemap"};
     for (auto k : kws)
       if (kw == k) return true;
     return false;
@@ -194,7 +195,8 @@ class ObjParser {
           fail_line("face index " + std::to_string(i + 1) + " out of range (" + std::to_string(n) + " vertices)");
         }
     if (mesh_.faces.empty())
-      fail(path_, skipped_ ? "no faces with 3 or more vertices (" + std::to_string(skipped_) + " skipped)" : "no faces");
+      fail(path_, skipped_ ? "no faces with 3 or more vertices (" + std::to_string(skipped_) + " skipped)"
+                           : "no faces");
     mesh_.id = !object_.empty() ? object_ : !comment_id_.empty() ? comment_id_
                                                                  : std::filesystem::path(path_).stem().string();
   }
@@ -440,8 +442,8 @@ class PlyReader {
       const auto& el = elements_[e];
       const std::uint64_t rec = el.min_record_size(format_);
       if (rec > 0 && el.count > (avail + 1) / rec + 1)
-        fail(path_, "header declares " + std::to_string(el.count) + " " + el.name + " records but the file holds only " +
-                        std::to_string(avail) + " data bytes");
+        fail(path_, "header declares " + std::to_string(el.count) + " " + el.name +
+                        " records but the file holds only " + std::to_string(avail) + " data bytes");
       need += el.count * rec;
     }
     const std::uint64_t slack = format_ == PlyFormat::Ascii ? 1 : 0;  // last value needs no separator
@@ -501,7 +503,8 @@ class PlyReader {
     std::vector<double> vals(el.props.size());
     for (std::uint64_t r = 0; r < el.count; ++r) {
       if (!record(data, el, vals))
-        fail(path_, "data ends after " + std::to_string(r) + " of " + std::to_string(el.count) + " vertices (truncated)");
+        fail(path_, "data ends after " + std::to_string(r) + " of " + std::to_string(el.count) +
+                        " vertices (truncated)");
       const Vec3 p(vals[xyz_[0]], vals[xyz_[1]], vals[xyz_[2]]);
       if (!p.allFinite()) fail(path_, "vertex " + std::to_string(r) + " has a non-finite coordinate");
       on_point(p);

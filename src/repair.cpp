@@ -56,7 +56,8 @@ std::vector<int> weld(const std::vector<Vec3>& pts, double tol, std::vector<Vec3
   centres.clear();
   for (std::size_t i = 0; i < pts.size(); ++i) {
     const Vec3& p = pts[i];
-    const Cell c{(long long)std::floor(p.x() / tol), (long long)std::floor(p.y() / tol), (long long)std::floor(p.z() / tol)};
+    const auto cell = [tol](double x) { return (long long)std::floor(x / tol); };
+    const Cell c{cell(p.x()), cell(p.y()), cell(p.z())};
     int best = -1;
     double best_d = tol;
     for (long long dx = -1; dx <= 1; ++dx)
@@ -469,7 +470,8 @@ Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report)
   flipped.resize(faces.size(), 0);
   orient_outward(V, faces, orient_consistently(faces, flipped), flipped);
   const EdgeUses uses = edge_uses(faces);
-  for (std::size_t f = first_new; f < faces.size(); ++f) faces[f].sem = fill_semantic(V, faces, int(f), uses, first_new);
+  for (std::size_t f = first_new; f < faces.size(); ++f)
+    faces[f].sem = fill_semantic(V, faces, int(f), uses, first_new);
   r.flipped_faces = int(std::count(flipped.begin(), flipped.begin() + long(first_new), 1));
 
   Mesh out = compact(V, std::move(faces), soup.id);

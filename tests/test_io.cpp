@@ -88,7 +88,8 @@ std::string binary_ply(bool big_endian, const char* type) {
   std::string s = std::string("ply\nformat ") + (big_endian ? "binary_big_endian" : "binary_little_endian") +
                   " 1.0\ncomment fixture\nelement vertex 3\nproperty " + type + " x\nproperty " + type +
                   " y\nproperty " + type + " z\nend_header\n";
-  for (const auto& p : kPoints) put<T>(s, T(p.x()), big_endian), put<T>(s, T(p.y()), big_endian), put<T>(s, T(p.z()), big_endian);
+  for (const auto& p : kPoints)
+    for (int k = 0; k < 3; ++k) put<T>(s, T(p[k]), big_endian);
   return s;
 }
 

@@ -184,3 +184,31 @@ TEST(Repair, UnclosableInputThrowsOneLineInputError) {
   bad.faces[0].v[0] = 99;
   expect_rejected(bad, "references missing vertex 99");
 }
+
+TEST(Repair, MergeJoinsCoplanarTilesButKeepsARingAroundAHoleApart) {
+  // A box whose flat roof is exported as 3 x 3 tiles; its walls are single long quads.
+  const auto roof_tiles = [](Semantic centre) {
+    auto faces = box({0, 0, 0}, {3, 3, 1});
+    faces.erase(faces.begin());
+    for (double x = 0; x < 3; ++x)
+      for (double y = 0; y < 3; ++y)
+        faces.push_back({{{x, y, 1}, {x + 1, y, 1}, {x + 1, y + 1, 1}, {x, y + 1, 1}},
+                         x == 1 && y == 1 ? centre : Semantic::Roof});
+    RepairReport r;
+    const Mesh m = repair_model(soup(faces), 0.01, &r);
+    EXPECT_EQ(r.split_t_junctions, 8);  // two tile corners on each wall's top edge
+    EXPECT_EQ(m.faces.size(), 5u + 9u);
+    return m;
+  };
+  const Mesh all_roof = merge_coplanar_faces(roof_tiles(Semantic::Roof));
+  EXPECT_EQ(all_roof.faces.size(), 6u);
+  EXPECT_EQ(all_roof.vertices.size(), 8u);
+  expect_valid_solid(all_roof, 9.0);
+
+  // A different centre leaves the eight roof tiles as a ring with a hole: they stay apart, and
+  // the walls keep the tile corners so that no T-junction appears.
+  const Mesh ring = merge_coplanar_faces(roof_tiles(Semantic::Other));
+  EXPECT_EQ(ring.faces.size(), 14u);
+  EXPECT_EQ(count_sem(ring, Semantic::Roof), 8);
+  expect_valid_solid(ring, 9.0);
+}

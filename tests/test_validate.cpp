@@ -73,7 +73,8 @@ TEST(Validate, ClosedCubeIsValid) {
 }
 
 TEST(Validate, GeoreferencedNonConvexPrismIsValid) {
-  const Mesh l = translated(prism({{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}}, 0, 3), {85123.4567, 447987.6543, 2});
+  const Mesh l =
+      translated(prism({{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}}, 0, 3), {85123.4567, 447987.6543, 2});
   const Validation v = validate_mesh(l);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_NEAR(v.volume, 9.0, 1e-6);
