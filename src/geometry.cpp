@@ -196,8 +196,11 @@ std::vector<std::array<int, 3>> triangulate_polygon(const std::vector<Vec3>& pol
   auto cross = [&](int a, int b, int c) {
     return (p[b].x() - p[a].x()) * (p[c].y() - p[a].y()) - (p[b].y() - p[a].y()) * (p[c].x() - p[a].x());
   };
+  // Closed triangle: a diagonal running through a reflex vertex is no ear. Vertices at the
+  // ear's own corners (repeated positions) do not block it.
   auto inside = [&](int a, int b, int c, int q) {
-    return cross(a, b, q) > 0 && cross(b, c, q) > 0 && cross(c, a, q) > 0;
+    if (p[q] == p[a] || p[q] == p[b] || p[q] == p[c]) return false;
+    return cross(a, b, q) >= 0 && cross(b, c, q) >= 0 && cross(c, a, q) >= 0;
   };
   int guard = 0;
   while (idx.size() > 3 && guard++ < 10 * n * n) {
