@@ -27,8 +27,15 @@ int main(int argc, char** argv) {
   app::add_convert_command(app);
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
+  } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {  // one line, like every other error (batch logs keep the last line)
+    std::fprintf(stderr, "lodrefine: error: %s (see --help)\n", e.what());
+    return 2;
   } catch (const InputError& e) {
     std::fprintf(stderr, "lodrefine: error: %s\n", e.what());
     return 2;
