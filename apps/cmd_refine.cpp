@@ -11,6 +11,7 @@ namespace {
 
 struct RefineArgs {
   std::string model, cloud, out, report;
+  std::uint64_t max_points = 20000000;
   Params params;
 };
 
@@ -25,6 +26,10 @@ nlohmann::json params_json(const Params& p) {
 void run(const RefineArgs& a) {
   a.params.validate();
   const Mesh model = read_obj(a.model);
+  const std::uint64_t declared = ply_vertex_count(a.cloud);
+  if (declared > a.max_points)
+    throw InputError(a.cloud + ": " + std::to_string(declared) + " points, more than --max-points " +
+                     std::to_string(a.max_points) + "; cut a crop per building first (lodrefine crop)");
   const PointCloud cloud = read_ply(a.cloud);
   if (cloud.points.empty()) throw InputError(a.cloud + ": the cloud has no points");
   RefineResult r = refine_building(model, cloud, a.params);
@@ -53,6 +58,7 @@ void add_refine_command(CLI::App& app) {
   cmd->add_option("--cloud", args.cloud, "MLS point cloud crop around the building (PLY)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args.out, "Refined model (OBJ), written atomically")->required();
   cmd->add_option("--report", args.report, "JSON report: matches, planes, candidates, MIP, timings, validation");
+  cmd->add_option("--max-points", args.max_points, "Refuse clouds with more points (a tile, not a crop)")->capture_default_str();
   add_param_options(cmd, args.params);
   cmd->callback([] { run(args); });
 }

@@ -647,6 +647,8 @@ void stream_ply(const std::string& path, const std::function<void(const Vec3&)>&
   PlyReader(path).read(on_point);
 }
 
+std::uint64_t ply_vertex_count(const std::string& path) { return PlyReader(path).vertex_count(); }
+
 void write_ply(const std::string& path, const PointCloud& cloud, const Vec3& origin, const std::vector<float>* scalar,
                const std::string& scalar_name) {
   AtomicFile file(path);

@@ -34,6 +34,10 @@ PointCloud read_ply(const std::string& path);
 // each point in file order. Same validation as read_ply.
 void stream_ply(const std::string& path, const std::function<void(const Vec3&)>& on_point);
 
+// The vertex count a PLY header declares (validated against the file size), without reading
+// the data: lets callers refuse clouds too large to hold.
+std::uint64_t ply_vertex_count(const std::string& path);
+
 // Writes x/y/z as binary little-endian doubles (plus an optional per-point float property).
 void write_ply(const std::string& path, const PointCloud& cloud, const Vec3& origin = Vec3::Zero(),
                const std::vector<float>* scalar = nullptr, const std::string& scalar_name = "scalar");
