@@ -298,8 +298,27 @@ StepResult replace_walls(const Mesh& mesh, const std::vector<ModelSurface>& surf
   std::vector<double> cost(cs.faces.size());
   for (std::size_t f = 0; f < cs.faces.size(); ++f) cost[f] = coverage_cost(cs.faces[f].area, conf[f].value, prm.tau_cov);
 
-  const SelectionResult sel = select_faces(cs, cost, outside, prm);
+  // Far from both the old and the new wall nothing changes: candidates there that the kept
+  // model fully covers stay, unsupported ones stay out. Only the slab around the change is
+  // left to the solver, which keeps large regions (many roof planes) tractable.
+  std::vector<int> fixed(cs.faces.size(), -1);
+  const double far = prm.bbox_margin;
+  for (std::size_t f = 0; f < cs.faces.size(); ++f) {
+    if (cs.planes[cs.faces[f].plane].from_scan) continue;
+    bool is_far = true;
+    for (int vi : cs.faces[f].v) {
+      const Vec3& x = cs.vertices[vi];
+      double d_old = 1e300;
+      for (int s : rep.surfaces) d_old = std::min(d_old, std::abs(surfaces[s].plane.distance(x)));
+      is_far = is_far && std::min(d_old, std::abs(rep.plane.distance(x))) > far;
+    }
+    if (!is_far) continue;
+    if (conf[f].value >= 0.99 && conf[f].model_ref >= 0) fixed[f] = 1;
+    else if (conf[f].value <= 0.01) fixed[f] = 0;
+  }
+  const SelectionResult sel = select_faces(cs, cost, outside, prm, &fixed);
   res.info["mip"] = {{"variables", sel.variables}, {"constraints", sel.constraints}, {"nonzeros", sel.nonzeros},
+                     {"fixed_candidates", sel.fixed},
                      {"status", sel.status},       {"objective", sel.objective},     {"seconds", sel.seconds}};
   if (!sel.ok) {
     res.reason = "face selection " + sel.status;

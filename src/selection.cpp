@@ -34,7 +34,7 @@ std::string describe(int ret, int status) {
 }  // namespace
 
 SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& cost, const std::vector<int>& outside,
-                             const Params& prm, const std::vector<char>* start) {
+                             const Params& prm, const std::vector<int>* fixed, const std::vector<char>* start) {
   const auto t0 = std::chrono::steady_clock::now();
   SelectionResult res;
   const int nf = int(cs.faces.size()), ne = int(cs.edges.size());
@@ -56,6 +56,10 @@ SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& 
   for (int f = 0; f < nf; ++f) {
     glp_set_col_kind(lp, f + 1, GLP_BV);
     glp_set_obj_coef(lp, f + 1, prm.lambda_coverage * cost[f]);
+    if (fixed != nullptr && (*fixed)[f] >= 0) {
+      glp_set_col_bnds(lp, f + 1, GLP_FX, (*fixed)[f], (*fixed)[f]);
+      ++res.fixed;
+    }
   }
   for (int e = 0; e < ne; ++e) glp_set_col_kind(lp, nf + e + 1, GLP_BV);
 

@@ -15,14 +15,17 @@ struct SelectionResult {
   std::vector<char> selected;  // per candidate
   std::string status;          // "optimal", "feasible (time limit)", "infeasible", "time limit", ...
   int variables = 0, constraints = 0, nonzeros = 0;
+  int fixed = 0;               // candidates fixed before solving
   double objective = 0.0;
   double seconds = 0.0;
 };
 
 // `cost[f]`: coverage cost of candidate f (already weighted); `outside[e]`: 1 where the kept
 // surface outside the region continues across edge e (counts as a selected face), else 0;
+// `fixed[f]`: -1 free, 0 or 1 to fix candidate f (presolve then removes it);
 // `start`: optional feasible selection handed to GLPK as its first incumbent.
 SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& cost, const std::vector<int>& outside,
-                             const Params& params, const std::vector<char>* start = nullptr);
+                             const Params& params, const std::vector<int>* fixed = nullptr,
+                             const std::vector<char>* start = nullptr);
 
 }  // namespace lodrefine
