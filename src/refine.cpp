@@ -298,25 +298,46 @@ StepResult replace_walls(const Mesh& mesh, const std::vector<ModelSurface>& surf
   std::vector<double> cost(cs.faces.size());
   for (std::size_t f = 0; f < cs.faces.size(); ++f) cost[f] = coverage_cost(cs.faces[f].area, conf[f].value, prm.tau_cov);
 
-  // Far from both the old and the new wall nothing changes: candidates there that the kept
-  // model fully covers stay, unsupported ones stay out. Only the slab around the change is
-  // left to the solver, which keeps large regions (many roof planes) tractable.
+  // Only the slab between the old and the new wall changes: outside it, candidates that the
+  // kept model fully covers stay and unsupported ones stay out. Fixing them leaves the solver
+  // the slab alone, which keeps regions crossed by many roof planes tractable.
   std::vector<int> fixed(cs.faces.size(), -1);
-  const double far = prm.bbox_margin;
+  constexpr double kSlabTolerance = 0.05;
+  auto in_slab = [&](const Vec3& x) {
+    const double dp = rep.plane.distance(x);
+    if (std::abs(dp) < kSlabTolerance) return true;
+    for (int s : rep.surfaces) {
+      const double ds = surfaces[s].plane.distance(x);
+      if (std::abs(ds) < kSlabTolerance || (ds > 0) != (dp > 0)) return true;
+    }
+    return false;
+  };
   for (std::size_t f = 0; f < cs.faces.size(); ++f) {
     if (cs.planes[cs.faces[f].plane].from_scan) continue;
-    bool is_far = true;
-    for (int vi : cs.faces[f].v) {
-      const Vec3& x = cs.vertices[vi];
-      double d_old = 1e300;
-      for (int s : rep.surfaces) d_old = std::min(d_old, std::abs(surfaces[s].plane.distance(x)));
-      is_far = is_far && std::min(d_old, std::abs(rep.plane.distance(x))) > far;
+    bool touches = false;
+    for (int vi : cs.faces[f].v) touches = touches || in_slab(cs.vertices[vi]);
+    if (touches) continue;
+    if (conf[f].value >= 0.99 && conf[f].model_ref >= 0) {
+      // Covered by a kept face on this very plane (confidence also accepts nearby parallels).
+      const Plane ref = polygon_plane(model_refs[conf[f].model_ref].polygon);
+      bool coplanar = true;
+      for (int vi : cs.faces[f].v) coplanar = coplanar && std::abs(ref.distance(cs.vertices[vi])) < 0.01;
+      if (coplanar) fixed[f] = 1;
+    } else if (conf[f].value <= 0.01) {
+      fixed[f] = 0;
     }
-    if (!is_far) continue;
-    if (conf[f].value >= 0.99 && conf[f].model_ref >= 0) fixed[f] = 1;
-    else if (conf[f].value <= 0.01) fixed[f] = 0;
   }
-  const SelectionResult sel = select_faces(cs, cost, outside, prm, &fixed);
+  SelectionResult sel = select_faces(cs, cost, outside, prm, &fixed);
+  if (!sel.ok && sel.fixed > 0) {
+    // A model only approximately consistent with its planes (warped faces, snapped vertices)
+    // can make the fixed cells contradict each other: then the whole region is free.
+    Params rest = prm;
+    rest.mip_time_limit = std::max(0.01, prm.mip_time_limit - sel.seconds);
+    const double first = sel.seconds;
+    sel = select_faces(cs, cost, outside, rest);
+    sel.seconds += first;
+    res.info["fixing_dropped"] = true;
+  }
   res.info["mip"] = {{"variables", sel.variables}, {"constraints", sel.constraints}, {"nonzeros", sel.nonzeros},
                      {"fixed_candidates", sel.fixed},
                      {"status", sel.status},       {"objective", sel.objective},     {"seconds", sel.seconds}};
