@@ -27,6 +27,18 @@ struct Rect {
   double area() const { return std::max(0.0, u1 - u0) * std::max(0.0, v1 - v0); }
 };
 
+// The surface's extent in its own plane frame (u, v) around its centroid.
+Rect surface_rect(const Mesh& mesh, const ModelSurface& surf) {
+  const auto [u, v] = surf.plane.basis();
+  Rect box;
+  for (int f : surf.faces)
+    for (int vi : mesh.faces[f].v) {
+      const Vec3 q = mesh.vertices[vi] - surf.centroid;
+      box.add(q.dot(u), q.dot(v));
+    }
+  return box;
+}
+
 double overlap_area(const Rect& a, const Rect& b) {
   const double du = std::min(a.u1, b.u1) - std::max(a.u0, b.u0);
   const double dv = std::min(a.v1, b.v1) - std::max(a.v0, b.v0);
@@ -142,12 +154,7 @@ MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& su
     // Slivers (e.g. hole fills) are no facades: a large scan box would "cover" them.
     if (surf.sem != Semantic::Wall || surf.area < prm.min_plane_area) continue;
     const auto [u, v] = surf.plane.basis();
-    Rect model_box;
-    for (int f : surf.faces)
-      for (int vi : mesh.faces[f].v) {
-        const Vec3 q = mesh.vertices[vi] - surf.centroid;
-        model_box.add(q.dot(u), q.dot(v));
-      }
+    const Rect model_box = surface_rect(mesh, surf);
     Match best;
     for (int p = 0; p < int(planes.size()); ++p) {
       const ScanPlane& sp = planes[p];
@@ -239,12 +246,7 @@ std::vector<int> select_facade_points(const Mesh& input, const PointCloud& cloud
   for (const auto& match : m.matches) {
     const ModelSurface& surf = surfaces[match.surface];
     const auto [u, v] = surf.plane.basis();
-    Rect box;
-    for (int f : surf.faces)
-      for (int vi : mesh.faces[f].v) {
-        const Vec3 q = mesh.vertices[vi] - surf.centroid;
-        box.add(q.dot(u), q.dot(v));
-      }
+    const Rect box = surface_rect(mesh, surf);
     const double margin = prm.corner_gap;
     for (int i : planes[match.scan_plane].inliers) {
       const Vec3 q = cloud.points[i] - surf.centroid;
