@@ -20,6 +20,7 @@ struct BenchArgs {
   int count = 3;
   int seed = 1;
   int points = 30000;
+  int facades = 0;
   Params params;
 };
 
@@ -40,6 +41,7 @@ void run(const BenchArgs& a) {
   }
   SynthOptions opt;
   opt.target_points = a.points;
+  opt.scanned_facades = a.facades;
   std::printf("%-24s %7s %6s %5s %6s %6s | %7s %7s %7s %7s %7s | %8s %8s | %s\n", "building", "points", "planes",
               "cand", "mipvar", "mip_s", "repair", "planes", "match", "replace", "total", "facade0", "facade1",
               "outcome");
@@ -102,6 +104,7 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--count", args.count, "Buildings per type")->capture_default_str()->check(CLI::Range(1, 100000));
   cmd->add_option("--first-seed", args.seed, "First building seed (the RANSAC seed is --seed)")->capture_default_str();
   cmd->add_option("--points", args.points, "Target facade points per building")->capture_default_str()->check(CLI::Range(100, 10000000));
+  cmd->add_option("--facades", args.facades, "Scanned facades per building (0: random 1..3, as in the generator)")->capture_default_str()->check(CLI::Range(0, 20));
   add_param_options(cmd, args.params);
   cmd->callback([] { run(args); });
 }
