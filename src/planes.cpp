@@ -9,7 +9,9 @@
 #include <CGAL/property_map.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
+#include <tuple>
 
 namespace lodrefine {
 namespace {
@@ -98,11 +100,30 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm)
   const std::size_t n = cloud.points.size();
   if (n < std::size_t(std::max(prm.ransac_min_points, prm.normal_neighbors + 1))) return result;
 
+  // Exact duplicates carry no shape and make RANSAC's octree loop forever (a cloud of one
+  // repeated point hangs it): detect on distinct points, and only with a real extent.
+  std::vector<int> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = int(i);
+  auto less = [&](int a, int b) {
+    const auto &p = cloud.points[a], &q = cloud.points[b];
+    return std::tie(p.x(), p.y(), p.z()) < std::tie(q.x(), q.y(), q.z());
+  };
+  std::sort(order.begin(), order.end(), less);
+  order.erase(std::unique(order.begin(), order.end(), [&](int a, int b) { return cloud.points[a] == cloud.points[b]; }),
+              order.end());
+  if (order.size() < std::size_t(std::max(prm.ransac_min_points, prm.normal_neighbors + 1))) return result;
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  for (int i : order) {
+    lo = lo.cwiseMin(cloud.points[i]);
+    hi = hi.cwiseMax(cloud.points[i]);
+  }
+  if ((hi - lo).norm() < 10.0 * prm.ransac_epsilon) return result;
+  std::sort(order.begin(), order.end());  // file order: keeps runs reproducible as before
   PointList pts;
-  pts.reserve(n);
-  for (std::size_t i = 0; i < n; ++i) {
+  pts.reserve(order.size());
+  for (int i : order) {
     const auto& p = cloud.points[i];
-    pts.emplace_back(Point(p.x(), p.y(), p.z()), Vector(0, 0, 0), int(i));
+    pts.emplace_back(Point(p.x(), p.y(), p.z()), Vector(0, 0, 0), i);
   }
   CGAL::pca_estimate_normals<CGAL::Sequential_tag>(
       pts, prm.normal_neighbors, CGAL::parameters::point_map(PointMap()).normal_map(NormalMap()));
