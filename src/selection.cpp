@@ -4,6 +4,7 @@
 
 #include <glpk.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -65,10 +66,19 @@ SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& 
 
   std::vector<int> ia{0}, ja{0};
   std::vector<double> ar{0.0};
-  auto add_row = [&](const std::vector<std::pair<int, double>>& terms, int type, double lo, double hi) {
+  auto add_row = [&](std::vector<std::pair<int, double>> terms, int type, double lo, double hi) {
     const int r = glp_add_rows(lp, 1);
     glp_set_row_bnds(lp, r, type, lo, hi);
+    // GLPK aborts the process on a repeated column in a row (a face listed twice on an edge
+    // of a degenerate candidate): sum such coefficients.
+    std::sort(terms.begin(), terms.end());
+    for (std::size_t i = 1; i < terms.size(); ++i)
+      if (terms[i].first == terms[i - 1].first) {
+        terms[i].second += terms[i - 1].second;
+        terms[i - 1].second = 0.0;
+      }
     for (const auto& [col, val] : terms) {
+      if (val == 0.0) continue;
       ia.push_back(r);
       ja.push_back(col);
       ar.push_back(val);
