@@ -1,5 +1,6 @@
 // `lodrefine refine`: one coarse building + its MLS crop -> the refined building.
 #include <cstdio>
+#include <filesystem>
 
 #include "commands.h"
 #include "lodrefine/io.h"
@@ -23,8 +24,18 @@ nlohmann::json params_json(const Params& p) {
   return j;
 }
 
+// Fails before any work when an output could not be written (so nothing is left half done).
+void check_output_dir(const std::string& path) {
+  if (path.empty()) return;
+  const std::filesystem::path dir = std::filesystem::absolute(path).parent_path();
+  if (!std::filesystem::is_directory(dir)) throw InputError(path + ": output directory " + dir.string() + " does not exist");
+  if (std::filesystem::is_directory(path)) throw InputError(path + ": is a directory");
+}
+
 void run(const RefineArgs& a) {
   a.params.validate();
+  check_output_dir(a.out);
+  check_output_dir(a.report);
   const Mesh model = read_obj(a.model);
   const std::uint64_t declared = ply_vertex_count(a.cloud);
   if (declared > a.max_points)
@@ -37,8 +48,8 @@ void run(const RefineArgs& a) {
   r.report["cloud"]["path"] = a.cloud;
   r.report["params"] = params_json(a.params);
   r.report["written"] = r.valid ? a.out : "";
-  if (r.valid) write_obj(a.out, r.mesh);
   if (!a.report.empty()) write_file_atomic(a.report, r.report.dump(2) + "\n");
+  if (r.valid) write_obj(a.out, r.mesh);
   if (!r.valid) {
     std::fprintf(stderr, "lodrefine: error: %s: no valid building to write: %s\n", model.id.c_str(),
                  r.report["output_validation"].value("problem", std::string("invalid")).c_str());

@@ -24,6 +24,10 @@
 #include <string_view>
 
 namespace lodrefine {
+
+// Georeferenced coordinates are at most a few 1e7 m (UTM northing); anything beyond 1e9 m is a
+// broken file, and would overflow the integer grids of welding and hashing downstream.
+constexpr double kMaxCoordinate = 1e9;
 namespace {
 
 [[noreturn]] void fail(const std::string& path, const std::string& fault) {
@@ -152,6 +156,7 @@ class ObjParser {
       const auto v = parse_number<double>(tok[i]);
       if (!v) fail_line("bad number " + quote(tok[i]));
       if (!std::isfinite(*v)) fail_line("non-finite coordinate " + quote(tok[i]));
+      if (i <= 3 && std::abs(*v) > kMaxCoordinate) fail_line("coordinate " + quote(tok[i]) + " is beyond 1e9 m");
       if (i <= 3) p[int(i - 1)] = *v;
     }
     mesh_.vertices.push_back(p);
@@ -507,6 +512,8 @@ class PlyReader {
                         " vertices (truncated)");
       const Vec3 p(vals[xyz_[0]], vals[xyz_[1]], vals[xyz_[2]]);
       if (!p.allFinite()) fail(path_, "vertex " + std::to_string(r) + " has a non-finite coordinate");
+      if (p.cwiseAbs().maxCoeff() > kMaxCoordinate)
+        fail(path_, "vertex " + std::to_string(r) + " has a coordinate beyond 1e9 m");
       on_point(p);
     }
   }
@@ -572,8 +579,9 @@ class AtomicFile {
 };
 
 void append_fixed(std::string& out, double v) {
-  char buf[64];
+  char buf[400];  // any finite double in fixed notation with 6 decimals fits
   const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed, 6);  // µm
+  if (r.ec != std::errc()) throw std::runtime_error("cannot print coordinate");
   out.append(buf, r.ptr);
 }
 

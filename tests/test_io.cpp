@@ -214,13 +214,13 @@ TEST(IoPly, BinaryIntegerCoordinatesExtraPropertiesAndFaceElement) {
     put<std::uint8_t>(s, 3, be), put<std::int32_t>(s, 0, be), put<std::int32_t>(s, 1, be), put<std::int32_t>(s, 0, be);
     put<std::uint16_t>(s, 7, be);
     put<std::uint8_t>(s, 0, be), put<std::uint16_t>(s, 9, be);
-    put<std::int16_t>(s, -300, be), put<std::int8_t>(s, 5, be), put<std::uint32_t>(s, 4000000000u, be);
+    put<std::int16_t>(s, -300, be), put<std::int8_t>(s, 5, be), put<std::uint32_t>(s, 900000000u, be);  // beyond int16, within the 1e9 m limit
     put<std::int8_t>(s, -5, be), put<double>(s, 1.0, be);
     put<std::int16_t>(s, 12, be), put<std::int8_t>(s, 0, be), put<std::uint32_t>(s, 1, be);
     put<std::int8_t>(s, 127, be), put<double>(s, 2.0, be);
     const PointCloud c = read_ply(write_bytes("i.ply", s));
     ASSERT_EQ(c.points.size(), 2u);
-    EXPECT_EQ(c.points[0], Vec3(-300, 4e9, -5)) << be;
+    EXPECT_EQ(c.points[0], Vec3(-300, 9e8, -5)) << be;
     EXPECT_EQ(c.points[1], Vec3(12, 1, 127)) << be;
   }
 }
@@ -331,4 +331,19 @@ TEST(IoWrite, AtomicWriteReplacesAndLeavesNoTempOnFailure) {
   std::size_t entries = 0;
   for ([[maybe_unused]] const auto& e : fs::directory_iterator(fs::path(path).parent_path())) ++entries;
   EXPECT_EQ(entries, 1u);  // no leftover .tmp.<pid>
+}
+
+TEST(IoObj, CoordinatesBeyondAMillionKilometresAreRefused) {
+  // Welding and hashing grids would overflow: a broken file, not a building.
+  const std::string dir = ::testing::TempDir();
+  const std::string path = dir + "/huge.obj";
+  FILE* f = std::fopen(path.c_str(), "w");
+  std::fputs("v 1e12 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\n", f);
+  std::fclose(f);
+  try {
+    read_obj(path);
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("beyond 1e9 m"), std::string::npos) << e.what();
+  }
 }
