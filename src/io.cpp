@@ -386,6 +386,11 @@ class PlyReader {
       else fail(path_, "unknown header line " + quote(line));
     }
     if (!have_format) fail(path_, "header has no format line");
+    // Records without properties take no bytes, so no file size bounds their count: a huge
+    // count would be skipped forever.
+    for (const auto& el : elements_)
+      if (el.props.empty() && el.count > 0)
+        fail(path_, "element " + quote(el.name) + " has " + std::to_string(el.count) + " records but no properties");
     find_vertex_element();
     check_counts_fit_file();
   }
