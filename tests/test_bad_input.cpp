@@ -9,6 +9,8 @@
 // The solver-fault tests drive select_faces() directly on synthetic hard/infeasible programs.
 #include <gtest/gtest.h>
 
+#include "ply_fixtures.h"
+
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -116,13 +118,6 @@ std::vector<Vec3> wall_scan(unsigned seed = 1) {
   return pts;
 }
 
-template <class T>
-void put(std::string& out, T v, bool big_endian) {
-  char b[sizeof(T)];
-  std::memcpy(b, &v, sizeof(T));
-  if (big_endian) std::reverse(b, b + sizeof(T));
-  out.append(b, sizeof(T));
-}
 
 std::string ply_header(const std::string& format, std::uint64_t count, const std::string& type = "double") {
   return "ply\nformat " + format + " 1.0\ncomment test\nelement vertex " + std::to_string(count) + "\nproperty " + type +

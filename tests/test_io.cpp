@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include "ply_fixtures.h"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -72,14 +74,6 @@ const char* kCubeTopObj =
     "usemtl RoofSurface_mat\n"
     "f 1//1 2//2 6//3\n";
 
-// Binary PLY writer for fixtures of any layout; values written in the given byte order.
-template <class T>
-void put(std::string& out, T v, bool big_endian) {
-  char b[sizeof(T)];
-  std::memcpy(b, &v, sizeof(T));
-  if (big_endian) std::reverse(b, b + sizeof(T));
-  out.append(b, sizeof(T));
-}
 
 const std::vector<Vec3> kPoints = {{85123.4567, 447987.6543, 1.25}, {-3.5, 0.0, 7.0}, {1e5, 5.801234567e6, -2.0}};
 
