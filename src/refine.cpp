@@ -328,11 +328,11 @@ StepResult replace_walls(const Mesh& mesh, const std::vector<ModelSurface>& surf
     }
   }
   SelectionResult sel = select_faces(cs, cost, outside, prm, &fixed);
-  if (!sel.ok && sel.fixed > 0) {
+  if (sel.status == "infeasible" && sel.fixed > 0 && prm.mip_time_limit > sel.seconds) {
     // A model only approximately consistent with its planes (warped faces, snapped vertices)
     // can make the fixed cells contradict each other: then the whole region is free.
     Params rest = prm;
-    rest.mip_time_limit = std::max(0.01, prm.mip_time_limit - sel.seconds);
+    rest.mip_time_limit = prm.mip_time_limit - sel.seconds;
     const double first = sel.seconds;
     sel = select_faces(cs, cost, outside, rest);
     sel.seconds += first;
@@ -544,7 +544,7 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
     // The MIP time limit holds for the whole building, over all its replacements.
     Params step_prm = prm;
     step_prm.mip_time_limit = prm.mip_time_limit - mip_seconds;
-    if (step_prm.mip_time_limit < 0.01) {
+    if (step_prm.mip_time_limit <= 0.0) {
       steps.push_back({{"scan_plane", next->scan_plane}, {"ok", false}, {"reason", "MIP time limit used up"}});
       break;
     }
