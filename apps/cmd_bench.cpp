@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "lodrefine/eval.h"
+#include "lodrefine/geometry.h"
 #include "lodrefine/refine.h"
 #include "lodrefine/synth.h"
 #include "options.h"
@@ -23,11 +24,6 @@ struct BenchArgs {
   int facades = 0;
   Params params;
 };
-
-Mesh shifted(Mesh m, const Vec3& d) {
-  for (auto& v : m.vertices) v += d;
-  return m;
-}
 
 void run(const BenchArgs& a) {
   std::vector<BuildingType> types;
@@ -66,8 +62,8 @@ void run(const BenchArgs& a) {
       const Vec3 o = local_origin(b.truth);
       PointCloud local_cloud = b.cloud;
       for (auto& p : local_cloud.points) p -= o;
-      const Mesh truth = shifted(b.truth, -o);
-      const BuildingEval ev = evaluate_building(shifted(b.coarse, -o), shifted(r.mesh, -o), local_cloud, &truth, a.params,
+      const Mesh truth = translated(b.truth, -o);
+      const BuildingEval ev = evaluate_building(translated(b.coarse, -o), translated(r.mesh, -o), local_cloud, &truth, a.params,
                                                 &b.scanned_truth_faces);
       const double f0 = ev.truth_facade_before ? ev.truth_facade_before->rmse : -1;
       const double f1 = ev.truth_facade_after ? ev.truth_facade_after->rmse : -1;

@@ -12,6 +12,7 @@
 
 #include "commands.h"
 #include "lodrefine/eval.h"
+#include "lodrefine/geometry.h"
 #include "lodrefine/io.h"
 #include "lodrefine/plots.h"
 #include "lodrefine/refine.h"
@@ -40,11 +41,6 @@ struct Row {
   std::string truth_faces_source;  // "meta.json", "detected" or empty
   json report;                     // the refine report.json, if any
 };
-
-Mesh shifted(Mesh m, const Vec3& d) {
-  for (auto& v : m.vertices) v += d;
-  return m;
-}
 
 json read_json_or_null(const std::string& path) {
   if (path.empty() || !fs::exists(path)) return nullptr;
@@ -104,15 +100,15 @@ Row evaluate_files(const BuildingFiles& f, const Params& params, const std::stri
   const Mesh original_geo = read_obj(f.original);
   row.origin = local_origin(original_geo);
   const Vec3 to_local = -row.origin;
-  const Mesh original = shifted(original_geo, to_local);
+  const Mesh original = translated(original_geo, to_local);
   PointCloud cloud = read_ply(f.cloud);
   for (auto& p : cloud.points) p += to_local;
   std::string refined_error;
-  const Mesh refined = shifted(read_refined(f.refined, refined_error), to_local);
+  const Mesh refined = translated(read_refined(f.refined, refined_error), to_local);
   std::optional<Mesh> truth;
   std::optional<std::vector<int>> scanned;
   if (!f.truth.empty()) {
-    truth = shifted(read_obj(f.truth), to_local);
+    truth = translated(read_obj(f.truth), to_local);
     scanned = meta_scanned_faces(f.meta, *truth);
     row.truth_faces_source = scanned ? "meta.json" : "detected";
   }

@@ -29,6 +29,18 @@ std::pair<Vec3, Vec3> Plane::basis() const {
   return {u, v};
 }
 
+std::vector<Vec3> face_points(const Mesh& mesh, const Face& face) {
+  std::vector<Vec3> pts;
+  pts.reserve(face.v.size());
+  for (int i : face.v) pts.push_back(mesh.vertices[i]);
+  return pts;
+}
+
+Mesh translated(Mesh mesh, const Vec3& offset) {
+  for (auto& v : mesh.vertices) v += offset;
+  return mesh;
+}
+
 Plane fit_plane(const std::vector<Vec3>& pts) {
   Vec3 c = Vec3::Zero();
   for (const auto& p : pts) c += p;

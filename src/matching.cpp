@@ -10,13 +10,6 @@
 namespace lodrefine {
 namespace {
 
-std::vector<Vec3> face_points(const Mesh& mesh, const Face& f) {
-  std::vector<Vec3> pts;
-  pts.reserve(f.v.size());
-  for (int i : f.v) pts.push_back(mesh.vertices[i]);
-  return pts;
-}
-
 // In-plane extent [min u, max u] x [min v, max v] of points in a surface's frame.
 struct Rect {
   double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;

@@ -32,17 +32,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-Mesh translated(Mesh m, const Vec3& d) {
-  for (auto& v : m.vertices) v += d;
-  return m;
-}
-
-std::vector<Vec3> face_polygon(const Mesh& m, int f) {
-  std::vector<Vec3> pts;
-  for (int i : m.faces[f].v) pts.push_back(m.vertices[i]);
-  return pts;
-}
-
 // Moves each vertex onto the meet of the planes of its surfaces (least squares), so that the
 // model is exactly consistent with the planes the arrangement uses. Moves beyond `max_move`
 // (a warped input face) are not made.
@@ -206,7 +195,7 @@ StepResult replace_walls(const Mesh& mesh, const std::vector<ModelSurface>& surf
       bool near = true, inside = false;
       for (int f : surfaces[s].faces) {
         for (int vi : mesh.faces[f].v) near = near && std::abs(rep.plane.distance(mesh.vertices[vi])) <= prm.merge_distance;
-        inside = inside || area_inside(face_polygon(mesh, f), region) > 1e-8;
+        inside = inside || area_inside(face_points(mesh, mesh.faces[f]), region) > 1e-8;
       }
       if (near && inside) {
         rep.surfaces.push_back(s);
@@ -225,7 +214,7 @@ StepResult replace_walls(const Mesh& mesh, const std::vector<ModelSurface>& surf
   std::vector<int> face_plane(mesh.faces.size(), -1);
   std::vector<char> face_in_region(mesh.faces.size(), 0);
   for (int f = 0; f < int(mesh.faces.size()); ++f)
-    face_in_region[f] = !replaced_faces.count(f) && area_inside(face_polygon(mesh, f), region) > 1e-8;
+    face_in_region[f] = !replaced_faces.count(f) && area_inside(face_points(mesh, mesh.faces[f]), region) > 1e-8;
   for (int s = 0; s < int(surfaces.size()); ++s) {
     if (replaced.count(s)) continue;
     bool in = false;
@@ -289,8 +278,8 @@ StepResult replace_walls(const Mesh& mesh, const std::vector<ModelSurface>& surf
   Region near_region = region;
   near_region.half += Vec3::Constant(prm.conf_model_distance);
   for (int f = 0; f < int(mesh.faces.size()); ++f)
-    if (!replaced_faces.count(f) && area_inside(face_polygon(mesh, f), near_region) > 1e-8)
-      model_refs.push_back({face_polygon(mesh, f)});
+    if (!replaced_faces.count(f) && area_inside(face_points(mesh, mesh.faces[f]), near_region) > 1e-8)
+      model_refs.push_back({face_points(mesh, mesh.faces[f])});
   CloudReference cloud_ref;
   for (const auto& p : rep.points)
     if (region.contains(p)) cloud_ref.points.push_back(p);
@@ -361,7 +350,7 @@ StepResult replace_walls(const Mesh& mesh, const std::vector<ModelSurface>& surf
   };
   for (int f = 0; f < int(mesh.faces.size()); ++f) {
     if (replaced_faces.count(f)) continue;
-    const auto poly = face_polygon(mesh, f);
+    const auto poly = face_points(mesh, mesh.faces[f]);
     if (!face_in_region[f]) {
       add_polygon(poly, mesh.faces[f].sem, mesh.faces[f].source);
       continue;

@@ -413,12 +413,6 @@ std::optional<std::vector<int>> outline(const Mesh& m, const std::vector<int>& g
   return loop;
 }
 
-std::vector<Vec3> face_points(const Mesh& m, const Face& f) {
-  std::vector<Vec3> pts;
-  for (int i : f.v) pts.push_back(m.vertices[i]);
-  return pts;
-}
-
 // Merges edge-adjacent coplanar faces of the same semantic (pieces of one wall, roofs of
 // parts of equal height, the parts' grounds) into single polygons.
 void merge_coplanar(Mesh& m) {

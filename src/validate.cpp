@@ -94,12 +94,6 @@ int count_components(const Mesh& m, const EdgeUses& uses) {
   return int(roots.size());
 }
 
-std::vector<Vec3> face_points(const Mesh& m, const Face& f) {
-  std::vector<Vec3> pts;
-  for (int i : f.v) pts.push_back(m.vertices[i]);
-  return pts;
-}
-
 double max_planarity_error(const Mesh& m) {
   double err = 0.0;
   for (const Face& f : m.faces) {

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "lodrefine/eval.h"
+#include "lodrefine/geometry.h"
 #include "lodrefine/refine.h"
 #include "lodrefine/synth.h"
 #include "lodrefine/validate.h"
@@ -13,11 +14,6 @@
 using namespace lodrefine;
 
 namespace {
-
-Mesh shifted(Mesh m, const Vec3& d) {
-  for (auto& v : m.vertices) v += d;
-  return m;
-}
 
 double median_abs(std::vector<double> d) {
   for (auto& x : d) x = std::abs(x);
@@ -49,7 +45,7 @@ TEST_P(EndToEnd, ScannedFacadesLandOnTheTruthAndTheShellIsValid) {
     SCOPED_TRACE(b.id + ": " + r.outcome);
     ASSERT_TRUE(r.valid);
     const Vec3 o = local_origin(b.truth);
-    const Mesh refined = shifted(r.mesh, -o), truth = shifted(b.truth, -o), coarse = shifted(b.coarse, -o);
+    const Mesh refined = translated(r.mesh, -o), truth = translated(b.truth, -o), coarse = translated(b.coarse, -o);
     const Validation v = validate_mesh(refined);
     EXPECT_TRUE(v.valid()) << v.problem;
     EXPECT_EQ(r.mesh.id, b.coarse.id);

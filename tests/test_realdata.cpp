@@ -295,11 +295,6 @@ const std::map<std::string, std::string> kSlow = {
     {"08835", "GLPK runs into mip_time_limit (30 s) on each of its 3 replacements"},
 };
 
-Mesh translated(Mesh m, const Vec3& d) {
-  for (auto& v : m.vertices) v += d;
-  return m;
-}
-
 std::vector<Vec3> polygon_of(const Mesh& m, const Face& f) {
   std::vector<Vec3> pts;
   for (int i : f.v) pts.push_back(m.vertices[i]);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <map>
 
+#include "lodrefine/geometry.h"
 #include "lodrefine/validate.h"
 
 using namespace lodrefine;
@@ -45,11 +46,6 @@ Mesh combined(const Mesh& a, const Mesh& b) {
     for (int& i : f.v) i = map[i];
     m.faces.push_back(f);
   }
-  return m;
-}
-
-Mesh translated(Mesh m, const Vec3& t) {
-  for (Vec3& p : m.vertices) p += t;
   return m;
 }
 

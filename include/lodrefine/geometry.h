@@ -22,6 +22,11 @@ struct Plane {
   std::pair<Vec3, Vec3> basis() const;
 };
 
+// The positions of a face's vertices, in order.
+std::vector<Vec3> face_points(const Mesh& mesh, const Face& face);
+// The mesh moved by `offset` (e.g. into or out of a local frame).
+Mesh translated(Mesh mesh, const Vec3& offset);
+
 // Least-squares (PCA) plane; the normal's sign is arbitrary. Needs >= 3 non-collinear points.
 Plane fit_plane(const std::vector<Vec3>& pts);
 // PCA plane oriented along the polygon's Newell normal (i.e. the face's outward side).
