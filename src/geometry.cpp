@@ -124,6 +124,13 @@ double signed_area_2d(const std::vector<Vec2>& poly) {
   return 0.5 * a;
 }
 
+double segment_distance_2d(const Vec2& p, const Vec2& a, const Vec2& b) {
+  const Vec2 ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (p - (a + t * ab)).norm();
+}
+
 bool point_in_polygon_2d(const Vec2& p, const std::vector<Vec2>& poly) {
   bool in = false;
   for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {

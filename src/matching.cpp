@@ -142,36 +142,100 @@ MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& su
                            const std::vector<ScanPlane>& planes, const Params& prm) {
   MatchResult result;
   const double cos_max = std::cos(prm.match_angle_deg * M_PI / 180.0);
+  // The candidate walls, each with its outline in its own plane frame.
+  struct Wall {
+    int surface;
+    Vec3 u, v;
+    Rect box;
+    std::vector<std::vector<Vec2>> outline;
+  };
+  std::vector<Wall> walls;
   for (int s = 0; s < int(surfaces.size()); ++s) {
     const ModelSurface& surf = surfaces[s];
     // Slivers (e.g. hole fills) are no facades: a large scan box would "cover" them.
     if (surf.sem != Semantic::Wall || surf.area < prm.min_plane_area) continue;
-    const auto [u, v] = surf.plane.basis();
-    const Rect model_box = surface_rect(mesh, surf);
-    Match best;
-    for (int p = 0; p < int(planes.size()); ++p) {
-      const ScanPlane& sp = planes[p];
-      if (!sp.facade) continue;
-      const double s_normal = sp.plane.n.dot(surf.plane.n);
-      const double d_c = std::abs(surf.plane.distance(sp.centroid));
-      if (std::abs(s_normal) < cos_max || d_c > prm.match_distance) continue;  // hard filters
-      // Both OBBs in the surface's frame, sharing the slab that spans both planes along the
-      // normal: the volume IoU of two flat boxes would vanish at any offset.
-      Rect scan_box;
-      for (int i : sp.inliers) {
-        const Vec3 q = cloud.points[i] - surf.centroid;
-        scan_box.add(q.dot(u), q.dot(v));
+    Wall w{s, Vec3::Zero(), Vec3::Zero(), surface_rect(mesh, surf), {}};
+    std::tie(w.u, w.v) = surf.plane.basis();
+    for (int f : surf.faces) {
+      std::vector<Vec2> poly;
+      for (int vi : mesh.faces[f].v) {
+        const Vec3 q = mesh.vertices[vi] - surf.centroid;
+        poly.emplace_back(q.dot(w.u), q.dot(w.v));
       }
-      const double inter = overlap_area(model_box, scan_box);
-      const double uni = model_box.area() + scan_box.area() - inter;
+      w.outline.push_back(std::move(poly));
+    }
+    walls.push_back(std::move(w));
+  }
+  auto in_outline = [&](const Wall& w, const Vec2& q) {
+    const double m = prm.match_margin;
+    if (q.x() < w.box.u0 - m || q.x() > w.box.u1 + m || q.y() < w.box.v0 - m || q.y() > w.box.v1 + m) return false;
+    for (const auto& poly : w.outline) {
+      if (point_in_polygon_2d(q, poly)) return true;
+      for (std::size_t k = 0; k < poly.size(); ++k)
+        if (segment_distance_2d(q, poly[k], poly[(k + 1) % poly.size()]) <= m) return true;
+    }
+    return false;
+  };
+
+  // Each facade point belongs to the nearest wall facing its way whose outline (grown by
+  // match_margin) it lies in front of: a plane spanning several walls, a setback or a flush
+  // neighbour then gives each wall only its own points, never those of a parallel wall.
+  for (int p = 0; p < int(planes.size()); ++p) {
+    const ScanPlane& sp = planes[p];
+    if (!sp.facade) continue;
+    std::vector<int> cand;
+    for (int k = 0; k < int(walls.size()); ++k)
+      if (std::abs(sp.plane.n.dot(surfaces[walls[k].surface].plane.n)) >= cos_max) cand.push_back(k);
+    if (cand.empty()) continue;
+    std::vector<Rect> owned(walls.size());
+    std::vector<int> count(walls.size(), 0);
+    std::vector<Vec3> sum(walls.size(), Vec3::Zero());
+    for (int i : sp.inliers) {
+      const Vec3& x = cloud.points[i];
+      int best = -1;
+      double best_d = prm.match_distance;
+      for (int k : cand) {
+        const ModelSurface& surf = surfaces[walls[k].surface];
+        const double d = std::abs(surf.plane.distance(x));
+        if (d > best_d) continue;
+        const Vec3 q = x - surf.centroid;
+        const Vec2 q2(q.dot(walls[k].u), q.dot(walls[k].v));
+        if (!in_outline(walls[k], q2)) continue;
+        best = k;
+        best_d = d;
+      }
+      if (best < 0) continue;
+      const ModelSurface& surf = surfaces[walls[best].surface];
+      const Vec3 q = x - surf.centroid;
+      owned[best].add(q.dot(walls[best].u), q.dot(walls[best].v));
+      ++count[best];
+      sum[best] += x;
+    }
+    for (int k : cand) {
+      if (count[k] < prm.ransac_min_points) continue;
+      const ModelSurface& surf = surfaces[walls[k].surface];
+      const Rect& model_box = walls[k].box;
+      const double inter = overlap_area(model_box, owned[k]);
+      const double uni = model_box.area() + owned[k].area() - inter;
       const double iou = uni > 0 ? inter / uni : 0.0;
-      const double coverage = std::max({iou, inter / std::max(1e-12, scan_box.area()),
+      const double coverage = std::max({iou, inter / std::max(1e-12, owned[k].area()),
                                         inter / std::max(1e-12, model_box.area())});
       if (coverage < prm.match_min_overlap) continue;
+      const double s_normal = sp.plane.n.dot(surf.plane.n);
+      const double d_c = std::abs(surf.plane.distance(sum[k] / count[k]));
       const double score = prm.w_normal * std::abs(s_normal) + prm.w_coverage * iou;
-      if (score > best.s_match) best = Match{p, s, s_normal, d_c, iou, score};
+      result.matches.push_back(Match{p, walls[k].surface, s_normal, d_c, iou, score, count[k]});
     }
-    if (best.scan_plane >= 0) result.matches.push_back(best);
+  }
+  // One scan plane per wall: the one with the most points in front of it.
+  {
+    std::map<int, Match> best;
+    for (const auto& m : result.matches) {
+      auto it = best.find(m.surface);
+      if (it == best.end() || m.points > it->second.points) best[m.surface] = m;
+    }
+    result.matches.clear();
+    for (const auto& [s, m] : best) result.matches.push_back(m);
   }
   // A scan plane sees one side of a wall: the surfaces it replaces must all face the way of
   // the surface it fits best (else a notch's opposite wall would be pulled onto it).

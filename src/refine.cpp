@@ -18,6 +18,8 @@
 #include "lodrefine/planes.h"
 #include "lodrefine/repair.h"
 #include "lodrefine/selection.h"
+#include "lodrefine/substitute.h"
+#include "lodrefine/eval.h"
 #include "lodrefine/validate.h"
 
 namespace lodrefine {
@@ -495,6 +497,42 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
   rep["planes"] = jplanes;
   if (planes.empty()) return finish("original (no planes found in the cloud near the model)");
 
+  // First choice: every outdated wall takes its scan plane at once, the model's topology kept.
+  t = Clock::now();
+  {
+    const auto surfaces = model_surfaces(current);
+    const MatchResult mr = match_surfaces(current, surfaces, local, planes, prm);
+    std::vector<WallMove> moves;
+    for (const auto& m : mr.matches) {
+      Plane pl = planes[m.scan_plane].plane;
+      if (pl.n.dot(surfaces[m.surface].plane.n) < 0) pl = pl.flipped();
+      if (deviation(current, surfaces[m.surface], pl) > prm.change_tolerance) moves.push_back({m.surface, pl});
+    }
+    if (!moves.empty()) {
+      SubstitutionResult sub = substitute_walls(current, surfaces, moves, prm.planarity_tolerance);
+      json js = {{"method", "substitution"}, {"walls", moves.size()}, {"ok", sub.ok}};
+      if (sub.ok) {
+        Mesh m = merge_coplanar_faces(sub.mesh);
+        const Validation vs = validate_mesh(m, prm.planarity_tolerance);
+        if (vs.valid()) {
+          current = std::move(m);
+          current.id = model.id;
+          out.refined = true;
+          js["moved_vertices"] = sub.moved_vertices;
+          js["max_vertex_move"] = sub.max_vertex_move;
+          js["split_faces"] = sub.split_faces;
+        } else {
+          js["ok"] = false;
+          js["reason"] = "substituted shell invalid: " + vs.problem;
+        }
+      } else {
+        js["reason"] = sub.reason;
+      }
+      rep["substitution"] = js;
+    }
+  }
+  timing["substitution"] = seconds_since(t);
+
   // Match, replace the most confident outdated wall, re-match on the new model, repeat.
   t = Clock::now();
   json steps = json::array();
@@ -537,7 +575,19 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
       steps.push_back({{"scan_plane", next->scan_plane}, {"ok", false}, {"reason", "MIP time limit used up"}});
       break;
     }
-    StepResult sr = replace_walls(current, surfaces, r, step_prm);
+    StepResult sr;
+    {
+      SubstitutionResult sub = substitute_walls(current, surfaces, {{next->surface, r.plane}}, prm.planarity_tolerance);
+      if (sub.ok) {
+        Mesh m = merge_coplanar_faces(sub.mesh);
+        if (validate_mesh(m, prm.planarity_tolerance).valid()) {
+          sr.ok = true;
+          sr.mesh = std::move(m);
+          sr.info["method"] = "substitution";
+        }
+      }
+    }
+    if (!sr.ok) sr = replace_walls(current, surfaces, r, step_prm);
     if (sr.info.contains("mip")) mip_seconds += sr.info["mip"].value("seconds", 0.0);
     json js = sr.info;
     js["scan_plane"] = next->scan_plane;

@@ -46,6 +46,8 @@ double unoriented_angle_deg(const Vec3& a, const Vec3& b);
 // 2D polygon helpers (coordinates in a plane's (u, v) basis).
 double signed_area_2d(const std::vector<Vec2>& poly);
 bool point_in_polygon_2d(const Vec2& p, const std::vector<Vec2>& poly);
+// Distance from p to the segment ab.
+double segment_distance_2d(const Vec2& p, const Vec2& a, const Vec2& b);
 std::vector<Vec2> convex_hull_2d(std::vector<Vec2> pts);
 // Area of the intersection of two convex CCW polygons.
 double convex_intersection_area(const std::vector<Vec2>& a, const std::vector<Vec2>& b);

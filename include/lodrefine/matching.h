@@ -27,6 +27,7 @@ struct Match {
   int scan_plane = -1;   // index into the scan planes
   int surface = -1;      // index into the model surfaces
   double s_normal = 0, d_centroid = 0, c_bbox = 0, s_match = 0;
+  int points = 0;        // scan points in front of the wall that belong to it
 };
 
 struct MatchResult {

@@ -22,6 +22,7 @@ namespace lodrefine {
   X(double, match_angle_deg, 10.0, 0.0, 90.0, "matching hard filter: max angle between normals (deg)")    \
   X(double, match_distance, 2.0, 0.0, 100.0, "matching hard filter: max centroid-to-plane distance (m)")  \
   X(double, match_min_overlap, 0.2, 0.0, 1.0, "matching: min OBB overlap (share of the scan box inside the face box)") \
+  X(double, match_margin, 0.5, 0.0, 10.0, "matching: scan points up to this far beyond a wall's outline (in its plane) still belong to it (m)") \
   X(double, corner_gap, 0.6, 0.0, 100.0, "a wall match is rejected if the new corner lies farther than this beyond the adjacent scanned facade's points (m)") \
   X(double, w_normal, 0.5, 0.0, 1.0, "matching score weight of |S_normal|")                              \
   X(double, w_coverage, 0.5, 0.0, 1.0, "matching score weight of the OBB IoU C_bbox")                    \

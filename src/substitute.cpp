@@ -1,0 +1,106 @@
+// Stage 3 (first choice): wall substitution, see substitute.h.
+#include "lodrefine/substitute.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+namespace lodrefine {
+namespace {
+
+// A wall plane is used in plan view (its trace at the vertex's height); roofs tilted less
+// than this from vertical are walls here too (only walls are matched to facade scans).
+constexpr double kWallMaxNz = 0.5;
+// Regulariser of the plan-view solve: picks the nearest point on the trace when only one wall
+// direction meets at a vertex; small against any real pair of walls (sin^2 of 0.1 deg ~ 3e-6).
+constexpr double kNearestWeight = 1e-7;
+// Walls at one vertex must meet there after the move; more than this apart means the move
+// changes the topology (then the arrangement takes over).
+constexpr double kMeetTolerance = 0.005;
+
+}  // namespace
+
+SubstitutionResult substitute_walls(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
+                                    const std::vector<WallMove>& moves, double planarity_tolerance) {
+  SubstitutionResult res;
+  const int nv = int(mesh.vertices.size());
+  std::vector<int> face_surface(mesh.faces.size(), -1);
+  for (int s = 0; s < int(surfaces.size()); ++s)
+    for (int f : surfaces[s].faces) face_surface[f] = s;
+  std::vector<int> moved_plane(surfaces.size(), -1);
+  for (int m = 0; m < int(moves.size()); ++m) moved_plane[moves[m].surface] = m;
+
+  std::vector<std::vector<int>> vertex_surfaces(nv);
+  for (int f = 0; f < int(mesh.faces.size()); ++f)
+    for (int v : mesh.faces[f].v) vertex_surfaces[v].push_back(face_surface[f]);
+
+  res.mesh = mesh;
+  for (int v = 0; v < nv; ++v) {
+    auto& ss = vertex_surfaces[v];
+    std::sort(ss.begin(), ss.end());
+    ss.erase(std::unique(ss.begin(), ss.end()), ss.end());
+    bool touched = false;
+    for (int s : ss) touched = touched || (s >= 0 && moved_plane[s] >= 0);
+    if (!touched) continue;
+    const Vec3 p = mesh.vertices[v];
+    // Each wall's trace at height z: n_xy . x = -(d + n_z z). Kept walls pass through the
+    // vertex itself, so a slightly warped input wall never pulls its vertices.
+    std::vector<std::pair<Vec2, double>> traces;
+    for (int s : ss) {
+      if (s < 0) continue;
+      const bool moved = moved_plane[s] >= 0;
+      const Plane pl = moved ? moves[moved_plane[s]].plane : Plane::through(p, surfaces[s].plane.n);
+      if (std::abs(pl.n.z()) > kWallMaxNz) continue;
+      const Vec2 n2(pl.n.x(), pl.n.y());
+      const double len = n2.norm();
+      traces.emplace_back(n2 / len, -(pl.d + pl.n.z() * p.z()) / len);
+    }
+    Eigen::Matrix2d a = kNearestWeight * Eigen::Matrix2d::Identity();
+    Vec2 b = kNearestWeight * p.head<2>();
+    for (const auto& [n2, c] : traces) {
+      a += n2 * n2.transpose();
+      b += c * n2;
+    }
+    const Vec2 x = a.ldlt().solve(b);
+    double residual = 0.0;
+    for (const auto& [n2, c] : traces) residual = std::max(residual, std::abs(n2.dot(x) - c));
+    if (!x.allFinite() || residual > kMeetTolerance) {
+      res.reason = "the moved walls no longer meet at one vertex (residual " + std::to_string(residual) + " m)";
+      return res;
+    }
+    res.mesh.vertices[v] = Vec3(x.x(), x.y(), p.z());
+    res.max_vertex_move = std::max(res.max_vertex_move, (res.mesh.vertices[v] - p).norm());
+    ++res.moved_vertices;
+  }
+
+  // A face that moved must keep its orientation (else a wall passed a short neighbour) and
+  // stay planar; a roof under a turned wall may not, and is split into triangles then.
+  std::vector<Face> faces;
+  for (const auto& f : mesh.faces) {
+    const auto before = face_points(mesh, f);
+    const auto after = face_points(res.mesh, f);
+    const Vec3 n0 = newell_normal(before), n1 = newell_normal(after);
+    if (n1.dot(n0) <= 0.0 || n1.norm() < 1e-3 * n0.norm()) {
+      res.reason = "a moved wall passes a neighbouring face (it would turn inside out)";
+      return res;
+    }
+    const Plane pl = polygon_plane(after);
+    double err = 0.0;
+    for (const auto& q : after) err = std::max(err, std::abs(pl.distance(q)));
+    if (err <= 0.5 * planarity_tolerance) {
+      faces.push_back(f);
+      continue;
+    }
+    ++res.split_faces;
+    for (const auto& t : triangulate_polygon(after)) {
+      Face tf = f;
+      tf.v = {f.v[t[0]], f.v[t[1]], f.v[t[2]]};
+      faces.push_back(std::move(tf));
+    }
+  }
+  res.mesh.faces = std::move(faces);
+  res.ok = true;
+  return res;
+}
+
+}  // namespace lodrefine
