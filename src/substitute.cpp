@@ -14,7 +14,10 @@ constexpr double kWallMaxNz = 0.5;
 // Regulariser of the plan-view solve: picks the nearest point on the trace when only one wall
 // direction meets at a vertex; small against any real pair of walls (sin^2 of 0.1 deg ~ 3e-6).
 constexpr double kNearestWeight = 1e-7;
-// Walls at one vertex must meet there after the move; more than this apart means the move
+// Two walls cross (and fix a vertex in plan view) when their traces differ by more than
+// this (sin 15 deg): nearer to parallel, their meet runs away with any small move.
+constexpr double kMinCrossing = 0.26;
+// Moved walls at one vertex must meet there after the move; more than this apart means the move
 // changes the topology (then the arrangement takes over).
 constexpr double kMeetTolerance = 0.005;
 
@@ -43,9 +46,14 @@ SubstitutionResult substitute_walls(const Mesh& mesh, const std::vector<ModelSur
     for (int s : ss) touched = touched || (s >= 0 && moved_plane[s] >= 0);
     if (!touched) continue;
     const Vec3 p = mesh.vertices[v];
-    // Each wall's trace at height z: n_xy . x = -(d + n_z z). Kept walls pass through the
-    // vertex itself, so a slightly warped input wall never pulls its vertices.
-    std::vector<std::pair<Vec2, double>> traces;
+    // Each wall's trace at height z: n_xy . x = c. Kept walls pass through the vertex itself,
+    // so a slightly warped input wall never pulls its vertices.
+    struct Trace {
+      Vec2 n;
+      double c;
+      bool moved;
+    };
+    std::vector<Trace> traces;
     for (int s : ss) {
       if (s < 0) continue;
       const bool moved = moved_plane[s] >= 0;
@@ -53,17 +61,28 @@ SubstitutionResult substitute_walls(const Mesh& mesh, const std::vector<ModelSur
       if (std::abs(pl.n.z()) > kWallMaxNz) continue;
       const Vec2 n2(pl.n.x(), pl.n.y());
       const double len = n2.norm();
-      traces.emplace_back(n2 / len, -(pl.d + pl.n.z() * p.z()) / len);
+      traces.push_back({n2 / len, -(pl.d + pl.n.z() * p.z()) / len, moved});
+    }
+    // At most two independent directions fix a point in plan view: the moved walls first, then
+    // the kept walls crossing them. A kept wall (nearly) parallel to a moved one cannot follow
+    // it; its face bends to the new vertex and is split below if no longer planar.
+    std::stable_sort(traces.begin(), traces.end(), [](const Trace& a, const Trace& b) { return a.moved > b.moved; });
+    std::vector<Trace> used;
+    for (const auto& t : traces) {
+      bool independent = used.size() < 2;
+      for (const auto& u : used) independent = independent && std::abs(u.n.x() * t.n.y() - u.n.y() * t.n.x()) > kMinCrossing;
+      if (independent) used.push_back(t);
     }
     Eigen::Matrix2d a = kNearestWeight * Eigen::Matrix2d::Identity();
     Vec2 b = kNearestWeight * p.head<2>();
-    for (const auto& [n2, c] : traces) {
-      a += n2 * n2.transpose();
-      b += c * n2;
+    for (const auto& t : used) {
+      a += t.n * t.n.transpose();
+      b += t.c * t.n;
     }
     const Vec2 x = a.ldlt().solve(b);
     double residual = 0.0;
-    for (const auto& [n2, c] : traces) residual = std::max(residual, std::abs(n2.dot(x) - c));
+    for (const auto& t : traces)
+      if (t.moved) residual = std::max(residual, std::abs(t.n.dot(x) - t.c));
     if (!x.allFinite() || residual > kMeetTolerance) {
       res.reason = "the moved walls no longer meet at one vertex (residual " + std::to_string(residual) + " m)";
       return res;

@@ -20,7 +20,7 @@ namespace lodrefine {
   X(double, vertical_snap_deg, 1.5, 0.0, 10.0, "facade planes tilted less than this are refitted exactly vertical (deg)") \
   X(double, change_tolerance, 0.02, 0.0, 1.0, "a matched wall within this of its scan plane everywhere is kept as is (m)") \
   X(double, match_angle_deg, 10.0, 0.0, 90.0, "matching hard filter: max angle between normals (deg)")    \
-  X(double, match_distance, 2.0, 0.0, 100.0, "matching hard filter: max centroid-to-plane distance (m)")  \
+  X(double, match_distance, 1.25, 0.0, 100.0, "matching hard filter: max distance of a wall to its scan points (m); airborne facades are decimetres to a metre off")  \
   X(double, match_min_overlap, 0.2, 0.0, 1.0, "matching: min OBB overlap (share of the scan box inside the face box)") \
   X(double, match_margin, 0.5, 0.0, 10.0, "matching: scan points up to this far beyond a wall's outline (in its plane) still belong to it (m)") \
   X(double, corner_gap, 0.6, 0.0, 100.0, "a wall match is rejected if the new corner lies farther than this beyond the adjacent scanned facade's points (m)") \
