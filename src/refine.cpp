@@ -19,6 +19,7 @@
 #include "lodrefine/repair.h"
 #include "lodrefine/selection.h"
 #include "lodrefine/substitute.h"
+#include "lodrefine/corners.h"
 #include "lodrefine/eval.h"
 #include "lodrefine/validate.h"
 
@@ -497,39 +498,58 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
   rep["planes"] = jplanes;
   if (planes.empty()) return finish("original (no planes found in the cloud near the model)");
 
-  // First choice: every outdated wall takes its scan plane at once, the model's topology kept.
+  // First choice: every outdated wall takes its scan plane at once, the model's topology kept;
+  // unscanned walls at a scanned facade's end move to where the scan shows the corner.
   t = Clock::now();
   {
     const auto surfaces = model_surfaces(current);
     const MatchResult mr = match_surfaces(current, surfaces, local, planes, prm);
     std::vector<WallMove> moves;
+    std::vector<ScannedWall> scanned;
     for (const auto& m : mr.matches) {
       Plane pl = planes[m.scan_plane].plane;
       if (pl.n.dot(surfaces[m.surface].plane.n) < 0) pl = pl.flipped();
+      scanned.push_back({m.surface, m.scan_plane, pl});
       if (deviation(current, surfaces[m.surface], pl) > prm.change_tolerance) moves.push_back({m.surface, pl});
     }
-    if (!moves.empty()) {
-      SubstitutionResult sub = substitute_walls(current, surfaces, moves, prm.planarity_tolerance);
-      json js = {{"method", "substitution"}, {"walls", moves.size()}, {"ok", sub.ok}};
-      if (sub.ok) {
-        Mesh m = merge_coplanar_faces(sub.mesh);
-        const Validation vs = validate_mesh(m, prm.planarity_tolerance);
-        if (vs.valid()) {
-          current = std::move(m);
-          current.id = model.id;
-          out.refined = true;
-          js["moved_vertices"] = sub.moved_vertices;
-          js["max_vertex_move"] = sub.max_vertex_move;
-          js["split_faces"] = sub.split_faces;
-        } else {
-          js["ok"] = false;
-          js["reason"] = "substituted shell invalid: " + vs.problem;
-        }
-      } else {
+    const auto corners = corner_moves(current, surfaces, scanned, local, planes, prm);
+    json jc = json::array();
+    for (const auto& c : corners)
+      jc.push_back({{"wall_faces", surfaces[c.move.surface].faces}, {"scanned_wall_faces", surfaces[c.scanned_surface].faces},
+                    {"corner_shift", c.shift}});
+    rep["corner_moves"] = jc;
+    auto try_moves = [&](const std::vector<WallMove>& mv, json& js) {
+      SubstitutionResult sub = substitute_walls(current, surfaces, mv, prm.planarity_tolerance);
+      js = {{"method", "substitution"}, {"walls", mv.size()}, {"ok", sub.ok}};
+      if (!sub.ok) {
         js["reason"] = sub.reason;
+        return false;
       }
-      rep["substitution"] = js;
+      Mesh m = merge_coplanar_faces(sub.mesh);
+      const Validation vs = validate_mesh(m, prm.planarity_tolerance);
+      if (!vs.valid()) {
+        js["ok"] = false;
+        js["reason"] = "substituted shell invalid: " + vs.problem;
+        return false;
+      }
+      js["moved_vertices"] = sub.moved_vertices;
+      js["max_vertex_move"] = sub.max_vertex_move;
+      js["split_faces"] = sub.split_faces;
+      current = std::move(m);
+      current.id = model.id;
+      out.refined = true;
+      return true;
+    };
+    json js;
+    std::vector<WallMove> all = moves;
+    for (const auto& c : corners) all.push_back(c.move);
+    if (!all.empty() && !try_moves(all, js) && !corners.empty() && !moves.empty()) {
+      js["with_corners"] = false;
+      json js2;
+      try_moves(moves, js2);
+      js["without_corners"] = js2;
     }
+    if (!all.empty()) rep["substitution"] = js;
   }
   timing["substitution"] = seconds_since(t);
 
