@@ -18,6 +18,8 @@ constexpr double kCornerTolerance = 0.05;
 // an occluder's outline.
 constexpr double kEndSpread = 0.15;
 constexpr int kBands = 4;
+// Stray inliers tolerated past a facade's end (noise, a drainpipe).
+constexpr int kStrayPoints = 10;
 // Adjacent walls turned less than this from the scanned one are no corner (cos 45 deg).
 constexpr double kMaxCornerCos = 0.707;
 
@@ -105,6 +107,11 @@ std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSu
       if (end < 0) continue;
       const double gap = end - s * uc;  // > 0: the scan runs past the corner
       if (std::abs(gap) <= kCornerTolerance || std::abs(gap) > prm.match_distance) continue;
+      // Points of this plane again past the end, short of the corner: the run ended at a gap
+      // in the facade (a recessed entrance), not at the building's edge.
+      int beyond = 0;
+      for (double x : t) beyond += x > end + kRunGap && x <= s * uc + prm.match_distance;
+      if (beyond > kStrayPoints) continue;
       // The same end in every height band that has points.
       double lo = 1e300, hi = -1e300;
       int bands = 0;
