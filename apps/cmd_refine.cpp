@@ -47,16 +47,10 @@ void run(const RefineArgs& a) {
   r.report["model"] = a.model;
   r.report["cloud"]["path"] = a.cloud;
   r.report["params"] = params_json(a.params);
-  r.report["written"] = r.valid ? a.out : "";
+  r.report["written"] = a.out;
   if (!a.report.empty()) write_file_atomic(a.report, r.report.dump(2) + "\n");
-  if (r.valid) write_obj(a.out, r.mesh);
-  if (!r.valid) {
-    std::fprintf(stderr, "lodrefine: error: %s: no valid building to write: %s\n", model.id.c_str(),
-                 r.report["output_validation"].value("problem", std::string("invalid")).c_str());
-    exit_code() = 3;
-    return;
-  }
-  std::printf("%s: %s -> %s (%.2f s)\n", model.id.c_str(), r.outcome.c_str(), a.out.c_str(),
+  write_obj(a.out, r.mesh);
+  std::printf("%s: %s (%s) -> %s (%.2f s)\n", model.id.c_str(), r.outcome.c_str(), r.reason.c_str(), a.out.c_str(),
               r.report["seconds"].value("total", 0.0));
 }
 

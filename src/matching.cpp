@@ -190,6 +190,7 @@ MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& su
     std::vector<Rect> owned(walls.size());
     std::vector<int> count(walls.size(), 0);
     std::vector<Vec3> sum(walls.size(), Vec3::Zero());
+    std::vector<std::vector<int>> owned_idx(walls.size());
     for (int i : sp.inliers) {
       const Vec3& x = cloud.points[i];
       int best = -1;
@@ -210,6 +211,7 @@ MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& su
       owned[best].add(q.dot(walls[best].u), q.dot(walls[best].v));
       ++count[best];
       sum[best] += x;
+      owned_idx[best].push_back(i);
     }
     for (int k : cand) {
       if (count[k] < prm.ransac_min_points) continue;
@@ -220,11 +222,15 @@ MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& su
       const double iou = uni > 0 ? inter / uni : 0.0;
       const double coverage = std::max({iou, inter / std::max(1e-12, owned[k].area()),
                                         inter / std::max(1e-12, model_box.area())});
-      if (coverage < prm.match_min_overlap) continue;
+      if (coverage < prm.match_min_overlap) {
+        result.rejected.push_back("scan plane " + std::to_string(p) + " / wall surface " + std::to_string(walls[k].surface) +
+                                  ": its points cover too little of the wall (" + std::to_string(coverage) + ")");
+        continue;
+      }
       const double s_normal = sp.plane.n.dot(surf.plane.n);
       const double d_c = std::abs(surf.plane.distance(sum[k] / count[k]));
       const double score = prm.w_normal * std::abs(s_normal) + prm.w_coverage * iou;
-      result.matches.push_back(Match{p, walls[k].surface, s_normal, d_c, iou, score, count[k]});
+      result.matches.push_back(Match{p, walls[k].surface, s_normal, d_c, iou, score, std::move(owned_idx[k])});
     }
   }
   // One scan plane per wall: the one with the most points in front of it.
@@ -232,7 +238,7 @@ MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& su
     std::map<int, Match> best;
     for (const auto& m : result.matches) {
       auto it = best.find(m.surface);
-      if (it == best.end() || m.points > it->second.points) best[m.surface] = m;
+      if (it == best.end() || m.owned.size() > it->second.owned.size()) best[m.surface] = m;
     }
     result.matches.clear();
     for (const auto& [s, m] : best) result.matches.push_back(m);
@@ -246,6 +252,8 @@ MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& su
       for (const auto& o : result.matches)
         if (o.scan_plane == m.scan_plane && o.d_centroid < ref->d_centroid) ref = &o;
       if (surfaces[m.surface].plane.n.dot(surfaces[ref->surface].plane.n) > 0) same_side.push_back(m);
+      else result.rejected.push_back("scan plane " + std::to_string(m.scan_plane) + " / wall surface " + std::to_string(m.surface) +
+                                     ": faces away from the wall the plane fits best");
     }
     result.matches = same_side;
   }
@@ -276,6 +284,8 @@ MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& su
     }
     if (worst < 0) break;
     alive[worst] = 0;
+    result.rejected.push_back("scan plane " + std::to_string(result.matches[worst].scan_plane) + " / wall surface " +
+                              std::to_string(result.matches[worst].surface) + ": its corner with an adjacent scanned facade lies beyond that facade's points");
   }
   std::vector<Match> kept;
   for (int i = 0; i < nm; ++i)

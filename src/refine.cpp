@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
+#include <optional>
 #include <set>
 
 #include "lodrefine/candidates.h"
@@ -420,6 +422,65 @@ Vec3 local_origin(const Mesh& model) {
   return Vec3(std::floor(lo.x() / 100.0) * 100.0, std::floor(lo.y() / 100.0) * 100.0, std::floor(lo.z() / 100.0) * 100.0);
 }
 
+namespace {
+
+// Vertices moved by the repair's weld are allowed to snap onto their surfaces' plane meet by at
+// most this, so that the arrangement's planes and the kept model agree (warped input faces
+// keep their vertices).
+constexpr double kSnapMove = 0.05;
+
+// The repaired input. Exports whose corners disagree by a little more than the weld tolerance
+// (roof jitter) are welded a little coarser; detailed models with features finer than it, finer.
+Mesh repair_input(const Mesh& local_model, const Params& prm, RepairReport& rr) {
+  constexpr double kFinerSteps[] = {1.0, 1.5, 2.0, 0.1, 0.01};
+  for (double f : kFinerSteps) {
+    try {
+      rr = RepairReport{};
+      Mesh m = repair_model(local_model, prm.weld_tolerance * f, &rr);
+      if (f != 1.0) rr.notes.push_back("welded at " + std::to_string(prm.weld_tolerance * f) + " m");
+      return m;
+    } catch (const InputError&) {
+      if (f == kFinerSteps[std::size(kFinerSteps) - 1]) throw;
+    }
+  }
+  throw InputError("unreachable");
+}
+
+// Faces the repair could not keep planar (a warped input face) split into triangles; nothing
+// moves. Returns how many were split.
+int split_warped_faces(Mesh& mesh, double tolerance) {
+  std::vector<Face> faces;
+  int split = 0;
+  for (const auto& f : mesh.faces) {
+    const auto pts = face_points(mesh, f);
+    const Plane pl = polygon_plane(pts);
+    double err = 0.0;
+    for (const auto& q : pts) err = std::max(err, std::abs(pl.distance(q)));
+    if (err <= tolerance) {
+      faces.push_back(f);
+      continue;
+    }
+    ++split;
+    for (const auto& t : triangulate_polygon(pts)) {
+      Face tf = f;
+      tf.v = {f.v[t[0]], f.v[t[1]], f.v[t[2]]};
+      faces.push_back(std::move(tf));
+    }
+  }
+  mesh.faces = std::move(faces);
+  return split;
+}
+
+// RMS distance of points to a mesh.
+double rms_distance(const Mesh& mesh, const std::vector<Vec3>& pts) {
+  if (pts.empty()) return 0.0;
+  double s = 0.0;
+  for (double d : cloud_to_mesh(mesh, pts)) s += d * d;
+  return std::sqrt(s / double(pts.size()));
+}
+
+}  // namespace
+
 RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const Params& prm) {
   prm.validate();
   const auto t_start = Clock::now();
@@ -430,50 +491,52 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
 
   const Vec3 origin = local_origin(model);
   rep["origin"] = {origin.x(), origin.y(), origin.z()};
+  auto finish = [&](const std::string& outcome, const std::string& reason, const Mesh& local_mesh) {
+    out.outcome = outcome;
+    out.reason = reason;
+    const Validation vf = validate_mesh(local_mesh, prm.planarity_tolerance);
+    out.valid = vf.valid();
+    out.refined = outcome == "refined";
+    rep["outcome"] = outcome;
+    rep["reason"] = reason;
+    rep["refined"] = out.refined;
+    rep["output_validation"] = validation_json(vf);
+    rep["faces"] = local_mesh.faces.size();
+    timing["total"] = seconds_since(t_start);
+    rep["seconds"] = timing;
+    out.mesh = translated(local_mesh, origin);
+    out.mesh.id = model.id;
+    return out;
+  };
 
-  // Repair the exported soup into a closed shell (this may throw: nothing valid to write).
+  // Repair the exported soup into a closed shell; a model that cannot be made one is written as
+  // read (kept-invalid) with the reason.
   auto t = Clock::now();
+  const Mesh local_model = translated(model, -origin);
   RepairReport rr;
-  // A coarse weld closes export gaps but collapses short edges of detailed models: retry finer.
-  Mesh current;
-  for (double tol = prm.weld_tolerance;; tol /= 10.0) {
-    try {
-      rr = RepairReport{};
-      current = merge_coplanar_faces(repair_model(translated(model, -origin), tol, &rr));
-      if (tol != prm.weld_tolerance) rr.notes.push_back("welded at " + std::to_string(tol) + " m");
-      break;
-    } catch (const InputError&) {
-      if (tol < 1e-4) throw;
-    }
+  Mesh kept;
+  try {
+    kept = repair_input(local_model, prm, rr);
+  } catch (const InputError& e) {
+    timing["repair"] = seconds_since(t);
+    return finish("kept-invalid", e.what(), local_model);
   }
-  current.id = model.id;
-  snap_to_surfaces(current, model_surfaces(current), 0.05);
+  kept.id = model.id;
+  const int warped = split_warped_faces(kept, prm.planarity_tolerance);
   rep["repair"] = {{"welded_vertices", rr.welded_vertices},
                    {"removed_degenerate_faces", rr.removed_degenerate_faces},
                    {"removed_duplicate_faces", rr.removed_duplicate_faces},
                    {"split_t_junctions", rr.split_t_junctions},
                    {"flipped_faces", rr.flipped_faces},
                    {"filled_holes", rr.filled_holes},
+                   {"split_warped_faces", warped},
                    {"notes", rr.notes}};
-  const Validation v0 = validate_mesh(current, prm.planarity_tolerance);
+  const Validation v0 = validate_mesh(kept, prm.planarity_tolerance);
   rep["input_validation"] = validation_json(v0);
   timing["repair"] = seconds_since(t);
-  const Mesh repaired = current;
-
-  auto finish = [&](const std::string& outcome) {
-    out.outcome = outcome;
-    const Validation vf = validate_mesh(current, prm.planarity_tolerance);
-    out.valid = vf.valid();
-    rep["outcome"] = outcome;
-    rep["refined"] = out.refined;
-    rep["output_validation"] = validation_json(vf);
-    rep["faces"] = current.faces.size();
-    timing["total"] = seconds_since(t_start);
-    rep["seconds"] = timing;
-    out.mesh = translated(current, origin);
-    out.mesh.id = model.id;
-    return out;
-  };
+  if (!v0.valid()) return finish("kept-invalid", "the input is no valid solid: " + v0.problem, local_model);
+  Mesh current = merge_coplanar_faces(kept);
+  current.id = model.id;
 
   // Only the cloud near the model matters (crops may carry whole streets).
   t = Clock::now();
@@ -496,147 +559,176 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
     jplanes.push_back({{"normal", {p.plane.n.x(), p.plane.n.y(), p.plane.n.z()}}, {"d", p.plane.d},
                        {"inliers", p.inliers.size()}, {"rms", p.rms}, {"area", p.hull_area}, {"facade", p.facade}});
   rep["planes"] = jplanes;
-  if (planes.empty()) return finish("original (no planes found in the cloud near the model)");
+  if (planes.empty()) return finish("kept", "no planes found in the cloud near the model", kept);
+
+  // Matching on the input: which walls the scan sees, where, and by which points.
+  t = Clock::now();
+  const auto surfaces = model_surfaces(current);
+  const MatchResult mr = match_surfaces(current, surfaces, local, planes, prm);
+  std::vector<Vec3> facade_points;  // the matched walls' own points: the fit is judged on them
+  std::vector<WallMove> moves;
+  std::vector<ScannedWall> scanned;
+  json jm = json::array();
+  for (const auto& m : mr.matches) {
+    Plane pl = planes[m.scan_plane].plane;
+    if (pl.n.dot(surfaces[m.surface].plane.n) < 0) pl = pl.flipped();
+    scanned.push_back({m.surface, m.scan_plane, pl});
+    const double dev = deviation(current, surfaces[m.surface], pl);
+    if (dev > prm.change_tolerance) moves.push_back({m.surface, pl});
+    for (int i : m.owned) facade_points.push_back(local.points[i]);
+    jm.push_back({{"scan_plane", m.scan_plane}, {"surface", m.surface}, {"s_normal", m.s_normal},
+                  {"d_centroid", m.d_centroid}, {"c_bbox", m.c_bbox}, {"s_match", m.s_match}, {"points", m.owned.size()},
+                  {"deviation", dev}, {"faces", surfaces[m.surface].faces}});
+  }
+  rep["matches"] = jm;
+  rep["rejected_matches"] = mr.rejected;
+  rep["q_model"] = mr.q_model;
+  const auto corners = corner_moves(current, surfaces, scanned, local, planes, prm);
+  timing["matching"] = seconds_since(t);
+  if (moves.empty() && corners.empty())
+    return finish("kept", mr.matches.empty() ? "no wall matched a scan plane" : "every matched wall agrees with the scan", kept);
 
   // First choice: every outdated wall takes its scan plane at once, the model's topology kept;
   // unscanned walls at a scanned facade's end move to where the scan shows the corner.
   t = Clock::now();
-  {
-    const auto surfaces = model_surfaces(current);
-    const MatchResult mr = match_surfaces(current, surfaces, local, planes, prm);
-    std::vector<WallMove> moves;
-    std::vector<ScannedWall> scanned;
-    for (const auto& m : mr.matches) {
-      Plane pl = planes[m.scan_plane].plane;
-      if (pl.n.dot(surfaces[m.surface].plane.n) < 0) pl = pl.flipped();
-      scanned.push_back({m.surface, m.scan_plane, pl});
-      if (deviation(current, surfaces[m.surface], pl) > prm.change_tolerance) moves.push_back({m.surface, pl});
+  json jfacades = json::array();
+  auto describe = [&](const WallMove& mv, const char* evidence) {
+    const ModelSurface& s = surfaces[mv.surface];
+    double mean = 0.0, n = 0.0;
+    for (int f : s.faces)
+      for (int v : current.faces[f].v) mean += std::abs(mv.plane.distance(current.vertices[v])), n += 1.0;
+    std::set<int> sources;
+    for (int f : s.faces) sources.insert(current.faces[f].source);
+    jfacades.push_back({{"input_faces", sources}, {"evidence", evidence}, {"max_move", deviation(current, s, mv.plane)},
+                        {"mean_move", n > 0 ? mean / n : 0.0}});
+  };
+  auto substitute = [&](const std::vector<WallMove>& mv, json& js) {
+    SubstitutionResult sub = substitute_walls(current, surfaces, mv, prm.planarity_tolerance);
+    js = {{"method", "substitution"}, {"walls", mv.size()}, {"ok", sub.ok}};
+    if (!sub.ok) {
+      js["reason"] = sub.reason;
+      return std::optional<Mesh>();
     }
-    const auto corners = corner_moves(current, surfaces, scanned, local, planes, prm);
-    json jc = json::array();
-    for (const auto& c : corners)
-      jc.push_back({{"wall_faces", surfaces[c.move.surface].faces}, {"scanned_wall_faces", surfaces[c.scanned_surface].faces},
-                    {"corner_shift", c.shift}});
-    rep["corner_moves"] = jc;
-    auto try_moves = [&](const std::vector<WallMove>& mv, json& js) {
-      SubstitutionResult sub = substitute_walls(current, surfaces, mv, prm.planarity_tolerance);
-      js = {{"method", "substitution"}, {"walls", mv.size()}, {"ok", sub.ok}};
-      if (!sub.ok) {
-        js["reason"] = sub.reason;
-        return false;
-      }
-      Mesh m = merge_coplanar_faces(sub.mesh);
-      const Validation vs = validate_mesh(m, prm.planarity_tolerance);
-      if (!vs.valid()) {
-        js["ok"] = false;
-        js["reason"] = "substituted shell invalid: " + vs.problem;
-        return false;
-      }
-      js["moved_vertices"] = sub.moved_vertices;
-      js["max_vertex_move"] = sub.max_vertex_move;
-      js["split_faces"] = sub.split_faces;
-      current = std::move(m);
-      current.id = model.id;
-      out.refined = true;
-      return true;
-    };
-    json js;
-    std::vector<WallMove> all = moves;
-    for (const auto& c : corners) all.push_back(c.move);
-    if (!all.empty() && !try_moves(all, js) && !corners.empty() && !moves.empty()) {
-      js["with_corners"] = false;
-      json js2;
-      try_moves(moves, js2);
-      js["without_corners"] = js2;
+    Mesh m = merge_coplanar_faces(sub.mesh);
+    const Validation vs = validate_mesh(m, prm.planarity_tolerance);
+    if (!vs.valid()) {
+      js["ok"] = false;
+      js["reason"] = "substituted shell invalid: " + vs.problem;
+      return std::optional<Mesh>();
     }
-    if (!all.empty()) rep["substitution"] = js;
+    js["moved_vertices"] = sub.moved_vertices;
+    js["max_vertex_move"] = sub.max_vertex_move;
+    js["split_faces"] = sub.split_faces;
+    m.id = model.id;
+    return std::optional<Mesh>(std::move(m));
+  };
+  std::vector<WallMove> all = moves;
+  for (const auto& c : corners) all.push_back(c.move);
+  json jsub;
+  std::optional<Mesh> refined = substitute(all, jsub);
+  if (refined) {
+    for (const auto& mv : moves) describe(mv, "scan");
+    for (const auto& c : corners) describe(c.move, "corner");
+  } else if (!corners.empty() && !moves.empty()) {
+    json without;
+    refined = substitute(moves, without);
+    jsub["without_corners"] = without;
+    if (refined)
+      for (const auto& mv : moves) describe(mv, "scan");
   }
+  rep["substitution"] = jsub;
   timing["substitution"] = seconds_since(t);
 
-  // Match, replace the most confident outdated wall, re-match on the new model, repeat.
+  // Fallback: one wall at a time, each by substitution or by the local candidate arrangement and
+  // GLPK, re-matching on the new model after each.
   t = Clock::now();
   json steps = json::array();
-  std::set<std::pair<int, long long>> tried;  // (scan plane, rounded wall position)
-  double t_match = 0.0, mip_seconds = 0.0;
-  for (int iter = 0; iter < 4 * int(planes.size()) + 4; ++iter) {
-    const auto tm = Clock::now();
-    const auto surfaces = model_surfaces(current);
-    const MatchResult mr = match_surfaces(current, surfaces, local, planes, prm);
-    if (iter == 0) {
-      json jm = json::array();
-      for (const auto& m : mr.matches)
-        jm.push_back({{"scan_plane", m.scan_plane}, {"surface", m.surface}, {"s_normal", m.s_normal},
-                      {"d_centroid", m.d_centroid}, {"c_bbox", m.c_bbox}, {"s_match", m.s_match},
-                      {"deviation", deviation(current, surfaces[m.surface], planes[m.scan_plane].plane)},
-                      {"faces", surfaces[m.surface].faces}});
-      rep["matches"] = jm;
-      rep["q_model"] = mr.q_model;
-    }
-    t_match += seconds_since(tm);
-    const Match* next = nullptr;
-    for (const auto& m : mr.matches) {
-      const auto key = std::make_pair(m.scan_plane, (long long)std::llround(surfaces[m.surface].centroid.squaredNorm() * 100));
-      if (tried.count(key) || deviation(current, surfaces[m.surface], planes[m.scan_plane].plane) <= prm.change_tolerance)
-        continue;
-      if (next == nullptr || m.s_match > next->s_match) next = &m;
-    }
-    if (next == nullptr) break;
-    const auto& surf = surfaces[next->surface];
-    tried.insert({next->scan_plane, (long long)std::llround(surf.centroid.squaredNorm() * 100)});
-    Replacement r;
-    r.surfaces = {next->surface};
-    r.plane = planes[next->scan_plane].plane;
-    if (r.plane.n.dot(surf.plane.n) < 0) r.plane = r.plane.flipped();
-    for (int i : planes[next->scan_plane].inliers) r.points.push_back(local.points[i]);
-    // The MIP time limit holds for the whole building, over all its replacements.
-    Params step_prm = prm;
-    step_prm.mip_time_limit = prm.mip_time_limit - mip_seconds;
-    if (step_prm.mip_time_limit <= 0.0) {
-      steps.push_back({{"scan_plane", next->scan_plane}, {"ok", false}, {"reason", "MIP time limit used up"}});
-      break;
-    }
-    StepResult sr;
-    {
-      SubstitutionResult sub = substitute_walls(current, surfaces, {{next->surface, r.plane}}, prm.planarity_tolerance);
-      if (sub.ok) {
-        Mesh m = merge_coplanar_faces(sub.mesh);
-        if (validate_mesh(m, prm.planarity_tolerance).valid()) {
-          sr.ok = true;
-          sr.mesh = std::move(m);
-          sr.info["method"] = "substitution";
+  if (!refined) {
+    Mesh step_mesh = current;
+    bool any = false;
+    std::set<std::pair<int, long long>> tried;  // (scan plane, rounded wall position)
+    double mip_seconds = 0.0;
+    for (int iter = 0; iter < 4 * int(planes.size()) + 4; ++iter) {
+      const auto ss = model_surfaces(step_mesh);
+      const MatchResult mi = match_surfaces(step_mesh, ss, local, planes, prm);
+      const Match* next = nullptr;
+      for (const auto& m : mi.matches) {
+        const auto key = std::make_pair(m.scan_plane, (long long)std::llround(ss[m.surface].centroid.squaredNorm() * 100));
+        if (tried.count(key) || deviation(step_mesh, ss[m.surface], planes[m.scan_plane].plane) <= prm.change_tolerance)
+          continue;
+        if (next == nullptr || m.s_match > next->s_match) next = &m;
+      }
+      if (next == nullptr) break;
+      const auto& surf = ss[next->surface];
+      tried.insert({next->scan_plane, (long long)std::llround(surf.centroid.squaredNorm() * 100)});
+      Replacement r;
+      r.surfaces = {next->surface};
+      r.plane = planes[next->scan_plane].plane;
+      if (r.plane.n.dot(surf.plane.n) < 0) r.plane = r.plane.flipped();
+      for (int i : planes[next->scan_plane].inliers) r.points.push_back(local.points[i]);
+      json js;
+      js["scan_plane"] = next->scan_plane;
+      js["wall_faces"] = surf.faces;
+      js["moved_by"] = deviation(step_mesh, surf, r.plane);
+      std::optional<Mesh> m;
+      {
+        SubstitutionResult sub = substitute_walls(step_mesh, ss, {{next->surface, r.plane}}, prm.planarity_tolerance);
+        if (sub.ok) {
+          Mesh mm = merge_coplanar_faces(sub.mesh);
+          if (validate_mesh(mm, prm.planarity_tolerance).valid()) m = std::move(mm);
         }
       }
+      if (m) {
+        js["method"] = "substitution";
+      } else {
+        // The arrangement needs the model to agree exactly with its planes.
+        Params step_prm = prm;
+        step_prm.mip_time_limit = prm.mip_time_limit - mip_seconds;
+        if (step_prm.mip_time_limit <= 0.0) {
+          js["ok"] = false;
+          js["reason"] = "MIP time limit used up";
+          steps.push_back(js);
+          break;
+        }
+        Mesh snapped = step_mesh;
+        snap_to_surfaces(snapped, ss, kSnapMove);
+        StepResult sr = replace_walls(snapped, model_surfaces(snapped), r, step_prm);
+        if (sr.info.contains("mip")) mip_seconds += sr.info["mip"].value("seconds", 0.0);
+        js.update(sr.info);
+        js["method"] = "arrangement";
+        if (sr.ok) m = std::move(sr.mesh);
+        else js["reason"] = sr.reason;
+      }
+      js["ok"] = bool(m);
+      steps.push_back(js);
+      if (m) {
+        describe({next->surface, r.plane}, "scan");
+        step_mesh = std::move(*m);
+        step_mesh.id = model.id;
+        any = true;
+      }
     }
-    if (!sr.ok) sr = replace_walls(current, surfaces, r, step_prm);
-    if (sr.info.contains("mip")) mip_seconds += sr.info["mip"].value("seconds", 0.0);
-    json js = sr.info;
-    js["scan_plane"] = next->scan_plane;
-    js["wall_faces"] = surf.faces;
-    js["moved_by"] = deviation(current, surf, r.plane);
-    js["ok"] = sr.ok;
-    if (!sr.ok) js["reason"] = sr.reason;
-    steps.push_back(js);
-    if (sr.ok) {
-      current = std::move(sr.mesh);
-      current.id = model.id;
-      out.refined = true;
-    }
+    if (any) refined = step_mesh;
   }
-  timing["matching"] = t_match;
-  timing["replacement"] = seconds_since(t) - t_match;
   rep["replacements"] = steps;
-  if (!out.refined) {
-    if (steps.empty()) return finish(rep["matches"].empty() ? "original (no wall matched a scan plane)"
-                                                            : "original (every matched wall agrees with the scan)");
-    return finish("original (" + steps.back().value("reason", std::string("no replacement succeeded")) + ")");
+  timing["replacement"] = seconds_since(t);
+  rep["facades"] = jfacades;
+  if (!refined) {
+    std::string why = "no wall could be replaced";
+    if (!steps.empty()) why = steps.back().value("reason", why);
+    else if (jsub.contains("reason")) why = jsub.value("reason", why);
+    return finish("kept", why, kept);
   }
-  const Validation vf = validate_mesh(current, prm.planarity_tolerance);
-  if (!vf.valid()) {  // never written as refined
-    current = repaired;
-    out.refined = false;
-    return finish("original (refined shell failed validation: " + vf.problem + ")");
-  }
-  return finish("refined");
+  const Validation vf = validate_mesh(*refined, prm.planarity_tolerance);
+  if (!vf.valid()) return finish("kept", "refined shell failed validation: " + vf.problem, kept);
+
+  // Never worse: the refined model must fit the matched walls' points better than the input.
+  const double fit_before = rms_distance(kept, facade_points), fit_after = rms_distance(*refined, facade_points);
+  rep["facade_fit"] = {{"points", facade_points.size()}, {"rms_before", fit_before}, {"rms_after", fit_after}};
+  if (!(fit_after < fit_before))
+    return finish("kept", "the refinement does not fit the scan better (RMS " + std::to_string(fit_before) + " -> " +
+                              std::to_string(fit_after) + " m)", kept);
+  return finish("refined", std::to_string(jfacades.size()) + " wall(s) moved", *refined);
 }
 
 }  // namespace lodrefine

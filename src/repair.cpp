@@ -46,40 +46,79 @@ struct CellHash {
   }
 };
 
-// Greedy clustering on a hash grid: a vertex joins the nearest cluster seed within `tol`, else
-// seeds a new cluster. Seeds never move, so a row of close points cannot chain into one cluster
-// metres long. Returns each vertex's cluster; `centres` gets each cluster's mean.
-std::vector<int> weld(const std::vector<Vec3>& pts, double tol, std::vector<Vec3>& centres) {
+// Clusters the soup's vertices: the closest pairs within `tol` first (Kruskal), never joining
+// two vertices of one face. Jittered exports (a corner a few mm off in each face) weld whole,
+// while a face's own short edges never collapse, however small `tol` is against them.
+// Returns each vertex's cluster; `centres` gets each cluster's mean.
+std::vector<int> weld(const Mesh& soup, double tol, std::vector<Vec3>& centres) {
+  const auto& pts = soup.vertices;
+  const int n = int(pts.size());
+  std::vector<std::vector<int>> faces_of(n);
+  for (int f = 0; f < int(soup.faces.size()); ++f)
+    for (int v : soup.faces[f].v)
+      if (faces_of[v].empty() || faces_of[v].back() != f) faces_of[v].push_back(f);
+  for (auto& fs : faces_of) {
+    std::sort(fs.begin(), fs.end());
+    fs.erase(std::unique(fs.begin(), fs.end()), fs.end());
+  }
   std::unordered_map<Cell, std::vector<int>, CellHash> grid;
-  std::vector<Vec3> seeds;
-  std::vector<int> count, cluster(pts.size());
-  centres.clear();
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    const Vec3& p = pts[i];
-    const auto cell = [tol](double x) { return (long long)std::floor(x / tol); };
-    const Cell c{cell(p.x()), cell(p.y()), cell(p.z())};
-    int best = -1;
-    double best_d = tol;
+  const auto cell = [tol](double x) { return (long long)std::floor(x / tol); };
+  for (int i = 0; i < n; ++i) grid[{cell(pts[i].x()), cell(pts[i].y()), cell(pts[i].z())}].push_back(i);
+  struct Pair {
+    double d;
+    int i, j;
+  };
+  std::vector<Pair> pairs;
+  for (int i = 0; i < n; ++i) {
+    const Cell c{cell(pts[i].x()), cell(pts[i].y()), cell(pts[i].z())};
     for (long long dx = -1; dx <= 1; ++dx)
       for (long long dy = -1; dy <= 1; ++dy)
         for (long long dz = -1; dz <= 1; ++dz) {
           const auto it = grid.find({c.x + dx, c.y + dy, c.z + dz});
           if (it == grid.end()) continue;
-          for (int id : it->second) {
-            const double d = (seeds[id] - p).norm();
-            if (d <= best_d) best = id, best_d = d;
+          for (int j : it->second) {
+            if (j <= i) continue;
+            const double d = (pts[j] - pts[i]).norm();
+            if (d <= tol) pairs.push_back({d, i, j});
           }
         }
-    if (best < 0) {
-      best = int(seeds.size());
-      seeds.push_back(p);
+  }
+  std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
+    return a.d != b.d ? a.d < b.d : std::make_pair(a.i, a.j) < std::make_pair(b.i, b.j);
+  });
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto find = [&parent](int a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  constexpr double kSamePoint = 1e-9;  // a repeated vertex within one face is one vertex
+  for (const auto& [d, i, j] : pairs) {
+    int a = find(i), b = find(j);
+    if (a == b) continue;
+    if (faces_of[a].size() < faces_of[b].size()) std::swap(a, b);
+    const auto& big = faces_of[a];
+    bool shared = false;
+    for (int f : faces_of[b]) shared = shared || std::binary_search(big.begin(), big.end(), f);
+    if (shared && d > kSamePoint) continue;
+    std::vector<int> merged;
+    std::set_union(big.begin(), big.end(), faces_of[b].begin(), faces_of[b].end(), std::back_inserter(merged));
+    faces_of[a] = std::move(merged);
+    faces_of[b].clear();
+    parent[b] = a;
+  }
+  std::vector<int> cluster(n), id(n, -1), count;
+  centres.clear();
+  for (int i = 0; i < n; ++i) {
+    const int r = find(i);
+    if (id[r] < 0) {
+      id[r] = int(centres.size());
       centres.push_back(Vec3::Zero());
       count.push_back(0);
-      grid[c].push_back(best);
     }
-    cluster[i] = best;
-    centres[best] += p;
-    ++count[best];
+    cluster[i] = id[r];
+    centres[id[r]] += pts[i];
+    ++count[id[r]];
   }
   for (std::size_t k = 0; k < centres.size(); ++k) centres[k] /= count[k];
   return cluster;
@@ -458,7 +497,7 @@ Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report)
   const double tol = std::max(weld_tolerance, 1e-9);
 
   std::vector<Vec3> V;
-  const std::vector<int> cluster = weld(soup.vertices, tol, V);
+  const std::vector<int> cluster = weld(soup, tol, V);
   r.welded_vertices = int(soup.vertices.size() - V.size());
   std::vector<Face> faces = clean_faces(soup, cluster, V, tol, r);
   r.split_t_junctions = split_t_junctions(V, faces, tol);

@@ -2,6 +2,7 @@
 // scan planes to wall surfaces (normal + centroid-distance hard filters, OBB IoU, S_match),
 // scores the model by Q_model.
 #pragma once
+#include <string>
 #include <vector>
 
 #include "lodrefine/geometry.h"
@@ -27,12 +28,13 @@ struct Match {
   int scan_plane = -1;   // index into the scan planes
   int surface = -1;      // index into the model surfaces
   double s_normal = 0, d_centroid = 0, c_bbox = 0, s_match = 0;
-  int points = 0;        // scan points in front of the wall that belong to it
+  std::vector<int> owned;  // the scan points in front of the wall that belong to it
 };
 
 struct MatchResult {
   std::vector<Match> matches;   // the accepted one-to-one matches (one scan plane per surface)
   double q_model = 0.0;         // sum of S_match
+  std::vector<std::string> rejected;  // one line per match a check turned down, and why
 };
 
 MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,

@@ -12,15 +12,19 @@ namespace lodrefine {
 
 struct RefineResult {
   Mesh mesh;               // in the input (georeferenced) frame; valid closed polyhedron
-  bool refined = false;    // at least one facade was replaced
-  std::string outcome;     // "refined", "original (<reason>)"
-  bool valid = false;      // passed validate_mesh
+  bool refined = false;    // outcome == "refined"
+  // "refined": walls moved, validated, and the matched walls' points fit better than before;
+  // "kept": the repaired input (nothing to change, or no refinement fitted better);
+  // "kept-invalid": the input cannot be made a valid solid and `mesh` is it as read.
+  std::string outcome;
+  std::string reason;      // one line: why this outcome
+  bool valid = false;      // `mesh` passed validate_mesh
   nlohmann::json report;   // matches, planes, candidates, MIP, timings, validation
 };
 
-// Throws InputError when the model cannot be repaired into a closed polyhedron (the caller
-// then has no valid building to write). Everything else degrades to the repaired original
-// with the reason in `outcome` and the report.
+// Every model gets an output: the refined building, the repaired input, or the input as read,
+// with the outcome and its reason in the result and the report. Never throws for a bad model
+// (only for parameters out of range).
 RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const Params& params);
 
 // The local origin used for a model: its bounding-box minimum rounded down to 100 m, so
