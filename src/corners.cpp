@@ -18,6 +18,10 @@ constexpr double kCornerTolerance = 0.05;
 // an occluder's outline.
 constexpr double kEndSpread = 0.15;
 constexpr int kBands = 4;
+// At a facade's end the scanner must have seen something off its plane within this (m), above
+// the low part of the wall (ground and clutter below kLowBand of its height do not count).
+constexpr double kLookPast = 1.0;
+constexpr double kLowBand = 0.25;
 // Stray inliers tolerated past a facade's end (noise, a drainpipe).
 constexpr int kStrayPoints = 10;
 // Adjacent walls turned less than this from the scanned one are no corner (cos 45 deg).
@@ -112,6 +116,20 @@ std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSu
       int beyond = 0;
       for (double x : t) beyond += x > end + kRunGap && x <= s * uc + prm.match_distance;
       if (beyond > kStrayPoints) continue;
+      // A facade ending short of the corner must end at something the scanner saw there off
+      // its plane (the side wall turning away, a neighbour's facade): where it saw nothing, the
+      // scan ended, not the building.
+      if (gap < 0) {
+        int seen = 0;
+        for (const auto& p : cloud.points) {
+          if (p.z() < z0 + kLowBand * (z1 - z0) || p.z() > z1) continue;
+          const double depth = std::abs(w.plane.distance(p));
+          if (depth <= 2.0 * prm.ransac_epsilon || depth > prm.match_distance + kLookPast) continue;
+          const double x = s * ((p - o).dot(u) - u_mid);
+          seen += x >= end - kCornerTolerance && x <= end + kLookPast;
+        }
+        if (seen <= kStrayPoints) continue;
+      }
       // The same end in every height band that has points.
       double lo = 1e300, hi = -1e300;
       int bands = 0;

@@ -432,15 +432,20 @@ constexpr double kSnapMove = 0.05;
 // The repaired input. Exports whose corners disagree by a little more than the weld tolerance
 // (roof jitter) are welded a little coarser; detailed models with features finer than it, finer.
 Mesh repair_input(const Mesh& local_model, const Params& prm, RepairReport& rr) {
-  constexpr double kFinerSteps[] = {1.0, 1.5, 2.0, 0.1, 0.01};
-  for (double f : kFinerSteps) {
+  struct Step {
+    double weld, gap;  // relative to weld_tolerance
+  };
+  constexpr Step kSteps[] = {{1.0, 1.0}, {1.0, 1.5}, {1.0, 2.0}, {0.1, 0.1}, {0.01, 0.01}};
+  for (const auto& [weld, gap] : kSteps) {
     try {
       rr = RepairReport{};
-      Mesh m = repair_model(local_model, prm.weld_tolerance * f, &rr);
-      if (f != 1.0) rr.notes.push_back("welded at " + std::to_string(prm.weld_tolerance * f) + " m");
+      Mesh m = repair_model(local_model, prm.weld_tolerance * weld, &rr, prm.weld_tolerance * gap);
+      if (weld != 1.0 || gap != 1.0)
+        rr.notes.push_back("welded at " + std::to_string(prm.weld_tolerance * weld) + " m, gaps up to " +
+                           std::to_string(prm.weld_tolerance * gap) + " m");
       return m;
     } catch (const InputError&) {
-      if (f == kFinerSteps[std::size(kFinerSteps) - 1]) throw;
+      if (&weld == &kSteps[std::size(kSteps) - 1].weld) throw;
     }
   }
   throw InputError("unreachable");
@@ -583,7 +588,7 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
   rep["matches"] = jm;
   rep["rejected_matches"] = mr.rejected;
   rep["q_model"] = mr.q_model;
-  const auto corners = corner_moves(current, surfaces, scanned, local, planes, prm);
+  const auto corners = prm.arrangement_only ? std::vector<CornerMove>{} : corner_moves(current, surfaces, scanned, local, planes, prm);
   timing["matching"] = seconds_since(t);
   if (moves.empty() && corners.empty())
     return finish("kept", mr.matches.empty() ? "no wall matched a scan plane" : "every matched wall agrees with the scan", kept);
@@ -625,7 +630,8 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
   std::vector<WallMove> all = moves;
   for (const auto& c : corners) all.push_back(c.move);
   json jsub;
-  std::optional<Mesh> refined = substitute(all, jsub);
+  std::optional<Mesh> refined;
+  if (!prm.arrangement_only) refined = substitute(all, jsub);
   if (refined) {
     for (const auto& mv : moves) describe(mv, "scan");
     for (const auto& c : corners) describe(c.move, "corner");
@@ -636,7 +642,7 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
     if (refined)
       for (const auto& mv : moves) describe(mv, "scan");
   }
-  rep["substitution"] = jsub;
+  if (!jsub.empty()) rep["substitution"] = jsub;
   timing["substitution"] = seconds_since(t);
 
   // Fallback: one wall at a time, each by substitution or by the local candidate arrangement and
@@ -671,7 +677,7 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
       js["wall_faces"] = surf.faces;
       js["moved_by"] = deviation(step_mesh, surf, r.plane);
       std::optional<Mesh> m;
-      {
+      if (!prm.arrangement_only) {
         SubstitutionResult sub = substitute_walls(step_mesh, ss, {{next->surface, r.plane}}, prm.planarity_tolerance);
         if (sub.ok) {
           Mesh mm = merge_coplanar_faces(sub.mesh);

@@ -46,11 +46,11 @@ struct CellHash {
   }
 };
 
-// Clusters the soup's vertices: the closest pairs within `tol` first (Kruskal), never joining
-// two vertices of one face. Jittered exports (a corner a few mm off in each face) weld whole,
-// while a face's own short edges never collapse, however small `tol` is against them.
-// Returns each vertex's cluster; `centres` gets each cluster's mean.
-std::vector<int> weld(const Mesh& soup, double tol, std::vector<Vec3>& centres) {
+// Clusters the soup's vertices: the closest pairs first (Kruskal), vertices of different faces
+// within `gap`, two vertices of one face only within `tol` (a repeated corner, a sliver's tip).
+// Jittered exports (a corner a few mm off in each face) weld whole, while a face's own short
+// edges never collapse. Returns each vertex's cluster; `centres` gets each cluster's mean.
+std::vector<int> weld(const Mesh& soup, double tol, double gap, std::vector<Vec3>& centres) {
   const auto& pts = soup.vertices;
   const int n = int(pts.size());
   std::vector<std::vector<int>> faces_of(n);
@@ -61,8 +61,9 @@ std::vector<int> weld(const Mesh& soup, double tol, std::vector<Vec3>& centres) 
     std::sort(fs.begin(), fs.end());
     fs.erase(std::unique(fs.begin(), fs.end()), fs.end());
   }
+  gap = std::max(gap, tol);
   std::unordered_map<Cell, std::vector<int>, CellHash> grid;
-  const auto cell = [tol](double x) { return (long long)std::floor(x / tol); };
+  const auto cell = [gap](double x) { return (long long)std::floor(x / gap); };
   for (int i = 0; i < n; ++i) grid[{cell(pts[i].x()), cell(pts[i].y()), cell(pts[i].z())}].push_back(i);
   struct Pair {
     double d;
@@ -79,7 +80,7 @@ std::vector<int> weld(const Mesh& soup, double tol, std::vector<Vec3>& centres) 
           for (int j : it->second) {
             if (j <= i) continue;
             const double d = (pts[j] - pts[i]).norm();
-            if (d <= tol) pairs.push_back({d, i, j});
+            if (d <= gap) pairs.push_back({d, i, j});
           }
         }
   }
@@ -92,7 +93,6 @@ std::vector<int> weld(const Mesh& soup, double tol, std::vector<Vec3>& centres) 
     while (parent[a] != a) a = parent[a] = parent[parent[a]];
     return a;
   };
-  constexpr double kSamePoint = 1e-9;  // a repeated vertex within one face is one vertex
   for (const auto& [d, i, j] : pairs) {
     int a = find(i), b = find(j);
     if (a == b) continue;
@@ -100,7 +100,7 @@ std::vector<int> weld(const Mesh& soup, double tol, std::vector<Vec3>& centres) 
     const auto& big = faces_of[a];
     bool shared = false;
     for (int f : faces_of[b]) shared = shared || std::binary_search(big.begin(), big.end(), f);
-    if (shared && d > kSamePoint) continue;
+    if (shared && d > tol) continue;
     std::vector<int> merged;
     std::set_union(big.begin(), big.end(), faces_of[b].begin(), faces_of[b].end(), std::back_inserter(merged));
     faces_of[a] = std::move(merged);
@@ -489,7 +489,7 @@ void drop_straight_vertices(const std::vector<Vec3>& V, std::vector<Face>& faces
 
 }  // namespace
 
-Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report) {
+Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report, double gap_tolerance) {
   RepairReport r;
   r.input_vertices = int(soup.vertices.size());
   r.input_faces = int(soup.faces.size());
@@ -497,7 +497,7 @@ Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report)
   const double tol = std::max(weld_tolerance, 1e-9);
 
   std::vector<Vec3> V;
-  const std::vector<int> cluster = weld(soup, tol, V);
+  const std::vector<int> cluster = weld(soup, tol, gap_tolerance, V);
   r.welded_vertices = int(soup.vertices.size() - V.size());
   std::vector<Face> faces = clean_faces(soup, cluster, V, tol, r);
   r.split_t_junctions = split_t_junctions(V, faces, tol);

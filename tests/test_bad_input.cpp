@@ -2,7 +2,8 @@
 // drives the real `lodrefine refine` binary on files written here and checks the contract:
 //   - refused: non-zero exit, exactly one stderr line "lodrefine: error: ...", no output file
 //     and no leftover temporary file;
-//   - degraded: exit 0, the repaired original written and valid, the report says "original (...)";
+//   - kept: exit 0, the repaired input written and valid, the report says "kept" and why;
+//   - kept-invalid: exit 0, a model that is no solid written as read, the report says why;
 //   - refined: exit 0, valid output, report "refined".
 // Each case prints a row "| input | what lodrefine says | exit |"; running the suite in one
 // process (lodrefine_tests --gtest_filter='BadInput*') prints the whole table at the end.
@@ -235,7 +236,8 @@ const testing::Environment* const kTablePrinter = testing::AddGlobalTestEnvironm
 
 enum class Expect {
   Error,          // refused with one error line, nothing written
-  Original,       // exit 0, repaired original written, report outcome "original (...)"
+  Kept,           // exit 0, repaired input written, report outcome "kept" (reason in "reason")
+  KeptInvalid,    // exit 0, the input written as read, report outcome "kept-invalid"
   Refined,        // exit 0, report outcome "refined"
   Valid,          // exit 0, valid output, any outcome
   ErrorOrValid,   // either of the first (refused) or a valid written building
@@ -251,7 +253,7 @@ struct Case {
   std::string name;       // the table's "input" column
   std::function<void(Paths&)> make;
   Expect expect;
-  std::string fragment;   // must appear in the error line (Error) or outcome (Original), if set
+  std::string fragment;   // must appear in the error line (Error) or the report's reason (Kept*), if set
   double max_seconds = 300;
 };
 
@@ -326,7 +328,7 @@ std::vector<Case> cases() {
                Expect::Refined});
   c.push_back({"model: only zero-area faces",
                [](Paths& p) { model_is(p, "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nf 1 2 3\nf 2 3 4\nf 1 2 4\nf 1 3 4\n"); },
-               Expect::Error});
+               Expect::KeptInvalid, "usable faces"});
   c.push_back({"model: self-intersecting (bow-tie) front wall",
                [](Paths& p) {
                  std::string s = box_obj();
@@ -338,9 +340,9 @@ std::vector<Case> cases() {
                Expect::ErrorOrValid});
   c.push_back({"model: just the 4 walls (no roof, no ground)", [](Paths& p) { model_is(p, box_obj({2, 3, 4, 5})); },
                Expect::ErrorOrValid});
-  c.push_back({"model: just 2 walls", [](Paths& p) { model_is(p, box_obj({2, 3})); }, Expect::Error});
+  c.push_back({"model: just 2 walls", [](Paths& p) { model_is(p, box_obj({2, 3})); }, Expect::KeptInvalid, "not closable"});
   c.push_back({"model: a single triangle", [](Paths& p) { model_is(p, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"); },
-               Expect::Error});
+               Expect::KeptInvalid, "usable faces"});
   c.push_back({"model: binary garbage", [](Paths& p) { model_is(p, std::string("\x7f" "ELF\x02\x01\x01\0\0\0", 10)); },
                Expect::Error, "binary"});
   c.push_back({"model: a PLY file given as the model", [](Paths& p) { model_is(p, ply_ascii({{0, 0, 0}})); },
@@ -418,16 +420,16 @@ std::vector<Case> cases() {
                [](Paths& p) { cloud_is(p, ply_header("ascii", 2) + "85001 447000 1\nnan 447000 2\n"); }, Expect::Error});
   c.push_back({"cloud: 0 points", [](Paths& p) { cloud_is(p, ply_binary({})); }, Expect::Error, "no points"});
   c.push_back({"cloud: 1 point", [](Paths& p) { cloud_is(p, ply_binary({kOrigin + Vec3(6, 0, 2)})); },
-               Expect::Original});
+               Expect::Kept});
   c.push_back({"cloud: 10 points on the wall",
                [](Paths& p) {
                  std::vector<Vec3> pts;
                  for (int i = 0; i < 10; ++i) pts.push_back(kOrigin + Vec3(1 + i, 0, 1 + 0.3 * i));
                  cloud_is(p, ply_binary(pts));
                },
-               Expect::Original});
+               Expect::Kept});
   c.push_back({"cloud: 10 km away from the model",
-               [](Paths& p) { cloud_is(p, ply_binary(shifted(wall_scan(), Vec3(10000, 0, 0)))); }, Expect::Original});
+               [](Paths& p) { cloud_is(p, ply_binary(shifted(wall_scan(), Vec3(10000, 0, 0)))); }, Expect::Kept});
   c.push_back({"cloud: pure clutter (uniform random around the building)",
                [](Paths& p) {
                  std::mt19937 rng(5);
@@ -436,7 +438,7 @@ std::vector<Case> cases() {
                  for (int i = 0; i < 6000; ++i) pts.push_back(kOrigin + Vec3(x(rng), y(rng), z(rng)));
                  cloud_is(p, ply_binary(pts));
                },
-               Expect::Original});
+               Expect::Kept});
   c.push_back({"cloud: every point duplicated 3 times",
                [](Paths& p) {
                  std::vector<Vec3> pts;
@@ -446,7 +448,7 @@ std::vector<Case> cases() {
                Expect::Valid});
   c.push_back({"cloud: 2000 copies of one point",
                [](Paths& p) { cloud_is(p, ply_binary(std::vector<Vec3>(2000, kOrigin + Vec3(6, 0, 2)))); },
-               Expect::Original, "", 30.0});
+               Expect::Kept, "", 30.0});
   c.push_back({"cloud: header claims 2^31 points, 1 KiB of data",
                [](Paths& p) { cloud_is(p, ply_header("binary_little_endian", 1ull << 31) + std::string(1024, '\0')); },
                Expect::Error, "header declares", 10.0});
@@ -647,9 +649,18 @@ TEST_P(BadInput, Contract) {
   EXPECT_NE(k.expect, Expect::Error) << "accepted, expected a refusal";
   EXPECT_TRUE(r.err.empty()) << "stderr on success";
   ASSERT_TRUE(fs::is_regular_file(out)) << "exit 0 but no output: the building was dropped";
-  EXPECT_EQ(output_problem(out), "");
   ASSERT_TRUE(report.is_object()) << "no report";
   EXPECT_EQ(report.value("written", std::string()), out);
+  const std::string reason = report.value("reason", std::string());
+  if (k.expect == Expect::KeptInvalid || outcome == "kept-invalid") {
+    EXPECT_TRUE(k.expect == Expect::KeptInvalid || k.expect == Expect::ErrorOrValid) << outcome << ": " << reason;
+    EXPECT_EQ(outcome, "kept-invalid");
+    EXPECT_FALSE(reason.empty());
+    if (!k.fragment.empty()) EXPECT_NE(reason.find(k.fragment), std::string::npos) << reason;
+    EXPECT_EQ(read_obj(out).faces.size(), read_obj(p.model).faces.size()) << "kept-invalid is the input as read";
+    return;
+  }
+  EXPECT_EQ(output_problem(out), "");
   EXPECT_TRUE(report["output_validation"].value("valid", false));
   if (k.expect == Expect::Refined) {
     EXPECT_EQ(outcome, "refined");
@@ -664,10 +675,10 @@ TEST_P(BadInput, Contract) {
     }
     EXPECT_LT(worst, 0.03) << "front wall not moved onto the scan";
   }
-  if (k.expect == Expect::Original) {
-    EXPECT_EQ(outcome.rfind("original (", 0), 0u) << outcome;
+  if (k.expect == Expect::Kept) {
+    EXPECT_EQ(outcome, "kept") << reason;
     EXPECT_FALSE(report.value("refined", true));
-    if (!k.fragment.empty()) EXPECT_NE(outcome.find(k.fragment), std::string::npos) << outcome;
+    if (!k.fragment.empty()) EXPECT_NE(reason.find(k.fragment), std::string::npos) << reason;
   }
 }
 
@@ -887,8 +898,8 @@ TEST(BadInputSolver, OneMillisecondLimitFailsEvenAnEasyProgram) {
           "ok=false, status '" + r.status + "' (30 s limit: '" + easy.status + "')", 0);
 }
 
-// The whole pipeline under a failing solver: refine_building must fall back to the repaired
-// original, valid, with the solver status as the reason. Needs Params to accept a 1 ms limit
+// The whole pipeline under a failing solver (the arrangement path forced): refine_building must
+// keep the repaired input, valid, with the solver status as the reason. Needs Params to accept a 1 ms limit
 // (params.h: mip_time_limit min 0.001); skipped while the bound is higher.
 TEST(BadInputSolver, RefineFallsBackToTheOriginalWhenSelectionTimesOut) {
   double min_limit = 0;
@@ -904,10 +915,12 @@ TEST(BadInputSolver, RefineFallsBackToTheOriginalWhenSelectionTimesOut) {
   cloud.points = wall_scan();
   Params prm;
   prm.mip_time_limit = 0.001;
+  prm.arrangement_only = 1;
   const RefineResult r = refine_building(model, cloud, prm);
   ASSERT_TRUE(r.valid) << r.report.dump(1);
   EXPECT_FALSE(r.refined);
-  EXPECT_EQ(r.outcome, "original (face selection time limit (no solution))");
+  EXPECT_EQ(r.outcome, "kept");
+  EXPECT_EQ(r.reason, "face selection time limit (no solution)");
   EXPECT_EQ(r.report.value("outcome", std::string()), r.outcome);
   ASSERT_FALSE(r.report["replacements"].empty());
   EXPECT_EQ(r.report["replacements"][0]["mip"].value("status", std::string()), "time limit (no solution)");
@@ -919,12 +932,13 @@ TEST(BadInputSolver, RefineFallsBackToTheOriginalWhenSelectionTimesOut) {
   write_text(dir + "/c.ply", valid_cloud());
   const CliRun cli = run_cli("refine --model " + shell_quote(dir + "/m.obj") + " --cloud " + shell_quote(dir + "/c.ply") +
                               " --out " + shell_quote(dir + "/r.obj") + " --report " + shell_quote(dir + "/r.json") +
-                              " --mip-time-limit 0.001",
+                              " --mip-time-limit 0.001 --arrangement-only 1",
                           dir);
   EXPECT_EQ(cli.exit, 0) << cli.err;
   EXPECT_EQ(output_problem(dir + "/r.obj"), "");
   const json rep = json::parse(read_text(dir + "/r.json"));
-  EXPECT_EQ(rep.value("outcome", std::string()), "original (face selection time limit (no solution))");
+  EXPECT_EQ(rep.value("outcome", std::string()), "kept");
+  EXPECT_EQ(rep.value("reason", std::string()), "face selection time limit (no solution)");
   add_row("valid input, --mip-time-limit 0.001", first_line(cli.out), cli.exit);
 }
 

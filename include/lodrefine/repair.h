@@ -25,8 +25,10 @@ struct RepairReport {
 // are carried over; filled holes get Semantic::Ground if they are horizontal facing down,
 // Semantic::Roof if horizontal facing up, else the semantic of their neighbours (by shared edge
 // length). A hole planar within 2 cm becomes one face, a non-planar one is triangulated (noted).
-// Welding clusters around seed vertices, so it never chains across more than `weld_tolerance`.
-Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report = nullptr);
+// Welding joins the closest pairs first: vertices of different faces within
+// max(weld_tolerance, gap_tolerance) (export gaps, jittered corners), two vertices of one face
+// only within weld_tolerance, so a face's own short edges never collapse.
+Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report = nullptr, double gap_tolerance = 0.0);
 
 // Merges edge-adjacent coplanar faces of the same semantic into single polygons (within
 // `angle_deg` / `distance`), removing the then-redundant collinear vertices. Input must be a
