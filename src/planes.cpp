@@ -119,9 +119,27 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm)
   }
   if ((hi - lo).norm() < 10.0 * prm.ransac_epsilon) return result;
   std::sort(order.begin(), order.end());  // file order: keeps runs reproducible as before
+  // Detection runs on one point per voxel (its cost grows with the points, not the facade
+  // area); every point of a voxel whose representative a plane took, and that lies within
+  // epsilon of that plane, is the plane's inlier.
+  const double voxel = prm.detect_voxel;
+  auto key = [&](const Vec3& p) -> std::uint64_t {
+    if (voxel <= 0) return 0;
+    const Vec3 q = (p - lo) / voxel;
+    return (std::uint64_t(q.x()) << 42) | (std::uint64_t(q.y()) << 21) | std::uint64_t(q.z());
+  };
+  std::vector<int> reps;  // indices into the cloud
+  std::unordered_map<std::uint64_t, int> voxel_rep;
+  if (voxel > 0 && ((hi - lo) / voxel).maxCoeff() < double(1 << 21)) {
+    for (int i : order)
+      if (voxel_rep.emplace(key(cloud.points[i]), int(reps.size())).second) reps.push_back(i);
+  } else {
+    reps = order;
+  }
+  if (reps.size() < std::size_t(std::max(prm.ransac_min_points, prm.normal_neighbors + 1))) return result;
   PointList pts;
-  pts.reserve(order.size());
-  for (int i : order) {
+  pts.reserve(reps.size());
+  for (int i : reps) {
     const auto& p = cloud.points[i];
     pts.emplace_back(Point(p.x(), p.y(), p.z()), Vector(0, 0, 0), i);
   }
@@ -135,15 +153,43 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm)
   ransac.add_shape_factory<RansacPlane>();
   Ransac::Parameters rp;
   rp.probability = prm.ransac_probability;
-  rp.min_points = std::size_t(prm.ransac_min_points);
+  // min_points counts points of the full cloud: scaled to the voxel representatives.
+  rp.min_points = std::max<std::size_t>(std::size_t(prm.normal_neighbors) + 1,
+                                        std::size_t(double(prm.ransac_min_points) * double(reps.size()) / double(order.size())));
   rp.epsilon = prm.ransac_epsilon;
   rp.cluster_epsilon = prm.ransac_cluster_epsilon;
   rp.normal_threshold = std::cos(prm.ransac_normal_deg * M_PI / 180.0);
   ransac.detect(rp);
 
+  std::vector<int> rep_shape(reps.size(), -1);
+  int shape_id = 0;
+  std::vector<std::vector<int>> shape_inliers;
   for (const auto& shape : ransac.shapes()) {
     std::vector<int> inl;
-    for (std::size_t k : shape->indices_of_assigned_points()) inl.push_back(std::get<2>(pts[k]));
+    for (std::size_t k : shape->indices_of_assigned_points()) {
+      inl.push_back(std::get<2>(pts[k]));
+      rep_shape[k] = shape_id;
+    }
+    shape_inliers.push_back(std::move(inl));
+    ++shape_id;
+  }
+  if (!voxel_rep.empty()) {
+    // Back to the full cloud: each shape takes the points of its voxels near its plane.
+    std::vector<Plane> fitted;
+    for (const auto& inl : shape_inliers) {
+      std::vector<Vec3> q;
+      for (int i : inl) q.push_back(cloud.points[i]);
+      fitted.push_back(q.size() >= 3 ? fit_plane(q) : Plane());
+      }
+    for (auto& inl : shape_inliers) inl.clear();
+    for (int i = 0; i < int(n); ++i) {
+      const auto it = voxel_rep.find(key(cloud.points[i]));
+      if (it == voxel_rep.end()) continue;
+      const int sh = rep_shape[it->second];
+      if (sh >= 0 && std::abs(fitted[sh].distance(cloud.points[i])) <= prm.ransac_epsilon) shape_inliers[sh].push_back(i);
+    }
+  }
+  for (auto& inl : shape_inliers) {
     if (inl.size() < 3) continue;
     ScanPlane sp = describe(cloud.points, std::move(inl), prm);
     if (sp.hull_area >= prm.min_plane_area) result.push_back(std::move(sp));
