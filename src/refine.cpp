@@ -484,6 +484,55 @@ double rms_distance(const Mesh& mesh, const std::vector<Vec3>& pts) {
   return std::sqrt(s / double(pts.size()));
 }
 
+// Whether `after` keeps every roof part of `before` that lies away from a wall moving from
+// plane `from` to `to`: the arrangement keeps roof planes, so a roof dropped, flattened or
+// replaced there shows as roof samples off the new model.
+bool roof_kept_away_from(const Mesh& before, const Mesh& after, const Plane& from, const Plane& to) {
+  constexpr double kZone = 1.0;      // m beyond the slab between the old and new wall
+  constexpr double kSpacing = 0.5;   // m between roof samples
+  constexpr double kOff = 0.05;      // m: a kept roof sample farther off the new model is damage
+  std::vector<int> roofs;
+  for (int f = 0; f < int(before.faces.size()); ++f)
+    if (before.faces[f].sem == Semantic::Roof) roofs.push_back(f);
+  const double reach = std::abs(to.distance(from.project(Vec3::Zero()))) + kZone;
+  std::vector<Vec3> far;
+  for (const auto& p : sample_faces(before, roofs, kSpacing))
+    if (std::abs(from.distance(p)) > reach && std::abs(to.distance(p)) > reach) far.push_back(p);
+  if (far.empty()) return true;
+  for (double d : cloud_to_mesh(after, far))
+    if (std::abs(d) > kOff) return false;
+  return true;
+}
+
+// Whether the scan shows a moved wall's eave where its pitched roof's plane meets the new wall
+// (the roof plane was right) rather than at the old eave height (the roof outline was right):
+// the top of the wall's own points decides, and only where it clearly does.
+bool eave_follows_roof(const Mesh& mesh, const std::vector<ModelSurface>& surfaces, const Match& m, const Plane& plane,
+                       const PointCloud& cloud) {
+  // m: the two eaves must differ by kDiffer; the scan's top must lie within kAgree of the
+  // followed one and closer to it than to the kept one by kMargin (a scan may stop short of
+  // the eave under an overhang).
+  constexpr double kDiffer = 0.2, kAgree = 0.3, kMargin = 0.15;
+  constexpr double kTopQuantile = 0.99;          // the wall's points' top, robust to a few strays
+  if (m.owned.empty()) return false;
+  auto top = [&](bool follow) {
+    const auto sub = substitute_walls(mesh, surfaces, {{m.surface, plane, follow}}, 1e300);
+    double z = -1e300;
+    if (!sub.ok) return z;
+    for (int f : surfaces[m.surface].faces)
+      for (int v : mesh.faces[f].v) z = std::max(z, sub.mesh.vertices[v].z());
+    return z;
+  };
+  const double keep = top(false), follow = top(true);
+  if (std::abs(keep - follow) < kDiffer) return false;
+  std::vector<double> z;
+  for (int i : m.owned) z.push_back(cloud.points[i].z());
+  const std::size_t k = std::size_t(kTopQuantile * double(z.size() - 1));
+  std::nth_element(z.begin(), z.begin() + long(k), z.end());
+  const double scan_top = z[k];
+  return std::abs(scan_top - follow) <= kAgree && std::abs(scan_top - follow) + kMargin < std::abs(scan_top - keep);
+}
+
 }  // namespace
 
 RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const Params& prm) {
@@ -579,7 +628,7 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
     if (pl.n.dot(surfaces[m.surface].plane.n) < 0) pl = pl.flipped();
     scanned.push_back({m.surface, m.scan_plane, pl});
     const double dev = deviation(current, surfaces[m.surface], pl);
-    if (dev > prm.change_tolerance) moves.push_back({m.surface, pl});
+    if (dev > prm.change_tolerance) moves.push_back({m.surface, pl, eave_follows_roof(current, surfaces, m, pl, local)});
     for (int i : m.owned) facade_points.push_back(local.points[i]);
     jm.push_back({{"scan_plane", m.scan_plane}, {"surface", m.surface}, {"s_normal", m.s_normal},
                   {"d_centroid", m.d_centroid}, {"c_bbox", m.c_bbox}, {"s_match", m.s_match}, {"points", m.owned.size()},
@@ -702,6 +751,10 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
         if (sr.info.contains("mip")) mip_seconds += sr.info["mip"].value("seconds", 0.0);
         js.update(sr.info);
         js["method"] = "arrangement";
+        if (sr.ok && !roof_kept_away_from(step_mesh, sr.mesh, surf.plane, r.plane)) {
+          sr.ok = false;
+          sr.reason = "the arrangement changed the roof away from the moved wall";
+        }
         if (sr.ok) m = std::move(sr.mesh);
         else js["reason"] = sr.reason;
       }

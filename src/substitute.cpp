@@ -14,6 +14,8 @@ constexpr double kWallMaxNz = 0.5;
 // Regulariser of the plan-view solve: picks the nearest point on the trace when only one wall
 // direction meets at a vertex; small against any real pair of walls (sin^2 of 0.1 deg ~ 3e-6).
 constexpr double kNearestWeight = 1e-7;
+// Planes flatter than this are flat roofs or ground: a vertex never slides along them.
+constexpr double kFlatNz = 0.999;
 // Two walls cross (and fix a vertex in plan view) when their traces differ by more than
 // this (sin 15 deg): nearer to parallel, their meet runs away with any small move.
 constexpr double kMinCrossing = 0.26;
@@ -46,48 +48,70 @@ SubstitutionResult substitute_walls(const Mesh& mesh, const std::vector<ModelSur
     for (int s : ss) touched = touched || (s >= 0 && moved_plane[s] >= 0);
     if (!touched) continue;
     const Vec3 p = mesh.vertices[v];
-    // Each wall's trace at height z: n_xy . x = c. Kept walls pass through the vertex itself,
-    // so a slightly warped input wall never pulls its vertices.
-    struct Trace {
-      Vec2 n;
-      double c;
-      bool moved;
+    // The planes that fix this vertex, in priority: the moved walls, then (where a moved wall
+    // follows its roof) the pitched roofs here, then the kept walls. Kept planes pass through
+    // the vertex itself, so a slightly warped input face never pulls it. Without a pitched
+    // roof to follow, a vertex keeps its height and only the walls' traces count.
+    struct Constraint {
+      Vec3 n;
+      double d;
+      int rank;  // 0 moved wall, 1 followed roof, 2 kept wall
     };
-    std::vector<Trace> traces;
+    std::vector<Constraint> cs;
+    bool follow = false;
+    for (int s : ss)
+      if (s >= 0 && moved_plane[s] >= 0) follow = follow || moves[moved_plane[s]].follow_roof;
     for (int s : ss) {
       if (s < 0) continue;
       const bool moved = moved_plane[s] >= 0;
       const Plane pl = moved ? moves[moved_plane[s]].plane : Plane::through(p, surfaces[s].plane.n);
-      if (std::abs(pl.n.z()) > kWallMaxNz) continue;
-      const Vec2 n2(pl.n.x(), pl.n.y());
-      const double len = n2.norm();
-      traces.push_back({n2 / len, -(pl.d + pl.n.z() * p.z()) / len, moved});
+      const double nz = std::abs(pl.n.z());
+      if (nz <= kWallMaxNz) {
+        cs.push_back({pl.n, pl.d, moved ? 0 : 2});
+      } else if (follow && nz < kFlatNz) {
+        cs.push_back({pl.n, pl.d, 1});
+      }
     }
-    // At most two independent directions fix a point in plan view: the moved walls first, then
-    // the kept walls crossing them. A kept wall (nearly) parallel to a moved one cannot follow
-    // it; its face bends to the new vertex and is split below if no longer planar.
-    std::stable_sort(traces.begin(), traces.end(), [](const Trace& a, const Trace& b) { return a.moved > b.moved; });
-    std::vector<Trace> used;
-    for (const auto& t : traces) {
-      bool independent = used.size() < 2;
-      for (const auto& u : used) independent = independent && std::abs(u.n.x() * t.n.y() - u.n.y() * t.n.x()) > kMinCrossing;
-      if (independent) used.push_back(t);
+    const bool in_3d = std::any_of(cs.begin(), cs.end(), [](const Constraint& c) { return c.rank == 1; });
+    if (!in_3d)  // plan view: each wall's trace at this height
+      for (auto& c : cs) {
+        c.d += c.n.z() * p.z();
+        c.n.z() = 0.0;
+        const double len = c.n.norm();
+        c.n /= len;
+        c.d /= len;
+      }
+    // At most as many independent directions as fix a point: a kept plane (nearly) parallel to
+    // a moved one cannot follow it; its face bends to the new vertex and is split below if no
+    // longer planar.
+    std::stable_sort(cs.begin(), cs.end(), [](const Constraint& a, const Constraint& b) { return a.rank < b.rank; });
+    std::vector<Constraint> used;
+    for (const auto& c : cs) {
+      bool independent = false;
+      if (used.empty()) independent = true;
+      else if (used.size() == 1) independent = used[0].n.cross(c.n).norm() > kMinCrossing;
+      else if (used.size() == 2 && in_3d) {
+        const Vec3 m = used[0].n.cross(used[1].n);
+        independent = std::abs(m.normalized().dot(c.n)) > kMinCrossing;
+      }
+      if (independent) used.push_back(c);
     }
-    Eigen::Matrix2d a = kNearestWeight * Eigen::Matrix2d::Identity();
-    Vec2 b = kNearestWeight * p.head<2>();
-    for (const auto& t : used) {
-      a += t.n * t.n.transpose();
-      b += t.c * t.n;
+    Eigen::Matrix3d a = kNearestWeight * Eigen::Matrix3d::Identity();
+    Vec3 b = kNearestWeight * p;
+    if (!in_3d) a(2, 2) = 1.0, b.z() = p.z();  // plan view: the height stays
+    for (const auto& c : used) {
+      a += c.n * c.n.transpose();
+      b -= c.d * c.n;
     }
-    const Vec2 x = a.ldlt().solve(b);
+    const Vec3 x = a.ldlt().solve(b);
     double residual = 0.0;
-    for (const auto& t : traces)
-      if (t.moved) residual = std::max(residual, std::abs(t.n.dot(x) - t.c));
+    for (const auto& c : cs)
+      if (c.rank == 0) residual = std::max(residual, std::abs(c.n.dot(x) + c.d));
     if (!x.allFinite() || residual > kMeetTolerance) {
       res.reason = "the moved walls no longer meet at one vertex (residual " + std::to_string(residual) + " m)";
       return res;
     }
-    res.mesh.vertices[v] = Vec3(x.x(), x.y(), p.z());
+    res.mesh.vertices[v] = x;
     res.max_vertex_move = std::max(res.max_vertex_move, (res.mesh.vertices[v] - p).norm());
     ++res.moved_vertices;
   }

@@ -283,10 +283,6 @@ constexpr double kRoofTolerance = 0.01;
 
 // Buildings known to fail, with the diagnosed reason (still run and printed, not asserted).
 const std::map<std::string, std::string> kKnownFailures = {
-    {"{228D167B-09BF-4CF8-A381-A2D9242DECAC}",
-     "repair fills a 16-vertex hole that is 7.3 m out of plane with 14 triangles (vertical ones labelled "
-     "GroundSurface, up-facing ground); the street wall's MIP is then infeasible, so the "
-     "repaired original is written with that reason"},
     {"08835", "GLPK stops at mip_time_limit with a suboptimal selection (scan RMS 5.4 cm)"},
 };
 
@@ -452,14 +448,14 @@ Row run_building(const Mesh& soup) {
     row.outcome = "repair left the model open";
     return row;
   }
-  // Without a scan the pipeline returns the repaired, planarised original: the reference for
-  // "unchanged" (planarising non-planar input faces moves vertices by up to a few cm).
+  // Without a scan the pipeline returns the repaired input ("kept"): the reference for
+  // "unchanged". Its coplanar faces merged give whole walls to scan.
   const RefineResult base = refine_building(soup, PointCloud{}, prm);
   if (!base.valid) {
     row.outcome = "repaired model invalid: " + base.report["output_validation"].value("problem", std::string());
     return row;
   }
-  const Mesh before = translated(base.mesh, -origin);
+  const Mesh before = merge_coplanar_faces(translated(base.mesh, -origin));
   for (const auto& v : before.vertices) row.snap = std::max(row.snap, nearest_vertex_distance(v, local));
   const int wall = longest_wall(before);
   if (wall < 0) {
@@ -500,7 +496,7 @@ Row run_building(const Mesh& soup) {
   const Validation val = validate_mesh(refined, 0.01);
   if (!r.valid || !val.valid())
     row.failures.push_back("invalid result: " + (val.problem.empty() ? std::string("r.valid false") : val.problem));
-  if (!r.refined) row.failures.push_back("not refined: " + r.outcome);
+  if (!r.refined) row.failures.push_back("not refined: " + r.outcome + " (" + r.reason + ")");
 
   // Scan facade points to the nearest refined face parallel to the wall (within 5 degrees).
   std::vector<std::vector<Vec3>> parallel;

@@ -1,7 +1,8 @@
 // Stage 3 (first choice): wall substitution. A matched wall takes its scan plane and every
 // vertex it carries is re-solved against the planes of the other walls at that vertex, at its
-// own height. The model keeps its topology, ids and semantics; roof and ground vertices keep
-// their heights, so eaves, ridges and flat roof levels stay where the airborne model had them.
+// own height (or, where the scan shows the eave moved with the roof, along the roof's plane).
+// The model keeps its topology, ids and semantics; flat roofs, ridges and the ground keep their
+// heights.
 // Where that is not possible (a wall moved past a short neighbour, walls that no longer meet
 // in one point) it says so, and the caller falls back to the local candidate arrangement.
 #pragma once
@@ -17,6 +18,10 @@ namespace lodrefine {
 struct WallMove {
   int surface = -1;  // index into the model surfaces
   Plane plane;       // its new plane (oriented like the wall)
+  // Where the wall carries a pitched roof: true slides the eave along the roof's plane (the
+  // roof plane is right, the footprint was wrong), false keeps the eave's height (the roof
+  // outline is right, its pitch follows the wall).
+  bool follow_roof = false;
 };
 
 struct SubstitutionResult {
