@@ -179,13 +179,13 @@ bool self_intersects(const Mesh& m) {
   return false;
 }
 
-std::string first_problem(const Validation& v, double planarity_tolerance) {
+std::string first_problem(const Validation& v, double planarity_tolerance, bool single_component) {
   const auto n = [](int k) { return std::to_string(k); };
   if (v.boundary_edges) return n(v.boundary_edges) + " boundary edges (mesh not closed)";
   if (v.nonmanifold_edges) return n(v.nonmanifold_edges) + " non-manifold edges (more than two faces)";
   if (v.nonmanifold_vertices) return n(v.nonmanifold_vertices) + " non-manifold vertices (faces meet only at a point)";
   if (v.inconsistent_edges) return n(v.inconsistent_edges) + " inconsistently oriented edges";
-  if (v.components != 1) return n(v.components) + " connected components (expected one)";
+  if (single_component && v.components != 1) return n(v.components) + " connected components (expected one)";
   if (!v.outward) return "faces point inward (signed volume " + format_number(v.volume) + " m^3)";
   if (v.max_planarity_error > planarity_tolerance)
     return "face planarity error " + format_number(v.max_planarity_error) + " m exceeds " +
@@ -227,7 +227,8 @@ double signed_volume(const std::vector<Vec3>& vertices, const std::vector<Face>&
   return volume;
 }
 
-Validation validate_mesh(const Mesh& mesh, double planarity_tolerance, bool check_self_intersections) {
+Validation validate_mesh(const Mesh& mesh, double planarity_tolerance, bool check_self_intersections,
+                         bool single_component) {
   Validation v;
   v.problem = mesh.faces.empty() ? "no faces" : malformed(mesh);
   if (!v.problem.empty()) return v;
@@ -239,7 +240,7 @@ Validation validate_mesh(const Mesh& mesh, double planarity_tolerance, bool chec
   v.outward = v.volume > 0;
   v.max_planarity_error = max_planarity_error(mesh);
   if (check_self_intersections) v.self_intersecting = self_intersects(mesh);
-  v.problem = first_problem(v, planarity_tolerance);
+  v.problem = first_problem(v, planarity_tolerance, single_component);
   return v;
 }
 

@@ -27,9 +27,10 @@ struct Validation {
 
 // Checks closed, 2-manifold (edges and vertices), consistently and outward oriented, planar
 // faces within `planarity_tolerance`, one component, no self-intersections (CGAL PMP on the
-// triangulated faces). Expects shared vertices.
+// triangulated faces). Expects shared vertices. `single_component` false accepts a building of
+// several closed shells (a multi-part export).
 Validation validate_mesh(const Mesh& mesh, double planarity_tolerance = 0.01,
-                         bool check_self_intersections = true);
+                         bool check_self_intersections = true, bool single_component = true);
 
 // Edge topology, shared with repair: each undirected edge (lower vertex index first) with the
 // faces using it, `forward` when the face runs from the lower to the higher vertex.
