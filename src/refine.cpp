@@ -429,28 +429,6 @@ namespace {
 // keep their vertices).
 constexpr double kSnapMove = 0.05;
 
-// The repaired input. Exports whose corners disagree by a little more than the weld tolerance
-// (roof jitter) are welded a little coarser; detailed models with features finer than it, finer.
-Mesh repair_input(const Mesh& local_model, const Params& prm, RepairReport& rr) {
-  struct Step {
-    double weld, gap;  // relative to weld_tolerance
-  };
-  constexpr Step kSteps[] = {{1.0, 1.0}, {1.0, 1.5}, {1.0, 2.0}, {0.1, 0.1}, {0.01, 0.01}};
-  for (const auto& [weld, gap] : kSteps) {
-    try {
-      rr = RepairReport{};
-      Mesh m = repair_model(local_model, prm.weld_tolerance * weld, &rr, prm.weld_tolerance * gap);
-      if (weld != 1.0 || gap != 1.0)
-        rr.notes.push_back("welded at " + std::to_string(prm.weld_tolerance * weld) + " m, gaps up to " +
-                           std::to_string(prm.weld_tolerance * gap) + " m");
-      return m;
-    } catch (const InputError&) {
-      if (&weld == &kSteps[std::size(kSteps) - 1].weld) throw;
-    }
-  }
-  throw InputError("unreachable");
-}
-
 // Faces the repair could not keep planar (a warped input face) split into triangles; nothing
 // moves. Returns how many were split.
 int split_warped_faces(Mesh& mesh, double tolerance) {
@@ -474,6 +452,39 @@ int split_warped_faces(Mesh& mesh, double tolerance) {
   }
   mesh.faces = std::move(faces);
   return split;
+}
+
+// The repaired input. Exports whose corners disagree by a little more than the weld tolerance
+// (roof jitter) are welded a little coarser across faces; detailed models with features finer
+// than it, finer. The first weld whose shell is valid wins; else the first that closed at all.
+Mesh repair_input(const Mesh& local_model, const Params& prm, RepairReport& rr) {
+  struct Step {
+    double weld, gap;  // relative to weld_tolerance
+  };
+  constexpr Step kSteps[] = {{1.0, 1.0}, {1.0, 1.5}, {1.0, 2.0}, {0.1, 0.1}, {0.01, 0.01}};
+  std::optional<std::pair<Mesh, RepairReport>> first;
+  std::string error;
+  for (const auto& [weld, gap] : kSteps) {
+    RepairReport r;
+    try {
+      Mesh m = repair_model(local_model, prm.weld_tolerance * weld, &r, prm.weld_tolerance * gap);
+      if (weld != 1.0 || gap != 1.0)
+        r.notes.push_back("welded at " + std::to_string(prm.weld_tolerance * weld) + " m, gaps up to " +
+                          std::to_string(prm.weld_tolerance * gap) + " m");
+      Mesh planar = m;
+      split_warped_faces(planar, prm.planarity_tolerance);
+      if (validate_mesh(planar, prm.planarity_tolerance).valid()) {
+        rr = r;
+        return m;
+      }
+      if (!first) first.emplace(std::move(m), r);
+    } catch (const InputError& e) {
+      if (error.empty()) error = e.what();
+    }
+  }
+  if (!first) throw InputError(error);
+  rr = first->second;
+  return first->first;
 }
 
 // RMS distance of points to a mesh.

@@ -801,6 +801,17 @@ std::vector<std::string> add_defects(Mesh& s, Rng& r) {
     copy_face(s, f);
     log.push_back("duplicate_face:" + std::to_string(f));
   }
+  // Drawn last, so the defects above stay those of earlier versions for every seed.
+  if (r.chance(0.5)) {  // every roof polygon's own copy of its corners a few mm off, some > 1 cm
+    constexpr double kJitterMin = 0.002, kJitterMax = 0.013;
+    for (const auto& f : s.faces)
+      if (f.sem == Semantic::Roof)
+        for (int i : f.v) {
+          const Vec2 d = r.unit2() * r.uniform(kJitterMin, kJitterMax);
+          s.vertices[i] += Vec3(d.x(), d.y(), r.uniform(-0.5, 0.5) * kJitterMin);
+        }
+    log.push_back("roof_jitter");
+  }
   return log;
 }
 

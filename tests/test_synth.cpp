@@ -329,7 +329,10 @@ TEST(SynthDefects, LoggedDefectsArePresentInTheSoup) {
         ++duplicates;
         const int f = std::stoi(d.substr(15));
         const auto a = pts_of(b.coarse, b.coarse.faces[f]), last = pts_of(b.coarse, b.coarse.faces.back());
-        EXPECT_EQ(a, last);
+        const bool jittered = std::count(b.defects.begin(), b.defects.end(), "roof_jitter") &&
+                              b.coarse.faces[f].sem == Semantic::Roof;  // each copy jittered on its own
+        if (!jittered) EXPECT_EQ(a, last);
+        else EXPECT_EQ(a.size(), last.size());
       }
       if (d.rfind("reversed_face:", 0) == 0) {
         ++reversed;
