@@ -809,3 +809,5 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
 }
 
 }  // namespace lodrefine
+
+
