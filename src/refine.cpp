@@ -556,10 +556,11 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
 
   const Vec3 origin = local_origin(model);
   rep["origin"] = {origin.x(), origin.y(), origin.z()};
-  auto finish = [&](const std::string& outcome, const std::string& reason, const Mesh& local_mesh) {
+  auto finish = [&](const std::string& outcome, const std::string& reason, const Mesh& local_mesh,
+                    bool single_shell = true) {
     out.outcome = outcome;
     out.reason = reason;
-    const Validation vf = validate_mesh(local_mesh, prm.planarity_tolerance);
+    const Validation vf = validate_mesh(local_mesh, prm.planarity_tolerance, true, single_shell);
     out.valid = vf.valid();
     out.refined = outcome == "refined";
     rep["outcome"] = outcome;
@@ -599,13 +600,9 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
   const Validation v0 = validate_mesh(kept, prm.planarity_tolerance);
   rep["input_validation"] = validation_json(v0);
   timing["repair"] = seconds_since(t);
-  if (!v0.valid() && v0.components > 1 && validate_mesh(kept, prm.planarity_tolerance, true, false).valid()) {
+  if (!v0.valid() && v0.components > 1 && validate_mesh(kept, prm.planarity_tolerance, true, false).valid())
     // Several closed shells (a multi-part export): each valid, the building kept whole.
-    out.outcome = "kept";
-    auto r = finish("kept", std::to_string(v0.components) + " separate closed shells: kept whole", kept);
-    r.valid = true;
-    return r;
-  }
+    return finish("kept", std::to_string(v0.components) + " separate closed shells: kept whole", kept, false);
   if (!v0.valid()) return finish("kept-invalid", "the input is no valid solid: " + v0.problem, local_model);
   Mesh current = merge_coplanar_faces(kept);
   current.id = model.id;
