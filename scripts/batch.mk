@@ -40,8 +40,9 @@ OUTPUTS := $(foreach id,$(IDS),$(if $(wildcard $(RUN)/$(id)/FAILED),$(RUN)/$(id)
 $(shell printf '%s\n' $(IDS) > '$(RUN)/.ids.tmp' && \
         { cmp -s '$(RUN)/.ids.tmp' '$(RUN)/.ids' && rm -f '$(RUN)/.ids.tmp' || mv -f '$(RUN)/.ids.tmp' '$(RUN)/.ids'; })
 
-.PHONY: all todo clean-results
+.PHONY: all refined todo clean-results
 all: $(RUN)/summary.txt
+refined: $(OUTPUTS)  # every building, without the summary
 todo: $(OUTPUTS)
 
 # One building (both targets come from one run): never fails the batch.
