@@ -1,14 +1,17 @@
 // `lodrefine eval`: the paper's evaluation (C2M, ΔD, watertight rate) of one building or of a
 // whole run directory, plus truth-based distances when a truth model is available.
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <mutex>
 #include <map>
 #include <optional>
+#include <thread>
 #include <tuple>
 
 #include <nlohmann/json.hpp>
@@ -31,6 +34,7 @@ using nlohmann::json;
 struct EvalArgs {
   std::string original, refined, cloud, truth, meta, dir, json_out, csv_out, svg_dir, html_out;
   int html_views = 20;
+  int jobs = int(std::max(1u, std::thread::hardware_concurrency()));
   Params params;
 };
 
@@ -274,21 +278,42 @@ void progress(std::size_t k, std::size_t n, const Row& r, double seconds) {
                fmt(e.delta_d).c_str(), e.watertight_before ? "yes" : "no", e.watertight_after ? "yes" : "no", seconds);
 }
 
-std::vector<Row> evaluate_run(const std::string& dir, const Params& params, const std::string& svg_dir) {
+// Buildings are independent: `jobs` threads take the next one; rows stay in id order and the
+// first unexpected error (not a building's bad input) is rethrown here.
+std::vector<Row> evaluate_run(const std::string& dir, const Params& params, const std::string& svg_dir, int jobs) {
   const auto buildings = discover(dir);
-  std::vector<Row> rows;
-  for (std::size_t k = 0; k < buildings.size(); ++k) {
-    const auto t0 = std::chrono::steady_clock::now();
-    try {
-      rows.push_back(evaluate_files(buildings[k], params, svg_dir));
-    } catch (const InputError& e) {
-      rows.push_back(failure_row(buildings[k].id, e.what()));
+  std::vector<Row> rows(buildings.size());
+  std::atomic<std::size_t> next{0};
+  std::size_t finished = 0;
+  std::mutex mutex;
+  std::exception_ptr error;
+  auto work = [&] {
+    for (std::size_t k; (k = next++) < buildings.size();) {
+      const auto t0 = std::chrono::steady_clock::now();
+      Row& row = rows[k];
+      try {
+        try {
+          row = evaluate_files(buildings[k], params, svg_dir);
+        } catch (const InputError& e) {
+          row = failure_row(buildings[k].id, e.what());
+        }
+        row.files = buildings[k];
+        add_refine_record(row, buildings[k]);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(mutex);
+        if (!error) error = std::current_exception();
+        next = buildings.size();
+        return;
+      }
+      const std::lock_guard<std::mutex> lock(mutex);
+      progress(++finished, buildings.size(), row, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     }
-    rows.back().files = buildings[k];
-    add_refine_record(rows.back(), buildings[k]);
-    progress(k + 1, buildings.size(), rows.back(),
-             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  }
+  };
+  std::vector<std::thread> threads;
+  for (int t = 1; t < std::max(1, jobs); ++t) threads.emplace_back(work);
+  work();
+  for (auto& t : threads) t.join();
+  if (error) std::rethrow_exception(error);
   return rows;
 }
 
@@ -608,7 +633,7 @@ void run(const EvalArgs& a) {
   if (!a.svg_dir.empty()) fs::create_directories(a.svg_dir);
   std::vector<Row> rows;
   if (batch) {
-    rows = evaluate_run(a.dir, a.params, a.svg_dir);
+    rows = evaluate_run(a.dir, a.params, a.svg_dir, a.jobs);
   } else {
     rows.push_back(evaluate_files({"", a.original, a.refined, a.cloud, a.truth, a.meta, "", ""}, a.params, a.svg_dir));
     if (!rows.back().eval.ok()) std::fprintf(stderr, "lodrefine: warning: %s\n", rows.back().eval.error.c_str());
@@ -644,6 +669,8 @@ void add_eval_command(CLI::App& app) {
   cmd->add_option("--html-views", a.html_views, "Buildings shown in 3D in the HTML report, worst first")
       ->capture_default_str()->check(CLI::Range(0, 100000));
   html->needs(dir);
+  cmd->add_option("--jobs", a.jobs, "With --dir: buildings evaluated at once (default: all cores)")
+      ->check(CLI::Range(1, 1024));
   dir->excludes(orig);
   add_param_options(cmd, a.params);
   cmd->callback([] { run(a); });

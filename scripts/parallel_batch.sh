@@ -10,20 +10,13 @@
 # file system). Like batch.mk it does only what is missing or out of date, holds RUN's lock while
 # it runs, and ends with batch.mk's summary (RUN/summary.*, RUN/report.html).
 set -euo pipefail
-if [[ $# -lt 1 ]]; then
-  sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'
-  exit 2
-fi
-run=$(realpath "$1")
+source "$(dirname "$0")/dispatch_common.sh"
 shift
-scripts=$(cd "$(dirname "$0")" && pwd)
-export LODREFINE=$(realpath "${LODREFINE:-$scripts/../build/lodrefine}") ARGS=${ARGS:-}
 command -v parallel > /dev/null || { echo "lodrefine: error: GNU Parallel not found (Debian: parallel)" >&2; exit 2; }
 
 exec 9>> "$run/.batch.lock"
 flock -n 9 || { echo "lodrefine: error: $run is in use by another batch run; wait for it to end" >&2; exit 1; }
 export LODREFINE_BATCH_LOCKED=1
-batch=(make -s -f "$scripts/batch.mk" RUN="$run" LODREFINE="$LODREFINE")
 todo=$(mktemp)
 trap 'rm -f "$todo"' EXIT
 "${batch[@]}" todo > "$todo"

@@ -12,29 +12,22 @@
 # RUN/.slurm/. --wait returns when the summary is written (exit non-zero if a job failed). Do not
 # start batch.mk on the same folder while the jobs run.
 set -euo pipefail
-if [[ $# -lt 1 ]]; then
-  sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'
-  exit 2
-fi
-run=$(realpath "$1")
+source "$(dirname "$0")/dispatch_common.sh"
 shift
 wait=()
 if [[ ${1:-} == --wait ]]; then
   wait=(--wait)
   shift
 fi
-scripts=$(cd "$(dirname "$0")" && pwd)
-export LODREFINE=$(realpath "${LODREFINE:-$scripts/../build/lodrefine}") ARGS=${ARGS:-}
 command -v sbatch > /dev/null || { echo "lodrefine: error: sbatch not found (Debian: slurm-client)" >&2; exit 2; }
 
 mkdir -p "$run/.slurm"
 list=$run/.slurm/todo.$$
-make -s -f "$scripts/batch.mk" RUN="$run" LODREFINE="$LODREFINE" todo > "$list"
+"${batch[@]}" todo > "$list"
 n=$(wc -l < "$list")
-summary=(make -s -f "$scripts/batch.mk" RUN="$run" LODREFINE="$LODREFINE")
 if ((n == 0)); then
   echo "nothing to refine"
-  exec "${summary[@]}"
+  exec "${batch[@]}"
 fi
 tasks=$((n < ${MAX_TASKS:-1000} ? n : ${MAX_TASKS:-1000}))
 # Each task: every tasks-th id of the list, starting at its own index.
@@ -45,5 +38,5 @@ array=$(sbatch --parsable --export=ALL --array=0-$((tasks - 1)) --job-name=lodre
 echo "submitted job array $array: $n buildings in $tasks tasks"
 last=$(sbatch --parsable --export=ALL --dependency=afterany:"$array" --job-name=lodrefine-summary \
        --output="$run/.slurm/summary_%j.out" "${wait[@]}" "$@" \
-       --wrap "$(printf '%q ' "${summary[@]}"); rm -f '$list'")
+       --wrap "$(printf '%q ' "${batch[@]}"); rm -f '$list'")
 echo "summary job $last (after $array): $run/summary.txt"
