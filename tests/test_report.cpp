@@ -87,7 +87,11 @@ Image decode_png(const std::string& file) {
 TEST(Report, PageLoadsWithoutErrorsAndTheScreenshotShowsTheModel) {
   if (!chromium_available()) GTEST_SKIP() << "chromium not installed (Debian: chromium; .ci/run installs it)";
   const fs::path run = fresh_dir("report");
-  make_tile(run, 3);
+  make_tile(run, 4);
+  // One building whose cloud cannot be read: a failed row, no view, and the page still works.
+  std::string broken;
+  for (const auto& e : fs::directory_iterator(run)) broken = std::max(broken, e.path().filename().string());
+  std::ofstream(run / broken / "cloud.ply") << "ply\nformat ascii 1.0\nelement vertex 5\nend_header\n1 2\n";
   ASSERT_EQ(shell(batch_command(run) + " > " + shell_quoted(run / "batch.log") + " 2>&1"), 0) << read_text(run / "batch.log");
   const std::string html = read_text(run / "report.html");
   ASSERT_FALSE(html.empty());
@@ -96,6 +100,12 @@ TEST(Report, PageLoadsWithoutErrorsAndTheScreenshotShowsTheModel) {
   EXPECT_EQ(html.find("href=\"http"), std::string::npos);
   EXPECT_EQ(html.find("<link"), std::string::npos);
   EXPECT_NE(html.find("<svg"), std::string::npos) << "plots and footprints are inline SVG";
+  const std::string reason = read_text(run / broken / "FAILED");
+  ASSERT_FALSE(reason.empty());
+  const auto failed_row = html.find("<tr class=\"failed\"><td>" + broken + "</td><td>failed</td>");
+  EXPECT_NE(failed_row, std::string::npos) << "the failed building heads the table";
+  EXPECT_LT(failed_row, html.find("<tr class=\"refined\">"));
+  EXPECT_EQ(html.find("id=\"view-" + broken + "\""), std::string::npos) << "no view of unreadable inputs";
 
   const fs::path dom = run / "dom.html", log = run / "chromium.log", shot = run / "shot.png";
   ASSERT_EQ(shell(chromium(run / "profile", 900) + "--enable-logging=stderr --v=0 --dump-dom " +
