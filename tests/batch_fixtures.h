@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -55,6 +56,11 @@ inline void make_tile(const fs::path& dir, int n, int points = 4000) {
               0);
 }
 
+// cp -a: timestamps kept, so a copied finished run is still up to date.
+inline void copy_run(const fs::path& from, const fs::path& to) {
+  EXPECT_EQ(shell("cp -a " + shell_quoted(from) + "/. " + shell_quoted(to)), 0);
+}
+
 // The batch Makefile over `run` (extra make arguments appended).
 inline std::string batch_command(const fs::path& run, const std::string& extra = "") {
   return "make -s -f " + shell_quoted(kSource / "scripts" / "batch.mk") + " RUN=" + shell_quoted(run) + " LODREFINE=" +
@@ -90,6 +96,24 @@ inline std::map<std::string, std::string> outcome_files(const fs::path& run) {
       out[id + "/report.json"] = without_timings(json::parse(read_text(e.path() / "report.json"))).dump(1);
   }
   return out;
+}
+
+// A generated tile (inputs only) and a finished local batch.mk run of it.
+struct TileRun {
+  fs::path inputs, done;
+  std::map<std::string, std::string> outputs;  // outcome_files(done)
+  double seconds = 0.0;                         // the batch's wall time
+};
+
+inline TileRun tile_and_batch(const std::string& name, int buildings) {
+  TileRun t{fresh_dir(name + "_inputs"), fresh_dir(name + "_reference"), {}, 0.0};
+  make_tile(t.inputs, buildings);
+  copy_run(t.inputs, t.done);
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_EQ(shell(batch_command(t.done) + " > /dev/null 2>&1"), 0);
+  t.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  t.outputs = outcome_files(t.done);
+  return t;
 }
 
 // Files a finished run must not leave behind (temporaries of killed writers).

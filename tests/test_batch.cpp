@@ -15,24 +15,15 @@ namespace {
 class Batch : public testing::Test {
  protected:
   static void SetUpTestSuite() {
-    inputs_ = new fs::path(fresh_dir("batch_inputs"));
-    make_tile(*inputs_, 4);
-    const fs::path ref = fresh_dir("batch_reference");
-    copy_run(*inputs_, ref);
-    const auto t0 = std::chrono::steady_clock::now();
-    ASSERT_EQ(shell(batch_command(ref) + " > /dev/null 2>&1"), 0);
-    seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    reference_ = new std::map<std::string, std::string>(outcome_files(ref));
-    done_ = new fs::path(ref);
+    TileRun t = tile_and_batch("batch", 4);
+    inputs_ = new fs::path(t.inputs);
+    done_ = new fs::path(t.done);
+    reference_ = new std::map<std::string, std::string>(std::move(t.outputs));
+    seconds_ = t.seconds;
   }
   static void TearDownTestSuite() {
     fs::remove_all(*inputs_);
     fs::remove_all(*done_);
-  }
-
-  // cp -a: timestamps kept, so a copied finished run is still up to date.
-  static void copy_run(const fs::path& from, const fs::path& to) {
-    ASSERT_EQ(shell("cp -a " + shell_quoted(from) + "/. " + shell_quoted(to)), 0);
   }
 
   // Runs the batch; returns the building ids it refined (its "ok <id>:" / "FAILED <id>:" lines).

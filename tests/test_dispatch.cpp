@@ -35,19 +35,16 @@ class Dispatch : public testing::Test {
  protected:
   // The tile (4 buildings) and its local batch.mk run, shared by both engines.
   static void SetUpTestSuite() {
-    inputs_ = new fs::path(fresh_dir("dispatch_inputs"));
-    make_tile(*inputs_, 4);
-    const fs::path local = fresh_dir("dispatch_local");
-    ASSERT_EQ(shell("cp -a " + shell_quoted(*inputs_) + "/. " + shell_quoted(local)), 0);
-    ASSERT_EQ(shell(batch_command(local) + " > /dev/null 2>&1"), 0);
-    local_ = new std::map<std::string, std::string>(outcome_files(local));
-    fs::remove_all(local);
+    TileRun t = tile_and_batch("dispatch", 4);
+    inputs_ = new fs::path(t.inputs);
+    local_ = new std::map<std::string, std::string>(std::move(t.outputs));
+    fs::remove_all(t.done);
   }
   static void TearDownTestSuite() { fs::remove_all(*inputs_); }
 
   static fs::path fresh_run(const std::string& name) {
     const fs::path run = fresh_dir(name);
-    EXPECT_EQ(shell("cp -a " + shell_quoted(*inputs_) + "/. " + shell_quoted(run)), 0);
+    copy_run(*inputs_, run);
     return run;
   }
 
