@@ -118,10 +118,13 @@ std::string footprint_svg(const BuildingEval& e, const Mesh& original, const Mes
                        max_points);
 }
 
+// Points drawn in a footprint file (svg_footprint's default): dense enough to see each facade.
+constexpr std::size_t kFootprintFilePoints = 5000;
+
 void write_footprint(const std::string& svg_dir, const BuildingEval& e, const Mesh& original, const Mesh& refined,
                      const PointCloud& cloud) {
   write_file_atomic((fs::path(svg_dir) / ("footprint_" + file_safe(e.id) + ".svg")).string(),
-                    footprint_svg(e, original, refined, cloud, 5000));
+                    footprint_svg(e, original, refined, cloud, kFootprintFilePoints));
 }
 
 // Inputs and refined model of one building in a local frame (georeferenced inputs): the given
