@@ -530,8 +530,7 @@ std::pair<std::string, std::string> c2m_plots(const std::vector<Row>& rows) {
   return {svg_histogram(before, after, title), svg_boxplot(before, after, title)};
 }
 
-void write_plots(const std::string& svg_dir, const std::vector<Row>& rows) {
-  const auto [histogram, boxplot] = c2m_plots(rows);
+void write_plots(const std::string& svg_dir, const std::string& histogram, const std::string& boxplot) {
   write_file_atomic((fs::path(svg_dir) / "c2m_histogram.svg").string(), histogram);
   write_file_atomic((fs::path(svg_dir) / "c2m_boxplot.svg").string(), boxplot);
 }
@@ -593,14 +592,15 @@ std::string captured(const std::function<void(std::FILE*)>& print) {
 }
 
 // The self-contained page: Table 1, plots, the table worst first, and the worst buildings in 3D.
-void write_html(const EvalArgs& a, const std::vector<Row>& rows, const PooledEval& pooled) {
+void write_html(const EvalArgs& a, const std::vector<Row>& rows, const PooledEval& pooled,
+                const std::pair<std::string, std::string>& plots) {
   HtmlReport h;
   h.title = "lodrefine run " + fs::path(a.dir).filename().string() + ": " + std::to_string(rows.size()) + " buildings";
   h.table1 = captured([&](std::FILE* out) {
     print_table(out, pooled, true);
     print_totals(out, run_totals(rows));
   });
-  std::tie(h.histogram_svg, h.boxplot_svg) = c2m_plots(rows);
+  std::tie(h.histogram_svg, h.boxplot_svg) = plots;
   h.columns = kHtmlColumns;
   h.rows = json::array();
   for (const Row* r : worst_first(rows)) {
@@ -624,8 +624,10 @@ void write_outputs(const EvalArgs& a, const std::vector<Row>& rows, const Pooled
     write_file_atomic(a.json_out, j.dump(2) + "\n");
   }
   if (!a.csv_out.empty()) write_file_atomic(a.csv_out, csv_text(order));
-  if (!a.svg_dir.empty()) write_plots(a.svg_dir, rows);
-  if (!a.html_out.empty()) write_html(a, rows, pooled);
+  if (a.svg_dir.empty() && a.html_out.empty()) return;
+  const auto plots = c2m_plots(rows);
+  if (!a.svg_dir.empty()) write_plots(a.svg_dir, plots.first, plots.second);
+  if (!a.html_out.empty()) write_html(a, rows, pooled, plots);
 }
 
 void run(const EvalArgs& a) {

@@ -294,6 +294,16 @@ double percentile_sorted(const std::vector<double>& s, double q) {
   return s[lo] + (pos - double(lo)) * (s[hi] - s[lo]);
 }
 
+double percentile(std::vector<double>& values, double q) {
+  if (values.empty()) return 0.0;
+  const double pos = q * double(values.size() - 1);
+  const std::size_t lo = std::size_t(std::floor(pos));
+  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(lo), values.end());
+  const double a = values[lo];
+  const double b = lo + 1 < values.size() ? *std::min_element(values.begin() + std::ptrdiff_t(lo) + 1, values.end()) : a;
+  return a + (pos - double(lo)) * (b - a);
+}
+
 DistanceStats summarize_distances(const std::vector<double>& d) {
   DistanceStats s;
   s.count = d.size();
@@ -305,6 +315,7 @@ DistanceStats summarize_distances(const std::vector<double>& d) {
     sum_abs += std::abs(d[i]);
     sum_sq += d[i] * d[i];
     abs_d[i] = std::abs(d[i]);
+    s.max_abs = std::max(s.max_abs, abs_d[i]);
   }
   const double n = double(d.size());
   s.mean = sum / n;
@@ -313,12 +324,9 @@ DistanceStats summarize_distances(const std::vector<double>& d) {
   double var = 0;  // two-pass: stable for small spreads around a large mean
   for (double x : d) var += (x - s.mean) * (x - s.mean);
   s.std = std::sqrt(var / n);
-  std::vector<double> sorted = d;
-  std::sort(sorted.begin(), sorted.end());
-  std::sort(abs_d.begin(), abs_d.end());
-  s.median = percentile_sorted(sorted, 0.5);
-  s.p95 = percentile_sorted(abs_d, 0.95);
-  s.max_abs = abs_d.back();
+  std::vector<double> values = d;
+  s.median = percentile(values, 0.5);
+  s.p95 = percentile(abs_d, 0.95);
   return s;
 }
 
