@@ -55,7 +55,7 @@ struct Row {
   BuildingEval eval;
   Vec3 origin = Vec3::Zero();      // local frame origin (added back to centroids in the JSON)
   std::string truth_faces_source;  // "meta.json", "detected" or empty
-  json report;                     // the refine report.json, if any
+  std::string refine_outcome;      // the refine report's "outcome" as written, if any
   // What the refine step recorded (report.json or FAILED).
   std::string outcome;             // "refined", "kept" (anything else written) or "failed"
   std::string reason;              // why kept / why failed
@@ -204,21 +204,23 @@ std::string first_line(const std::string& path) {
 // any evaluation error, e.g. "refined model missing") or report.json. Anything written that is
 // not "refined" counts as kept; the report's "reason", else the outcome's "(...)" says why.
 void add_refine_record(Row& row, const BuildingFiles& f) {
-  row.report = read_json_or_null(f.report);
+  // Only what the table needs is kept: a city's reports in full would weigh hundreds of MB.
+  const json rep = read_json_or_null(f.report);
+  const json outcome_value = rep.is_object() ? rep.value("outcome", json()) : json();
+  if (outcome_value.is_string()) row.refine_outcome = outcome_value.get<std::string>();
   if (!f.failed.empty()) row.eval.error = first_line(f.failed);
   if (!row.eval.ok()) {
     row.outcome = "failed";
     row.reason = row.eval.error;
     return;
   }
-  const json& rep = row.report;
   if (!rep.is_object()) {
     row.outcome = "kept";
     row.reason = "no report.json";
     return;
   }
   try {
-    const std::string outcome = rep.value("outcome", std::string());
+    const std::string& outcome = row.refine_outcome;
     row.outcome = outcome.rfind("refined", 0) == 0 ? "refined" : "kept";
     row.reason = rep.value("reason", std::string());
     const auto open = outcome.find('('), close = outcome.rfind(')');
@@ -377,7 +379,7 @@ json row_json(const Row& r) {
                   {"scanned_faces_from", r.truth_faces_source},
                   {"facade", {{"original", stats_json(e.truth_facade_before)}, {"refined", stats_json(e.truth_facade_after)}}},
                   {"roof", {{"original", stats_json(e.truth_roof_before)}, {"refined", stats_json(e.truth_roof_after)}}}};
-  if (r.report.is_object()) j["refine_outcome"] = r.report.value("outcome", std::string());
+  if (!r.refine_outcome.empty()) j["refine_outcome"] = r.refine_outcome;
   return j;
 }
 
@@ -463,7 +465,7 @@ std::string csv_text(const std::vector<const Row*>& rows) {
            csv_stats(measured && e.ok() ? std::optional(e.after) : std::nullopt) + ',' + opt(e.delta_d) + ',' +
            csv_rmse(e.truth_facade_before) + ',' + csv_rmse(e.truth_facade_after) + ',' + csv_rmse(e.truth_roof_before) +
            ',' + csv_rmse(e.truth_roof_after) + ',' +
-           csv_field(r->report.is_object() ? r->report.value("outcome", std::string()) : std::string()) + '\n';
+           csv_field(r->refine_outcome) + '\n';
   }
   return out;
 }
