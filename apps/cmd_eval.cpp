@@ -167,7 +167,8 @@ Row evaluate_files(const BuildingFiles& f, const Params& params, const std::stri
   return row;
 }
 
-// The moved facades of a refine report: its "facades" list (surface, displacement) when present,
+// The moved facades of a refine report: its "facades" list when present (a facade is named by
+// "surface" or its "input_faces"; it moved by "displacement", else its largest move "max_move"),
 // else the successful "replacements" (scan plane, moved_by) mapped to the matched surface.
 std::vector<MovedFacade> moved_facades(const json& report) {
   std::vector<MovedFacade> out;
@@ -175,8 +176,11 @@ std::vector<MovedFacade> moved_facades(const json& report) {
   if (facades.is_array()) {
     for (const auto& f : facades) {
       if (!f.is_object()) continue;
-      const json d = f.contains("displacement") ? f["displacement"] : f.value("moved_by", json());
-      if (d.is_number()) out.push_back({f.value("surface", json()), std::abs(d.get<double>())});
+      json d = f.value("displacement", json());
+      if (!d.is_number()) d = f.value("max_move", json());
+      if (!d.is_number()) d = f.value("moved_by", json());
+      const json surface = f.contains("surface") ? f["surface"] : f.value("input_faces", json());
+      if (d.is_number()) out.push_back({surface, std::abs(d.get<double>())});
     }
     return out;
   }
@@ -226,7 +230,7 @@ void add_refine_record(Row& row, const BuildingFiles& f) {
     const auto open = outcome.find('('), close = outcome.rfind(')');
     if (row.reason.empty() && open != std::string::npos && close > open) row.reason = outcome.substr(open + 1, close - open - 1);
     if (row.reason.empty() && row.outcome == "kept") row.reason = outcome;
-    row.moved = moved_facades(rep);
+    if (row.outcome == "refined") row.moved = moved_facades(rep);  // a kept building's model moved nothing
     const json total = rep.value("seconds", json::object()).value("total", json());
     if (total.is_number()) row.refine_seconds = total.get<double>();
   } catch (const json::exception& e) {  // a hand-edited or foreign report: keep the row
