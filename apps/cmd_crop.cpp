@@ -1,4 +1,6 @@
 // `lodrefine crop`: one cloud per building from a large tile, in one streaming pass.
+#include <unistd.h>
+
 #include <cstdio>
 #include <filesystem>
 
@@ -14,6 +16,9 @@ namespace fs = std::filesystem;
 struct CropArgs {
   std::string tile, models, out;
   double expand = 0.1, margin = 3.0;
+  // Points held in memory before spilling to per-building files: ~100 MB at 24 bytes a point,
+  // whatever the tile's size.
+  std::size_t buffer_points = 4000000;
 };
 
 // Models: DIR/*.obj (id = stem) or DIR/<id>/coarse.obj.
@@ -44,15 +49,22 @@ void run(const CropArgs& a) {
       ++skipped;
     }
   }
-  const std::size_t n = crop_tile(a.tile, targets);
+  std::vector<std::string> clouds;
+  for (const auto& id : ids) {
+    fs::create_directories(fs::path(a.out) / id);
+    clouds.push_back((fs::path(a.out) / id / "cloud.ply").string());
+  }
+  std::vector<std::size_t> counts;
+  const std::size_t n = crop_tile_to_files(a.tile, targets, clouds, a.buffer_points, counts);
   for (std::size_t i = 0; i < targets.size(); ++i) {
     const fs::path dir = fs::path(a.out) / ids[i];
-    fs::create_directories(dir);
-    write_ply((dir / "cloud.ply").string(), targets[i].cloud);
     const fs::path model = models[i].second;
-    if (fs::absolute(model) != fs::absolute(dir / "coarse.obj"))
-      fs::copy_file(model, dir / "coarse.obj", fs::copy_options::overwrite_existing);
-    std::printf("%s: %zu points\n", ids[i].c_str(), targets[i].cloud.points.size());
+    if (fs::absolute(model) != fs::absolute(dir / "coarse.obj")) {  // copied atomically, as every output
+      const fs::path tmp = dir / ("coarse.obj.tmp." + std::to_string(::getpid()));
+      fs::copy_file(model, tmp, fs::copy_options::overwrite_existing);
+      fs::rename(tmp, dir / "coarse.obj");
+    }
+    std::printf("%s: %zu points\n", ids[i].c_str(), counts[i]);
   }
   std::printf("%zu tile points, %zu buildings cropped, %d skipped\n", n, targets.size(), skipped);
   if (skipped) exit_code() = 1;
@@ -68,6 +80,8 @@ void add_crop_command(CLI::App& app) {
   cmd->add_option("--out", args.out, "Run folder: writes <id>/cloud.ply and <id>/coarse.obj")->required();
   cmd->add_option("--expand", args.expand, "Relative box growth on each side")->capture_default_str()->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--margin", args.margin, "Absolute box growth on each side (m)")->capture_default_str()->check(CLI::Range(0.0, 1000.0));
+  cmd->add_option("--buffer-points", args.buffer_points, "Points held in memory before spilling to disk (memory bound)")
+      ->capture_default_str()->check(CLI::Range(std::size_t(1), std::size_t(1) << 40));
   cmd->callback([] { run(args); });
 }
 

@@ -13,7 +13,8 @@ struct SynthArgs {
   std::string type = "all";
   std::uint64_t seed = 1;
   int count = 1;
-  std::string out;
+  std::string out, tile;
+  double grid = 80.0;
   bool no_defects = false, no_nuisances = false;
   SynthOptions opt;
 };
@@ -38,6 +39,15 @@ std::string scanned_summary(const SynthBuilding& b) {
 void run(SynthArgs& a) {
   a.opt.defects = !a.no_defects;
   a.opt.nuisances = !a.no_nuisances;
+  if (!a.tile.empty()) {
+    std::size_t done = 0;
+    const std::uint64_t points = write_synth_tile(a.out, a.tile, a.count, a.seed, a.grid, a.opt, [&](const SynthBuilding&) {
+      if (++done % 100 == 0) std::fprintf(stderr, "[%zu/%d] buildings\n", done, a.count);
+    });
+    std::printf("%d buildings -> %s/<id>/{coarse,truth}.obj, %llu points -> %s\n", a.count, a.out.c_str(),
+                static_cast<unsigned long long>(points), a.tile.c_str());
+    return;
+  }
   const auto types =
       a.type == "all" ? all_building_types() : std::vector<BuildingType>{building_type_from_name(a.type)};
   for (auto t : types)
@@ -61,6 +71,9 @@ void add_synth_command(CLI::App& app) {
   cmd->add_option("--seed", a.seed, "first seed (seeds seed..seed+count-1)")->capture_default_str();
   cmd->add_option("--count", a.count, "buildings per type")->capture_default_str()->check(CLI::Range(1, 100000));
   cmd->add_option("--out", a.out, "output directory (one subdirectory per building)")->required();
+  cmd->add_option("--tile", a.tile, "city tile: --count buildings in all (types cycling) on a grid, their clouds "
+                                    "streamed into this one PLY instead of <id>/cloud.ply (cut with `lodrefine crop`)");
+  cmd->add_option("--grid", a.grid, "with --tile: grid spacing between buildings (m)")->capture_default_str()->check(CLI::Range(10.0, 10000.0));
   auto& o = a.opt;
   cmd->add_option("--shift-min", o.min_shift, "min facade offset (m)")
       ->capture_default_str()

@@ -1,12 +1,22 @@
 #!/usr/bin/env bash
 # Installs lodrefine's build and test dependencies from Debian's packages (Debian 12).
-# Usage: scripts/deps.sh [--with-cloudcompare]
+# Usage: scripts/deps.sh [--with-cloudcompare] [--with-browser] [--with-cluster]
+#   --with-cloudcompare  CloudCompare, for the independent C2M cross-check test
+#   --with-browser       Chromium, for the headless test of the HTML report
+#   --with-cluster       Slurm, munge and GNU Parallel, for the cluster dispatch tests
 set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 PKGS="build-essential cmake ccache libcgal-dev libeigen3-dev libglpk-dev libtinyobjloader-dev
-      libcli11-dev nlohmann-json3-dev libtbb-dev libgtest-dev libboost-dev"
-if [ "${1:-}" = "--with-cloudcompare" ]; then PKGS="$PKGS cloudcompare"; fi
+      libcli11-dev nlohmann-json3-dev libtbb-dev libgtest-dev libboost-dev zlib1g-dev"
+for flag in "$@"; do
+  case "$flag" in
+    --with-cloudcompare) PKGS="$PKGS cloudcompare" ;;
+    --with-browser) PKGS="$PKGS chromium" ;;
+    --with-cluster) PKGS="$PKGS slurm-wlm munge parallel" ;;
+    *) echo "deps.sh: unknown option $flag" >&2; exit 2 ;;
+  esac
+done
 missing=""
 for p in $PKGS; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
@@ -14,5 +24,5 @@ done
 if [ -n "$missing" ]; then
   echo "installing:$missing"
   $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends $missing
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get -o DPkg::Lock::Timeout=600 install -y -qq --no-install-recommends $missing
 fi

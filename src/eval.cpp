@@ -294,6 +294,16 @@ double percentile_sorted(const std::vector<double>& s, double q) {
   return s[lo] + (pos - double(lo)) * (s[hi] - s[lo]);
 }
 
+double percentile(std::vector<double>& values, double q) {
+  if (values.empty()) return 0.0;
+  const double pos = q * double(values.size() - 1);
+  const std::size_t lo = std::size_t(std::floor(pos));
+  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(lo), values.end());
+  const double a = values[lo];
+  const double b = lo + 1 < values.size() ? *std::min_element(values.begin() + std::ptrdiff_t(lo) + 1, values.end()) : a;
+  return a + (pos - double(lo)) * (b - a);
+}
+
 DistanceStats summarize_distances(const std::vector<double>& d) {
   DistanceStats s;
   s.count = d.size();
@@ -305,6 +315,7 @@ DistanceStats summarize_distances(const std::vector<double>& d) {
     sum_abs += std::abs(d[i]);
     sum_sq += d[i] * d[i];
     abs_d[i] = std::abs(d[i]);
+    s.max_abs = std::max(s.max_abs, abs_d[i]);
   }
   const double n = double(d.size());
   s.mean = sum / n;
@@ -313,12 +324,9 @@ DistanceStats summarize_distances(const std::vector<double>& d) {
   double var = 0;  // two-pass: stable for small spreads around a large mean
   for (double x : d) var += (x - s.mean) * (x - s.mean);
   s.std = std::sqrt(var / n);
-  std::vector<double> sorted = d;
-  std::sort(sorted.begin(), sorted.end());
-  std::sort(abs_d.begin(), abs_d.end());
-  s.median = percentile_sorted(sorted, 0.5);
-  s.p95 = percentile_sorted(abs_d, 0.95);
-  s.max_abs = abs_d.back();
+  std::vector<double> values = d;
+  s.median = percentile(values, 0.5);
+  s.p95 = percentile(abs_d, 0.95);
   return s;
 }
 
@@ -422,7 +430,7 @@ BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const 
 PooledEval pool_evaluations(const std::vector<BuildingEval>& buildings) {
   PooledEval p;
   p.buildings = buildings.size();
-  std::vector<double> before, after, delta, tf_before, tf_after, tr_before, tr_after;
+  std::vector<double> delta;
   std::vector<const DistanceStats*> per_before, per_after;
   std::size_t wt_before = 0, wt_after = 0;
   for (const auto& b : buildings) {
@@ -433,15 +441,20 @@ PooledEval pool_evaluations(const std::vector<BuildingEval>& buildings) {
       continue;
     }
     if (b.truth_facade_before || b.truth_roof_before) ++p.truth_buildings;
-    append(tf_before, b.truth_facade_d_before), append(tf_after, b.truth_facade_d_after);
-    append(tr_before, b.truth_roof_d_before), append(tr_after, b.truth_roof_d_after);
     if (b.facade_points == 0) continue;
     ++p.evaluated;
-    append(before, b.c2m_before), append(after, b.c2m_after);
     per_before.push_back(&b.before), per_after.push_back(&b.after);
     if (std::isfinite(b.delta_d)) delta.push_back(b.delta_d);
   }
-  p.before = summarize_distances(before), p.after = summarize_distances(after);
+  // One pooled series at a time: a city's distances are held once more, not six times.
+  auto pooled = [&](std::vector<double> BuildingEval::*series, bool with_facade_points) {
+    std::vector<double> all;
+    for (const auto& b : buildings)
+      if (b.ok() && (!with_facade_points || b.facade_points > 0)) append(all, b.*series);
+    return all;
+  };
+  p.before = summarize_distances(pooled(&BuildingEval::c2m_before, true));
+  p.after = summarize_distances(pooled(&BuildingEval::c2m_after, true));
   p.mean_before = average_stats(per_before), p.mean_after = average_stats(per_after);
   if (!delta.empty()) {
     const DistanceStats s = summarize_distances(delta);
@@ -451,8 +464,10 @@ PooledEval pool_evaluations(const std::vector<BuildingEval>& buildings) {
     p.watertight_rate_before = double(wt_before) / double(p.buildings);
     p.watertight_rate_after = double(wt_after) / double(p.buildings);
   }
-  p.truth_facade_before = stats_if_any(tf_before), p.truth_facade_after = stats_if_any(tf_after);
-  p.truth_roof_before = stats_if_any(tr_before), p.truth_roof_after = stats_if_any(tr_after);
+  p.truth_facade_before = stats_if_any(pooled(&BuildingEval::truth_facade_d_before, false));
+  p.truth_facade_after = stats_if_any(pooled(&BuildingEval::truth_facade_d_after, false));
+  p.truth_roof_before = stats_if_any(pooled(&BuildingEval::truth_roof_d_before, false));
+  p.truth_roof_after = stats_if_any(pooled(&BuildingEval::truth_roof_d_after, false));
   return p;
 }
 

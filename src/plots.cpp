@@ -113,8 +113,7 @@ double auto_range(const std::vector<double>& a, const std::vector<double>& b) {
   std::vector<double> all;
   for (double x : a) all.push_back(std::abs(x));
   for (double x : b) all.push_back(std::abs(x));
-  std::sort(all.begin(), all.end());
-  const double q = percentile_sorted(all, 0.99);
+  const double q = percentile(all, 0.99);
   if (!(q > 0)) return 0.1;
   const double step = nice_step(q, 4);
   return std::max(0.1, std::ceil(q / step) * step);
@@ -179,8 +178,7 @@ struct BoxStats {
 BoxStats box_stats(std::vector<double> d) {
   BoxStats b;
   if (d.empty()) return b;
-  std::sort(d.begin(), d.end());
-  b.q1 = percentile_sorted(d, 0.25), b.median = percentile_sorted(d, 0.5), b.q3 = percentile_sorted(d, 0.75);
+  b.q1 = percentile(d, 0.25), b.median = percentile(d, 0.5), b.q3 = percentile(d, 0.75);
   const double iqr = b.q3 - b.q1, fence_lo = b.q1 - 1.5 * iqr, fence_hi = b.q3 + 1.5 * iqr;
   b.lo = b.q1, b.hi = b.q3;
   double sum = 0;

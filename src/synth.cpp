@@ -9,14 +9,19 @@
 // Everything is built in the building's own frame and georeferenced at the end.
 #include "lodrefine/synth.h"
 
+#include <unistd.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <numeric>
 #include <optional>
@@ -1294,14 +1299,73 @@ Json meta_json(const SynthBuilding& b) {
 
 }  // namespace
 
-void write_synth_building(const std::string& dir, const SynthBuilding& b) {
+void write_synth_building(const std::string& dir, const SynthBuilding& b, bool with_cloud) {
   const std::filesystem::path out = std::filesystem::path(dir) / b.id;
   std::filesystem::create_directories(out);
   write_obj((out / "truth.obj").string(), b.truth);
   write_obj((out / "coarse.obj").string(), b.coarse);
-  const std::vector<float> labels(b.point_label.begin(), b.point_label.end());
-  write_ply((out / "cloud.ply").string(), b.cloud, Vec3::Zero(), &labels, "label");
+  if (with_cloud) {
+    const std::vector<float> labels(b.point_label.begin(), b.point_label.end());
+    write_ply((out / "cloud.ply").string(), b.cloud, Vec3::Zero(), &labels, "label");
+  }
   write_file_atomic((out / "meta.json").string(), meta_json(b).dump(2) + "\n");
+}
+
+#if !defined(__BYTE_ORDER__) || __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
+#error "write_synth_tile writes the host's doubles as binary_little_endian"
+#endif
+
+std::uint64_t write_synth_tile(const std::string& dir, const std::string& tile_ply, int count, std::uint64_t first_seed,
+                               double spacing, const SynthOptions& opt,
+                               const std::function<void(const SynthBuilding&)>& progress) {
+  const std::string tmp = tile_ply + ".tmp." + std::to_string(::getpid());
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(tmp.c_str(), "wb"), std::fclose);
+  if (!f) throw InputError("cannot write " + tmp + ": " + std::strerror(errno));
+  // The count is only known at the end: a fixed-width field, rewritten in place.
+  constexpr int kCountWidth = 15;
+  const std::string head = "ply\nformat binary_little_endian 1.0\ncomment lodrefine synth tile\nelement vertex ";
+  const std::string tail = "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
+  auto header = [&](std::uint64_t n) {
+    char num[32];
+    std::snprintf(num, sizeof num, "%0*llu", kCountWidth, static_cast<unsigned long long>(n));
+    return head + num + tail;
+  };
+  auto fail = [&] {
+    const std::string reason = std::strerror(errno);
+    f.reset();
+    std::remove(tmp.c_str());
+    throw InputError("cannot write " + tmp + ": " + reason);
+  };
+  auto put = [&](const void* data, std::size_t bytes) {
+    if (std::fwrite(data, 1, bytes, f.get()) != bytes) fail();
+  };
+  put(header(0).data(), header(0).size());
+  const auto types = all_building_types();
+  const int columns = std::max(1, int(std::ceil(std::sqrt(double(count)))));
+  std::uint64_t points = 0;
+  for (int i = 0; i < count; ++i) {
+    SynthBuilding b = make_building(types[std::size_t(i) % types.size()], first_seed + std::uint64_t(i), opt);
+    // Onto its grid cell: a pure translation, so truth, model, scan and meta stay consistent.
+    const Vec3 cell = opt.origin + Vec3(spacing * (i % columns), spacing * (i / columns), 0.0);
+    const Vec3 shift(cell.x() - b.frame_origin.x(), cell.y() - b.frame_origin.y(), 0.0);
+    b.truth = translated(std::move(b.truth), shift);
+    b.coarse = translated(std::move(b.coarse), shift);
+    for (auto& p : b.cloud.points) p += shift;
+    b.frame_origin += shift;
+    write_synth_building(dir, b, false);
+    std::vector<double> xyz;
+    xyz.reserve(3 * b.cloud.points.size());
+    for (const auto& p : b.cloud.points) xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
+    put(xyz.data(), xyz.size() * sizeof(double));
+    points += b.cloud.points.size();
+    if (progress) progress(b);
+  }
+  if (std::fseek(f.get(), 0, SEEK_SET) != 0) fail();
+  put(header(points).data(), header(points).size());
+  if (std::fflush(f.get()) != 0 || ::fsync(::fileno(f.get())) != 0) fail();
+  f.reset();
+  std::filesystem::rename(tmp, tile_ply);
+  return points;
 }
 
 }  // namespace lodrefine

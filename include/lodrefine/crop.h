@@ -21,4 +21,13 @@ CropTarget crop_target(const Mesh& model, double relative, double absolute);
 // grid over the targets keeps this O(points)). Returns the number of points read.
 std::size_t crop_tile(const std::string& tile_ply, std::vector<CropTarget>& targets);
 
+// The same pass for a whole city tile, with memory bounded by `buffer_points`, not by the tile:
+// each target's points go to `out_paths[i]` (a PLY, written atomically), and points held beyond
+// the bound are spilled to per-target temporary files beside them. Only one target's crop is
+// in memory at a time when the PLYs are written. Returns the number of points read and sets
+// `counts[i]` to each crop's size.
+std::size_t crop_tile_to_files(const std::string& tile_ply, const std::vector<CropTarget>& targets,
+                               const std::vector<std::string>& out_paths, std::size_t buffer_points,
+                               std::vector<std::size_t>& counts);
+
 }  // namespace lodrefine

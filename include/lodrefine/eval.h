@@ -21,6 +21,9 @@ struct DistanceStats {
 DistanceStats summarize_distances(const std::vector<double>& d);
 // Linearly interpolated quantile q (0..1) of an ascending vector; 0 when empty.
 double percentile_sorted(const std::vector<double>& sorted, double q);
+// The same value from unsorted values in O(n) (selection, not a sort; a city's tens of millions
+// of distances): reorders `values`.
+double percentile(std::vector<double>& values, double q);
 
 // Signed distance from each point to the nearest point of the mesh surface (positive on the
 // side the nearest face's outward normal points to). CGAL AABB tree on the triangulated faces.

@@ -2,6 +2,7 @@
 // model of it (facades shifted/rotated, export defects) and a simulated MLS crop.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -56,7 +57,17 @@ struct SynthBuilding {
 // Deterministic for (type, seed, options).
 SynthBuilding make_building(BuildingType type, std::uint64_t seed, const SynthOptions& opt = {});
 
-// Writes DIR/<id>/{truth.obj, coarse.obj, cloud.ply, meta.json}.
-void write_synth_building(const std::string& dir, const SynthBuilding& b);
+// Writes DIR/<id>/{truth.obj, coarse.obj, cloud.ply, meta.json} (without cloud.ply when
+// `with_cloud` is false).
+void write_synth_building(const std::string& dir, const SynthBuilding& b, bool with_cloud = true);
+
+// A city tile for the city-scale bench: `count` buildings (types cycling, seeds first_seed...)
+// on a square grid of `spacing` metres from opt.origin, each written as DIR/<id>/{truth.obj,
+// coarse.obj, meta.json}, and all their clouds streamed into one binary PLY `tile_ply` (one
+// building in memory at a time; written under a temporary name, renamed when complete).
+// `progress` (may be empty) gets each building after it is written. Returns the tile's points.
+std::uint64_t write_synth_tile(const std::string& dir, const std::string& tile_ply, int count, std::uint64_t first_seed,
+                               double spacing, const SynthOptions& opt,
+                               const std::function<void(const SynthBuilding&)>& progress);
 
 }  // namespace lodrefine

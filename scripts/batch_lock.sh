@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Called by batch.mk through $(shell): takes RUN/.batch.lock (flock) for as long as the calling
+# make lives, so two batch runs on one folder cannot interleave. Prints "ok", or the one-line
+# reason the run must not start (batch.mk stops with it).
+set -u
+run=$1
+if [[ ! -d $run ]]; then
+  echo "lodrefine: error: $run: no such run folder"
+  exit 0
+fi
+# A dispatcher (parallel_batch.sh) that holds the lock itself runs make for the summary.
+if [[ -n ${LODREFINE_BATCH_LOCKED:-} ]]; then
+  echo ok
+  exit 0
+fi
+# make may start us through sh: the lock belongs to make itself.
+owner=$PPID
+[[ $(cat "/proc/$owner/comm" 2>/dev/null) == sh ]] && owner=$(awk '{print $4}' "/proc/$owner/stat")
+exec 9>> "$run/.batch.lock"
+# A short wait: the holder of a run that just ended needs up to 0.05 s to notice.
+if ! flock -w 1 9; then
+  echo "lodrefine: error: $run is in use by another batch run (make pid $(cat "$run/.batch.pid" 2>/dev/null)); wait for it to end"
+  exit 0
+fi
+echo "$owner" > "$run/.batch.pid"
+# Temporaries of writers killed in an earlier run (nobody else writes here while we hold the lock).
+find "$run" -maxdepth 3 -name '*.tmp.*' -type f -delete 2> /dev/null
+# The holder keeps fd 9 (the lock) open until make exits, however it exits (SIGKILL included).
+tail --pid="$owner" -s 0.05 -f /dev/null < /dev/null > /dev/null 2>&1 &
+echo ok
