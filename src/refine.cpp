@@ -808,3 +808,4 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
 }  // namespace lodrefine
 
 
+

@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 namespace lodrefine {
 namespace {
@@ -118,6 +119,10 @@ SubstitutionResult substitute_walls(const Mesh& mesh, const std::vector<ModelSur
 
   // A face that moved must keep its orientation (else a wall passed a short neighbour) and
   // stay planar; a roof under a turned wall may not, and is split into triangles then.
+  std::set<std::pair<int, int>> edges;
+  for (const auto& f : mesh.faces)
+    for (std::size_t k = 0; k < f.v.size(); ++k)
+      edges.insert({std::min(f.v[k], f.v[(k + 1) % f.v.size()]), std::max(f.v[k], f.v[(k + 1) % f.v.size()])});
   std::vector<Face> faces;
   for (const auto& f : mesh.faces) {
     const auto before = face_points(mesh, f);
@@ -135,9 +140,30 @@ SubstitutionResult substitute_walls(const Mesh& mesh, const std::vector<ModelSur
       continue;
     }
     ++res.split_faces;
-    for (const auto& t : triangulate_polygon(after)) {
+    // Ear clipping, unless one of its diagonals is already an edge of the mesh (a sliver the
+    // face shares with a neighbour): then a fan around a new vertex at the face's centre.
+    const auto tris = triangulate_polygon(after);
+    bool clash = false;
+    for (const auto& t : tris)
+      for (int k = 0; k < 3; ++k) {
+        const int a = f.v[t[k]], b = f.v[t[(k + 1) % 3]];
+        const int n = int(f.v.size()), ia = t[k], ib = t[(k + 1) % 3];
+        const bool boundary = (ia + 1) % n == ib || (ib + 1) % n == ia;
+        clash = clash || (!boundary && edges.count({std::min(a, b), std::max(a, b)}));
+      }
+    if (!clash) {
+      for (const auto& t : tris) {
+        Face tf = f;
+        tf.v = {f.v[t[0]], f.v[t[1]], f.v[t[2]]};
+        faces.push_back(std::move(tf));
+      }
+      continue;
+    }
+    const int centre = int(res.mesh.vertices.size());
+    res.mesh.vertices.push_back(polygon_centroid(after));
+    for (std::size_t k = 0; k < f.v.size(); ++k) {
       Face tf = f;
-      tf.v = {f.v[t[0]], f.v[t[1]], f.v[t[2]]};
+      tf.v = {f.v[k], f.v[(k + 1) % f.v.size()], centre};
       faces.push_back(std::move(tf));
     }
   }
