@@ -590,6 +590,34 @@ TEST(RealData, RotterdamMovedWall) {
   run_set("Rotterdam (CityJSON 2.0)", pick);
 }
 
+// The whole Delfshaven file with a cloud that overlaps nothing: every building gets an output and
+// an outcome, and a kept building is its input (no vertex farther than the weld tolerance from
+// an input vertex).
+TEST(RealData, RotterdamEveryBuildingKeptOrKeptInvalid) {
+  REQUIRE_REALDATA("val3dity/data/rotterdam/3-20-DELFSHAVEN.city.json");
+  const CityJsonFile f = read_cityjson(data_path.string());
+  PointCloud far;
+  for (int i = 0; i < 200; ++i) far.points.emplace_back(0.1 * i, 0.0, 0.0);
+  const Params prm;
+  std::map<std::string, int> outcomes;
+  double worst = 0.0;
+  for (const auto& b : f.buildings) {
+    const RefineResult r = refine_building(b.mesh, far, prm);
+    ++outcomes[r.outcome];
+    ASSERT_EQ(r.mesh.id, b.mesh.id);
+    ASSERT_FALSE(r.mesh.faces.empty()) << b.mesh.id;
+    ASSERT_NE(r.outcome, "refined") << b.mesh.id;
+    if (r.outcome != "kept") continue;
+    EXPECT_TRUE(r.valid) << b.mesh.id << ": " << r.reason;
+    for (const auto& v : r.mesh.vertices) worst = std::max(worst, nearest_vertex_distance(v, b.mesh));
+  }
+  std::printf("Delfshaven: %zu buildings, %d kept, %d kept-invalid; largest kept vertex move %.4f m\n",
+              f.buildings.size(), outcomes["kept"], outcomes["kept-invalid"], worst);
+  EXPECT_EQ(outcomes["kept"] + outcomes["kept-invalid"], int(f.buildings.size()));
+  EXPECT_GT(outcomes["kept"], int(0.8 * f.buildings.size()));
+  EXPECT_LE(worst, prm.weld_tolerance);
+}
+
 TEST(RealData, ThreeDBagSeqMovedWall) {
   REQUIRE_REALDATA("val3dity/data/cityjsonseq/3dbag_b2.city.jsonl");
   run_set("3DBAG (CityJSONSeq 2.0)", meshes_of(read_cityjson(data_path.string())));
