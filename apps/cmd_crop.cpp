@@ -5,6 +5,7 @@
 #include "commands.h"
 #include "lodrefine/crop.h"
 #include "lodrefine/io.h"
+#include "options.h"
 
 namespace lodrefine::app {
 namespace {
@@ -14,6 +15,7 @@ namespace fs = std::filesystem;
 struct CropArgs {
   std::string tile, models, out;
   double expand = 0.1, margin = 3.0;
+  CloudOptions cloud_options;
 };
 
 // Models: DIR/*.obj (id = stem) or DIR/<id>/coarse.obj.
@@ -44,7 +46,7 @@ void run(const CropArgs& a) {
       ++skipped;
     }
   }
-  const std::size_t n = crop_tile(a.tile, targets);
+  const std::size_t n = crop_tile(a.tile, targets, a.cloud_options);
   for (std::size_t i = 0; i < targets.size(); ++i) {
     const fs::path dir = fs::path(a.out) / ids[i];
     fs::create_directories(dir);
@@ -62,12 +64,13 @@ void run(const CropArgs& a) {
 
 void add_crop_command(CLI::App& app) {
   static CropArgs args;
-  auto* cmd = app.add_subcommand("crop", "Cut one cloud per building from a large PLY tile (streaming)");
-  cmd->add_option("--tile", args.tile, "Large point cloud tile (PLY)")->required()->check(CLI::ExistingFile);
+  auto* cmd = app.add_subcommand("crop", "Cut one cloud per building from a large PLY or LAS tile (streaming)");
+  cmd->add_option("--tile", args.tile, "Large point cloud tile (PLY or LAS)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--models", args.models, "Folder of models: *.obj or <id>/coarse.obj")->required();
   cmd->add_option("--out", args.out, "Run folder: writes <id>/cloud.ply and <id>/coarse.obj")->required();
   cmd->add_option("--expand", args.expand, "Relative box growth on each side")->capture_default_str()->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--margin", args.margin, "Absolute box growth on each side (m)")->capture_default_str()->check(CLI::Range(0.0, 1000.0));
+  add_cloud_options(cmd, args.cloud_options);
   cmd->callback([] { run(args); });
 }
 

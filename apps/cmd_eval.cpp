@@ -27,6 +27,7 @@ using nlohmann::json;
 struct EvalArgs {
   std::string original, refined, cloud, truth, meta, dir, json_out, csv_out, svg_dir;
   Params params;
+  CloudOptions cloud_options;  // single-building mode (a run folder holds cropped PLYs)
 };
 
 // The files of one building; empty strings for absent optional ones.
@@ -95,13 +96,14 @@ void write_footprint(const std::string& svg_dir, const BuildingEval& e, const Me
 }
 
 // Reads, moves to a local frame (georeferenced inputs) and evaluates one building.
-Row evaluate_files(const BuildingFiles& f, const Params& params, const std::string& svg_dir) {
+Row evaluate_files(const BuildingFiles& f, const Params& params, const std::string& svg_dir,
+                   const CloudOptions& cloud_options = {}) {
   Row row;
   const Mesh original_geo = read_obj(f.original);
   row.origin = local_origin(original_geo);
   const Vec3 to_local = -row.origin;
   const Mesh original = translated(original_geo, to_local);
-  PointCloud cloud = read_ply(f.cloud);
+  PointCloud cloud = read_cloud(f.cloud, cloud_options);
   for (auto& p : cloud.points) p += to_local;
   std::string refined_error;
   const Mesh refined = translated(read_refined(f.refined, refined_error), to_local);
@@ -341,7 +343,7 @@ void run(const EvalArgs& a) {
   if (batch) {
     rows = evaluate_run(a.dir, a.params, a.svg_dir);
   } else {
-    rows.push_back(evaluate_files({"", a.original, a.refined, a.cloud, a.truth, a.meta, ""}, a.params, a.svg_dir));
+    rows.push_back(evaluate_files({"", a.original, a.refined, a.cloud, a.truth, a.meta, ""}, a.params, a.svg_dir, a.cloud_options));
     if (!rows.back().eval.ok()) std::fprintf(stderr, "lodrefine: warning: %s\n", rows.back().eval.error.c_str());
   }
   std::vector<BuildingEval> evals;
@@ -361,7 +363,7 @@ void add_eval_command(CLI::App& app) {
                                               "meta.json,report.json]}, pooled over all buildings");
   auto* orig = cmd->add_option("--original", a.original, "Coarse model (OBJ)")->check(CLI::ExistingFile);
   cmd->add_option("--refined", a.refined, "Refined model (OBJ); a missing file is reported as a failure");
-  cmd->add_option("--cloud", a.cloud, "MLS crop (PLY)")->check(CLI::ExistingFile);
+  cmd->add_option("--cloud", a.cloud, "MLS crop (PLY or LAS)")->check(CLI::ExistingFile);
   cmd->add_option("--truth", a.truth, "Truth model (OBJ): adds truth_facade_* / truth_roof_* distances")
       ->check(CLI::ExistingFile);
   cmd->add_option("--meta", a.meta, "Generator meta.json listing the scanned truth faces (else detected)")
@@ -370,6 +372,7 @@ void add_eval_command(CLI::App& app) {
   cmd->add_option("--csv", a.csv_out, "Write one row per building as CSV");
   cmd->add_option("--svg-dir", a.svg_dir, "Write C2M histogram + boxplot and a footprint per building (SVG)");
   dir->excludes(orig);
+  add_cloud_options(cmd, a.cloud_options);
   add_param_options(cmd, a.params);
   cmd->callback([] { run(a); });
 }

@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "commands.h"
+#include "lodrefine/cloud.h"
 #include "lodrefine/io.h"
 #include "lodrefine/refine.h"
 #include "options.h"
@@ -14,6 +15,7 @@ struct RefineArgs {
   std::string model, cloud, out, report;
   std::uint64_t max_points = 20000000;
   Params params;
+  CloudOptions cloud_options;
 };
 
 nlohmann::json params_json(const Params& p) {
@@ -37,12 +39,16 @@ void run(const RefineArgs& a) {
   check_output_dir(a.out);
   check_output_dir(a.report);
   const Mesh model = read_obj(a.model);
-  const std::uint64_t declared = ply_vertex_count(a.cloud);
+  const std::uint64_t declared = cloud_point_count(a.cloud);
   if (declared > a.max_points)
     throw InputError(a.cloud + ": " + std::to_string(declared) + " points, more than --max-points " +
                      std::to_string(a.max_points) + "; cut a crop per building first (lodrefine crop)");
-  const PointCloud cloud = read_ply(a.cloud);
-  if (cloud.points.empty()) throw InputError(a.cloud + ": the cloud has no points");
+  const PointCloud cloud = read_cloud(a.cloud, a.cloud_options);
+  if (cloud.points.empty())
+    throw InputError(a.cloud + ": the cloud has no points" +
+                     (a.cloud_options.classes.empty() ? std::string()
+                                                      : " of classes " + classes_text(a.cloud_options.classes) +
+                                                            " (of " + std::to_string(declared) + ")"));
   RefineResult r = refine_building(model, cloud, a.params);
   r.report["model"] = a.model;
   r.report["cloud"]["path"] = a.cloud;
@@ -66,10 +72,11 @@ void add_refine_command(CLI::App& app) {
   static RefineArgs args;
   auto* cmd = app.add_subcommand("refine", "Refine one building model with an MLS point cloud");
   cmd->add_option("--model", args.model, "Coarse building model (OBJ, CityGML fan-out export)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--cloud", args.cloud, "MLS point cloud crop around the building (PLY)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--cloud", args.cloud, "MLS point cloud crop around the building (PLY or LAS)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args.out, "Refined model (OBJ), written atomically")->required();
   cmd->add_option("--report", args.report, "JSON report: matches, planes, candidates, MIP, timings, validation");
   cmd->add_option("--max-points", args.max_points, "Refuse clouds with more points (a tile, not a crop)")->capture_default_str();
+  add_cloud_options(cmd, args.cloud_options);
   add_param_options(cmd, args.params);
   cmd->callback([] { run(args); });
 }

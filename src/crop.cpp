@@ -4,7 +4,6 @@
 #include <cmath>
 #include <unordered_map>
 
-#include "lodrefine/io.h"
 
 namespace lodrefine {
 
@@ -24,7 +23,7 @@ CropTarget crop_target(const Mesh& model, double relative, double absolute) {
   return t;
 }
 
-std::size_t crop_tile(const std::string& tile_ply, std::vector<CropTarget>& targets) {
+std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets, const CloudOptions& options) {
   if (targets.empty()) return 0;
   // Grid cell size: about the median box size, so each box touches few cells.
   std::vector<double> sizes;
@@ -41,7 +40,7 @@ std::size_t crop_tile(const std::string& tile_ply, std::vector<CropTarget>& targ
       for (double y = std::floor(t.lo.y() / cell) * cell; y <= t.hi.y(); y += cell) grid[key(x + 0.5 * cell, y + 0.5 * cell)].push_back(i);
   }
   std::size_t n = 0;
-  stream_ply(tile_ply, [&](const Vec3& p) {
+  stream_cloud(tile, options, [&](const Vec3& p) {
     ++n;
     const auto it = grid.find(key(p.x(), p.y()));
     if (it == grid.end()) return;

@@ -25,9 +25,6 @@
 
 namespace lodrefine {
 
-// Georeferenced coordinates are at most a few 1e7 m (UTM northing); anything beyond 1e9 m is a
-// broken file, and would overflow the integer grids of welding and hashing downstream.
-constexpr double kMaxCoordinate = 1e9;
 namespace {
 
 [[noreturn]] void fail(const std::string& path, const std::string& fault) {

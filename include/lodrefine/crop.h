@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "lodrefine/cloud.h"
 #include "lodrefine/types.h"
 
 namespace lodrefine {
@@ -17,8 +18,9 @@ struct CropTarget {
 // (vertically by `absolute` only).
 CropTarget crop_target(const Mesh& model, double relative, double absolute);
 
-// Streams `tile_ply` once and appends each point to every target whose box holds it (a 2D
-// grid over the targets keeps this O(points)). Returns the number of points read.
-std::size_t crop_tile(const std::string& tile_ply, std::vector<CropTarget>& targets);
+// Streams the tile (PLY or LAS, `options` filtering LAS classes) once and appends each point
+// to every target whose box holds it (a 2D grid over the targets keeps this O(points)).
+// Returns the number of points read (after the class filter).
+std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets, const CloudOptions& options = {});
 
 }  // namespace lodrefine

@@ -10,6 +10,11 @@
 
 namespace lodrefine {
 
+// Georeferenced coordinates are at most a few 1e7 m (UTM northing); anything beyond 1e9 m is a
+// broken file, and would overflow the integer grids of welding and hashing downstream. Every
+// reader refuses such coordinates.
+constexpr double kMaxCoordinate = 1e9;
+
 // Reads an OBJ polygon soup as exported per building from CityGML: `g WallSurface` /
 // `g RoofSurface` / `g GroundSurface` groups (also `usemtl`), polygons of 3+ vertices,
 // georeferenced doubles. Building id from `o NAME`, else a `# id: X` comment, else the file
