@@ -28,6 +28,9 @@ void run(const ConvertArgs& a) {
     if (wanted.empty() || wanted.count(b.mesh.id)) chosen.push_back(&b), found.insert(b.mesh.id);
   for (const auto& id : wanted)
     if (!found.count(id)) throw InputError(a.cityjson + ": no Building/BuildingPart '" + id + "' with an LoD 2.x geometry");
+  if (chosen.empty())
+    throw InputError(a.cityjson + ": no Building/BuildingPart with an LoD 2.x geometry (" +
+                     std::to_string(file.objects_without_lod2) + " building object(s) without one); nothing to convert");
   fs::create_directories(a.out_dir);
   std::set<std::string> stems;
   for (const CityJsonBuilding* b : chosen) {

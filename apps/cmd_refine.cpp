@@ -49,7 +49,10 @@ void run(const RefineArgs& a) {
                      (a.cloud_options.classes.empty() ? std::string()
                                                       : " of classes " + classes_text(a.cloud_options.classes) +
                                                             " (of " + std::to_string(declared) + ")"));
+  const std::string overlap = overlap_problem(bounding_box(cloud.points), bounding_box(model.vertices));
+  if (!overlap.empty()) std::fprintf(stderr, "lodrefine: warning: %s\n", overlap.c_str());
   RefineResult r = refine_building(model, cloud, a.params);
+  if (!overlap.empty()) r.report["warnings"].push_back(overlap);
   r.report["model"] = a.model;
   r.report["cloud"]["path"] = a.cloud;
   r.report["params"] = params_json(a.params);

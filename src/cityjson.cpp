@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lodrefine/geometry.h"
+#include "lodrefine/io.h"
 
 namespace lodrefine {
 namespace {
@@ -400,6 +401,9 @@ std::string file_stem_for_id(const std::string& id) {
 CityJsonFile parse_cityjson(const std::string& text, const std::string& name) { return Reader(name).read(text); }
 
 CityJsonFile read_cityjson(const std::string& path) {
+  const FileKind kind = sniff_file(path);
+  if (kind != FileKind::Json && kind != FileKind::Other)
+    throw InputError(path + ": not a CityJSON file: the file is " + file_kind_text(kind));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open the file");
   std::ostringstream ss;

@@ -1,40 +1,19 @@
 // Format dispatch for point clouds: PLY (io) or LAS (las), by content.
 #include "lodrefine/cloud.h"
 
-#include <cstring>
-#include <fstream>
+#include <cstdio>
 
 #include "lodrefine/io.h"
 #include "lodrefine/las.h"
 
 namespace lodrefine {
-namespace {
-
-// What a file that is not a cloud looks like, for the message (the first bytes, whitespace
-// skipped): XML (CityGML), JSON (CityJSON), OBJ; empty when unknown.
-std::string what_else(const std::string& head) {
-  const auto b = head.find_first_not_of(" \t\r\n");
-  if (b == std::string::npos) return {};
-  const std::string s = head.substr(b);
-  if (s.rfind("<?xml", 0) == 0 || s[0] == '<') return "XML (a CityGML model?)";
-  if (s[0] == '{' || s[0] == '[') return "JSON (a CityJSON model?)";
-  if (s.rfind("v ", 0) == 0 || s.rfind("o ", 0) == 0 || s.rfind("# ", 0) == 0 || s.rfind("g ", 0) == 0)
-    return "an OBJ model?";
-  return {};
-}
-
-}  // namespace
 
 CloudFormat cloud_format(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  char head[64] = {};
-  if (in) in.read(head, sizeof head);
-  const std::string h(head, std::size_t(in ? sizeof head : in.gcount()));
-  if (h.rfind("LASF", 0) == 0) return CloudFormat::Las;
-  if (!in.is_open() || h.rfind("ply", 0) == 0) return CloudFormat::Ply;  // the PLY reader reports the fault
-  const std::string other = what_else(h);
-  if (!other.empty()) throw InputError(path + ": not a PLY or LAS point cloud: the file is " + other);
-  return CloudFormat::Ply;  // unknown content: the PLY reader says "not a PLY file"
+  const FileKind kind = sniff_file(path);
+  if (kind == FileKind::Las) return CloudFormat::Las;
+  if (kind == FileKind::Xml || kind == FileKind::Json)
+    throw InputError(path + ": not a PLY or LAS point cloud: the file is " + file_kind_text(kind));
+  return CloudFormat::Ply;  // the PLY reader reports any other content ("not a PLY file")
 }
 
 std::uint64_t cloud_point_count(const std::string& path) {
@@ -59,6 +38,26 @@ PointCloud read_cloud(const std::string& path, const CloudOptions& options) {
   if (options.classes.empty()) cloud.points.reserve(cloud_point_count(path));
   stream_cloud(path, options, [&](const Vec3& p) { cloud.points.push_back(p); });
   return cloud;
+}
+
+Eigen::AlignedBox3d bounding_box(const std::vector<Vec3>& points) {
+  Eigen::AlignedBox3d box;
+  for (const auto& p : points) box.extend(p);
+  return box;
+}
+
+std::string overlap_problem(const Eigen::AlignedBox3d& cloud, const Eigen::AlignedBox3d& model, const std::string& what,
+                            double margin) {
+  if (cloud.isEmpty() || model.isEmpty()) return {};
+  const Eigen::AlignedBox2d c(cloud.min().head<2>(), cloud.max().head<2>());
+  const Eigen::AlignedBox2d m(model.min().head<2>() - Vec2::Constant(margin), model.max().head<2>() + Vec2::Constant(margin));
+  if (c.intersects(m)) return {};
+  const auto range = [](const Eigen::AlignedBox3d& b) {
+    char s[160];
+    std::snprintf(s, sizeof s, "x %.1f..%.1f y %.1f..%.1f", b.min().x(), b.max().x(), b.min().y(), b.max().y());
+    return std::string(s);
+  };
+  return "cloud " + range(cloud) + " does not overlap " + what + " " + range(model) + ": wrong CRS or tile?";
 }
 
 std::string classes_text(const std::vector<int>& classes) {

@@ -634,6 +634,8 @@ void put_le(std::string& out, T v) {
 }  // namespace
 
 Mesh read_obj(const std::string& path, int* skipped_faces) {
+  const FileKind kind = sniff_file(path);
+  if (kind != FileKind::Other) fail(path, "not an OBJ model: the file is " + file_kind_text(kind));
   return ObjParser(path).parse(read_whole_file(path), skipped_faces);
 }
 
@@ -677,6 +679,31 @@ void write_ply(const std::string& path, const PointCloud& cloud, const Vec3& ori
   }
   file.write(out);
   file.commit();
+}
+
+FileKind sniff_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char head[64] = {};
+  if (in) in.read(head, sizeof head);
+  const std::string h(head, std::size_t(in.gcount()));
+  if (h.rfind("LASF", 0) == 0) return FileKind::Las;
+  if (h.rfind("ply\n", 0) == 0 || h.rfind("ply\r", 0) == 0) return FileKind::Ply;
+  std::string_view s = h;
+  if (s.compare(0, 3, "\xEF\xBB\xBF") == 0) s.remove_prefix(3);  // UTF-8 byte order mark
+  s = trim(s);
+  if (!s.empty() && s[0] == '<') return FileKind::Xml;
+  if (!s.empty() && (s[0] == '{' || s[0] == '[')) return FileKind::Json;
+  return FileKind::Other;
+}
+
+std::string file_kind_text(FileKind kind) {
+  switch (kind) {
+    case FileKind::Ply: return "a PLY point cloud";
+    case FileKind::Las: return "a LAS/LAZ point cloud";
+    case FileKind::Xml: return "XML (a CityGML model?)";
+    case FileKind::Json: return "JSON (a CityJSON model?)";
+    default: return "";
+  }
 }
 
 void write_file_atomic(const std::string& path, const std::string& content) {

@@ -286,7 +286,7 @@ TEST(Las, OtherFilesGivenAsACloudSayWhatTheyAre) {
   };
   check("<?xml version=\"1.0\"?>\n<CityModel/>", "not a PLY or LAS point cloud: the file is XML (a CityGML model?)");
   check("{\"type\": \"CityJSON\"}", "the file is JSON (a CityJSON model?)");
-  check("o b\nv 0 0 0\n", "the file is an OBJ model?");
+  check("o b\nv 0 0 0\n", "not a PLY file");
   check("\x01\x02garbage", "not a PLY file");
 }
 

@@ -33,6 +33,16 @@ void stream_cloud(const std::string& path, const CloudOptions& options,
 // Reads the whole cloud.
 PointCloud read_cloud(const std::string& path, const CloudOptions& options = {});
 
+// Axis-aligned bounding box of points (empty for none).
+Eigen::AlignedBox3d bounding_box(const std::vector<Vec3>& points);
+
+// CRS / tile sanity: one line "cloud x a..b y c..d does not overlap <what> x e..f y g..h: wrong
+// CRS or tile?" when the boxes are disjoint in XY (the model grown by `margin` metres); empty
+// when they overlap. A cloud in another CRS or of another tile otherwise only shows up as
+// "no planes found".
+std::string overlap_problem(const Eigen::AlignedBox3d& cloud, const Eigen::AlignedBox3d& model,
+                            const std::string& what = "the model", double margin = 3.0);
+
 // "--classes 2,6" as text, for messages ("" without a filter).
 std::string classes_text(const std::vector<int>& classes);
 

@@ -47,6 +47,14 @@ std::uint64_t ply_vertex_count(const std::string& path);
 void write_ply(const std::string& path, const PointCloud& cloud, const Vec3& origin = Vec3::Zero(),
                const std::vector<float>* scalar = nullptr, const std::string& scalar_name = "scalar");
 
+// What a file holds, judged by its first bytes (not its name): lets each reader say what a
+// file given in the wrong place is, and lets commands that take several formats pick one.
+enum class FileKind { Ply, Las, Xml, Json, Other };
+FileKind sniff_file(const std::string& path);  // Other also for unreadable files (the reader reports)
+// "a PLY point cloud", "a LAS/LAZ point cloud", "XML (a CityGML model?)", "JSON (a CityJSON
+// model?)"; empty for Other.
+std::string file_kind_text(FileKind kind);
+
 // Writes `content` to `path` atomically (temp file in the same directory + rename).
 void write_file_atomic(const std::string& path, const std::string& content);
 
