@@ -5,7 +5,8 @@ set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 PKGS="build-essential cmake ccache libcgal-dev libeigen3-dev libglpk-dev libtinyobjloader-dev
-      libcli11-dev nlohmann-json3-dev libtbb-dev libgtest-dev libboost-dev"
+      libcli11-dev nlohmann-json3-dev libtbb-dev libgtest-dev libboost-dev libcitygml-dev
+      python3-jsonschema"
 if [ "${1:-}" = "--with-cloudcompare" ]; then PKGS="$PKGS cloudcompare"; fi
 missing=""
 for p in $PKGS; do

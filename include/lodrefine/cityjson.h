@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "lodrefine/types.h"
 
 namespace lodrefine {
@@ -25,9 +27,11 @@ struct CityJsonBuilding {
   int skipped_holes = 0;      // inner rings dropped (the surface keeps its outer ring only)
   int skipped_rings = 0;      // outer rings with < 3 distinct vertices, dropped
   int skipped_shells = 0;     // interior shells of solids, dropped
+  nlohmann::json attributes;  // CityGML input: the object's attributes (CityJSON input keeps its own JSON)
 };
 
 struct CityJsonFile {
+  std::string format = "CityJSON";  // or "CityGML"
   std::string version;        // "1.0", "1.1", "2.0"
   bool sequence = false;      // read as CityJSONSeq
   std::string crs;            // metadata.referenceSystem, empty when absent
