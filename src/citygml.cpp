@@ -300,7 +300,7 @@ nlohmann::ordered_json citygml_to_cityjson(const std::string& path, std::string*
 CityJsonFile read_citygml(const std::string& path) {
   std::string version;
   const auto doc = citygml_to_cityjson(path, &version);
-  CityJsonFile f = parse_cityjson(doc.dump(), path);
+  CityJsonFile f = read_cityjson_document(doc, path);
   f.format = "CityGML";
   f.version = version;
   // Attributes travel with each building (CityJSON input keeps them in its own document).

@@ -23,7 +23,8 @@ CropTarget crop_target(const Mesh& model, double relative, double absolute) {
   return t;
 }
 
-std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets, const CloudOptions& options) {
+std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets, const CloudOptions& options,
+                      Eigen::AlignedBox3d* bounds) {
   if (targets.empty()) return 0;
   // Grid cell size: about the median box size, so each box touches few cells.
   std::vector<double> sizes;
@@ -42,6 +43,7 @@ std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets,
   std::size_t n = 0;
   stream_cloud(tile, options, [&](const Vec3& p) {
     ++n;
+    if (bounds) bounds->extend(p);
     const auto it = grid.find(key(p.x(), p.y()));
     if (it == grid.end()) return;
     for (int i : it->second) {

@@ -66,8 +66,15 @@ TEST(Formats, WrongKindOfFileSaysWhatItIs) {
   std::ofstream(dir + "/lod1.city.json") << kLod1CityJson;
   std::ofstream(dir + "/other.json") << "{\"type\": \"FeatureCollection\", \"features\": []}";
   const std::string out = " --out " + dir + "/r.obj";
-  expect_error(run_cli("refine --model " + dir + "/city.gml --cloud " + dir + "/c.ply" + out, dir),
+  expect_error(run_cli("eval --original " + dir + "/city.gml --refined " + dir + "/m.obj --cloud " + dir + "/c.ply", dir),
                "city.gml: not an OBJ model: the file is XML (a CityGML model?)");
+  // A city file as the model is the city workflow; one without LoD 2 buildings is an error.
+  expect_error(run_cli("refine --model " + dir + "/city.gml --cloud " + dir + "/c.ply --out " + dir + "/r.city.json", dir),
+               "city.gml: no Building/BuildingPart with an LoD 2.x geometry");
+  expect_error(run_cli("refine --model " + dir + "/lod1.city.json --cloud " + dir + "/c.ply --out " + dir + "/r.city.json", dir),
+               "lod1.city.json: no Building/BuildingPart with an LoD 2.x geometry (1 building object(s) without one); nothing to refine");
+  expect_error(run_cli("refine --model " + dir + "/other.json --cloud " + dir + "/c.ply --out " + dir + "/r.city.json", dir),
+               "other.json: not a CityJSON file (no \"type\": \"CityJSON\")");
   expect_error(run_cli("refine --model " + dir + "/c.ply --cloud " + dir + "/m.obj" + out, dir),
                "c.ply: not an OBJ model: the file is a PLY point cloud");
   expect_error(run_cli("refine --model " + dir + "/c.las --cloud " + dir + "/c.ply" + out, dir),

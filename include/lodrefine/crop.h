@@ -20,7 +20,9 @@ CropTarget crop_target(const Mesh& model, double relative, double absolute);
 
 // Streams the tile (PLY or LAS, `options` filtering LAS classes) once and appends each point
 // to every target whose box holds it (a 2D grid over the targets keeps this O(points)).
-// Returns the number of points read (after the class filter).
-std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets, const CloudOptions& options = {});
+// Returns the number of points read (after the class filter); `bounds` (optional) gets the
+// bounding box of every point read.
+std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets, const CloudOptions& options = {},
+                      Eigen::AlignedBox3d* bounds = nullptr);
 
 }  // namespace lodrefine
