@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <sstream>
 
@@ -19,6 +20,10 @@ namespace {
 
 using json = nlohmann::ordered_json;
 using Clock = std::chrono::steady_clock;
+
+// A CityJSONSeq header line holds metadata and the transform, never objects: a first line
+// longer than this is a one-line CityJSON file, not parsed twice to find out.
+constexpr std::size_t kMaxSequenceHeader = 1 << 20;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
@@ -53,28 +58,31 @@ Eigen::AlignedBox3d model_box(const std::vector<CityJsonBuilding>& buildings) {
   return box;
 }
 
-// One document (a whole CityJSON file, or one CityJSONFeature with the header's transform):
-// its buildings and the crop targets the cloud pass fills.
-struct Work {
-  std::vector<CityJsonBuilding> buildings;
-  std::vector<std::size_t> target_of;  // per building: index into the targets, or npos
-};
+// The transform of a CityJSON header (validated by the reader before this is used).
+CityJsonTransform transform_of(const json& header) {
+  CityJsonTransform t;
+  const json& j = header.at("transform");
+  t.scale = Vec3(j.at("scale")[0].get<double>(), j.at("scale")[1].get<double>(), j.at("scale")[2].get<double>());
+  t.translate = Vec3(j.at("translate")[0].get<double>(), j.at("translate")[1].get<double>(), j.at("translate")[2].get<double>());
+  return t;
+}
 
-// Refines the buildings of `doc` that have points and writes the results into `doc`.
-void refine_document(json& doc, const std::vector<CityJsonBuilding>& buildings, std::vector<CropTarget>& targets,
-                     const std::vector<std::size_t>& target_of, const Params& params, CityRefineSummary& sum) {
-  const json& t = doc.contains("transform") ? doc["transform"] : json();
-  const Vec3 scale = t.is_object() ? Vec3(t["scale"][0], t["scale"][1], t["scale"][2]) : Vec3::Ones();
-  const Vec3 translate = t.is_object() ? Vec3(t["translate"][0], t["translate"][1], t["translate"][2]) : Vec3::Zero();
+// Refines the buildings of `doc` (a CityJSON file or one CityJSONFeature: "CityObjects" and
+// "vertices") that have points, and writes the results into `doc`. `buildings` are the doc's
+// buildings in order; `target_of[first + i]` is building i's crop target (npos: not asked for).
+void refine_document(json& doc, const CityJsonTransform& tf, const std::vector<CityJsonBuilding>& buildings,
+                     std::vector<CropTarget>& targets, const std::vector<std::size_t>& target_of, std::size_t first,
+                     const Params& params, CityRefineSummary& sum) {
   json& objects = doc["CityObjects"];
   for (std::size_t i = 0; i < buildings.size(); ++i) {
     const CityJsonBuilding& b = buildings[i];
-    if (target_of[i] == std::string::npos || targets[target_of[i]].cloud.points.empty()) {
+    const std::size_t ti = target_of[first + i];
+    if (ti == std::string::npos || targets[ti].cloud.points.empty()) {
       ++sum.untouched;
       continue;
     }
-    PointCloud cloud = std::move(targets[target_of[i]].cloud);
-    targets[target_of[i]].cloud = PointCloud();  // the crop is no longer needed: free it now
+    PointCloud cloud = std::move(targets[ti].cloud);
+    targets[ti].cloud = PointCloud();  // the crop is no longer needed: free it now
     const auto t0 = Clock::now();
     CityBuildingOutcome o;
     RefineResult r;
@@ -93,7 +101,7 @@ void refine_document(json& doc, const std::vector<CityJsonBuilding>& buildings, 
       const std::string lod = obj["geometry"][std::size_t(b.geometry_index)]["lod"].is_string()
                                   ? obj["geometry"][std::size_t(b.geometry_index)]["lod"].get<std::string>()
                                   : b.lod;
-      obj["geometry"][std::size_t(b.geometry_index)] = cityjson_solid(r.mesh, lod, scale, translate, doc["vertices"]);
+      obj["geometry"][std::size_t(b.geometry_index)] = cityjson_solid(r.mesh, lod, tf.scale, tf.translate, doc["vertices"]);
       ++sum.refined;
     } else {
       ++(o.outcome == "kept" ? sum.kept : sum.kept_invalid);
@@ -126,17 +134,27 @@ std::string read_text(const std::string& path) {
   return ss.str();
 }
 
-// Chooses the buildings to refine and their crop boxes.
-std::vector<CropTarget> make_targets(const std::vector<CityJsonBuilding>& buildings, const CityRefineOptions& o,
-                                     std::vector<std::size_t>& target_of) {
-  std::vector<CropTarget> targets;
-  target_of.assign(buildings.size(), std::string::npos);
-  for (std::size_t i = 0; i < buildings.size(); ++i) {
-    if (!o.building.empty() && buildings[i].mesh.id != o.building) continue;
-    target_of[i] = targets.size();
-    targets.push_back(crop_target(buildings[i].mesh, o.crop_expand, o.crop_margin));
+// Adds the buildings to refine and their crop boxes (appending to target_of).
+void add_targets(const std::vector<CityJsonBuilding>& buildings, const CityRefineOptions& o,
+                 std::vector<CropTarget>& targets, std::vector<std::size_t>& target_of) {
+  for (const auto& b : buildings) {
+    if (!o.building.empty() && b.mesh.id != o.building) {
+      target_of.push_back(std::string::npos);
+      continue;
+    }
+    target_of.push_back(targets.size());
+    targets.push_back(crop_target(b.mesh, o.crop_expand, o.crop_margin));
   }
-  return targets;
+}
+
+void check_targets(const std::vector<CropTarget>& targets, const std::string& model_path, const CityRefineOptions& o) {
+  if (targets.empty()) throw InputError(model_path + ": no building '" + o.building + "' with the LoD asked for");
+}
+
+[[noreturn]] void fail_no_lod(const std::string& model_path, const CityRefineOptions& o, int without) {
+  throw InputError(model_path + ": no Building/BuildingPart with " +
+                   (o.lod.empty() ? std::string("an LoD 2.x") : "an LoD " + o.lod) + " geometry (" +
+                   std::to_string(without) + " building object(s) without one); nothing to refine");
 }
 
 void check_cloud_reaches(const std::vector<CropTarget>& targets, const Eigen::AlignedBox3d& cloud_box,
@@ -146,6 +164,91 @@ void check_cloud_reaches(const std::vector<CropTarget>& targets, const Eigen::Al
   std::string why = overlap_problem(cloud_box, city_box, "the city model");
   if (why.empty()) why = "the cloud has no point within " + std::to_string(targets.size()) + " building box(es)";
   throw InputError(cloud_path + ": " + why);
+}
+
+// A CityJSONSeq feature as a CityJSON document the reader takes: the header's transform
+// with the feature's objects and vertices.
+json feature_document(const json& header, json feature) {
+  json d = {{"type", "CityJSON"}, {"version", header.value("version", "2.0")}, {"transform", header.at("transform")}};
+  d["CityObjects"] = std::move(feature["CityObjects"]);
+  d["vertices"] = std::move(feature["vertices"]);
+  return d;
+}
+
+// The first line of a file when it is a CityJSONSeq header (a "CityJSON" object on one line);
+// null otherwise.
+json sequence_header(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  if (!in || !std::getline(in, line) || line.size() > kMaxSequenceHeader) return nullptr;
+  json first = json::parse(line, nullptr, false);
+  if (!first.is_object() || first.value("type", "") != "CityJSON" ||
+      (first.contains("CityObjects") && !first["CityObjects"].empty()))
+    return nullptr;
+  while (std::getline(in, line))
+    if (line.find_first_not_of(" \t\r") != std::string::npos) return first;
+  return nullptr;
+}
+
+// CityJSONSeq in, CityJSONSeq out, streamed: pass 1 reads each feature's buildings for the
+// crop boxes (keeping only the boxes), the cloud pass fills them, pass 2 reads each feature
+// again, refines its buildings and writes the line out.
+CityRefineSummary refine_sequence(const json& header, const std::string& model_path, const std::string& cloud_path,
+                                  const std::string& out_path, const Params& params, const CityRefineOptions& options) {
+  CityRefineSummary sum;
+  sum.input_format = "CityJSONSeq " + header.value("version", std::string("?"));
+  if (!header.contains("transform")) throw InputError(model_path + ": line 1: a CityJSONSeq header needs a \"transform\"");
+  const CityJsonTransform tf = transform_of(header);
+  auto t = Clock::now();
+  std::vector<CropTarget> targets;
+  std::vector<std::size_t> target_of;
+  Eigen::AlignedBox3d city_box;
+  const auto for_each_feature = [&](const std::function<void(int, json&&)>& f) {
+    std::ifstream in(model_path, std::ios::binary);
+    std::string line;
+    std::getline(in, line);
+    for (int n = 2; std::getline(in, line); ++n) {
+      if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+      json feature = json::parse(line, nullptr, false);
+      if (!feature.is_object() || feature.value("type", "") != "CityJSONFeature")
+        throw InputError(model_path + ": line " + std::to_string(n) + ": expected a CityJSONFeature object");
+      f(n, std::move(feature));
+    }
+  };
+  for_each_feature([&](int n, json&& feature) {
+    const CityJsonFile f = read_cityjson_document(feature_document(header, std::move(feature)),
+                                                  model_path + ": line " + std::to_string(n), options.lod);
+    sum.buildings += int(f.buildings.size());
+    sum.objects_without_lod += f.objects_without_lod2;
+    city_box.extend(model_box(f.buildings));
+    add_targets(f.buildings, options, targets, target_of);
+  });
+  if (sum.buildings == 0) fail_no_lod(model_path, options, sum.objects_without_lod);
+  check_targets(targets, model_path, options);
+  sum.seconds_read = seconds_since(t);
+
+  t = Clock::now();
+  Eigen::AlignedBox3d cloud_box;
+  sum.cloud_points = crop_tile(cloud_path, targets, options.cloud, &cloud_box);
+  check_cloud_reaches(targets, cloud_box, city_box, cloud_path);
+  sum.seconds_crop = seconds_since(t);
+
+  t = Clock::now();
+  AtomicFile out(out_path);
+  json h = header;
+  h["version"] = "2.0";
+  out.write(h.dump() + "\n");
+  std::size_t first = 0;
+  for_each_feature([&](int n, json&& feature) {
+    const CityJsonFile f = read_cityjson_document(feature_document(header, feature),
+                                                  model_path + ": line " + std::to_string(n), options.lod);
+    refine_document(feature, tf, f.buildings, targets, target_of, first, params, sum);
+    first += f.buildings.size();
+    out.write(feature.dump() + "\n");
+  });
+  out.commit();
+  sum.seconds_refine = seconds_since(t);
+  return sum;
 }
 
 }  // namespace
@@ -186,13 +289,16 @@ CityRefineSummary refine_city(const std::string& model_path, const std::string& 
   auto t = Clock::now();
   json doc;
   std::string format;
+  if (sniff_file(model_path) != FileKind::Xml) {
+    const json header = sequence_header(model_path);
+    if (!header.is_null()) return refine_sequence(header, model_path, cloud_path, out_path, params, options);
+  }
   if (sniff_file(model_path) == FileKind::Xml) {
     std::string version;
     doc = citygml_to_cityjson(model_path, &version);
     format = "CityGML " + version;
   } else {
     const std::string text = read_text(model_path);
-    if (is_cityjson_sequence(text)) throw InputError(model_path + ": CityJSONSeq: not handled by this path");
     doc = json::parse(text, nullptr, false);
     if (doc.is_discarded()) parse_cityjson(text, model_path);  // throws the reader's own message
     format = "CityJSON " + (doc.contains("version") && doc["version"].is_string() ? doc["version"].get<std::string>() : "?");
@@ -201,13 +307,11 @@ CityRefineSummary refine_city(const std::string& model_path, const std::string& 
   sum.input_format = format;
   sum.buildings = int(file.buildings.size());
   sum.objects_without_lod = file.objects_without_lod2;
-  if (file.buildings.empty())
-    throw InputError(model_path + ": no Building/BuildingPart with " +
-                     (options.lod.empty() ? std::string("an LoD 2.x") : "an LoD " + options.lod) + " geometry (" +
-                     std::to_string(file.objects_without_lod2) + " building object(s) without one); nothing to refine");
+  if (file.buildings.empty()) fail_no_lod(model_path, options, file.objects_without_lod2);
   std::vector<std::size_t> target_of;
-  std::vector<CropTarget> targets = make_targets(file.buildings, options, target_of);
-  if (targets.empty()) throw InputError(model_path + ": no building '" + options.building + "' with the LoD asked for");
+  std::vector<CropTarget> targets;
+  add_targets(file.buildings, options, targets, target_of);
+  check_targets(targets, model_path, options);
   sum.seconds_read = seconds_since(t);
 
   t = Clock::now();
@@ -218,7 +322,7 @@ CityRefineSummary refine_city(const std::string& model_path, const std::string& 
 
   t = Clock::now();
   ensure_transform(doc);
-  refine_document(doc, file.buildings, targets, target_of, params, sum);
+  refine_document(doc, transform_of(doc), file.buildings, targets, target_of, 0, params, sum);
   sum.seconds_refine = seconds_since(t);
 
   t = Clock::now();

@@ -374,3 +374,54 @@ TEST(CityFile, DenHaagCityGml) {
   EXPECT_EQ(out["metadata"]["referenceSystem"], "https://www.opengis.net/def/crs/EPSG/0/28992");
   for (const auto& [id, obj] : out["CityObjects"].items()) EXPECT_EQ(id.find("genID"), std::string::npos) << id;
 }
+
+TEST(CityFile, CityJsonSeqStreamedThrough) {
+  const std::string dir = test_dir();
+  std::vector<SynthBuilding> bs;
+  PointCloud cloud;
+  SynthOptions so;
+  so.target_points = 6000;
+  so.scanned_facades = 2;
+  for (int k = 0; k < 3; ++k) {
+    so.origin = Vec3(93000.0 + 80.0 * k, 436000.0, 0.0);
+    bs.push_back(make_building(k == 1 ? BuildingType::Shed : BuildingType::Gable, std::uint64_t(31 + k), so));
+    if (k != 2) cloud.points.insert(cloud.points.end(), bs.back().cloud.points.begin(), bs.back().cloud.points.end());
+  }
+  // One feature per building, each with its own vertices (as cjseq writes them).
+  std::vector<json> lines;
+  json header = synth_city({}, Vec3(93000, 436000, 0));
+  lines.push_back(header);
+  for (const auto& b : bs) {
+    json one = synth_city({b}, Vec3(93000, 436000, 0));
+    lines.push_back({{"type", "CityJSONFeature"}, {"id", b.id}, {"CityObjects", one["CityObjects"]}, {"vertices", one["vertices"]}});
+  }
+  std::string text;
+  for (const auto& l : lines) text += l.dump() + "\n";
+  write_file_atomic(dir + "/city.city.jsonl", text);
+  write_ply(dir + "/cloud.ply", cloud);
+  const CityRefineSummary s = refine_city(dir + "/city.city.jsonl", dir + "/cloud.ply", dir + "/out.city.jsonl", Params{}, {});
+  EXPECT_EQ(s.input_format, "CityJSONSeq 2.0");
+  EXPECT_EQ(s.buildings, 3);
+  EXPECT_EQ(s.untouched, 1);
+  EXPECT_GE(s.refined, 1);
+  EXPECT_EQ(s.refined + s.kept + s.kept_invalid + s.untouched, 3);
+  std::ifstream in(dir + "/out.city.jsonl");
+  std::vector<json> out;
+  for (std::string l; std::getline(in, l);) out.push_back(json::parse(l));
+  ASSERT_EQ(out.size(), 4u);
+  EXPECT_EQ(out[0], lines[0]);
+  EXPECT_EQ(out[3], lines[3]);  // no cloud points: the feature exactly as read
+  const CityJsonFile back = read_cityjson(dir + "/out.city.jsonl");
+  ASSERT_EQ(back.buildings.size(), 3u);
+  for (const auto& o : s.outcomes)
+    for (const auto& b : back.buildings)
+      if (b.mesh.id == o.id && o.outcome == "refined") EXPECT_EQ(geometry_problem(b.mesh), "") << b.mesh.id;
+  const fs::path schemas = shared_dir() / "schemas" / "cityjson-2.0.2";
+  if (fs::exists(schemas) && fs::exists("/usr/bin/python3")) {
+    const int st = std::system(("/usr/bin/python3 " + std::string(LODREFINE_SOURCE_DIR) + "/scripts/validate_cityjson.py " +
+                                schemas.string() + " " + dir + "/out.city.jsonl --seq >" + dir + "/v.txt 2>&1").c_str());
+    std::ifstream v(dir + "/v.txt");
+    const std::string verdict((std::istreambuf_iterator<char>(v)), {});
+    if (!(WIFEXITED(st) && WEXITSTATUS(st) == 2)) EXPECT_EQ(verdict, "valid\n");
+  }
+}

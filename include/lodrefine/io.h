@@ -55,6 +55,27 @@ FileKind sniff_file(const std::string& path);  // Other also for unreadable file
 // model?)"; empty for Other.
 std::string file_kind_text(FileKind kind);
 
+// A file written through a temporary beside the target and renamed over it on commit();
+// the temporary is removed if commit() is never reached (an exception, a kill leaves only a
+// "<path>.tmp.<pid>"). For outputs written in pieces (streams); write_file_atomic for one piece.
+class AtomicFile {
+ public:
+  explicit AtomicFile(const std::string& path);
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  ~AtomicFile();
+  void write(const char* data, std::size_t n);
+  void write(const std::string& s) { write(s.data(), s.size()); }
+  void commit();
+  [[noreturn]] void fail(const std::string& reason);  // discards, throws std::runtime_error
+
+ private:
+  void discard();
+  std::string path_, tmp_;
+  int fd_ = -1;
+  bool committed_ = false;
+};
+
 // Writes `content` to `path` atomically (temp file in the same directory + rename).
 void write_file_atomic(const std::string& path, const std::string& content);
 
