@@ -4,8 +4,7 @@
 // 2.0.2, python3-jsonschema) and its refined geometry valid by the project's own check.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-#include <unistd.h>
+#include "cli_fixtures.h"
 
 #include <chrono>
 #include <functional>
@@ -29,12 +28,10 @@ using json = nlohmann::ordered_json;
 
 namespace {
 
-std::string test_dir() {
-  const auto* info = testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir = fs::path(testing::TempDir()) / ("lodrefine_city_" + std::to_string(::getpid())) / info->name();
-  fs::create_directories(dir);
-  return dir.string();
-}
+using cli_fixtures::Cli;
+using cli_fixtures::run_cli;
+
+std::string test_dir() { return cli_fixtures::test_dir("lodrefine_city"); }
 
 json load(const std::string& path) {
   std::ifstream in(path);
@@ -110,25 +107,6 @@ json synth_city(const std::vector<SynthBuilding>& bs, const Vec3& translate) {
   return doc;
 }
 
-struct Cli {
-  int exit = -1;
-  std::string out, err;
-  double seconds = 0;
-};
-
-Cli run_cli(const std::string& args, const std::string& dir) {
-  const std::string out = dir + "/.out", err = dir + "/.err";
-  const auto t0 = std::chrono::steady_clock::now();
-  const int st = std::system((std::string(LODREFINE_BINARY) + " " + args + " >" + out + " 2>" + err).c_str());
-  Cli r;
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  r.exit = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  std::ifstream o(out), e(err);
-  r.out.assign(std::istreambuf_iterator<char>(o), {});
-  r.err.assign(std::istreambuf_iterator<char>(e), {});
-  return r;
-}
-
 // Checks the contract on an output: counts add up, untouched and kept buildings identical to
 // the input (objects and their vertices), refined ones a valid Solid with semantics, schema.
 void check_city_output(const json& in, const std::string& out_path, const CityRefineSummary& s) {
@@ -191,6 +169,21 @@ void check_city_output(const json& in, const std::string& out_path, const CityRe
               verdict.empty() ? "not checked (validator or schemas absent)" : verdict.c_str());
 }
 
+// Generated buildings 80 m apart along x and the clouds of the first `scanned` of them.
+std::vector<SynthBuilding> synth_street(const std::vector<BuildingType>& types, std::uint64_t first_seed, int points,
+                                        std::size_t scanned, PointCloud& cloud) {
+  std::vector<SynthBuilding> bs;
+  SynthOptions so;
+  so.target_points = points;
+  so.scanned_facades = 2;
+  for (std::size_t k = 0; k < types.size(); ++k) {
+    so.origin = Vec3(93000.0 + 80.0 * double(k), 436000.0, 0.0);
+    bs.push_back(make_building(types[k], first_seed + k, so));
+    if (k < scanned) cloud.points.insert(cloud.points.end(), bs.back().cloud.points.begin(), bs.back().cloud.points.end());
+  }
+  return bs;
+}
+
 // Points on a wall face moved `offset` along its normal, every `step` metres, with noise.
 void sample_face(const std::vector<Vec3>& poly, double offset, double step, std::mt19937& rng, PointCloud& out) {
   const Plane pl = polygon_plane(poly);
@@ -213,17 +206,9 @@ void sample_face(const std::vector<Vec3>& poly, double offset, double step, std:
 
 TEST(CityFile, GeneratedCityRefinedIntoCityJson2) {
   const std::string dir = test_dir();
-  std::vector<SynthBuilding> bs;
   PointCloud cloud;
-  SynthOptions so;
-  so.target_points = 8000;
-  so.scanned_facades = 2;
-  const BuildingType types[] = {BuildingType::Gable, BuildingType::LShape, BuildingType::Flat, BuildingType::Hip};
-  for (int k = 0; k < 4; ++k) {
-    so.origin = Vec3(93000.0 + 80.0 * k, 436000.0, 0.0);
-    bs.push_back(make_building(types[k], std::uint64_t(11 + k), so));
-    if (k < 3) cloud.points.insert(cloud.points.end(), bs.back().cloud.points.begin(), bs.back().cloud.points.end());
-  }
+  const std::vector<SynthBuilding> bs = synth_street(
+      {BuildingType::Gable, BuildingType::LShape, BuildingType::Flat, BuildingType::Hip}, 11, 8000, 3, cloud);
   const json in = synth_city(bs, Vec3(93000, 436000, 0));
   write_file_atomic(dir + "/city.json", in.dump());
   write_ply(dir + "/cloud.ply", cloud);
@@ -377,16 +362,9 @@ TEST(CityFile, DenHaagCityGml) {
 
 TEST(CityFile, CityJsonSeqStreamedThrough) {
   const std::string dir = test_dir();
-  std::vector<SynthBuilding> bs;
   PointCloud cloud;
-  SynthOptions so;
-  so.target_points = 6000;
-  so.scanned_facades = 2;
-  for (int k = 0; k < 3; ++k) {
-    so.origin = Vec3(93000.0 + 80.0 * k, 436000.0, 0.0);
-    bs.push_back(make_building(k == 1 ? BuildingType::Shed : BuildingType::Gable, std::uint64_t(31 + k), so));
-    if (k != 2) cloud.points.insert(cloud.points.end(), bs.back().cloud.points.begin(), bs.back().cloud.points.end());
-  }
+  const std::vector<SynthBuilding> bs =
+      synth_street({BuildingType::Gable, BuildingType::Shed, BuildingType::Gable}, 31, 6000, 2, cloud);
   // One feature per building, each with its own vertices (as cjseq writes them).
   std::vector<json> lines;
   json header = synth_city({}, Vec3(93000, 436000, 0));

@@ -115,11 +115,12 @@ TEST(CityGml, BoundarySurfacesSolidsIdsAttributesCrs) {
 }
 
 TEST(CityGml, CrsNamesBecomeCityJsonUrls) {
-  EXPECT_EQ(crs_url("urn:ogc:def:crs:EPSG::28992"), "https://www.opengis.net/def/crs/EPSG/0/28992");
-  EXPECT_EQ(crs_url("EPSG:25832"), "https://www.opengis.net/def/crs/EPSG/0/25832");
-  EXPECT_EQ(crs_url("urn:ogc:def:crs:EPSG:6.12:31467"), "https://www.opengis.net/def/crs/EPSG/0/31467");
-  EXPECT_EQ(crs_url("http://www.opengis.net/def/crs/EPSG/0/7415"), "https://www.opengis.net/def/crs/EPSG/0/7415");
-  EXPECT_EQ(crs_url("local"), "local");
+  const std::string url = "https://www.opengis.net/def/crs/EPSG/0/";
+  const std::vector<std::pair<std::string, std::string>> names = {
+      {"urn:ogc:def:crs:EPSG::28992", url + "28992"},      {"EPSG:25832", url + "25832"},
+      {"urn:ogc:def:crs:EPSG:6.12:31467", url + "31467"}, {"http://www.opengis.net/def/crs/EPSG/0/7415", url + "7415"},
+      {"local", "local"}};
+  for (const auto& [name, expected] : names) EXPECT_EQ(crs_url(name), expected) << name;
 }
 
 TEST(CityGml, BadFilesAreOneClearError) {

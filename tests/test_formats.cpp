@@ -2,8 +2,7 @@
 // a cloud of another CRS or tile called out as such.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-#include <unistd.h>
+#include "cli_fixtures.h"
 
 #include <filesystem>
 #include <fstream>
@@ -19,28 +18,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string test_dir() {
-  const auto* info = testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir = fs::path(testing::TempDir()) / ("lodrefine_formats_" + std::to_string(::getpid())) / info->name();
-  fs::create_directories(dir);
-  return dir.string();
-}
+using cli_fixtures::Cli;
+using cli_fixtures::run_cli;
+using cli_fixtures::slurp;
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-struct Cli {
-  int exit = -1;
-  std::string out, err;
-};
-
-Cli run_cli(const std::string& args, const std::string& dir) {
-  const std::string out = dir + "/.out", err = dir + "/.err";
-  const int st = std::system((std::string(LODREFINE_BINARY) + " " + args + " >" + out + " 2>" + err).c_str());
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(out), slurp(err)};
-}
+std::string test_dir() { return cli_fixtures::test_dir("lodrefine_formats"); }
 
 // One line on stderr, "lodrefine: error: ..." containing `fault`, and a non-zero exit.
 void expect_error(const Cli& r, const std::string& fault) {

@@ -2,14 +2,15 @@
 // itself, read back exactly; class filters; lying and truncated headers; LAZ refused.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-#include <unistd.h>
+#include "cli_fixtures.h"
 
 #include <algorithm>
 #include <cstring>
 #include <limits>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <tuple>
 
 #include "lodrefine/cloud.h"
 #include "lodrefine/io.h"
@@ -21,17 +22,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string temp_path(const std::string& name) {
-  const auto* info = testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir = fs::path(testing::TempDir()) / ("lodrefine_las_" + std::to_string(::getpid())) / info->name();
-  fs::create_directories(dir);
-  return (dir / name).string();
-}
+std::string temp_path(const std::string& name) { return cli_fixtures::test_dir("lodrefine_las") + "/" + name; }
 
-std::string read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
+std::string read_bytes(const std::string& path) { return cli_fixtures::slurp(path); }
 
 std::string write_bytes(const std::string& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
@@ -199,55 +192,23 @@ TEST(Las, LyingAndTruncatedHeadersAreOneClearError) {
   expect_error(good.substr(0, good.size() - 1), "(truncated?)");
   expect_error(good.substr(0, 100), "LAS header truncated");
   expect_error("LASF", "LAS header truncated");
-  {
-    std::string b = good;
-    poke<std::uint16_t>(b, 105, 19);
-    expect_error(b, "point record length 19 is below the 28 bytes of point format 1");
-  }
-  {
-    std::string b = good;
-    b[104] = 11;
-    expect_error(b, "unknown point data format 11");
-  }
-  {
-    std::string b = good;
-    poke<std::uint32_t>(b, 96, 100);
-    expect_error(b, "point data offset 100 lies inside the header");
-  }
-  {
-    std::string b = good;
-    poke<std::uint32_t>(b, 96, 1u << 30);
-    expect_error(b, "point data offset 1073741824 is beyond the end of the file");
-  }
-  {
-    std::string b = good;
-    poke<std::uint16_t>(b, 94, 100);
-    expect_error(b, "header size 100 is below the 227 bytes");
-  }
-  {
-    std::string b = good14;
-    poke<std::uint16_t>(b, 94, 227);
-    expect_error(b, "header size 227 is below the 375 bytes of LAS 1.4");
-  }
-  {
-    std::string b = good;
-    b[24] = 2;
-    expect_error(b, "unsupported LAS version 2.2");
-  }
-  {
-    std::string b = good;
-    poke<double>(b, 131, 0.0);
-    expect_error(b, "scale factor of x is zero or not finite");
-  }
-  {
-    std::string b = good;
-    poke<double>(b, 171, std::numeric_limits<double>::quiet_NaN());
-    expect_error(b, "offset of z is not finite");
-  }
-  {
-    std::string b = good;
-    poke<double>(b, 139, 1e6);  // y = Y · 1e6 m
-    expect_error(b, "has a coordinate beyond 1e9 m");
+  // One field of a valid header changed: (file, edit, expected fault).
+  const std::vector<std::tuple<const std::string*, std::function<void(std::string&)>, std::string>> lies = {
+      {&good, [](std::string& b) { poke<std::uint16_t>(b, 105, 19); }, "point record length 19 is below the 28 bytes of point format 1"},
+      {&good, [](std::string& b) { b[104] = 11; }, "unknown point data format 11"},
+      {&good, [](std::string& b) { poke<std::uint32_t>(b, 96, 100); }, "point data offset 100 lies inside the header"},
+      {&good, [](std::string& b) { poke<std::uint32_t>(b, 96, 1u << 30); }, "point data offset 1073741824 is beyond the end of the file"},
+      {&good, [](std::string& b) { poke<std::uint16_t>(b, 94, 100); }, "header size 100 is below the 227 bytes"},
+      {&good14, [](std::string& b) { poke<std::uint16_t>(b, 94, 227); }, "header size 227 is below the 375 bytes of LAS 1.4"},
+      {&good, [](std::string& b) { b[24] = 2; }, "unsupported LAS version 2.2"},
+      {&good, [](std::string& b) { poke<double>(b, 131, 0.0); }, "scale factor of x is zero or not finite"},
+      {&good, [](std::string& b) { poke<double>(b, 171, std::numeric_limits<double>::quiet_NaN()); }, "offset of z is not finite"},
+      {&good, [](std::string& b) { poke<double>(b, 139, 1e6); }, "has a coordinate beyond 1e9 m"},  // y = Y · 1e6 m
+  };
+  for (const auto& [base, edit, fault] : lies) {
+    std::string b = *base;
+    edit(b);
+    expect_error(b, fault);
   }
   {
     std::string b = good;
@@ -290,20 +251,8 @@ TEST(Las, OtherFilesGivenAsACloudSayWhatTheyAre) {
   check("\x01\x02garbage", "not a PLY file");
 }
 
-namespace {
-
-struct Cli {
-  int exit = -1;
-  std::string out, err;
-};
-
-Cli run_cli(const std::string& args, const std::string& dir) {
-  const std::string out = dir + "/.out", err = dir + "/.err";
-  const int st = std::system((std::string(LODREFINE_BINARY) + " " + args + " >" + out + " 2>" + err).c_str());
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, read_bytes(out), read_bytes(err)};
-}
-
-}  // namespace
+using cli_fixtures::Cli;
+using cli_fixtures::run_cli;
 
 TEST(Las, RefineCropAndEvalTakeLasWithClasses) {
   SynthOptions so;
