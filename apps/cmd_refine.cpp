@@ -87,8 +87,8 @@ void run(const RefineArgs& a) {
                      (a.cloud_options.classes.empty() ? std::string()
                                                       : " of classes " + classes_text(a.cloud_options.classes) +
                                                             " (of " + std::to_string(declared) + ")"));
+  // Said on stdout and in the report (stderr is for the one error line of a failed run).
   const std::string overlap = overlap_problem(bounding_box(cloud.points), bounding_box(model.vertices));
-  if (!overlap.empty()) std::fprintf(stderr, "lodrefine: warning: %s\n", overlap.c_str());
   RefineResult r = refine_building(model, cloud, a.params);
   if (!overlap.empty()) r.report["warnings"].push_back(overlap);
   r.report["model"] = a.model;
@@ -103,8 +103,8 @@ void run(const RefineArgs& a) {
     exit_code() = 3;
     return;
   }
-  std::printf("%s: %s -> %s (%.2f s)\n", model.id.c_str(), r.outcome.c_str(), a.out.c_str(),
-              r.report["seconds"].value("total", 0.0));
+  std::printf("%s: %s -> %s (%.2f s)%s\n", model.id.c_str(), r.outcome.c_str(), a.out.c_str(),
+              r.report["seconds"].value("total", 0.0), overlap.empty() ? "" : ("; warning: " + overlap).c_str());
 }
 
 }  // namespace
