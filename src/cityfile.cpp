@@ -114,6 +114,36 @@ void refine_document(json& doc, const CityJsonTransform& tf, const std::vector<C
   }
 }
 
+// CityJSON 1.0 / 1.1 objects as 2.0 wants them: "lod" a string (1.0 wrote numbers), the
+// GenericCityObject extension type now core. A 2.0 input is not touched.
+void upgrade_objects(json& objects) {
+  for (auto& [id, obj] : objects.items()) {
+    if (obj.value("type", "") == "+GenericCityObject") obj["type"] = "GenericCityObject";
+    if (!obj.contains("geometry") || !obj["geometry"].is_array()) continue;
+    for (auto& g : obj["geometry"])
+      if (g.is_object() && g.contains("lod") && g["lod"].is_number()) {
+        std::ostringstream s;
+        s << g["lod"].get<double>();
+        g["lod"] = s.str();
+      }
+  }
+}
+
+// The 1.x header fields 2.0 changed: the CRS as a URL, a point of contact's address an object.
+void upgrade_header(json& doc) {
+  json& md = doc["metadata"];
+  if (!md.is_object()) {
+    doc.erase("metadata");
+    return;
+  }
+  if (md.contains("referenceSystem") && md["referenceSystem"].is_string())
+    md["referenceSystem"] = crs_url(md["referenceSystem"].get<std::string>());
+  if (md.contains("pointOfContact") && md["pointOfContact"].is_object()) {
+    json& poc = md["pointOfContact"];
+    if (poc.contains("address") && poc["address"].is_string()) poc["address"] = {{"addressLine", poc["address"]}};
+  }
+}
+
 // CityJSON 1.x without a transform: 2.0 needs integer vertices, so one is made (0.1 mm).
 void ensure_transform(json& doc) {
   if (doc.contains("transform")) return;
@@ -157,10 +187,12 @@ void check_targets(const std::vector<CropTarget>& targets, const std::string& mo
                    std::to_string(without) + " building object(s) without one); nothing to refine");
 }
 
-void check_cloud_reaches(const std::vector<CropTarget>& targets, const Eigen::AlignedBox3d& cloud_box,
-                         const Eigen::AlignedBox3d& city_box, const std::string& cloud_path) {
-  for (const auto& t : targets)
-    if (!t.cloud.points.empty()) return;
+// Returns the number of points the crops hold; throws when the cloud reaches no building.
+std::uint64_t check_cloud_reaches(const std::vector<CropTarget>& targets, const Eigen::AlignedBox3d& cloud_box,
+                                  const Eigen::AlignedBox3d& city_box, const std::string& cloud_path) {
+  std::uint64_t held = 0;
+  for (const auto& t : targets) held += t.cloud.points.size();
+  if (held > 0) return held;
   std::string why = overlap_problem(cloud_box, city_box, "the city model");
   if (why.empty()) why = "the cloud has no point within " + std::to_string(targets.size()) + " building box(es)";
   throw InputError(cloud_path + ": " + why);
@@ -230,18 +262,21 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
   t = Clock::now();
   Eigen::AlignedBox3d cloud_box;
   sum.cloud_points = crop_tile(cloud_path, targets, options.cloud, &cloud_box);
-  check_cloud_reaches(targets, cloud_box, city_box, cloud_path);
+  sum.cropped_points = check_cloud_reaches(targets, cloud_box, city_box, cloud_path);
   sum.seconds_crop = seconds_since(t);
 
   t = Clock::now();
   AtomicFile out(out_path);
   json h = header;
+  const bool upgrade = header.value("version", "") != "2.0";
+  if (upgrade) upgrade_header(h);
   h["version"] = "2.0";
   out.write(h.dump() + "\n");
   std::size_t first = 0;
   for_each_feature([&](int n, json&& feature) {
     const CityJsonFile f = read_cityjson_document(feature_document(header, feature),
                                                   model_path + ": line " + std::to_string(n), options.lod);
+    if (upgrade) upgrade_objects(feature["CityObjects"]);
     refine_document(feature, tf, f.buildings, targets, target_of, first, params, sum);
     first += f.buildings.size();
     out.write(feature.dump() + "\n");
@@ -317,10 +352,14 @@ CityRefineSummary refine_city(const std::string& model_path, const std::string& 
   t = Clock::now();
   Eigen::AlignedBox3d cloud_box;
   sum.cloud_points = crop_tile(cloud_path, targets, options.cloud, &cloud_box);
-  check_cloud_reaches(targets, cloud_box, model_box(file.buildings), cloud_path);
+  sum.cropped_points = check_cloud_reaches(targets, cloud_box, model_box(file.buildings), cloud_path);
   sum.seconds_crop = seconds_since(t);
 
   t = Clock::now();
+  if (doc.value("version", "") != "2.0") {
+    upgrade_header(doc);
+    upgrade_objects(doc["CityObjects"]);
+  }
   ensure_transform(doc);
   refine_document(doc, transform_of(doc), file.buildings, targets, target_of, 0, params, sum);
   sum.seconds_refine = seconds_since(t);

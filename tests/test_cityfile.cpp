@@ -403,3 +403,71 @@ TEST(CityFile, CityJsonSeqStreamedThrough) {
     if (!(WIFEXITED(st) && WEXITSTATUS(st) == 2)) EXPECT_EQ(verdict, "valid\n");
   }
 }
+
+TEST(CityFile, CityJson1xUpgradedTo2) {
+  const std::string dir = test_dir();
+  PointCloud cloud;
+  const std::vector<SynthBuilding> bs = synth_street({BuildingType::Gable, BuildingType::Flat}, 41, 6000, 1, cloud);
+  json in = synth_city(bs, Vec3(93000, 436000, 0));
+  in["version"] = "1.1";
+  in["metadata"]["referenceSystem"] = "urn:ogc:def:crs:EPSG::7415";
+  in["metadata"]["pointOfContact"] = {
+      {"contactName", "someone"}, {"emailAddress", "someone@example.org"}, {"address", "Julianalaan 134, Delft"}};
+  for (auto& [id, obj] : in["CityObjects"].items()) obj["geometry"][1]["lod"] = 2.2;  // a number, as 1.0 wrote it
+  write_file_atomic(dir + "/city.json", in.dump());
+  write_ply(dir + "/cloud.ply", cloud);
+  const CityRefineSummary s = refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/out.city.json", Params{}, {});
+  EXPECT_EQ(s.input_format, "CityJSON 1.1");
+  EXPECT_EQ(s.untouched, 1);
+  const json out = load(dir + "/out.city.json");
+  EXPECT_EQ(out["version"], "2.0");
+  EXPECT_EQ(out["metadata"]["referenceSystem"], "https://www.opengis.net/def/crs/EPSG/0/7415");
+  EXPECT_EQ(out["metadata"]["pointOfContact"]["address"]["addressLine"], "Julianalaan 134, Delft");
+  for (const auto& [id, obj] : out["CityObjects"].items()) EXPECT_EQ(obj["geometry"][1]["lod"], "2.2") << id;
+  const std::string verdict = schema_verdict(dir + "/out.city.json");
+  if (!verdict.empty()) EXPECT_EQ(verdict, "valid");
+}
+
+TEST(CityFile, LodPicksTheGeometryToRefine) {
+  const fs::path path = shared_dir() / "realdata/val3dity/data/test_cityjson/several_lods_valid.json";
+  if (!fs::exists(path)) GTEST_SKIP() << path << " absent";
+  const std::string dir = test_dir();
+  const json in = load(path.string());
+  std::map<std::string, int> lods;  // the building part's solids (LoD 1.2, 1.3, 2.2) -> geometry index
+  std::string id;
+  for (const auto& [oid, obj] : in["CityObjects"].items()) {
+    if (obj["type"] != "BuildingPart" || !obj.contains("geometry")) continue;
+    for (std::size_t k = 0; k < obj["geometry"].size(); ++k) lods[obj["geometry"][k]["lod"]] = int(k), id = oid;
+  }
+  ASSERT_EQ(lods.size(), 3u);
+  std::mt19937 rng(6);
+  for (const auto& [lod, index] : lods) {
+    const CityJsonFile f = read_cityjson(path.string(), lod);
+    ASSERT_EQ(f.buildings.size(), 1u);
+    EXPECT_EQ(f.buildings[0].geometry_index, index);
+    PointCloud cloud;
+    const Mesh& m = f.buildings[0].mesh;
+    double largest = 0;
+    std::size_t big = 0;
+    const auto vertical = [&](std::size_t k) { return std::abs(newell_normal(face_points(m, m.faces[k])).normalized().z()) < 0.1; };
+    for (std::size_t k = 0; k < m.faces.size(); ++k)
+      if (vertical(k) && polygon_area(face_points(m, m.faces[k])) > largest)
+        largest = polygon_area(face_points(m, m.faces[k])), big = k;
+    for (std::size_t k = 0; k < m.faces.size(); ++k)
+      if (vertical(k)) sample_face(face_points(m, m.faces[k]), k == big ? 0.3 : 0.0, 0.1, rng, cloud);
+    write_ply(dir + "/c.ply", cloud);
+    CityRefineOptions o;
+    o.lod = lod;
+    const CityRefineSummary s = refine_city(path.string(), dir + "/c.ply", dir + "/out.city.json", Params{}, o);
+    ASSERT_EQ(s.outcomes.size(), 1u);
+    const json out = load(dir + "/out.city.json");
+    for (std::size_t k = 0; k < in["CityObjects"][id]["geometry"].size(); ++k) {
+      const json& before = in["CityObjects"][id]["geometry"][k];
+      const json& after = out["CityObjects"][id]["geometry"][k];
+      EXPECT_EQ(after["lod"], before["lod"]);
+      if (int(k) != index || s.outcomes[0].outcome != "refined") EXPECT_EQ(after, before) << "LoD " << before["lod"];
+      else EXPECT_EQ(after["type"], "Solid");
+    }
+    std::printf("  --lod %s: %s (%s)\n", lod.c_str(), s.outcomes[0].outcome.c_str(), s.outcomes[0].reason.c_str());
+  }
+}

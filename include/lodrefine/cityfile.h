@@ -47,6 +47,7 @@ struct CityRefineSummary {
   int untouched = 0;          // no cloud point in their box: written exactly as read
   int objects_without_lod = 0;  // Building/BuildingPart objects without the LoD asked for
   std::uint64_t cloud_points = 0;  // points read (after the class filter)
+  std::uint64_t cropped_points = 0;  // points held in the crops after the cloud pass (the memory that grows)
   std::vector<CityBuildingOutcome> outcomes;  // the buildings the cloud reached, in file order
   double seconds_read = 0.0, seconds_crop = 0.0, seconds_refine = 0.0, seconds_write = 0.0;
 };
