@@ -335,6 +335,8 @@ void write_outputs(const EvalArgs& a, const std::vector<Row>& rows, const Pooled
 
 void run(const EvalArgs& a) {
   a.params.validate();
+  if (!a.dir.empty() && !a.cloud_options.classes.empty())
+    throw InputError(a.dir + ": --classes applies to --cloud; a run folder holds cropped PLY clouds");
   const bool batch = !a.dir.empty();
   if (!batch && (a.original.empty() || a.refined.empty() || a.cloud.empty()))
     throw InputError("eval: give --dir RUN_DIR, or --original, --refined and --cloud");

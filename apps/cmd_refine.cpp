@@ -74,7 +74,12 @@ void run(const RefineArgs& a) {
   a.params.validate();
   check_output_dir(a.out);
   check_output_dir(a.report);
-  if (is_city_file(a.model)) return run_city(a);
+  if (is_city_file(a.model)) {
+    const std::string ext = std::filesystem::path(a.out).extension().string();
+    if (ext == ".obj" || ext == ".OBJ")
+      throw InputError(a.out + ": a city file in gives a CityJSON city file out; name it e.g. refined.city.json");
+    return run_city(a);
+  }
   if (!a.building.empty() || !a.lod.empty())
     throw InputError(a.model + ": --building and --lod pick buildings of a city file (CityJSON, CityGML), not of an OBJ");
   const Mesh model = read_obj(a.model);

@@ -55,6 +55,8 @@ TEST(Formats, WrongKindOfFileSaysWhatItIs) {
                "city.gml: no Building/BuildingPart with an LoD 2.x geometry");
   expect_error(run_cli("refine --model " + dir + "/lod1.city.json --cloud " + dir + "/c.ply --out " + dir + "/r.city.json", dir),
                "lod1.city.json: no Building/BuildingPart with an LoD 2.x geometry (1 building object(s) without one); nothing to refine");
+  expect_error(run_cli("refine --model " + dir + "/lod1.city.json --cloud " + dir + "/c.ply --out " + dir + "/r.obj", dir),
+               "r.obj: a city file in gives a CityJSON city file out; name it e.g. refined.city.json");
   expect_error(run_cli("refine --model " + dir + "/other.json --cloud " + dir + "/c.ply --out " + dir + "/r.city.json", dir),
                "other.json: not a CityJSON file (no \"type\": \"CityJSON\")");
   expect_error(run_cli("refine --model " + dir + "/c.ply --cloud " + dir + "/m.obj" + out, dir),
