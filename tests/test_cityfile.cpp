@@ -18,6 +18,7 @@
 #include "lodrefine/citygml.h"
 #include "lodrefine/geometry.h"
 #include "lodrefine/io.h"
+#include "lodrefine/las.h"
 #include "lodrefine/refine.h"
 #include "lodrefine/synth.h"
 #include "lodrefine/validate.h"
@@ -470,4 +471,38 @@ TEST(CityFile, LodPicksTheGeometryToRefine) {
     }
     std::printf("  --lod %s: %s (%s)\n", lod.c_str(), s.outcomes[0].outcome.c_str(), s.outcomes[0].reason.c_str());
   }
+}
+
+TEST(CityFile, LasTileWithClassesThroughTheCli) {
+  const std::string dir = test_dir();
+  PointCloud cloud;
+  const std::vector<SynthBuilding> bs = synth_street({BuildingType::Gable, BuildingType::LShape}, 51, 6000, 2, cloud);
+  write_file_atomic(dir + "/city.json", synth_city(bs, Vec3(93000, 436000, 0)).dump());
+  write_ply(dir + "/cloud.ply", cloud);
+  // The same points as class 6, and as many class-1 points scattered through the buildings' boxes.
+  PointCloud tile = cloud;
+  std::vector<int> classes(cloud.points.size(), 6);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> jitter(-4.0, 4.0);
+  for (const auto& p : cloud.points) {
+    tile.points.push_back(p + Vec3(jitter(rng), jitter(rng), jitter(rng)));
+    classes.push_back(1);
+  }
+  LasWriteOptions lo;
+  lo.version_minor = 4, lo.point_format = 6, lo.scale = Vec3::Constant(1e-4), lo.offset = Vec3(93000, 436000, 0);
+  write_las(dir + "/tile.las", tile, classes, lo);
+  const Cli ply = run_cli("refine --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir +
+                              "/a.city.json --report " + dir + "/a.json", dir);
+  const Cli las = run_cli("refine --model " + dir + "/city.json --cloud " + dir + "/tile.las --classes 6 --out " + dir +
+                              "/b.city.json --report " + dir + "/b.json", dir);
+  ASSERT_EQ(ply.exit, 0) << ply.err;
+  ASSERT_EQ(las.exit, 0) << las.err;
+  const json a = load(dir + "/a.json"), b = load(dir + "/b.json");
+  EXPECT_EQ(b["cloud_points"], cloud.points.size());
+  ASSERT_EQ(a["outcomes"].size(), b["outcomes"].size());
+  for (std::size_t i = 0; i < a["outcomes"].size(); ++i) {
+    EXPECT_EQ(a["outcomes"][i]["outcome"], b["outcomes"][i]["outcome"]);
+    EXPECT_EQ(a["outcomes"][i]["facades_moved"], b["outcomes"][i]["facades_moved"]);
+  }
+  EXPECT_GE(b["refined"].get<int>(), 1);
 }
