@@ -15,14 +15,16 @@ namespace {
 namespace fs = std::filesystem;
 
 struct ConvertArgs {
-  std::string cityjson, citygml, out_dir;
+  std::string cityjson, citygml, out_dir, lod;
   std::vector<std::string> ids;
 };
 
 void run(const ConvertArgs& a) {
   if (a.cityjson.empty() && a.citygml.empty()) throw InputError("convert needs --cityjson FILE or --citygml FILE");
   const std::string& path = a.citygml.empty() ? a.cityjson : a.citygml;
-  const CityJsonFile file = a.citygml.empty() ? read_cityjson(path) : read_citygml(path);
+  if (!a.citygml.empty() && !a.lod.empty() && a.lod != "2")
+    throw InputError(path + ": CityGML buildings are read at LoD 2 only (--lod " + a.lod + ")");
+  const CityJsonFile file = a.citygml.empty() ? read_cityjson(path, a.lod) : read_citygml(path);
   const std::set<std::string> wanted(a.ids.begin(), a.ids.end());
   std::vector<const CityJsonBuilding*> chosen;
   std::set<std::string> found;
@@ -31,7 +33,8 @@ void run(const ConvertArgs& a) {
   for (const auto& id : wanted)
     if (!found.count(id)) throw InputError(path + ": no Building/BuildingPart '" + id + "' with an LoD 2.x geometry");
   if (chosen.empty())
-    throw InputError(path + ": no Building/BuildingPart with an LoD 2.x geometry (" +
+    throw InputError(path + ": no Building/BuildingPart with " +
+                     (a.lod.empty() ? std::string("an LoD 2.x") : "an LoD " + a.lod) + " geometry (" +
                      std::to_string(file.objects_without_lod2) + " building object(s) without one); nothing to convert");
   fs::create_directories(a.out_dir);
   std::set<std::string> stems;
@@ -43,9 +46,10 @@ void run(const ConvertArgs& a) {
       std::fprintf(stderr, "lodrefine: note: %s: dropped %d inner ring(s), %d degenerate surface(s), %d interior shell(s)\n",
                    b->mesh.id.c_str(), b->skipped_holes, b->skipped_rings, b->skipped_shells);
   }
-  std::printf("%zu building(s) written to %s (%s %s%s, %s; %d object(s) without LoD 2.x skipped)\n", chosen.size(),
+  std::printf("%zu building(s) written to %s (%s %s%s, %s; %d object(s) without LoD %s skipped)\n", chosen.size(),
               a.out_dir.c_str(), file.format.c_str(), file.version.c_str(), file.sequence ? " sequence" : "",
-              file.crs.empty() ? "no CRS" : file.crs.c_str(), file.objects_without_lod2);
+              file.crs.empty() ? "no CRS" : file.crs.c_str(), file.objects_without_lod2,
+              a.lod.empty() ? "2.x" : a.lod.c_str());
 }
 
 }  // namespace
@@ -58,6 +62,7 @@ void add_convert_command(CLI::App& app) {
   cmd->add_option("--citygml", args.citygml, "CityGML 1.0/2.0 file (Building, BuildingPart)")
       ->check(CLI::ExistingFile)
       ->excludes(json_in);
+  cmd->add_option("--lod", args.lod, "The LoD geometry to write, e.g. 2.2 or 1.2 (default: the highest 2.x)");
   cmd->add_option("--id", args.ids, "Only these CityObject ids (repeatable; default: every building)");
   cmd->add_option("--out-dir", args.out_dir, "Directory for <id>.obj (created if missing)")->required();
   cmd->callback([] { run(args); });

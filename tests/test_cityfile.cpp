@@ -470,6 +470,10 @@ TEST(CityFile, LodPicksTheGeometryToRefine) {
       else EXPECT_EQ(after["type"], "Solid");
     }
     std::printf("  --lod %s: %s (%s)\n", lod.c_str(), s.outcomes[0].outcome.c_str(), s.outcomes[0].reason.c_str());
+    // convert --lod writes that LoD's faces.
+    const Cli c = run_cli("convert --cityjson " + path.string() + " --lod " + lod + " --out-dir " + dir + "/obj_" + lod, dir);
+    ASSERT_EQ(c.exit, 0) << c.err;
+    EXPECT_EQ(read_obj(dir + "/obj_" + lod + "/" + id + ".obj").faces.size(), m.faces.size()) << lod;
   }
 }
 
