@@ -169,7 +169,8 @@ class Converter {
     if (g.getLOD() != 2) return;
     for (unsigned i = 0; i < g.getPolygonsCount(); ++i) {
       const auto p = g.getPolygon(i);
-      if (!p || !p->exteriorRing() || !seen.insert(p.get()).second) continue;
+      // Rings libcitygml could not read (bad posList) come back empty: no surface.
+      if (!p || !p->exteriorRing() || p->exteriorRing()->getVertices().size() < 3 || !seen.insert(p.get()).second) continue;
       json surface = json::array({ring(*p->exteriorRing())});
       for (const auto& hole : p->interiorRings())
         if (hole) surface.push_back(ring(*hole));
