@@ -196,7 +196,8 @@ class Converter {
 
   struct Hash {
     std::size_t operator()(const std::array<long long, 3>& q) const {
-      return std::size_t(q[0] * 73856093LL ^ q[1] * 19349663LL ^ q[2] * 83492791LL);
+      // Unsigned: wraps instead of overflowing (coordinates reach 1e13 units).
+      return std::size_t(std::uint64_t(q[0]) * 73856093u ^ std::uint64_t(q[1]) * 19349663u ^ std::uint64_t(q[2]) * 83492791u);
     }
   };
 

@@ -167,3 +167,16 @@ TEST(CityGml, DenHaagBuildingParts) {
   EXPECT_EQ(semantics(f.buildings[0].mesh),
             (std::map<Semantic, int>{{Semantic::Wall, 6}, {Semantic::Roof, 2}, {Semantic::Ground, 1}}));
 }
+
+// Found by fuzz_citygml (UBSan, signed overflow in the vertex hash): coordinates 1800 km apart
+// are 1.8e10 units of 0.1 mm; they must read back, not overflow.
+TEST(CityGml, CoordinatesFarApart) {
+  std::string s = kHeader;
+  s += "<cityObjectMember><bldg:Building gml:id=\"far\"><bldg:lod2MultiSurface><gml:MultiSurface><gml:surfaceMember>" +
+       polygon({{-9e8, 0, 0}, {9e8, 0, 0}, {9e8, 5e8, 0}}, "") +
+       "</gml:surfaceMember></gml:MultiSurface></bldg:lod2MultiSurface></bldg:Building></cityObjectMember></CityModel>\n";
+  const CityJsonFile f = read_citygml(write_temp("far.gml", s));
+  ASSERT_EQ(f.buildings.size(), 1u);
+  ASSERT_EQ(f.buildings[0].mesh.faces.size(), 1u);
+  EXPECT_EQ(f.buildings[0].mesh.vertices[1], Vec3(9e8, 0, 0));
+}
