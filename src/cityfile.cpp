@@ -45,8 +45,12 @@ CityBuildingOutcome classify(const RefineResult& r) {
     if (!r.valid && r.report.contains("output_validation"))
       o.reason += " (not valid: " + r.report["output_validation"].value("problem", std::string("invalid")) + ")";
   }
-  if (r.report.contains("replacements"))
+  // The report lists the moved facades ("facades"); older reports only the replacement steps.
+  if (r.report.contains("facades") && r.report["facades"].is_array()) {
+    o.facades_moved = int(r.report["facades"].size());
+  } else if (r.report.contains("replacements")) {
     for (const auto& step : r.report["replacements"]) o.facades_moved += step.value("ok", false) ? 1 : 0;
+  }
   if (o.outcome != "refined") o.facades_moved = 0;
   return o;
 }
