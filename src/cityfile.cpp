@@ -42,7 +42,7 @@ CityBuildingOutcome classify(const RefineResult& r) {
     if (o.reason.empty() && open != std::string::npos && close != std::string::npos && close > open)
       o.reason = s.substr(open + 1, close - open - 1);
     if (o.reason.empty()) o.reason = s;
-    if (!r.valid && r.report.contains("output_validation"))
+    if (!r.valid && s.rfind("kept-invalid", 0) != 0 && r.report.contains("output_validation"))
       o.reason += " (not valid: " + r.report["output_validation"].value("problem", std::string("invalid")) + ")";
   }
   // The report lists the moved facades ("facades"); older reports only the replacement steps.
