@@ -7,6 +7,7 @@
 #include "commands.h"
 #include "lodrefine/crop.h"
 #include "lodrefine/io.h"
+#include "options.h"
 
 namespace lodrefine::app {
 namespace {
@@ -19,6 +20,7 @@ struct CropArgs {
   // Points held in memory before spilling to per-building files: ~100 MB at 24 bytes a point,
   // whatever the tile's size.
   std::size_t buffer_points = 4000000;
+  CloudOptions cloud_options;
 };
 
 // Models: DIR/*.obj (id = stem) or DIR/<id>/coarse.obj.
@@ -55,7 +57,7 @@ void run(const CropArgs& a) {
     clouds.push_back((fs::path(a.out) / id / "cloud.ply").string());
   }
   std::vector<std::size_t> counts;
-  const std::size_t n = crop_tile_to_files(a.tile, targets, clouds, a.buffer_points, counts);
+  const std::size_t n = crop_tile_to_files(a.tile, targets, clouds, a.buffer_points, counts, a.cloud_options);
   for (std::size_t i = 0; i < targets.size(); ++i) {
     const fs::path dir = fs::path(a.out) / ids[i];
     const fs::path model = models[i].second;
@@ -74,14 +76,15 @@ void run(const CropArgs& a) {
 
 void add_crop_command(CLI::App& app) {
   static CropArgs args;
-  auto* cmd = app.add_subcommand("crop", "Cut one cloud per building from a large PLY tile (streaming)");
-  cmd->add_option("--tile", args.tile, "Large point cloud tile (PLY)")->required()->check(CLI::ExistingFile);
+  auto* cmd = app.add_subcommand("crop", "Cut one cloud per building from a large PLY or LAS tile (streaming)");
+  cmd->add_option("--tile", args.tile, "Large point cloud tile (PLY or LAS)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--models", args.models, "Folder of models: *.obj or <id>/coarse.obj")->required();
   cmd->add_option("--out", args.out, "Run folder: writes <id>/cloud.ply and <id>/coarse.obj")->required();
   cmd->add_option("--expand", args.expand, "Relative box growth on each side")->capture_default_str()->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--margin", args.margin, "Absolute box growth on each side (m)")->capture_default_str()->check(CLI::Range(0.0, 1000.0));
   cmd->add_option("--buffer-points", args.buffer_points, "Points held in memory before spilling to disk (memory bound)")
       ->capture_default_str()->check(CLI::Range(std::size_t(1), std::size_t(1) << 40));
+  add_cloud_options(cmd, args.cloud_options);
   cmd->callback([] { run(args); });
 }
 

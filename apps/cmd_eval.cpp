@@ -36,6 +36,7 @@ struct EvalArgs {
   int html_views = 20;
   int jobs = int(std::max(1u, std::thread::hardware_concurrency()));
   Params params;
+  CloudOptions cloud_options;  // single-building mode (a run folder holds cropped PLYs)
 };
 
 // The files of one building; empty strings for absent optional ones.
@@ -135,23 +136,25 @@ struct LocalBuilding {
   Vec3 origin;
 };
 
-LocalBuilding read_local(const BuildingFiles& f, std::optional<Vec3> origin, std::string& refined_error) {
+LocalBuilding read_local(const BuildingFiles& f, std::optional<Vec3> origin, std::string& refined_error,
+                         const CloudOptions& cloud_options = {}) {
   LocalBuilding b;
   b.original = read_obj(f.original);
   b.origin = origin ? *origin : local_origin(b.original);
   b.original = translated(std::move(b.original), -b.origin);
-  b.cloud = read_ply(f.cloud);
+  b.cloud = read_cloud(f.cloud, cloud_options);
   for (auto& p : b.cloud.points) p -= b.origin;
   b.refined = translated(read_refined(f.refined, refined_error), -b.origin);
   return b;
 }
 
 // Reads, moves to a local frame (georeferenced inputs) and evaluates one building.
-Row evaluate_files(const BuildingFiles& f, const Params& params, const std::string& svg_dir) {
+Row evaluate_files(const BuildingFiles& f, const Params& params, const std::string& svg_dir,
+                   const CloudOptions& cloud_options = {}) {
   Row row;
   row.files = f;
   std::string refined_error;
-  const auto [original, refined, cloud, origin] = read_local(f, std::nullopt, refined_error);
+  const auto [original, refined, cloud, origin] = read_local(f, std::nullopt, refined_error, cloud_options);
   row.origin = origin;
   std::optional<Mesh> truth;
   std::optional<std::vector<int>> scanned;
@@ -638,6 +641,8 @@ void write_outputs(const EvalArgs& a, const std::vector<Row>& rows, const Pooled
 
 void run(const EvalArgs& a) {
   a.params.validate();
+  if (!a.dir.empty() && !a.cloud_options.classes.empty())
+    throw InputError(a.dir + ": --classes applies to --cloud; a run folder holds cropped PLY clouds");
   const bool batch = !a.dir.empty();
   if (!batch && (a.original.empty() || a.refined.empty() || a.cloud.empty()))
     throw InputError("eval: give --dir RUN_DIR, or --original, --refined and --cloud");
@@ -646,7 +651,8 @@ void run(const EvalArgs& a) {
   if (batch) {
     rows = evaluate_run(a.dir, a.params, a.svg_dir, a.jobs);
   } else {
-    rows.push_back(evaluate_files({"", a.original, a.refined, a.cloud, a.truth, a.meta, "", ""}, a.params, a.svg_dir));
+    rows.push_back(evaluate_files({"", a.original, a.refined, a.cloud, a.truth, a.meta, "", ""}, a.params, a.svg_dir,
+                                  a.cloud_options));
     if (!rows.back().eval.ok()) std::fprintf(stderr, "lodrefine: warning: %s\n", rows.back().eval.error.c_str());
   }
   std::vector<BuildingEval> evals;
@@ -667,7 +673,7 @@ void add_eval_command(CLI::App& app) {
                                               "meta.json,report.json]}, pooled over all buildings");
   auto* orig = cmd->add_option("--original", a.original, "Coarse model (OBJ)")->check(CLI::ExistingFile);
   cmd->add_option("--refined", a.refined, "Refined model (OBJ); a missing file is reported as a failure");
-  cmd->add_option("--cloud", a.cloud, "MLS crop (PLY)")->check(CLI::ExistingFile);
+  cmd->add_option("--cloud", a.cloud, "MLS crop (PLY or LAS)")->check(CLI::ExistingFile);
   cmd->add_option("--truth", a.truth, "Truth model (OBJ): adds truth_facade_* / truth_roof_* distances")
       ->check(CLI::ExistingFile);
   cmd->add_option("--meta", a.meta, "Generator meta.json listing the scanned truth faces (else detected)")
@@ -683,6 +689,7 @@ void add_eval_command(CLI::App& app) {
   cmd->add_option("--jobs", a.jobs, "With --dir: buildings evaluated at once (default: all cores)")
       ->check(CLI::Range(1, 1024));
   dir->excludes(orig);
+  add_cloud_options(cmd, a.cloud_options);
   add_param_options(cmd, a.params);
   cmd->callback([] { run(a); });
 }

@@ -3,6 +3,8 @@
 #include <filesystem>
 
 #include "commands.h"
+#include "lodrefine/cityfile.h"
+#include "lodrefine/cloud.h"
 #include "lodrefine/io.h"
 #include "lodrefine/refine.h"
 #include "options.h"
@@ -14,6 +16,8 @@ struct RefineArgs {
   std::string model, cloud, out, report;
   std::uint64_t max_points = 20000000;
   Params params;
+  CloudOptions cloud_options;
+  std::string building, lod;  // city files only
 };
 
 nlohmann::json params_json(const Params& p) {
@@ -32,26 +36,75 @@ void check_output_dir(const std::string& path) {
   if (std::filesystem::is_directory(path)) throw InputError(path + ": is a directory");
 }
 
+// A city file (CityJSON, CityJSONSeq, CityGML) in: every building the cloud covers, one
+// CityJSON 2.0 file out.
+void run_city(const RefineArgs& a) {
+  CityRefineOptions o;
+  o.building = a.building;
+  o.lod = a.lod;
+  o.cloud = a.cloud_options;
+  const CityRefineSummary s = refine_city(a.model, a.cloud, a.out, a.params, o);
+  if (!a.report.empty()) {
+    nlohmann::json j = {{"model", a.model}, {"cloud", a.cloud}, {"written", a.out}, {"input", s.input_format},
+                        {"buildings", s.buildings}, {"refined", s.refined}, {"kept", s.kept},
+                        {"kept_invalid", s.kept_invalid}, {"untouched", s.untouched},
+                        {"objects_without_lod", s.objects_without_lod}, {"cloud_points", s.cloud_points},
+                        {"cropped_points", s.cropped_points},
+                        {"seconds", {{"read", s.seconds_read}, {"crop", s.seconds_crop}, {"refine", s.seconds_refine},
+                                     {"write", s.seconds_write}}},
+                        {"params", params_json(a.params)}, {"outcomes", nlohmann::json::array()}};
+    for (const auto& b : s.outcomes)
+      j["outcomes"].push_back({{"id", b.id}, {"outcome", b.outcome}, {"reason", b.reason},
+                               {"facades_moved", b.facades_moved}, {"points", b.points}, {"seconds", b.seconds}});
+    write_file_atomic(a.report, j.dump(2) + "\n");
+  }
+  std::printf("%s: %d building(s), %llu cloud points (%llu in building crops): %d refined, %d kept, %d kept-invalid, "
+              "%d untouched (no cloud points) -> %s (read %.1f s, crop %.1f s, refine %.1f s, write %.1f s)\n",
+              s.input_format.c_str(), s.buildings, (unsigned long long)s.cloud_points,
+              (unsigned long long)s.cropped_points, s.refined, s.kept, s.kept_invalid, s.untouched, a.out.c_str(),
+              s.seconds_read, s.seconds_crop, s.seconds_refine, s.seconds_write);
+}
+
+bool is_city_file(const std::string& path) {
+  const FileKind k = sniff_file(path);
+  return k == FileKind::Xml || k == FileKind::Json;
+}
+
 void run(const RefineArgs& a) {
   a.params.validate();
   check_output_dir(a.out);
   check_output_dir(a.report);
+  if (is_city_file(a.model)) {
+    const std::string ext = std::filesystem::path(a.out).extension().string();
+    if (ext == ".obj" || ext == ".OBJ")
+      throw InputError(a.out + ": a city file in gives a CityJSON city file out; name it e.g. refined.city.json");
+    return run_city(a);
+  }
+  if (!a.building.empty() || !a.lod.empty())
+    throw InputError(a.model + ": --building and --lod pick buildings of a city file (CityJSON, CityGML), not of an OBJ");
   const Mesh model = read_obj(a.model);
-  const std::uint64_t declared = ply_vertex_count(a.cloud);
+  const std::uint64_t declared = cloud_point_count(a.cloud);
   if (declared > a.max_points)
     throw InputError(a.cloud + ": " + std::to_string(declared) + " points, more than --max-points " +
                      std::to_string(a.max_points) + "; cut a crop per building first (lodrefine crop)");
-  const PointCloud cloud = read_ply(a.cloud);
-  if (cloud.points.empty()) throw InputError(a.cloud + ": the cloud has no points");
+  const PointCloud cloud = read_cloud(a.cloud, a.cloud_options);
+  if (cloud.points.empty())
+    throw InputError(a.cloud + ": the cloud has no points" +
+                     (a.cloud_options.classes.empty() ? std::string()
+                                                      : " of classes " + classes_text(a.cloud_options.classes) +
+                                                            " (of " + std::to_string(declared) + ")"));
+  // Said on stdout and in the report (stderr is for the one error line of a failed run).
+  const std::string overlap = overlap_problem(bounding_box(cloud.points), bounding_box(model.vertices));
   RefineResult r = refine_building(model, cloud, a.params);
+  if (!overlap.empty()) r.report["warnings"].push_back(overlap);
   r.report["model"] = a.model;
   r.report["cloud"]["path"] = a.cloud;
   r.report["params"] = params_json(a.params);
   r.report["written"] = a.out;
   if (!a.report.empty()) write_file_atomic(a.report, r.report.dump(2) + "\n");
   write_obj(a.out, r.mesh);
-  std::printf("%s: %s (%s) -> %s (%.2f s)\n", model.id.c_str(), r.outcome.c_str(), r.reason.c_str(), a.out.c_str(),
-              r.report["seconds"].value("total", 0.0));
+  std::printf("%s: %s (%s) -> %s (%.2f s)%s\n", model.id.c_str(), r.outcome.c_str(), r.reason.c_str(), a.out.c_str(),
+              r.report["seconds"].value("total", 0.0), overlap.empty() ? "" : ("; warning: " + overlap).c_str());
 }
 
 }  // namespace
@@ -59,11 +112,16 @@ void run(const RefineArgs& a) {
 void add_refine_command(CLI::App& app) {
   static RefineArgs args;
   auto* cmd = app.add_subcommand("refine", "Refine one building model with an MLS point cloud");
-  cmd->add_option("--model", args.model, "Coarse building model (OBJ, CityGML fan-out export)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--cloud", args.cloud, "MLS point cloud crop around the building (PLY)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--out", args.out, "Refined model (OBJ), written atomically")->required();
+  cmd->add_option("--model", args.model,
+                  "Coarse building model (OBJ, CityGML fan-out export), or a city file (CityJSON, CityJSONSeq, "
+                  "CityGML): then --out is a CityJSON 2.0 city file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--cloud", args.cloud, "MLS point cloud crop around the building (PLY or LAS)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--out", args.out, "Refined model (OBJ; CityJSON for a city file), written atomically")->required();
+  cmd->add_option("--building", args.building, "City file: refine only this CityObject id");
+  cmd->add_option("--lod", args.lod, "City file: the LoD geometry to refine, e.g. 2.2 (default: the highest 2.x)");
   cmd->add_option("--report", args.report, "JSON report: matches, planes, candidates, MIP, timings, validation");
   cmd->add_option("--max-points", args.max_points, "Refuse clouds with more points (a tile, not a crop)")->capture_default_str();
+  add_cloud_options(cmd, args.cloud_options);
   add_param_options(cmd, args.params);
   cmd->callback([] { run(args); });
 }

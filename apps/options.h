@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "lodrefine/cloud.h"
 #include "lodrefine/params.h"
 
 namespace lodrefine::app {
@@ -27,6 +28,15 @@ inline void add_param_options(CLI::App* cmd, Params& params) {
   ++i;
   LODREFINE_PARAMS(LODREFINE_PARAM_OPTION)
 #undef LODREFINE_PARAM_OPTION
+}
+
+// `--classes 2,6`: the LAS classification filter of a command that reads a cloud.
+inline void add_cloud_options(CLI::App* cmd, CloudOptions& options) {
+  cmd->add_option("--classes", options.classes,
+                  "Keep only LAS points of these classification codes (comma-separated, e.g. 1,6; "
+                  "formats 0-5: 0-31, 6-10: 0-255)")
+      ->delimiter(',')
+      ->check(CLI::Range(0, 255));
 }
 
 }  // namespace lodrefine::app

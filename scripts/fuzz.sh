@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (clang, ASan + UBSan) into build-fuzz/ and runs them.
-#   scripts/fuzz.sh [TARGET|all] [SECONDS]   fuzz TARGET (fuzz_obj, fuzz_ply, fuzz_refine; default
-#                                           all, one after the other) for SECONDS each (default 600)
+#   scripts/fuzz.sh [TARGET|all] [SECONDS]   fuzz TARGET (fuzz_obj, fuzz_ply, fuzz_las, fuzz_citygml,
+#                                           fuzz_refine; default all, one after the other) for SECONDS
+#                                           each (default 600)
 #   scripts/fuzz.sh regress                 run every saved input of tests/fuzz/regressions/<target>/
 #                                           and the seed corpus once through its target (no fuzzing)
 # New corpus entries go to build-fuzz/corpus/<target>/ (the seeds in tests/fuzz/corpus/ are only
@@ -10,7 +11,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
-TARGETS=(fuzz_obj fuzz_ply fuzz_refine)
+TARGETS=(fuzz_obj fuzz_ply fuzz_las fuzz_citygml fuzz_refine)
 what=${1:-all}
 seconds=${2:-600}
 

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lodrefine/geometry.h"
+#include "lodrefine/io.h"
 
 namespace lodrefine {
 namespace {
@@ -34,7 +35,7 @@ const json& member(const json& obj, const char* key) {
 
 class Reader {
  public:
-  explicit Reader(std::string name) : name_(std::move(name)) {}
+  Reader(std::string name, std::string lod) : name_(std::move(name)), lod_(std::move(lod)) {}
 
   [[noreturn]] void fail(const std::string& fault) const {
     throw InputError(name_ + ": " + (where_.empty() ? "" : where_ + ": ") + fault);
@@ -53,13 +54,14 @@ class Reader {
   }
 
   CityJsonFile read(const std::string& text) {
-    // CityJSONSeq: the first line is a complete "CityJSON" object and more lines follow.
-    const auto eol = text.find('\n');
-    if (eol != std::string::npos && text.find_first_not_of(" \t\r\n", eol) != std::string::npos) {
-      const json first = json::parse(text.substr(0, eol), nullptr, false);
-      if (first.is_object() && member(first, "type") == "CityJSON") return read_sequence(first, text, eol + 1);
+    if (is_cityjson_sequence(text)) {
+      const auto eol = text.find('\n');
+      return read_sequence(json::parse(text.substr(0, eol)), text, eol + 1);
     }
-    const json root = parse(text, "the file");
+    return read_document(parse(text, "the file"));
+  }
+
+  CityJsonFile read_document(const json& root) {
     CityJsonFile out;
     read_header(root, out);
     const std::vector<Vec3> vertices = read_vertices(root, out);
@@ -70,6 +72,7 @@ class Reader {
 
  private:
   std::string name_;
+  std::string lod_;    // the LoD asked for ("" = the highest 2.x)
   std::string where_;  // "line N" / "object ID" context for error messages
   int degenerate_rings_ = 0, degenerate_objects_ = 0;
 
@@ -159,6 +162,7 @@ class Reader {
       const json& lod = (*geom)["lod"];
       b.lod = lod.is_string() ? lod.get<std::string>() : lod.dump();
       b.geometry_type = (*geom)["type"].get<std::string>();
+      b.geometry_index = int(geom - &obj["geometry"][0]);
       read_geometry(*geom, vertices, b);
       if (b.skipped_holes > 0)
         out.notes.push_back(one_line(id, 60) + ": " + std::to_string(b.skipped_holes) +
@@ -201,6 +205,11 @@ class Reader {
         if (s.empty() || *end != '\0') fail("geometry lod \"" + one_line(s, 20) + "\" is not a number");
       } else {
         fail("a geometry has no \"lod\"");
+      }
+      if (!lod_.empty()) {  // an exact LoD asked for: "2.2" matches "2.2" and 2.2
+        char* end = nullptr;
+        if (best == nullptr && std::strtod(lod_.c_str(), &end) == value && *end == '\0') best = &g;
+        continue;
       }
       if (value >= 2.0 && value < 3.0 && value > best_lod) {
         best = &g;
@@ -380,6 +389,14 @@ class Reader {
 
 }  // namespace
 
+bool is_cityjson_sequence(const std::string& text) {
+  // CityJSONSeq: the first line is a complete "CityJSON" object and more lines follow.
+  const auto eol = text.find('\n');
+  if (eol == std::string::npos || text.find_first_not_of(" \t\r\n", eol) == std::string::npos) return false;
+  const json first = json::parse(text.substr(0, eol), nullptr, false);
+  return first.is_object() && member(first, "type") == "CityJSON";
+}
+
 Semantic semantic_from_cityjson(const std::string& type) {
   if (type == "WallSurface") return Semantic::Wall;
   if (type == "RoofSurface") return Semantic::Roof;
@@ -397,15 +414,24 @@ std::string file_stem_for_id(const std::string& id) {
   return out;
 }
 
-CityJsonFile parse_cityjson(const std::string& text, const std::string& name) { return Reader(name).read(text); }
+CityJsonFile parse_cityjson(const std::string& text, const std::string& name, const std::string& lod) {
+  return Reader(name, lod).read(text);
+}
 
-CityJsonFile read_cityjson(const std::string& path) {
+CityJsonFile read_cityjson_document(const nlohmann::ordered_json& doc, const std::string& name, const std::string& lod) {
+  return Reader(name, lod).read_document(doc);
+}
+
+CityJsonFile read_cityjson(const std::string& path, const std::string& lod) {
+  const FileKind kind = sniff_file(path);
+  if (kind != FileKind::Json && kind != FileKind::Other)
+    throw InputError(path + ": not a CityJSON file: the file is " + file_kind_text(kind));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open the file");
   std::ostringstream ss;
   ss << in.rdbuf();
   if (in.bad()) throw InputError(path + ": cannot read the file");
-  return parse_cityjson(ss.str(), path);
+  return parse_cityjson(ss.str(), path, lod);
 }
 
 }  // namespace lodrefine

@@ -34,10 +34,11 @@ CropTarget crop_target(const Mesh& model, double relative, double absolute) {
 
 namespace {
 
-// Streams `tile_ply` once and calls on_hit(i, p) for every target i whose box holds p; a 2D
-// grid over the targets keeps this O(points). Returns the number of points read.
-std::size_t for_each_hit(const std::string& tile_ply, const std::vector<CropTarget>& targets,
-                         const std::function<void(std::size_t, const Vec3&)>& on_hit) {
+// Streams the tile (PLY or LAS, `options` filtering LAS classes) once and calls on_hit(i, p)
+// for every target i whose box holds p; a 2D grid over the targets keeps this O(points).
+// Returns the number of points read; `bounds` (optional) gets their bounding box.
+std::size_t for_each_hit(const std::string& tile, const std::vector<CropTarget>& targets, const CloudOptions& options,
+                         Eigen::AlignedBox3d* bounds, const std::function<void(std::size_t, const Vec3&)>& on_hit) {
   if (targets.empty()) return 0;
   // Grid cell size: about the median box size, so each box touches few cells.
   std::vector<double> sizes;
@@ -54,8 +55,9 @@ std::size_t for_each_hit(const std::string& tile_ply, const std::vector<CropTarg
       for (double y = std::floor(t.lo.y() / cell) * cell; y <= t.hi.y(); y += cell) grid[key(x + 0.5 * cell, y + 0.5 * cell)].push_back(i);
   }
   std::size_t n = 0;
-  stream_ply(tile_ply, [&](const Vec3& p) {
+  stream_cloud(tile, options, [&](const Vec3& p) {
     ++n;
+    if (bounds) bounds->extend(p);
     const auto it = grid.find(key(p.x(), p.y()));
     if (it == grid.end()) return;
     for (std::size_t i : it->second) {
@@ -85,13 +87,15 @@ std::vector<Vec3> unspill(const std::string& path) {
 
 }  // namespace
 
-std::size_t crop_tile(const std::string& tile_ply, std::vector<CropTarget>& targets) {
-  return for_each_hit(tile_ply, targets, [&](std::size_t i, const Vec3& p) { targets[i].cloud.points.push_back(p); });
+std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets, const CloudOptions& options,
+                      Eigen::AlignedBox3d* bounds) {
+  return for_each_hit(tile, targets, options, bounds,
+                      [&](std::size_t i, const Vec3& p) { targets[i].cloud.points.push_back(p); });
 }
 
-std::size_t crop_tile_to_files(const std::string& tile_ply, const std::vector<CropTarget>& targets,
+std::size_t crop_tile_to_files(const std::string& tile, const std::vector<CropTarget>& targets,
                                const std::vector<std::string>& out_paths, std::size_t buffer_points,
-                               std::vector<std::size_t>& counts) {
+                               std::vector<std::size_t>& counts, const CloudOptions& options) {
   static_assert(sizeof(Vec3) == 3 * sizeof(double), "spill files hold Vec3 as three doubles");
   std::vector<std::vector<Vec3>> held(targets.size());
   std::vector<std::string> spills;
@@ -105,7 +109,7 @@ std::size_t crop_tile_to_files(const std::string& tile_ply, const std::vector<Cr
   };
   std::size_t n = 0;
   try {
-    n = for_each_hit(tile_ply, targets, [&](std::size_t i, const Vec3& p) {
+    n = for_each_hit(tile, targets, options, nullptr, [&](std::size_t i, const Vec3& p) {
       held[i].push_back(p);
       ++counts[i];
       if (++in_memory > buffer_points) flush_all();

@@ -25,9 +25,6 @@
 
 namespace lodrefine {
 
-// Georeferenced coordinates are at most a few 1e7 m (UTM northing); anything beyond 1e9 m is a
-// broken file, and would overflow the integer grids of welding and hashing downstream.
-constexpr double kMaxCoordinate = 1e9;
 namespace {
 
 [[noreturn]] void fail(const std::string& path, const std::string& fault) {
@@ -536,53 +533,6 @@ class PlyReader {
 // ---------------------------------------------------------------------------------------------
 // Writing
 
-// A temporary file beside the target, renamed over it on commit(); removed if never committed.
-class AtomicFile {
- public:
-  explicit AtomicFile(const std::string& path) : path_(path), tmp_(path + ".tmp." + std::to_string(::getpid())) {
-    fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd_ < 0) fail(std::strerror(errno));
-  }
-  AtomicFile(const AtomicFile&) = delete;
-  AtomicFile& operator=(const AtomicFile&) = delete;
-  ~AtomicFile() { discard(); }
-
-  void write(const char* data, std::size_t n) {
-    while (n > 0) {
-      const ssize_t k = ::write(fd_, data, n);
-      if (k < 0 && errno == EINTR) continue;
-      if (k <= 0) fail(std::strerror(errno));
-      data += k, n -= std::size_t(k);
-    }
-  }
-  void write(const std::string& s) { write(s.data(), s.size()); }
-
-  void commit() {
-    if (::fsync(fd_) != 0) fail(std::strerror(errno));
-    const int fd = fd_;
-    fd_ = -1;
-    if (::close(fd) != 0) fail(std::strerror(errno));
-    if (std::rename(tmp_.c_str(), path_.c_str()) != 0) fail(std::strerror(errno));
-    committed_ = true;
-  }
-
-  [[noreturn]] void fail(const std::string& reason) {
-    discard();
-    throw std::runtime_error("cannot write " + path_ + ": " + reason);
-  }
-
- private:
-  void discard() {
-    if (fd_ >= 0) ::close(fd_);
-    fd_ = -1;
-    if (!committed_) ::unlink(tmp_.c_str());
-  }
-
-  std::string path_, tmp_;
-  int fd_ = -1;
-  bool committed_ = false;
-};
-
 void append_fixed(std::string& out, double v) {
   char buf[400];  // any finite double in fixed notation with 6 decimals fits
   const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed, 6);  // µm
@@ -636,7 +586,45 @@ void put_le(std::string& out, T v) {
 
 }  // namespace
 
+AtomicFile::AtomicFile(const std::string& path) : path_(path), tmp_(path + ".tmp." + std::to_string(::getpid())) {
+  fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0) fail(std::strerror(errno));
+}
+
+AtomicFile::~AtomicFile() { discard(); }
+
+void AtomicFile::write(const char* data, std::size_t n) {
+  while (n > 0) {
+    const ssize_t k = ::write(fd_, data, n);
+    if (k < 0 && errno == EINTR) continue;
+    if (k <= 0) fail(std::strerror(errno));
+    data += k, n -= std::size_t(k);
+  }
+}
+
+void AtomicFile::commit() {
+  if (::fsync(fd_) != 0) fail(std::strerror(errno));
+  const int fd = fd_;
+  fd_ = -1;
+  if (::close(fd) != 0) fail(std::strerror(errno));
+  if (std::rename(tmp_.c_str(), path_.c_str()) != 0) fail(std::strerror(errno));
+  committed_ = true;
+}
+
+void AtomicFile::fail(const std::string& reason) {
+  discard();
+  throw std::runtime_error("cannot write " + path_ + ": " + reason);
+}
+
+void AtomicFile::discard() {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+  if (!committed_) ::unlink(tmp_.c_str());
+}
+
 Mesh read_obj(const std::string& path, int* skipped_faces) {
+  const FileKind kind = sniff_file(path);
+  if (kind != FileKind::Other) fail(path, "not an OBJ model: the file is " + file_kind_text(kind));
   return ObjParser(path).parse(read_whole_file(path), skipped_faces);
 }
 
@@ -680,6 +668,31 @@ void write_ply(const std::string& path, const PointCloud& cloud, const Vec3& ori
   }
   file.write(out);
   file.commit();
+}
+
+FileKind sniff_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char head[64] = {};
+  if (in) in.read(head, sizeof head);
+  const std::string h(head, std::size_t(in.gcount()));
+  if (h.rfind("LASF", 0) == 0) return FileKind::Las;
+  if (h.rfind("ply\n", 0) == 0 || h.rfind("ply\r", 0) == 0) return FileKind::Ply;
+  std::string_view s = h;
+  if (s.compare(0, 3, "\xEF\xBB\xBF") == 0) s.remove_prefix(3);  // UTF-8 byte order mark
+  s = trim(s);
+  if (!s.empty() && s[0] == '<') return FileKind::Xml;
+  if (!s.empty() && (s[0] == '{' || s[0] == '[')) return FileKind::Json;
+  return FileKind::Other;
+}
+
+std::string file_kind_text(FileKind kind) {
+  switch (kind) {
+    case FileKind::Ply: return "a PLY point cloud";
+    case FileKind::Las: return "a LAS/LAZ point cloud";
+    case FileKind::Xml: return "XML (a CityGML model?)";
+    case FileKind::Json: return "JSON (a CityJSON model?)";
+    default: return "";
+  }
 }
 
 void write_file_atomic(const std::string& path, const std::string& content) {

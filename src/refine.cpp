@@ -164,7 +164,8 @@ bool subtract_region(const std::vector<Vec3>& poly, const Plane& plane, const Re
     pieces.push_back(poly);
     return true;
   }
-  const auto [u, v] = plane.basis();
+  const auto uv = plane.basis();  // named, not bound: clang-14 lambdas cannot capture bindings
+  const Vec3 u = uv.first, v = uv.second;
   const Vec3 o = plane.project(poly.front());
   auto to2 = [&](const std::vector<Vec3>& pts) {
     BPolygon bp;

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "lodrefine/types.h"
 
 namespace lodrefine {
@@ -22,12 +24,15 @@ struct CityJsonBuilding {
   std::string parent;         // first parent id (BuildingPart), empty otherwise
   std::string lod;            // the LoD used, as written in the file ("2", "2.2")
   std::string geometry_type;  // "Solid", "MultiSurface", ...
+  int geometry_index = -1;    // position of that geometry in the object's "geometry" array
   int skipped_holes = 0;      // inner rings dropped (the surface keeps its outer ring only)
   int skipped_rings = 0;      // outer rings with < 3 distinct vertices, dropped
   int skipped_shells = 0;     // interior shells of solids, dropped
+  nlohmann::json attributes;  // CityGML input: the object's attributes (CityJSON input keeps its own JSON)
 };
 
 struct CityJsonFile {
+  std::string format = "CityJSON";  // or "CityGML"
   std::string version;        // "1.0", "1.1", "2.0"
   bool sequence = false;      // read as CityJSONSeq
   std::string crs;            // metadata.referenceSystem, empty when absent
@@ -42,10 +47,19 @@ struct CityJsonFile {
 // is a complete "CityJSON" object followed by "CityJSONFeature" lines). Throws InputError with
 // a one-line message "<path>: <fault>" on unreadable or malformed input (bad JSON, wrong type,
 // vertex index out of range, boundaries or semantics not shaped as the geometry type says).
-CityJsonFile read_cityjson(const std::string& path);
+// `lod` (e.g. "2.2") picks that LoD instead of the highest 2.x one; objects without it count
+// as objects_without_lod2.
+CityJsonFile read_cityjson(const std::string& path, const std::string& lod = "");
 
 // Same, from text in memory; `name` is used in error messages.
-CityJsonFile parse_cityjson(const std::string& text, const std::string& name = "<cityjson>");
+CityJsonFile parse_cityjson(const std::string& text, const std::string& name = "<cityjson>", const std::string& lod = "");
+
+// Same, from a parsed CityJSON object (not a sequence).
+CityJsonFile read_cityjson_document(const nlohmann::ordered_json& doc, const std::string& name, const std::string& lod = "");
+
+// True when `text` is a CityJSONSeq: a first line holding a complete "CityJSON" object, then
+// more lines (the CityJSONFeatures).
+bool is_cityjson_sequence(const std::string& text);
 
 // A file name (without extension) for a CityObject id: characters that are unsafe in paths
 // (separators, whitespace, control and shell-special characters) become '_'.

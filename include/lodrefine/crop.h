@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "lodrefine/cloud.h"
 #include "lodrefine/types.h"
 
 namespace lodrefine {
@@ -17,17 +18,20 @@ struct CropTarget {
 // (vertically by `absolute` only).
 CropTarget crop_target(const Mesh& model, double relative, double absolute);
 
-// Streams `tile_ply` once and appends each point to every target whose box holds it (a 2D
-// grid over the targets keeps this O(points)). Returns the number of points read.
-std::size_t crop_tile(const std::string& tile_ply, std::vector<CropTarget>& targets);
+// Streams the tile (PLY or LAS, `options` filtering LAS classes) once and appends each point
+// to every target whose box holds it (a 2D grid over the targets keeps this O(points)).
+// Returns the number of points read (after the class filter); `bounds` (optional) gets the
+// bounding box of every point read.
+std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets, const CloudOptions& options = {},
+                      Eigen::AlignedBox3d* bounds = nullptr);
 
 // The same pass for a whole city tile, with memory bounded by `buffer_points`, not by the tile:
 // each target's points go to `out_paths[i]` (a PLY, written atomically), and points held beyond
 // the bound are spilled to per-target temporary files beside them. Only one target's crop is
 // in memory at a time when the PLYs are written. Returns the number of points read and sets
 // `counts[i]` to each crop's size.
-std::size_t crop_tile_to_files(const std::string& tile_ply, const std::vector<CropTarget>& targets,
+std::size_t crop_tile_to_files(const std::string& tile, const std::vector<CropTarget>& targets,
                                const std::vector<std::string>& out_paths, std::size_t buffer_points,
-                               std::vector<std::size_t>& counts);
+                               std::vector<std::size_t>& counts, const CloudOptions& options = {});
 
 }  // namespace lodrefine

@@ -52,6 +52,39 @@ def ply(points, fmt="binary_little_endian", typ="float", extra=""):
     return head.encode() + body
 
 
+MIN_RECORD = [20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67]
+
+
+def las(points, minor=2, fmt=1, extra=0, classes=None, offset=(85000.0, 447000.0, 0.0)):
+    """Uncompressed LAS 1.minor, point format fmt, scale 1 mm (as write_las in src/las.cpp)."""
+    header = {2: 227, 3: 235, 4: 375}[minor]
+    rec = MIN_RECORD[fmt] + extra
+    n = len(points)
+    legacy = n if fmt < 6 else 0
+    xs = [p[0] for p in points] or [0]
+    ys = [p[1] for p in points] or [0]
+    zs = [p[2] for p in points] or [0]
+    h = b"LASF" + struct.pack("<HH16sBB32s32sHHHIIBHI5I", 0, 0, b"", 1, minor, b"fuzz", b"fuzz", 1, 2026, header,
+                              header, 0, fmt, rec, legacy, legacy, 0, 0, 0, 0)
+    h += struct.pack("<3d3d6d", 0.001, 0.001, 0.001, *offset, max(xs), min(xs), max(ys), min(ys), max(zs), min(zs))
+    if minor >= 3:
+        h += struct.pack("<Q", 0)
+    if minor >= 4:
+        h += struct.pack("<QIQ15Q", 0, 0, n, n, *([0] * 14))
+    assert len(h) == header
+    body = b""
+    for i, (x, y, z) in enumerate(points):
+        r = bytearray(rec)
+        struct.pack_into("<3i", r, 0, *(round((v - o) / 0.001) for v, o in zip((x, y, z), offset)))
+        c = classes[i] if classes else 1
+        if fmt >= 6:
+            r[14], r[16] = 0x11, c & 0xFF
+        else:
+            r[14], r[15] = 0x09, c & 0x1F
+        body += bytes(r)
+    return h + body
+
+
 def main():
     rng = random.Random(7)
     # --- OBJ reader seeds
@@ -78,6 +111,16 @@ def main():
            b"element vertex 1\nproperty double z\nproperty double y\nproperty double x\nend_header\n"
            + struct.pack("<B2f", 2, 1.0, 2.0) + struct.pack("<3d", 3.0, 2.0, 1.0))
     put("fuzz_ply", "list_first.ply", pre)
+    # --- LAS reader seeds: each version, formats 0-10, extra bytes, classes
+    geo = [(85000.0 + x, 447000.0 + y, z) for x, y, z in pts[:6]]
+    cls = [2, 6, 1, 200, 6, 2]
+    put("fuzz_las", "v12_f0.las", las(geo, 2, 0, classes=cls))
+    put("fuzz_las", "v12_f1_extra.las", las(geo, 2, 1, extra=3, classes=cls))
+    put("fuzz_las", "v13_f3.las", las(geo[:3], 3, 3, classes=cls))
+    put("fuzz_las", "v13_f5.las", las(geo[:2], 3, 5, classes=cls))
+    put("fuzz_las", "v14_f6.las", las(geo, 4, 6, classes=cls))
+    put("fuzz_las", "v14_f10.las", las(geo[:2], 4, 10, classes=cls))
+    put("fuzz_las", "v14_f1_empty.las", las([], 4, 1))
     # --- whole refine: [len lo, len hi, flags] + OBJ + PLY
     for name, flags, cloud in [
         ("moved_wall_tiny", 1, wall_points(10, 6, 0.3, 5.7, 2.8, 0.0, rng)),   # model wall at y = -0.4
