@@ -41,40 +41,6 @@ std::vector<Vec3> CandidateSet::polygon(int f) const {
   return pts;
 }
 
-std::vector<SupportPlane> merge_support_planes(const std::vector<SupportPlane>& planes, double angle_deg,
-                                               double distance, const Vec3& anchor) {
-  std::vector<SupportPlane> out;
-  std::vector<int> weight;
-  for (const auto& p : planes) {
-    int target = -1;
-    for (int k = 0; k < int(out.size()) && target < 0; ++k) {
-      const auto& q = out[k];
-      if (!p.from_scan && !q.from_scan && p.sem != q.sem) continue;
-      if (unoriented_angle_deg(p.plane.n, q.plane.n) > angle_deg) continue;
-      if (std::abs(q.plane.distance(p.plane.project(anchor))) > distance) continue;
-      target = k;
-    }
-    if (target < 0) {
-      out.push_back(p);
-      weight.push_back(1);
-      continue;
-    }
-    SupportPlane& q = out[target];
-    if (q.from_scan != p.from_scan) {  // the measured plane replaces the prior
-      if (p.from_scan) q = p;
-      continue;
-    }
-    // Average parameters (orientation of q), anchored at the projection of `anchor`.
-    const Vec3 pn = p.plane.n.dot(q.plane.n) < 0 ? Vec3(-p.plane.n) : p.plane.n;
-    const double w = weight[target];
-    const Vec3 n = (q.plane.n * w + pn).normalized();
-    const Vec3 c = (q.plane.project(anchor) * w + p.plane.project(anchor)) / (w + 1);
-    q.plane = Plane::through(c, n);
-    ++weight[target];
-  }
-  return out;
-}
-
 namespace {
 
 // A convex polygon under construction: vertex positions and, per edge i (v[i] -> v[i+1]), the

@@ -11,18 +11,6 @@
 namespace lodrefine {
 namespace {
 
-struct StartInfo {
-  const std::vector<double>* values = nullptr;  // 1-based column values
-  bool given = false;
-};
-
-void heuristic_callback(glp_tree* tree, void* info) {
-  auto* s = static_cast<StartInfo*>(info);
-  if (glp_ios_reason(tree) != GLP_IHEUR || s->given || s->values == nullptr) return;
-  s->given = true;
-  glp_ios_heur_sol(tree, s->values->data());  // GLPK ignores it if it is not feasible
-}
-
 std::string describe(int ret, int status) {
   if (status == GLP_OPT) return "optimal";
   if (status == GLP_FEAS) return ret == GLP_ETMLIM ? "feasible (time limit)" : "feasible";
@@ -35,7 +23,7 @@ std::string describe(int ret, int status) {
 }  // namespace
 
 SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& cost, const std::vector<int>& outside,
-                             const Params& prm, const std::vector<int>* fixed, const std::vector<char>* start) {
+                             const Params& prm, const std::vector<int>* fixed) {
   const auto t0 = std::chrono::steady_clock::now();
   SelectionResult res;
   const int nf = int(cs.faces.size()), ne = int(cs.edges.size());
@@ -110,21 +98,6 @@ SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& 
   res.constraints = glp_get_num_rows(lp);
   res.nonzeros = int(ia.size()) - 1;
 
-  // A warm start: the given selection with its implied edge and sharp values.
-  std::vector<double> start_values;
-  StartInfo info;
-  if (start != nullptr) {
-    start_values.assign(res.variables + 1, 0.0);
-    for (int f = 0; f < nf; ++f) start_values[f + 1] = (*start)[f] ? 1.0 : 0.0;
-    for (int e = 0; e < ne; ++e) {
-      double sum = outside[e];
-      for (int f : cs.edges[e].faces) sum += start_values[f + 1];
-      start_values[nf + e + 1] = sum / 2.0;
-    }
-    for (int c = nf + ne + 1; c <= res.variables; ++c) start_values[c] = 1.0;  // sharp: upper bound is feasible
-    info.values = &start_values;
-  }
-
   glp_iocp parm;
   glp_init_iocp(&parm);
   parm.presolve = GLP_ON;
@@ -135,10 +108,6 @@ SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& 
   parm.mip_gap = prm.mip_gap;
   parm.tm_lim = int(std::min(2.0e9, std::ceil(prm.mip_time_limit * 1000.0)));
   parm.msg_lev = GLP_MSG_OFF;
-  if (start != nullptr) {
-    parm.cb_func = heuristic_callback;
-    parm.cb_info = &info;
-  }
   const int ret = glp_intopt(lp, &parm);
   const int status = glp_mip_status(lp);
   res.status = describe(ret, status);

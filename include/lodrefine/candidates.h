@@ -19,12 +19,6 @@ struct SupportPlane {
   int source = -1;         // model surface or scan plane index
 };
 
-// Merges planes whose normals are within `angle_deg` and whose offsets (at `anchor`) differ by
-// less than `distance`, averaging their parameters, except that a scan plane wins over model
-// planes (it is measured, they are the outdated prior). Same-semantic model planes only.
-std::vector<SupportPlane> merge_support_planes(const std::vector<SupportPlane>& planes, double angle_deg,
-                                               double distance, const Vec3& anchor);
-
 // An oriented box: the region where candidates are generated.
 struct Region {
   Vec3 center = Vec3::Zero();

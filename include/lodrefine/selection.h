@@ -20,12 +20,10 @@ struct SelectionResult {
   double seconds = 0.0;
 };
 
-// `cost[f]`: coverage cost of candidate f (already weighted); `outside[e]`: 1 where the kept
-// surface outside the region continues across edge e (counts as a selected face), else 0;
-// `fixed[f]`: -1 free, 0 or 1 to fix candidate f (presolve then removes it);
-// `start`: optional feasible selection handed to GLPK as its first incumbent.
+// `cost[f]`: coverage cost of candidate f (weighted here by lambda_coverage); `outside[e]`: 1
+// where the kept surface outside the region continues across edge e (counts as a selected
+// face), else 0; `fixed[f]`: -1 free, 0 or 1 to fix candidate f (presolve then removes it).
 SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& cost, const std::vector<int>& outside,
-                             const Params& params, const std::vector<int>* fixed = nullptr,
-                             const std::vector<char>* start = nullptr);
+                             const Params& params, const std::vector<int>* fixed = nullptr);
 
 }  // namespace lodrefine
