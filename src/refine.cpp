@@ -323,7 +323,7 @@ StepResult replace_walls(const Mesh& mesh, const std::vector<ModelSurface>& surf
     }
   }
   SelectionResult sel = select_faces(cs, cost, outside, prm, &fixed);
-  if (sel.status == "infeasible" && sel.fixed > 0 && prm.mip_time_limit > sel.seconds) {
+  if (sel.status == SolveStatus::Infeasible && sel.fixed > 0 && prm.mip_time_limit > sel.seconds) {
     // A model only approximately consistent with its planes (warped faces, snapped vertices)
     // can make the fixed cells contradict each other: then the whole region is free.
     Params rest = prm;
@@ -335,9 +335,9 @@ StepResult replace_walls(const Mesh& mesh, const std::vector<ModelSurface>& surf
   }
   res.info["mip"] = {{"variables", sel.variables}, {"constraints", sel.constraints}, {"nonzeros", sel.nonzeros},
                      {"fixed_candidates", sel.fixed},
-                     {"status", sel.status},       {"objective", sel.objective},     {"seconds", sel.seconds}};
+                     {"status", sel.status_text()},       {"objective", sel.objective},     {"seconds", sel.seconds}};
   if (!sel.ok) {
-    res.reason = "face selection " + sel.status;
+    res.reason = "face selection " + sel.status_text();
     return res;
   }
 

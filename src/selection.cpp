@@ -11,16 +11,31 @@
 namespace lodrefine {
 namespace {
 
-std::string describe(int ret, int status) {
-  if (status == GLP_OPT) return "optimal";
-  if (status == GLP_FEAS) return ret == GLP_ETMLIM ? "feasible (time limit)" : "feasible";
-  if (status == GLP_NOFEAS || ret == GLP_ENOPFS) return "infeasible";
-  if (ret == GLP_ETMLIM) return "time limit (no solution)";
-  if (ret == GLP_ENODFS) return "no dual feasible solution";
-  return "solver failure (glp_intopt " + std::to_string(ret) + ")";
+SolveStatus classify(int ret, int status) {
+  if (status == GLP_OPT) return SolveStatus::Optimal;
+  if (status == GLP_FEAS) return ret == GLP_ETMLIM ? SolveStatus::FeasibleTimeLimit : SolveStatus::Feasible;
+  if (status == GLP_NOFEAS || ret == GLP_ENOPFS) return SolveStatus::Infeasible;
+  if (ret == GLP_ETMLIM) return SolveStatus::TimeLimitNoSolution;
+  if (ret == GLP_ENODFS) return SolveStatus::NoDualFeasible;
+  return SolveStatus::SolverFailure;
 }
 
 }  // namespace
+
+std::string status_name(SolveStatus status, int glpk_code) {
+  switch (status) {
+    case SolveStatus::NotRun: return "not run";
+    case SolveStatus::NoCandidates: return "no candidates";
+    case SolveStatus::Optimal: return "optimal";
+    case SolveStatus::Feasible: return "feasible";
+    case SolveStatus::FeasibleTimeLimit: return "feasible (time limit)";
+    case SolveStatus::Infeasible: return "infeasible";
+    case SolveStatus::TimeLimitNoSolution: return "time limit (no solution)";
+    case SolveStatus::NoDualFeasible: return "no dual feasible solution";
+    case SolveStatus::SolverFailure: break;
+  }
+  return "solver failure (glp_intopt " + std::to_string(glpk_code) + ")";
+}
 
 SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& cost, const std::vector<int>& outside,
                              const Params& prm, const std::vector<int>* fixed) {
@@ -29,7 +44,7 @@ SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& 
   const int nf = int(cs.faces.size()), ne = int(cs.edges.size());
   res.selected.assign(nf, 0);
   if (nf == 0) {  // GLPK aborts on empty column sets
-    res.status = "no candidates";
+    res.status = SolveStatus::NoCandidates;
     return res;
   }
 
@@ -110,7 +125,8 @@ SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& 
   parm.msg_lev = GLP_MSG_OFF;
   const int ret = glp_intopt(lp, &parm);
   const int status = glp_mip_status(lp);
-  res.status = describe(ret, status);
+  res.status = classify(ret, status);
+  res.glpk_code = ret;
   // A zero return code alone is not success: only a primal feasible MIP point counts.
   res.ok = status == GLP_OPT || status == GLP_FEAS;
   if (res.ok) {

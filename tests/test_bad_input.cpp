@@ -778,7 +778,7 @@ TEST(BadInputRegression, FaceListedTwiceOnAnEdgeDoesNotAbortTheSolver) {
     e.faces = {0, 0, 1};
     cs.edges = {e};
     const SelectionResult r = select_faces(cs, {-1.0, -1.0}, {0}, Params{});
-    ::_exit(r.status.empty() ? 1 : 0);
+    ::_exit(r.status == SolveStatus::NotRun ? 1 : 0);
   }
   int st = 0;
   ::waitpid(pid, &st, 0);
@@ -828,15 +828,15 @@ TEST(BadInputSolver, InfeasibleProgramIsReportedNotSelected) {
   cs.edges = {e0, e1};
   const SelectionResult r = select_faces(cs, {-1.0}, {1, 0}, Params{});
   EXPECT_FALSE(r.ok);
-  EXPECT_EQ(r.status, "infeasible");
+  EXPECT_EQ(r.status_text(), "infeasible");
   EXPECT_EQ(r.selected, std::vector<char>(1, 0));
-  add_row("select_faces: infeasible program", "ok=false, status '" + r.status + "'", 0);
+  add_row("select_faces: infeasible program", "ok=false, status '" + r.status_text() + "'", 0);
 }
 
 TEST(BadInputSolver, NoCandidatesIsReported) {
   const SelectionResult r = select_faces(CandidateSet{}, {}, {}, Params{});
   EXPECT_FALSE(r.ok);
-  EXPECT_EQ(r.status, "no candidates");
+  EXPECT_EQ(r.status_text(), "no candidates");
 }
 
 TEST(BadInputSolver, TimeLimitWithoutSolutionIsReported) {
@@ -846,16 +846,16 @@ TEST(BadInputSolver, TimeLimitWithoutSolutionIsReported) {
   Params prm;
   prm.mip_time_limit = 0.01;
   const SelectionResult r = select_faces(cs, cost, outside, prm);
-  EXPECT_NE(r.status.find("time limit"), std::string::npos) << r.status;
+  EXPECT_NE(r.status_text().find("time limit"), std::string::npos) << r.status_text();
   if (!r.ok) {
-    EXPECT_EQ(r.status, "time limit (no solution)");
+    EXPECT_EQ(r.status_text(), "time limit (no solution)");
     EXPECT_EQ(r.selected, std::vector<char>(cs.faces.size(), 0));
   } else {
-    EXPECT_EQ(r.status, "feasible (time limit)");
+    EXPECT_EQ(r.status_text(), "feasible (time limit)");
   }
   EXPECT_LT(r.seconds, 5.0) << "the time limit was not honoured";
   add_row("select_faces: 3000-face parity program, 10 ms limit",
-          "ok=" + std::string(r.ok ? "true" : "false") + ", status '" + r.status + "', " + fmt(r.seconds) + " s", 0);
+          "ok=" + std::string(r.ok ? "true" : "false") + ", status '" + r.status_text() + "', " + fmt(r.seconds) + " s", 0);
 }
 
 // A real, easy program: the arrangement of a cube's six planes in a larger region (54
@@ -884,18 +884,18 @@ TEST(BadInputSolver, OneMillisecondLimitFailsEvenAnEasyProgram) {
   const CandidateSet cs = cube_program(cost, outside);
   ASSERT_GE(cs.faces.size(), 6u);
   const SelectionResult easy = select_faces(cs, cost, outside, Params{});
-  ASSERT_TRUE(easy.ok) << easy.status;
-  EXPECT_EQ(easy.status, "optimal");
+  ASSERT_TRUE(easy.ok) << easy.status_text();
+  EXPECT_EQ(easy.status_text(), "optimal");
   EXPECT_EQ(std::count(easy.selected.begin(), easy.selected.end(), 1), 6);
   // GLPK stops at its first time check when tm_lim <= 1 ms: a deterministic solver fault.
   Params prm;
   prm.mip_time_limit = 0.001;
   const SelectionResult r = select_faces(cs, cost, outside, prm);
   EXPECT_FALSE(r.ok);
-  EXPECT_EQ(r.status, "time limit (no solution)");
+  EXPECT_EQ(r.status_text(), "time limit (no solution)");
   EXPECT_EQ(std::count(r.selected.begin(), r.selected.end(), 1), 0);
   add_row("select_faces: cube arrangement (" + std::to_string(cs.faces.size()) + " candidates), 1 ms limit",
-          "ok=false, status '" + r.status + "' (30 s limit: '" + easy.status + "')", 0);
+          "ok=false, status '" + r.status_text() + "' (30 s limit: '" + easy.status_text() + "')", 0);
 }
 
 // The whole pipeline under a failing solver (the arrangement path forced): refine_building must

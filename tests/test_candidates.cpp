@@ -78,8 +78,8 @@ TEST(Selection, RecoversTheClosedBoxFromConfidence) {
   }
   EXPECT_EQ(full, 6);
   const SelectionResult sel = select_faces(cs, cost, std::vector<int>(cs.edges.size(), 0), prm);
-  ASSERT_TRUE(sel.ok) << sel.status;
-  EXPECT_EQ(sel.status, "optimal");
+  ASSERT_TRUE(sel.ok) << sel.status_text();
+  EXPECT_EQ(sel.status_text(), "optimal");
   double area = 0.0;
   int count = 0;
   for (std::size_t f = 0; f < cs.faces.size(); ++f)
@@ -109,7 +109,7 @@ TEST(Selection, InfeasibleBoundaryIsReportedNotCrashed) {
   Params prm;
   const SelectionResult sel = select_faces(cs, {-1.0}, outside, prm);
   EXPECT_FALSE(sel.ok);
-  EXPECT_EQ(sel.status, "infeasible");
+  EXPECT_EQ(sel.status_text(), "infeasible");
 }
 
 TEST(Confidence, SigmoidCostChangesSignAtTau) {

@@ -10,10 +10,27 @@
 
 namespace lodrefine {
 
+// What GLPK made of the program (glp_intopt's return code with glp_mip_status).
+enum class SolveStatus {
+  NotRun,               // nothing solved yet
+  NoCandidates,         // an empty program (GLPK aborts on one; never handed to it)
+  Optimal,
+  Feasible,             // stopped at the gap
+  FeasibleTimeLimit,    // a selection, not proven optimal
+  Infeasible,
+  TimeLimitNoSolution,
+  NoDualFeasible,
+  SolverFailure,        // any other glp_intopt return code (SelectionResult::glpk_code)
+};
+// "optimal", "feasible (time limit)", "infeasible", "time limit (no solution)", ...
+std::string status_name(SolveStatus status, int glpk_code = 0);
+
 struct SelectionResult {
   bool ok = false;             // a feasible selection satisfying every edge constraint
   std::vector<char> selected;  // per candidate
-  std::string status;          // "optimal", "feasible (time limit)", "infeasible", "time limit", ...
+  SolveStatus status = SolveStatus::NotRun;
+  int glpk_code = 0;           // glp_intopt's return code
+  std::string status_text() const { return status_name(status, glpk_code); }
   int variables = 0, constraints = 0, nonzeros = 0;
   int fixed = 0;               // candidates fixed before solving
   double objective = 0.0;
