@@ -662,16 +662,19 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
   // unscanned walls at a scanned facade's end move to where the scan shows the corner.
   t = Clock::now();
   json jfacades = json::array();
-  auto describe = [&](const WallMove& mv, const char* evidence) {
-    const ModelSurface& s = surfaces[mv.surface];
+  // A moved wall for the report, on the mesh (and its surfaces) the move was made on.
+  auto describe_on = [&](const Mesh& mesh, const std::vector<ModelSurface>& ss, const WallMove& mv,
+                         const char* evidence) {
+    const ModelSurface& s = ss[mv.surface];
     double mean = 0.0, n = 0.0;
     for (int f : s.faces)
-      for (int v : current.faces[f].v) mean += std::abs(mv.plane.distance(current.vertices[v])), n += 1.0;
+      for (int v : mesh.faces[f].v) mean += std::abs(mv.plane.distance(mesh.vertices[v])), n += 1.0;
     std::set<int> sources;
-    for (int f : s.faces) sources.insert(current.faces[f].source);
-    jfacades.push_back({{"input_faces", sources}, {"evidence", evidence}, {"max_move", deviation(current, s, mv.plane)},
+    for (int f : s.faces) sources.insert(mesh.faces[f].source);
+    jfacades.push_back({{"input_faces", sources}, {"evidence", evidence}, {"max_move", deviation(mesh, s, mv.plane)},
                         {"mean_move", n > 0 ? mean / n : 0.0}});
   };
+  auto describe = [&](const WallMove& mv, const char* evidence) { describe_on(current, surfaces, mv, evidence); };
   auto substitute = [&](const std::vector<WallMove>& mv, json& js) {
     SubstitutionResult sub = substitute_walls(current, surfaces, mv, prm.planarity_tolerance);
     js = {{"method", "substitution"}, {"walls", mv.size()}, {"ok", sub.ok}};
@@ -777,7 +780,7 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
       js["ok"] = bool(m);
       steps.push_back(js);
       if (m) {
-        describe({next->surface, r.plane}, "scan");
+        describe_on(step_mesh, ss, {next->surface, r.plane}, "scan");
         step_mesh = std::move(*m);
         step_mesh.id = model.id;
         any = true;
