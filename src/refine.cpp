@@ -430,34 +430,10 @@ namespace {
 // keep their vertices).
 constexpr double kSnapMove = 0.05;
 
-// Faces the repair could not keep planar (a warped input face) split into triangles; nothing
-// moves. Returns how many were split.
-int split_warped_faces(Mesh& mesh, double tolerance) {
-  std::vector<Face> faces;
-  int split = 0;
-  for (const auto& f : mesh.faces) {
-    const auto pts = face_points(mesh, f);
-    const Plane pl = polygon_plane(pts);
-    double err = 0.0;
-    for (const auto& q : pts) err = std::max(err, std::abs(pl.distance(q)));
-    if (err <= tolerance) {
-      faces.push_back(f);
-      continue;
-    }
-    ++split;
-    for (const auto& t : triangulate_polygon(pts)) {
-      Face tf = f;
-      tf.v = {f.v[t[0]], f.v[t[1]], f.v[t[2]]};
-      faces.push_back(std::move(tf));
-    }
-  }
-  mesh.faces = std::move(faces);
-  return split;
-}
-
 // The repaired input. Exports whose corners disagree by a little more than the weld tolerance
 // (roof jitter) are welded a little coarser across faces; detailed models with features finer
 // than it, finer. The first weld whose shell is valid wins; else the first that closed at all.
+// Warped faces come back split into triangles (counted in the report).
 Mesh repair_input(const Mesh& local_model, const Params& prm, RepairReport& rr) {
   struct Step {
     double weld, gap;  // relative to weld_tolerance
@@ -472,9 +448,8 @@ Mesh repair_input(const Mesh& local_model, const Params& prm, RepairReport& rr) 
       if (weld != 1.0 || gap != 1.0)
         r.notes.push_back("welded at " + std::to_string(prm.weld_tolerance * weld) + " m, gaps up to " +
                           std::to_string(prm.weld_tolerance * gap) + " m");
-      Mesh planar = m;
-      split_warped_faces(planar, prm.planarity_tolerance);
-      if (validate_mesh(planar, prm.planarity_tolerance).valid()) {
+      r.split_warped_faces = split_warped_faces(m, prm.planarity_tolerance);
+      if (validate_mesh(m, prm.planarity_tolerance).valid()) {
         rr = r;
         return m;
       }
@@ -589,14 +564,13 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
     return finish("kept-invalid", e.what(), local_model);
   }
   kept.id = model.id;
-  const int warped = split_warped_faces(kept, prm.planarity_tolerance);
   rep["repair"] = {{"welded_vertices", rr.welded_vertices},
                    {"removed_degenerate_faces", rr.removed_degenerate_faces},
                    {"removed_duplicate_faces", rr.removed_duplicate_faces},
                    {"split_t_junctions", rr.split_t_junctions},
                    {"flipped_faces", rr.flipped_faces},
                    {"filled_holes", rr.filled_holes},
-                   {"split_warped_faces", warped},
+                   {"split_warped_faces", rr.split_warped_faces},
                    {"notes", rr.notes}};
   const Validation v0 = validate_mesh(kept, prm.planarity_tolerance);
   rep["input_validation"] = validation_json(v0);

@@ -522,6 +522,44 @@ Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report,
   return out;
 }
 
+int split_warped_faces(Mesh& mesh, double tolerance) {
+  std::set<std::pair<int, int>> edges;
+  for (const auto& f : mesh.faces)
+    for (std::size_t k = 0; k < f.v.size(); ++k)
+      edges.insert(std::minmax(f.v[k], f.v[(k + 1) % f.v.size()]));
+  std::vector<Face> faces;
+  int split = 0;
+  for (const auto& f : mesh.faces) {
+    const auto pts = positions(mesh.vertices, f.v);
+    const Plane pl = polygon_plane(pts);
+    double err = 0.0;
+    for (const auto& q : pts) err = std::max(err, std::abs(pl.distance(q)));
+    if (err <= tolerance) {
+      faces.push_back(f);
+      continue;
+    }
+    ++split;
+    const auto tris = triangulate_polygon(pts);
+    const int n = int(f.v.size());
+    bool clash = false;
+    for (const auto& t : tris)
+      for (int k = 0; k < 3; ++k) {
+        const int ia = t[k], ib = t[(k + 1) % 3];
+        const bool boundary = (ia + 1) % n == ib || (ib + 1) % n == ia;
+        clash = clash || (!boundary && edges.count(std::minmax(f.v[ia], f.v[ib])));
+      }
+    if (!clash) {
+      for (const auto& t : tris) faces.push_back({{f.v[t[0]], f.v[t[1]], f.v[t[2]]}, f.sem, f.source});
+      continue;
+    }
+    const int centre = int(mesh.vertices.size());
+    mesh.vertices.push_back(polygon_centroid(pts));
+    for (int k = 0; k < n; ++k) faces.push_back({{f.v[k], f.v[(k + 1) % n], centre}, f.sem, f.source});
+  }
+  mesh.faces = std::move(faces);
+  return split;
+}
+
 Mesh merge_coplanar_faces(const Mesh& mesh, double angle_deg, double distance) {
   const EdgeUses uses = edge_uses(mesh.faces);
   const std::vector<int> region = coplanar_regions(mesh, adjacency(mesh.faces, uses), angle_deg, distance);

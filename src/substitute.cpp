@@ -1,10 +1,11 @@
 // Stage 3 (first choice): wall substitution, see substitute.h.
 #include "lodrefine/substitute.h"
 
+#include "lodrefine/repair.h"
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <set>
 
 namespace lodrefine {
 namespace {
@@ -119,55 +120,14 @@ SubstitutionResult substitute_walls(const Mesh& mesh, const std::vector<ModelSur
 
   // A face that moved must keep its orientation (else a wall passed a short neighbour) and
   // stay planar; a roof under a turned wall may not, and is split into triangles then.
-  std::set<std::pair<int, int>> edges;
-  for (const auto& f : mesh.faces)
-    for (std::size_t k = 0; k < f.v.size(); ++k)
-      edges.insert({std::min(f.v[k], f.v[(k + 1) % f.v.size()]), std::max(f.v[k], f.v[(k + 1) % f.v.size()])});
-  std::vector<Face> faces;
   for (const auto& f : mesh.faces) {
-    const auto before = face_points(mesh, f);
-    const auto after = face_points(res.mesh, f);
-    const Vec3 n0 = newell_normal(before), n1 = newell_normal(after);
+    const Vec3 n0 = newell_normal(face_points(mesh, f)), n1 = newell_normal(face_points(res.mesh, f));
     if (n1.dot(n0) <= 0.0 || n1.norm() < 1e-3 * n0.norm()) {
       res.reason = "a moved wall passes a neighbouring face (it would turn inside out)";
       return res;
     }
-    const Plane pl = polygon_plane(after);
-    double err = 0.0;
-    for (const auto& q : after) err = std::max(err, std::abs(pl.distance(q)));
-    if (err <= 0.5 * planarity_tolerance) {
-      faces.push_back(f);
-      continue;
-    }
-    ++res.split_faces;
-    // Ear clipping, unless one of its diagonals is already an edge of the mesh (a sliver the
-    // face shares with a neighbour): then a fan around a new vertex at the face's centre.
-    const auto tris = triangulate_polygon(after);
-    bool clash = false;
-    for (const auto& t : tris)
-      for (int k = 0; k < 3; ++k) {
-        const int a = f.v[t[k]], b = f.v[t[(k + 1) % 3]];
-        const int n = int(f.v.size()), ia = t[k], ib = t[(k + 1) % 3];
-        const bool boundary = (ia + 1) % n == ib || (ib + 1) % n == ia;
-        clash = clash || (!boundary && edges.count({std::min(a, b), std::max(a, b)}));
-      }
-    if (!clash) {
-      for (const auto& t : tris) {
-        Face tf = f;
-        tf.v = {f.v[t[0]], f.v[t[1]], f.v[t[2]]};
-        faces.push_back(std::move(tf));
-      }
-      continue;
-    }
-    const int centre = int(res.mesh.vertices.size());
-    res.mesh.vertices.push_back(polygon_centroid(after));
-    for (std::size_t k = 0; k < f.v.size(); ++k) {
-      Face tf = f;
-      tf.v = {f.v[k], f.v[(k + 1) % f.v.size()], centre};
-      faces.push_back(std::move(tf));
-    }
   }
-  res.mesh.faces = std::move(faces);
+  res.split_faces = split_warped_faces(res.mesh, 0.5 * planarity_tolerance);
   res.ok = true;
   return res;
 }

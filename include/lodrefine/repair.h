@@ -16,6 +16,7 @@ struct RepairReport {
   int split_t_junctions = 0;         // vertices inserted into edges that passed through them
   int flipped_faces = 0;             // faces reversed to make the orientation consistent/outward
   int filled_holes = 0;              // boundary loops closed with a new face (missing ground ...)
+  int split_warped_faces = 0;        // faces split by split_warped_faces
   bool closed = false;               // closed 2-manifold after repair
   std::vector<std::string> notes;
 };
@@ -29,6 +30,12 @@ struct RepairReport {
 // max(weld_tolerance, gap_tolerance) (export gaps, jittered corners), two vertices of one face
 // only within weld_tolerance, so a face's own short edges never collapse.
 Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report = nullptr, double gap_tolerance = 0.0);
+
+// Splits every face farther than `tolerance` from planar into triangles, keeping its semantic
+// and source; no vertex moves. Ear clipping, unless one of its diagonals is already an edge of
+// the mesh (a sliver the face shares with a neighbour): then a fan around a new vertex at the
+// face's centre. Returns how many faces were split.
+int split_warped_faces(Mesh& mesh, double tolerance);
 
 // Merges edge-adjacent coplanar faces of the same semantic into single polygons (within
 // `angle_deg` / `distance`), removing the then-redundant collinear vertices. Input must be a
