@@ -649,8 +649,10 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
                         {"mean_move", n > 0 ? mean / n : 0.0}});
   };
   auto describe = [&](const WallMove& mv, const char* evidence) { describe_on(current, surfaces, mv, evidence); };
-  auto substitute = [&](const std::vector<WallMove>& mv, json& js) {
-    SubstitutionResult sub = substitute_walls(current, surfaces, mv, prm.planarity_tolerance);
+  // Substitution on `mesh`, merged and validated; `js` says what happened.
+  auto substitute_on = [&](const Mesh& mesh, const std::vector<ModelSurface>& ss, const std::vector<WallMove>& mv,
+                           json& js) {
+    SubstitutionResult sub = substitute_walls(mesh, ss, mv, prm.planarity_tolerance);
     js = {{"method", "substitution"}, {"walls", mv.size()}, {"ok", sub.ok}};
     if (!sub.ok) {
       js["reason"] = sub.reason;
@@ -669,6 +671,7 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
     m.id = model.id;
     return std::optional<Mesh>(std::move(m));
   };
+  auto substitute = [&](const std::vector<WallMove>& mv, json& js) { return substitute_on(current, surfaces, mv, js); };
   std::vector<WallMove> all = moves;
   for (const auto& c : corners) all.push_back(c.move);
   json jsub;
@@ -720,11 +723,8 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
       js["moved_by"] = deviation(step_mesh, surf, r.plane);
       std::optional<Mesh> m;
       if (!prm.arrangement_only) {
-        SubstitutionResult sub = substitute_walls(step_mesh, ss, {{next->surface, r.plane}}, prm.planarity_tolerance);
-        if (sub.ok) {
-          Mesh mm = merge_coplanar_faces(sub.mesh);
-          if (validate_mesh(mm, prm.planarity_tolerance).valid()) m = std::move(mm);
-        }
+        json unused;
+        m = substitute_on(step_mesh, ss, {{next->surface, r.plane}}, unused);
       }
       if (m) {
         js["method"] = "substitution";
