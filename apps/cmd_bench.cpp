@@ -7,10 +7,10 @@
 #include <cstdio>
 
 #include "commands.h"
-#include "lodrefine/eval.h"
-#include "lodrefine/geometry.h"
-#include "lodrefine/refine.h"
-#include "lodrefine/synth.h"
+#include "lodrefine/eval/eval.h"
+#include "lodrefine/core/geometry.h"
+#include "lodrefine/core/refine.h"
+#include "lodrefine/synth/synth.h"
 #include "options.h"
 
 namespace lodrefine::app {

@@ -6,8 +6,8 @@
 #include <set>
 
 #include "commands.h"
-#include "lodrefine/citygml.h"
-#include "lodrefine/io.h"
+#include "lodrefine/io/citygml.h"
+#include "lodrefine/io/obj.h"
 
 namespace lodrefine::app {
 namespace {

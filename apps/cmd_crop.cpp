@@ -5,8 +5,8 @@
 #include <filesystem>
 
 #include "commands.h"
-#include "lodrefine/crop.h"
-#include "lodrefine/io.h"
+#include "lodrefine/io/crop.h"
+#include "lodrefine/io/obj.h"
 #include "options.h"
 
 namespace lodrefine::app {

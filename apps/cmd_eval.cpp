@@ -17,12 +17,13 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
-#include "lodrefine/eval.h"
-#include "lodrefine/geometry.h"
-#include "lodrefine/io.h"
-#include "lodrefine/plots.h"
-#include "lodrefine/refine.h"
-#include "lodrefine/report.h"
+#include "lodrefine/eval/eval.h"
+#include "lodrefine/core/geometry.h"
+#include "lodrefine/io/obj.h"
+#include "lodrefine/io/files.h"
+#include "lodrefine/eval/plots.h"
+#include "lodrefine/core/refine.h"
+#include "lodrefine/eval/report.h"
 #include "options.h"
 
 namespace lodrefine::app {

@@ -2,7 +2,7 @@
 #include <cstdio>
 
 #include "commands.h"
-#include "lodrefine/params.h"
+#include "lodrefine/core/params.h"
 #include "options.h"
 
 namespace lodrefine::app {

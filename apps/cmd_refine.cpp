@@ -3,10 +3,11 @@
 #include <filesystem>
 
 #include "commands.h"
-#include "lodrefine/cityfile.h"
-#include "lodrefine/cloud.h"
-#include "lodrefine/io.h"
-#include "lodrefine/refine.h"
+#include "lodrefine/io/cityfile.h"
+#include "lodrefine/io/cloud.h"
+#include "lodrefine/io/obj.h"
+#include "lodrefine/io/files.h"
+#include "lodrefine/core/refine.h"
 #include "options.h"
 
 namespace lodrefine::app {

@@ -3,7 +3,7 @@
 #include <string>
 
 #include "commands.h"
-#include "lodrefine/synth.h"
+#include "lodrefine/synth/synth.h"
 
 namespace lodrefine::app {
 

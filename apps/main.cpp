@@ -4,7 +4,7 @@
 #include <new>
 
 #include "commands.h"
-#include "lodrefine/types.h"
+#include "lodrefine/core/types.h"
 
 namespace lodrefine::app {
 int& exit_code() {

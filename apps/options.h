@@ -5,8 +5,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "lodrefine/cloud.h"
-#include "lodrefine/params.h"
+#include "lodrefine/io/cloud.h"
+#include "lodrefine/core/params.h"
 
 namespace lodrefine::app {
 

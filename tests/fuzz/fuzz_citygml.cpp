@@ -5,7 +5,7 @@
 #include <string>
 
 #include "fuzz_common.h"
-#include "lodrefine/citygml.h"
+#include "lodrefine/io/citygml.h"
 
 using namespace lodrefine;
 

@@ -6,9 +6,9 @@
 #include <string>
 
 #include "fuzz_common.h"
-#include "lodrefine/cloud.h"
-#include "lodrefine/io.h"
-#include "lodrefine/las.h"
+#include "lodrefine/io/cloud.h"
+#include "lodrefine/io/files.h"
+#include "lodrefine/io/las.h"
 
 using namespace lodrefine;
 

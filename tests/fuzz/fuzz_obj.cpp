@@ -7,7 +7,7 @@
 #include <string>
 
 #include "fuzz_common.h"
-#include "lodrefine/io.h"
+#include "lodrefine/io/obj.h"
 
 using namespace lodrefine;
 

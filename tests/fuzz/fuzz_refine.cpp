@@ -10,8 +10,9 @@
 #include <string>
 
 #include "fuzz_common.h"
-#include "lodrefine/io.h"
-#include "lodrefine/refine.h"
+#include "lodrefine/io/obj.h"
+#include "lodrefine/io/ply.h"
+#include "lodrefine/core/refine.h"
 
 using namespace lodrefine;
 

@@ -1,0 +1,32 @@
+// Stage 2b: corners from the scan's extent. A scanned facade ends where the building's corner
+// is; when it ends short of the model's corner (or runs on a little past it, then stops), the
+// adjacent wall that was not scanned is misplaced, and moves so that the corner is where the
+// scan says. Evidence must hold over the facade's height (an occluding car or tree does not).
+#pragma once
+#include <vector>
+
+#include "lodrefine/core/matching.h"
+#include "lodrefine/core/params.h"
+#include "lodrefine/core/planes.h"
+#include "lodrefine/core/substitute.h"
+#include "lodrefine/core/types.h"
+
+namespace lodrefine {
+
+struct ScannedWall {
+  int surface = -1;    // model surface
+  int scan_plane = -1;
+  Plane plane;         // the scan plane oriented like the wall
+};
+
+struct CornerMove {
+  WallMove move;        // the unscanned adjacent wall and its new plane
+  int scanned_surface;  // the scanned wall whose extent shows the corner
+  double shift = 0.0;   // how far the corner moves along the scanned facade (m, + outwards)
+};
+
+std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
+                                     const std::vector<ScannedWall>& scanned, const PointCloud& cloud,
+                                     const std::vector<ScanPlane>& planes, const Params& params);
+
+}  // namespace lodrefine

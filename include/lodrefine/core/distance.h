@@ -1,0 +1,44 @@
+// Point-to-surface distances of a mesh (CGAL AABB tree on its triangulated faces): the
+// never-worse check of the pipeline and every C2M figure of the evaluation use this one measure.
+#pragma once
+#include <memory>
+#include <vector>
+
+#include "lodrefine/core/types.h"
+
+namespace lodrefine {
+
+// The triangulated faces of a mesh, indexed for nearest-point queries. Works in any frame
+// (shifts to the mesh's first vertex internally, so georeferenced inputs keep their precision).
+// Throws InputError when the mesh has no non-degenerate face.
+class MeshDistance {
+ public:
+  explicit MeshDistance(const Mesh& mesh);
+  ~MeshDistance();
+  MeshDistance(const MeshDistance&) = delete;
+  MeshDistance& operator=(const MeshDistance&) = delete;
+
+  struct Nearest {
+    double distance;  // signed when asked for (positive on the outward side), else >= 0
+    int face;         // the face of the nearest point
+  };
+  // When the nearest point lies on an edge or vertex, the sign comes from the angle-weighted
+  // pseudonormal of all triangles touching it (found geometrically, so it also works on polygon
+  // soups with T-junctions).
+  Nearest nearest(const Vec3& point, bool signed_distance) const;
+
+ private:
+  struct Index;
+  std::unique_ptr<Index> index_;
+};
+
+// Signed distance from each point to the nearest point of the mesh surface.
+std::vector<double> cloud_to_mesh(const Mesh& mesh, const std::vector<Vec3>& points);
+// The same, unsigned.
+std::vector<double> unsigned_distances(const Mesh& mesh, const std::vector<Vec3>& points);
+
+// Deterministic samples every `spacing` metres on the given faces: a grid in each face's plane
+// (cell centres inside the polygon), or the face centroid if no cell centre falls inside.
+std::vector<Vec3> sample_faces(const Mesh& mesh, const std::vector<int>& faces, double spacing);
+
+}  // namespace lodrefine

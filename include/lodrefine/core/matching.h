@@ -1,0 +1,51 @@
+// Stage 2: model-to-surface matching. Groups the model's faces into planar surfaces, matches
+// scan planes to wall surfaces (normal + centroid-distance hard filters, OBB IoU, S_match),
+// scores the model by Q_model.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "lodrefine/core/geometry.h"
+#include "lodrefine/core/params.h"
+#include "lodrefine/core/planes.h"
+#include "lodrefine/core/types.h"
+
+namespace lodrefine {
+
+// Edge-connected coplanar faces: one supporting plane of the model; its semantic is the one
+// covering most of its area.
+struct ModelSurface {
+  Plane plane;             // PCA plane of all its vertices, oriented outward
+  std::vector<int> faces;  // indices into Mesh::faces
+  Semantic sem = Semantic::Other;
+  double area = 0.0;
+  Vec3 centroid = Vec3::Zero();
+};
+
+std::vector<ModelSurface> model_surfaces(const Mesh& mesh, double angle_deg = 1.0, double distance = 0.02);
+
+struct Match {
+  int scan_plane = -1;   // index into the scan planes
+  int surface = -1;      // index into the model surfaces
+  double s_normal = 0, d_centroid = 0, c_bbox = 0, s_match = 0;
+  std::vector<int> owned;  // the scan points in front of the wall that belong to it
+};
+
+struct MatchResult {
+  std::vector<Match> matches;   // the accepted one-to-one matches (one scan plane per surface)
+  double q_model = 0.0;         // sum of S_match
+  std::vector<std::string> rejected;  // one line per match a check turned down, and why
+};
+
+MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
+                           const PointCloud& cloud, const std::vector<ScanPlane>& planes,
+                           const Params& params);
+
+// The inliers of each matched scan plane that lie in front of its wall, grown by `margin` (a
+// plane may run on along a flush neighbouring facade, whose points are not this building's);
+// indices into `cloud`, ascending.
+std::vector<int> points_in_front(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
+                                 const std::vector<ScanPlane>& planes, const MatchResult& matched,
+                                 const PointCloud& cloud, double margin);
+
+}  // namespace lodrefine

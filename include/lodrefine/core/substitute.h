@@ -1,0 +1,40 @@
+// Stage 3 (first choice): wall substitution. A matched wall takes its scan plane and every
+// vertex it carries is re-solved against the planes of the other walls at that vertex, at its
+// own height (or, where the scan shows the eave moved with the roof, along the roof's plane).
+// The model keeps its topology, ids and semantics; flat roofs, ridges and the ground keep their
+// heights.
+// Where that is not possible (a wall moved past a short neighbour, walls that no longer meet
+// in one point) it says so, and the caller falls back to the local candidate arrangement.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "lodrefine/core/geometry.h"
+#include "lodrefine/core/matching.h"
+#include "lodrefine/core/types.h"
+
+namespace lodrefine {
+
+struct WallMove {
+  int surface = -1;  // index into the model surfaces
+  Plane plane;       // its new plane (oriented like the wall)
+  // Where the wall carries a pitched roof: true slides the eave along the roof's plane (the
+  // roof plane is right, the footprint was wrong), false keeps the eave's height (the roof
+  // outline is right, its pitch follows the wall).
+  bool follow_roof = false;
+};
+
+struct SubstitutionResult {
+  bool ok = false;
+  std::string reason;          // why not, when !ok
+  Mesh mesh;                   // the moved model (closed, same faces; split where needed)
+  int moved_vertices = 0;
+  int split_faces = 0;         // faces that no longer were planar and were triangulated
+  double max_vertex_move = 0;  // (m)
+};
+
+// `surfaces` are model_surfaces(mesh). Vertices on no moved wall keep their exact position.
+SubstitutionResult substitute_walls(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
+                                    const std::vector<WallMove>& moves, double planarity_tolerance);
+
+}  // namespace lodrefine

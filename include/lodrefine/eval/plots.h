@@ -1,0 +1,28 @@
+// SVG figures of an evaluation, as plain text without dependencies: C2M histogram and boxplot
+// before/after (the paper's Fig. 6c–e) and an XY footprint overlay per building (Fig. 5).
+#pragma once
+#include <string>
+#include <vector>
+
+#include "lodrefine/core/types.h"
+
+namespace lodrefine {
+
+// Overlaid histograms of signed C2M distances (m) of the original (blue) and refined (orange)
+// model, as percent of points per bin. `range` clips the x axis to ±range (0: the 99th
+// percentile of |d| over both series, at least 0.1 m); the share beyond it is in the legend.
+std::string svg_histogram(const std::vector<double>& before, const std::vector<double>& after,
+                          const std::string& title, double range = 0.0, int bins = 60);
+
+// Tukey boxplots of signed C2M distances: box Q1–Q3, red median line, whiskers at the farthest
+// value within 1.5 IQR of the box, mean as a cross; outliers are counted, not drawn.
+std::string svg_boxplot(const std::vector<double>& before, const std::vector<double>& after,
+                        const std::string& title);
+
+// Top view (XY): outlines of the original (blue, dashed) and refined (orange) model — wall and
+// ground faces, or every face if none is labelled — over the facade points (green, a regular
+// subsample of at most `max_points`), with a scale bar in metres. Any common frame.
+std::string svg_footprint(const Mesh& original, const Mesh& refined, const std::vector<Vec3>& facade_points,
+                          const std::string& title, std::size_t max_points = 5000);
+
+}  // namespace lodrefine

@@ -1,0 +1,67 @@
+// A city file in, a city file out: every building of a CityJSON / CityJSONSeq / CityGML model
+// that the cloud covers is refined, and one CityJSON 2.0 file (or CityJSONSeq for a sequence)
+// is written with everything else kept exactly.
+//
+// The cloud is read once: one streaming pass cuts a crop per building (lodrefine crop's box),
+// then each building is refined on its crop, one after another (memory: the crops, not the
+// cloud). A refined building's chosen LoD geometry is replaced by a Solid with semantics
+// (WallSurface / RoofSurface / GroundSurface from the refined mesh's faces); its other LoDs,
+// attributes and id stay. Every other building, attribute, LoD, the metadata and the transform
+// are kept as read (new vertices are appended, so existing indices hold). Each building the
+// cloud reaches gets the attributes lodrefine_outcome ("refined" / "kept" / "kept-invalid"),
+// lodrefine_reason and lodrefine_facades_moved; buildings without cloud points are untouched.
+// CityGML input is converted first (citygml_to_cityjson) and written as CityJSON 2.0.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "lodrefine/io/cloud.h"
+#include "lodrefine/core/params.h"
+
+namespace lodrefine {
+
+struct CityRefineOptions {
+  std::string building;  // refine only this CityObject id ("" = every building the cloud covers)
+  std::string lod;       // the LoD geometry to refine, e.g. "2.2" ("" = the highest 2.x)
+  CloudOptions cloud;    // LAS class filter
+  double crop_expand = 0.1;  // crop box growth, relative and absolute (as lodrefine crop)
+  double crop_margin = 3.0;
+};
+
+struct CityBuildingOutcome {
+  std::string id;
+  std::string outcome;  // "refined", "kept", "kept-invalid"
+  std::string reason;   // why kept / kept-invalid (empty when refined)
+  int facades_moved = 0;
+  std::size_t points = 0;  // cloud points in the building's crop box
+  double seconds = 0.0;
+};
+
+struct CityRefineSummary {
+  std::string input_format;   // "CityJSON 2.0", "CityJSONSeq 2.0", "CityGML 2.0"
+  int buildings = 0;          // LoD 2 buildings / building parts in the file
+  int refined = 0, kept = 0, kept_invalid = 0;
+  int untouched = 0;          // no cloud point in their box: written exactly as read
+  int objects_without_lod = 0;  // Building/BuildingPart objects without the LoD asked for
+  std::uint64_t cloud_points = 0;  // points read (after the class filter)
+  std::uint64_t cropped_points = 0;  // points held in the crops after the cloud pass (the memory that grows)
+  std::vector<CityBuildingOutcome> outcomes;  // the buildings the cloud reached, in file order
+  double seconds_read = 0.0, seconds_crop = 0.0, seconds_refine = 0.0, seconds_write = 0.0;
+};
+
+// Throws InputError (one line, nothing written) when the model or cloud cannot be read, when
+// no building has the LoD asked for, when --building names no such building, or when the cloud
+// overlaps no building ("cloud x..y does not overlap the city model x..y: wrong CRS or tile?").
+// A building whose refinement throws is kept as read with outcome kept-invalid and the reason.
+CityRefineSummary refine_city(const std::string& model_path, const std::string& cloud_path, const std::string& out_path,
+                              const Params& params, const CityRefineOptions& options);
+
+// The refined mesh as a CityJSON Solid geometry of LoD `lod` with semantics, its vertices
+// appended to `vertices` quantised by the document's transform (`scale`, `translate`).
+nlohmann::ordered_json cityjson_solid(const Mesh& mesh, const std::string& lod, const Vec3& scale,
+                                      const Vec3& translate, nlohmann::ordered_json& vertices);
+
+}  // namespace lodrefine

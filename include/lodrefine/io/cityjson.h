@@ -1,0 +1,71 @@
+// Reading LoD2 buildings from CityJSON (1.0, 1.1, 2.0) and CityJSONSeq (.jsonl) files.
+//
+// Every Building and every BuildingPart that has an LoD 2.x geometry becomes one Mesh (id =
+// its CityObject id; parts are NOT merged into their parent). The geometry used is the highest
+// LoD 2.x one: Solid -> its exterior shell, MultiSolid/CompositeSolid -> the exterior shell of
+// each solid, MultiSurface/CompositeSurface -> all surfaces. The output is a polygon soup in
+// the georeferenced frame (the file's `transform` applied), each face with its own vertices,
+// as an OBJ fan-out export of the same building would be; Face::source is the surface's index
+// in the geometry (running over all shells), Face::sem comes from the semantics
+// (WallSurface / RoofSurface / GroundSurface, anything else -> Other).
+#pragma once
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "lodrefine/core/types.h"
+
+namespace lodrefine {
+
+struct CityJsonBuilding {
+  Mesh mesh;                  // polygon soup, georeferenced, mesh.id = CityObject id
+  std::string type;           // "Building" or "BuildingPart"
+  std::string parent;         // first parent id (BuildingPart), empty otherwise
+  std::string lod;            // the LoD used, as written in the file ("2", "2.2")
+  std::string geometry_type;  // "Solid", "MultiSurface", ...
+  int geometry_index = -1;    // position of that geometry in the object's "geometry" array
+  int skipped_holes = 0;      // inner rings dropped (the surface keeps its outer ring only)
+  int skipped_rings = 0;      // outer rings with < 3 distinct vertices, dropped
+  int skipped_shells = 0;     // interior shells of solids, dropped
+  nlohmann::json attributes;  // CityGML input: the object's attributes (CityJSON input keeps its own JSON)
+};
+
+struct CityJsonFile {
+  std::string format = "CityJSON";  // or "CityGML"
+  std::string version;        // "1.0", "1.1", "2.0"
+  bool sequence = false;      // read as CityJSONSeq
+  std::string crs;            // metadata.referenceSystem, empty when absent
+  Vec3 scale = Vec3::Ones();  // transform (identity when the file has none)
+  Vec3 translate = Vec3::Zero();
+  std::vector<CityJsonBuilding> buildings;  // in file order (object order within a feature)
+  int objects_without_lod2 = 0;             // Building/BuildingPart objects with no LoD 2.x geometry
+  std::vector<std::string> notes;           // one line per thing worth knowing (holes dropped ...)
+};
+
+// Reads a CityJSON file or a CityJSONSeq stream (recognised by its content: a first line that
+// is a complete "CityJSON" object followed by "CityJSONFeature" lines). Throws InputError with
+// a one-line message "<path>: <fault>" on unreadable or malformed input (bad JSON, wrong type,
+// vertex index out of range, boundaries or semantics not shaped as the geometry type says).
+// `lod` (e.g. "2.2") picks that LoD instead of the highest 2.x one; objects without it count
+// as objects_without_lod2.
+CityJsonFile read_cityjson(const std::string& path, const std::string& lod = "");
+
+// Same, from text in memory; `name` is used in error messages.
+CityJsonFile parse_cityjson(const std::string& text, const std::string& name = "<cityjson>", const std::string& lod = "");
+
+// Same, from a parsed CityJSON object (not a sequence).
+CityJsonFile read_cityjson_document(const nlohmann::ordered_json& doc, const std::string& name, const std::string& lod = "");
+
+// True when `text` is a CityJSONSeq: a first line holding a complete "CityJSON" object, then
+// more lines (the CityJSONFeatures).
+bool is_cityjson_sequence(const std::string& text);
+
+// A file name (without extension) for a CityObject id: characters that are unsafe in paths
+// (separators, whitespace, control and shell-special characters) become '_'.
+std::string file_stem_for_id(const std::string& id);
+
+// Semantic of a CityJSON semantic surface type ("WallSurface" -> Wall, ...; others -> Other).
+Semantic semantic_from_cityjson(const std::string& type);
+
+}  // namespace lodrefine

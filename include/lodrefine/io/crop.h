@@ -1,0 +1,37 @@
+// Cutting one MLS crop per building out of a large tile, in one streaming pass.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "lodrefine/io/cloud.h"
+#include "lodrefine/core/types.h"
+
+namespace lodrefine {
+
+struct CropTarget {
+  std::string id;
+  Vec3 lo, hi;        // expanded bounding box (georeferenced)
+  PointCloud cloud;   // filled by crop_tile
+};
+
+// The model's bounding box grown by `relative` of its size and `absolute` metres on each side
+// (vertically by `absolute` only).
+CropTarget crop_target(const Mesh& model, double relative, double absolute);
+
+// Streams the tile (PLY or LAS, `options` filtering LAS classes) once and appends each point
+// to every target whose box holds it (a 2D grid over the targets keeps this O(points)).
+// Returns the number of points read (after the class filter); `bounds` (optional) gets the
+// bounding box of every point read.
+std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets, const CloudOptions& options = {},
+                      Eigen::AlignedBox3d* bounds = nullptr);
+
+// The same pass for a whole city tile, with memory bounded by `buffer_points`, not by the tile:
+// each target's points go to `out_paths[i]` (a PLY, written atomically), and points held beyond
+// the bound are spilled to per-target temporary files beside them. Only one target's crop is
+// in memory at a time when the PLYs are written. Returns the number of points read and sets
+// `counts[i]` to each crop's size.
+std::size_t crop_tile_to_files(const std::string& tile, const std::vector<CropTarget>& targets,
+                               const std::vector<std::string>& out_paths, std::size_t buffer_points,
+                               std::vector<std::size_t>& counts, const CloudOptions& options = {});
+
+}  // namespace lodrefine

@@ -1,0 +1,58 @@
+// Reading ASPRS LAS point clouds: versions 1.0–1.4, point data record formats 0–10,
+// uncompressed. Debian ships no LAS library (no PDAL, LASlib, liblas) and no LAZ decoder, so
+// this is a small reader of the public header block and the x/y/z/classification fields.
+// Compressed LAZ is recognised and refused with a message saying how to decompress it.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "lodrefine/core/types.h"
+
+namespace lodrefine {
+
+// The public header block fields the reader uses, validated against the file.
+struct LasHeader {
+  int version_major = 1, version_minor = 2;
+  int point_format = 0;            // 0..10
+  std::uint32_t record_length = 0; // bytes per point record (>= the format's minimum; extra bytes are skipped)
+  std::uint32_t header_size = 0;
+  std::uint64_t point_offset = 0;  // byte offset of the first point record
+  std::uint64_t point_count = 0;   // LAS 1.4: the 64-bit count; before: the 32-bit legacy count
+  Vec3 scale = Vec3::Ones(), offset = Vec3::Zero();
+  Vec3 min = Vec3::Zero(), max = Vec3::Zero();  // bounding box as declared by the writer
+};
+
+// Smallest record length of point data format 0..10 (ASPRS LAS 1.4 R15, Tables 7–17).
+std::uint32_t las_min_record_length(int point_format);
+
+// Reads and checks the header: 'LASF' signature, version 1.0–1.4, header size, point data
+// offset and record length within the file, point format 0–10, record length at least the
+// format's minimum, the point count times the record length within the file, finite non-zero
+// scales and finite offsets. A compressed LAZ file (point format bit 7 or 6, or a
+// "laszip encoded" VLR) is refused with a message to decompress it first. Throws InputError
+// "<path>: <fault>" (one line); never allocates more than the header.
+LasHeader read_las_header(const std::string& path);
+
+// Streams the points (x = X·scale + offset, in double) in file order, reading the file in
+// chunks. `classes` (empty: every point) keeps only points whose classification is listed:
+// formats 0–5 carry a 5-bit class (bits 0–4 of byte 15), formats 6–10 a full byte (byte 16).
+// Returns the number of points passed on. Rejects coordinates beyond 1e9 m (kMaxCoordinate).
+std::uint64_t stream_las(const std::string& path, const std::vector<int>& classes,
+                         const std::function<void(const Vec3&)>& on_point);
+
+// Writes an uncompressed LAS file (for tests and tools): `version_minor` 2..4, `point_format`
+// 0..10, `record_length` 0 = the format's minimum (more: zero padding as extra bytes), one
+// classification per point (or none: class 1), scale 1 mm and the given offset.
+struct LasWriteOptions {
+  int version_minor = 2;
+  int point_format = 0;
+  std::uint32_t record_length = 0;
+  Vec3 scale = Vec3::Constant(0.001);
+  Vec3 offset = Vec3::Zero();
+};
+void write_las(const std::string& path, const PointCloud& cloud, const std::vector<int>& classes,
+               const LasWriteOptions& options);
+
+}  // namespace lodrefine

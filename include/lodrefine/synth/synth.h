@@ -1,0 +1,73 @@
+// Generator of test buildings with known ground truth: the true building, a coarse LoD2-like
+// model of it (facades shifted/rotated, export defects) and a simulated MLS crop.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "lodrefine/core/types.h"
+
+namespace lodrefine {
+
+enum class BuildingType { Flat, Gable, Hip, Shed, Stepped, LShape, TShape, Polygon };
+const char* building_type_name(BuildingType t);          // "flat", "gable", ...
+BuildingType building_type_from_name(const std::string&); // throws InputError
+std::vector<BuildingType> all_building_types();
+
+struct SynthOptions {
+  double max_shift = 0.8;        // facade offset, uniform in [min_shift, max_shift] with random sign (m)
+  double min_shift = 0.2;
+  double max_rotation_deg = 3.0; // facade rotation about a vertical axis
+  double global_shift = 0.03;    // whole coarse model shifted by up to this (m)
+  int scanned_facades = 0;       // 0: random 1..3
+  double noise = 0.01;           // MLS range noise sigma (m)
+  int target_points = 30000;     // points on scanned facades, before nuisances
+  bool defects = true;           // missing ground / mm gaps / flipped face / duplicate face
+  bool nuisances = true;         // windows, recesses, occlusion holes, trees, cars, ground, neighbours
+  Vec3 origin{85000.0, 447000.0, 0.0};  // georeferenced offset (RD New-like by default)
+};
+
+// A facade of the coarse model that differs from the truth.
+struct MovedWall {
+  std::vector<int> truth_faces;  // truth walls on the moved facade plane (first: the pivot wall)
+  double offset = 0.0;           // perpendicular shift (m), positive = outward
+  double rotation_deg = 0.0;     // about a vertical axis through the pivot wall's midpoint, CCW seen from above
+  bool scanned = false;          // one of scanned_truth_faces
+};
+
+struct SynthBuilding {
+  std::string id;
+  BuildingType type;
+  std::uint64_t seed = 0;
+  SynthOptions options;
+  Vec3 frame_origin = Vec3::Zero();  // georeferenced origin of the building's own frame
+  double frame_rotation_deg = 0.0;   // rotation of the building's own frame about z
+  std::vector<MovedWall> moved_walls;
+  Vec3 coarse_shift = Vec3::Zero();  // global shift applied to the whole coarse model
+  std::vector<std::string> defects;  // export defects of the coarse soup, e.g. "reversed_face:7"
+  double point_spacing = 0.0;        // facade sampling grid step (m)
+  Mesh truth;    // closed, oriented, shared vertices, georeferenced
+  Mesh coarse;   // polygon soup as exported from CityGML (defects included), georeferenced
+  PointCloud cloud;                // georeferenced MLS crop
+  std::vector<int> scanned_truth_faces;  // indices into truth.faces of the scanned walls
+  std::vector<int> point_label;    // per cloud point: truth face index for facade points, -1 window recess, -2 clutter, -3 ground, -4 neighbour
+};
+
+// Deterministic for (type, seed, options).
+SynthBuilding make_building(BuildingType type, std::uint64_t seed, const SynthOptions& opt = {});
+
+// Writes DIR/<id>/{truth.obj, coarse.obj, cloud.ply, meta.json} (without cloud.ply when
+// `with_cloud` is false).
+void write_synth_building(const std::string& dir, const SynthBuilding& b, bool with_cloud = true);
+
+// A city tile for the city-scale bench: `count` buildings (types cycling, seeds first_seed...)
+// on a square grid of `spacing` metres from opt.origin, each written as DIR/<id>/{truth.obj,
+// coarse.obj, meta.json}, and all their clouds streamed into one binary PLY `tile_ply` (one
+// building in memory at a time; written under a temporary name, renamed when complete).
+// `progress` (may be empty) gets each building after it is written. Returns the tile's points.
+std::uint64_t write_synth_tile(const std::string& dir, const std::string& tile_ply, int count, std::uint64_t first_seed,
+                               double spacing, const SynthOptions& opt,
+                               const std::function<void(const SynthBuilding&)>& progress);
+
+}  // namespace lodrefine

@@ -1,0 +1,174 @@
+// Stage 2b: corners from the scan's extent, see corners.h.
+#include "lodrefine/core/corners.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+namespace lodrefine {
+namespace {
+
+// Inliers of a facade plane are connected within the RANSAC cluster epsilon; a longer empty
+// stretch along the facade ends it (a gap to a neighbour, or the corner).
+constexpr double kRunGap = 0.5;
+// Corners closer than this to the scan's end already agree with it (scan spacing ~ cm).
+constexpr double kCornerTolerance = 0.05;
+// The end must be the same in every height band within this: a vertical building edge, not
+// an occluder's outline.
+constexpr double kEndSpread = 0.15;
+constexpr int kBands = 4;
+// At a facade's end the scanner must have seen something off its plane within this (m), above
+// the low part of the wall (ground and clutter below kLowBand of its height do not count).
+constexpr double kLookPast = 1.0;
+constexpr double kLowBand = 0.25;
+// Stray inliers tolerated past a facade's end (noise, a drainpipe).
+constexpr int kStrayPoints = 10;
+// Adjacent walls turned less than this from the scanned one are no corner (cos 45 deg).
+constexpr double kMaxCornerCos = 0.707;
+
+// How far along +t the run of points starting at t = 0 reaches (-1 when it does not start).
+double run_end(std::vector<double> t) {
+  std::sort(t.begin(), t.end());
+  double e = 0.0;
+  bool started = false;
+  for (double x : t) {
+    if (x < 0) continue;
+    if (x - e > kRunGap) break;
+    e = std::max(e, x);
+    started = true;
+  }
+  return started ? e : -1.0;
+}
+
+}  // namespace
+
+std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
+                                     const std::vector<ScannedWall>& scanned, const PointCloud& cloud,
+                                     const std::vector<ScanPlane>& planes, const Params& prm) {
+  std::vector<int> face_surface(mesh.faces.size(), -1);
+  for (int s = 0; s < int(surfaces.size()); ++s)
+    for (int f : surfaces[s].faces) face_surface[f] = s;
+  // Surfaces adjacent across an edge, with the shared edges.
+  std::map<std::pair<int, int>, std::vector<int>> edge_surfaces;
+  for (int f = 0; f < int(mesh.faces.size()); ++f) {
+    const auto& v = mesh.faces[f].v;
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      const int a = v[k], b = v[(k + 1) % v.size()];
+      edge_surfaces[{std::min(a, b), std::max(a, b)}].push_back(face_surface[f]);
+    }
+  }
+  std::map<std::pair<int, int>, std::vector<std::pair<int, int>>> shared;  // (wall, neighbour) -> edges
+  for (const auto& [e, ss] : edge_surfaces)
+    if (ss.size() == 2 && ss[0] != ss[1]) {
+      shared[{ss[0], ss[1]}].push_back(e);
+      shared[{ss[1], ss[0]}].push_back(e);
+    }
+  std::set<int> is_scanned;
+  for (const auto& w : scanned) is_scanned.insert(w.surface);
+
+  std::map<int, std::vector<CornerMove>> evidence;  // per adjacent wall
+  for (const auto& w : scanned) {
+    const ModelSurface& ws = surfaces[w.surface];
+    const auto [u, v] = w.plane.basis();  // u horizontal
+    const Vec3 o = w.plane.project(ws.centroid);
+    double u0 = 1e300, u1 = -1e300, z0 = 1e300, z1 = -1e300;
+    for (int f : ws.faces)
+      for (int vi : mesh.faces[f].v) {
+        const Vec3& p = mesh.vertices[vi];
+        u0 = std::min(u0, (p - o).dot(u));
+        u1 = std::max(u1, (p - o).dot(u));
+        z0 = std::min(z0, p.z());
+        z1 = std::max(z1, p.z());
+      }
+    const double u_mid = 0.5 * (u0 + u1);
+    // The scan plane's points over the wall's height, along the facade.
+    std::vector<double> pu, pz;
+    for (int i : planes[w.scan_plane].inliers) {
+      const Vec3& p = cloud.points[i];
+      if (p.z() < z0 || p.z() > z1) continue;
+      pu.push_back((p - o).dot(u) - u_mid);
+      pz.push_back(p.z());
+    }
+    if (pu.empty()) continue;
+    for (const auto& [key, edges] : shared) {
+      if (key.first != w.surface) continue;
+      const int a = key.second;
+      const ModelSurface& as = surfaces[a];
+      if (as.sem != Semantic::Wall || is_scanned.count(a)) continue;
+      if (std::abs(as.plane.n.dot(ws.plane.n)) > kMaxCornerCos) continue;
+      // The corner on the scanned plane, at mid height of the shared edge.
+      double zc = 0.0;
+      for (const auto& [i, j] : edges) zc += 0.5 * (mesh.vertices[i].z() + mesh.vertices[j].z());
+      zc /= double(edges.size());
+      const auto c = meet(w.plane, as.plane, Plane(Vec3::UnitZ(), -zc));
+      if (!c) continue;
+      const double uc = (*c - o).dot(u) - u_mid;
+      const double s = uc >= 0 ? 1.0 : -1.0;
+      std::vector<double> t(pu.size());
+      for (std::size_t k = 0; k < pu.size(); ++k) t[k] = s * pu[k];
+      const double end = run_end(t);
+      if (end < 0) continue;
+      const double gap = end - s * uc;  // > 0: the scan runs past the corner
+      if (std::abs(gap) <= kCornerTolerance || std::abs(gap) > prm.match_distance) continue;
+      // Points of this plane again past the end, short of the corner: the run ended at a gap
+      // in the facade (a recessed entrance), not at the building's edge.
+      int beyond = 0;
+      for (double x : t) beyond += x > end + kRunGap && x <= s * uc + prm.match_distance;
+      if (beyond > kStrayPoints) continue;
+      // A facade ending short of the corner must end at something the scanner saw there off
+      // its plane (the side wall turning away, a neighbour's facade): where it saw nothing, the
+      // scan ended, not the building.
+      if (gap < 0) {
+        int seen = 0;
+        for (const auto& p : cloud.points) {
+          if (p.z() < z0 + kLowBand * (z1 - z0) || p.z() > z1) continue;
+          const double depth = std::abs(w.plane.distance(p));
+          if (depth <= 2.0 * prm.ransac_epsilon || depth > prm.match_distance + kLookPast) continue;
+          const double x = s * ((p - o).dot(u) - u_mid);
+          seen += x >= end - kCornerTolerance && x <= end + kLookPast;
+        }
+        if (seen <= kStrayPoints) continue;
+      }
+      // The same end in every height band that has points.
+      double lo = 1e300, hi = -1e300;
+      int bands = 0;
+      for (int b = 0; b < kBands; ++b) {
+        const double za = z0 + (z1 - z0) * b / kBands, zb = z0 + (z1 - z0) * (b + 1) / kBands;
+        std::vector<double> tb;
+        for (std::size_t k = 0; k < pu.size(); ++k)
+          if (pz[k] >= za && pz[k] < zb) tb.push_back(t[k]);
+        const double eb = run_end(tb);
+        if (eb < 0) continue;
+        ++bands;
+        lo = std::min(lo, eb);
+        hi = std::max(hi, eb);
+      }
+      if (bands < kBands - 1 || hi - lo > kEndSpread) continue;
+      const Vec3 delta = s * gap * u;
+      CornerMove cm;
+      cm.move.surface = a;
+      cm.move.plane = Plane(as.plane.n, as.plane.d - as.plane.n.dot(delta));
+      cm.scanned_surface = w.surface;
+      cm.shift = gap;
+      evidence[a].push_back(cm);
+    }
+  }
+  // A wall between two scanned facades must get the same answer from both.
+  std::vector<CornerMove> out;
+  for (const auto& [a, list] : evidence) {
+    double lo = 1e300, hi = -1e300, sum = 0.0;
+    for (const auto& cm : list) {
+      lo = std::min(lo, cm.move.plane.d);
+      hi = std::max(hi, cm.move.plane.d);
+      sum += cm.move.plane.d;
+    }
+    if (hi - lo > kEndSpread) continue;
+    CornerMove cm = list.front();
+    cm.move.plane.d = sum / double(list.size());
+    out.push_back(cm);
+  }
+  return out;
+}
+
+}  // namespace lodrefine

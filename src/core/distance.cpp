@@ -1,0 +1,182 @@
+// Point-to-mesh distances on a CGAL AABB tree. The only CGAL-heavy unit the distance needs.
+#include "lodrefine/core/distance.h"
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Simple_cartesian.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "lodrefine/core/geometry.h"
+
+namespace lodrefine {
+namespace {
+
+using K = CGAL::Simple_cartesian<double>;
+using CgalTriangles = std::vector<K::Triangle_3>;
+using Primitive = CGAL::AABB_triangle_primitive<K, CgalTriangles::const_iterator>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
+
+// Triangles whose nearest point is this much farther than the nearest one still count as
+// touching it (double rounding in a local frame is ~1e-13 m).
+constexpr double kTieTolerance = 1e-7;
+constexpr double kMinTriangleArea = 1e-12;
+
+K::Point_3 to_cgal(const Vec3& p) { return {p.x(), p.y(), p.z()}; }
+
+// Nearest point of a triangle to p (Ericson, Real-Time Collision Detection 5.1.5) and the angle
+// the triangle subtends around it: 2π inside, π on an edge, the corner angle at a vertex.
+struct Closest {
+  Vec3 q;
+  double angle;
+};
+
+double corner_angle(const Vec3& at, const Vec3& u, const Vec3& w) {
+  const Vec3 e1 = (u - at).normalized(), e2 = (w - at).normalized();
+  return std::acos(std::clamp(e1.dot(e2), -1.0, 1.0));
+}
+
+Closest closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return {a, corner_angle(a, b, c)};
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return {b, corner_angle(b, c, a)};
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return {a + ab * (d1 / (d1 - d3)), kPi};
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return {c, corner_angle(c, a, b)};
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return {a + ac * (d2 / (d2 - d6)), kPi};
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return {b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))), kPi};
+  const double denom = 1.0 / (va + vb + vc);
+  return {a + ab * (vb * denom) + ac * (vc * denom), 2 * kPi};
+}
+
+// AABB tree over a mesh's triangles, in a frame shifted to the mesh's first vertex so that
+// georeferenced inputs keep their precision.
+class SurfaceIndex {
+ public:
+  explicit SurfaceIndex(const Mesh& mesh) {
+    if (!mesh.vertices.empty()) origin_ = mesh.vertices.front().array().floor().matrix();
+    for_each_triangle(mesh, [&](const Vec3& a, const Vec3& b, const Vec3& c, int face) {
+      Tri t{a - origin_, b - origin_, c - origin_, Vec3::Zero(), face};
+      const Vec3 n = (t.b - t.a).cross(t.c - t.a);
+      if (0.5 * n.norm() < kMinTriangleArea) return;
+      t.n = n.normalized();
+      tris_.push_back(t);
+      cgal_.emplace_back(to_cgal(t.a), to_cgal(t.b), to_cgal(t.c));
+    });
+    if (tris_.empty()) throw InputError("mesh '" + mesh.id + "' has no non-degenerate face");
+    tree_.insert(cgal_.cbegin(), cgal_.cend());
+    tree_.build();
+    tree_.accelerate_distance_queries();
+  }
+  SurfaceIndex(const SurfaceIndex&) = delete;  // the tree points into cgal_
+  SurfaceIndex& operator=(const SurfaceIndex&) = delete;
+
+  struct Nearest {
+    double distance;  // signed if asked for, else >= 0
+    int face;
+  };
+
+  Nearest nearest(const Vec3& world, bool want_sign) const {
+    const Vec3 p = world - origin_;
+    const auto hit = tree_.closest_point_and_primitive(to_cgal(p));
+    const std::size_t i = std::size_t(hit.second - cgal_.cbegin());
+    const Closest c = closest_on_triangle(p, tris_[i].a, tris_[i].b, tris_[i].c);
+    const double d = (p - c.q).norm();
+    if (!want_sign || d == 0.0) return {d, tris_[i].face};
+    return {sign_at(p, c, i) * d, tris_[i].face};
+  }
+
+ private:
+  struct Tri {
+    Vec3 a, b, c, n;
+    int face;
+  };
+
+  // Inside a face the face normal decides. On an edge or vertex, the angle-weighted pseudonormal
+  // of every triangle touching the nearest point decides (Bærentzen & Aanæs 2005): correct on a
+  // closed surface whatever the triangulation, where a single adjacent normal can be wrong.
+  double sign_at(const Vec3& p, const Closest& c, std::size_t i) const {
+    const double own = tris_[i].n.dot(p - c.q);
+    if (c.angle == 2 * kPi) return own >= 0 ? 1.0 : -1.0;
+    const double r = (p - c.q).norm() + kTieTolerance;
+    std::vector<Primitive::Id> touching;
+    tree_.all_intersected_primitives(K::Sphere_3(to_cgal(p), r * r), std::back_inserter(touching));
+    double s = 0.0;
+    for (const auto& id : touching) {
+      const Tri& t = tris_[std::size_t(id - cgal_.cbegin())];
+      const Closest ct = closest_on_triangle(p, t.a, t.b, t.c);
+      if ((p - ct.q).norm() <= r) s += ct.angle * t.n.dot(p - ct.q);
+    }
+    if (s == 0.0) s = own;
+    return s >= 0 ? 1.0 : -1.0;
+  }
+
+  Vec3 origin_ = Vec3::Zero();
+  std::vector<Tri> tris_;
+  CgalTriangles cgal_;
+  Tree tree_;
+};
+
+}  // namespace
+
+struct MeshDistance::Index : SurfaceIndex {
+  using SurfaceIndex::SurfaceIndex;
+};
+
+MeshDistance::MeshDistance(const Mesh& mesh) : index_(std::make_unique<Index>(mesh)) {}
+MeshDistance::~MeshDistance() = default;
+
+MeshDistance::Nearest MeshDistance::nearest(const Vec3& point, bool signed_distance) const {
+  const auto n = index_->nearest(point, signed_distance);
+  return {n.distance, n.face};
+}
+
+std::vector<double> cloud_to_mesh(const Mesh& mesh, const std::vector<Vec3>& points) {
+  const SurfaceIndex index(mesh);
+  std::vector<double> d(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) d[i] = index.nearest(points[i], true).distance;
+  return d;
+}
+
+std::vector<double> unsigned_distances(const Mesh& mesh, const std::vector<Vec3>& pts) {
+  if (pts.empty()) return {};
+  const MeshDistance index(mesh);
+  std::vector<double> d(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) d[i] = index.nearest(pts[i], false).distance;
+  return d;
+}
+
+std::vector<Vec3> sample_faces(const Mesh& mesh, const std::vector<int>& faces, double spacing) {
+  std::vector<Vec3> out;
+  for (int f : faces) {
+    std::vector<Vec3> poly;
+    for (int v : mesh.faces.at(f).v) poly.push_back(mesh.vertices.at(v));
+    if (poly.size() < 3 || polygon_area(poly) <= 0) continue;
+    const auto [u, v] = polygon_plane(poly).basis();
+    std::vector<Vec2> p2;
+    Vec2 lo = Vec2::Constant(std::numeric_limits<double>::max()), hi = -lo;
+    for (const auto& p : poly) {
+      p2.emplace_back((p - poly[0]).dot(u), (p - poly[0]).dot(v));
+      lo = lo.cwiseMin(p2.back()), hi = hi.cwiseMax(p2.back());
+    }
+    const std::size_t before = out.size();
+    for (double x = lo.x() + 0.5 * spacing; x < hi.x(); x += spacing)
+      for (double y = lo.y() + 0.5 * spacing; y < hi.y(); y += spacing)
+        if (point_in_polygon_2d(Vec2(x, y), p2)) out.push_back(poly[0] + x * u + y * v);
+    if (out.size() == before) out.push_back(polygon_centroid(poly));
+  }
+  return out;
+}
+
+}  // namespace lodrefine

@@ -1,0 +1,319 @@
+// Stage 2: model-to-surface matching (paper Sec. 3.1).
+#include "lodrefine/core/matching.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+
+namespace lodrefine {
+namespace {
+
+// In-plane extent [min u, max u] x [min v, max v] of points in a surface's frame.
+struct Rect {
+  double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
+  void add(double u, double v) {
+    u0 = std::min(u0, u); u1 = std::max(u1, u);
+    v0 = std::min(v0, v); v1 = std::max(v1, v);
+  }
+  double area() const { return std::max(0.0, u1 - u0) * std::max(0.0, v1 - v0); }
+};
+
+// The surface's extent in its own plane frame (u, v) around its centroid.
+Rect surface_rect(const Mesh& mesh, const ModelSurface& surf) {
+  const auto [u, v] = surf.plane.basis();
+  Rect box;
+  for (int f : surf.faces)
+    for (int vi : mesh.faces[f].v) {
+      const Vec3 q = mesh.vertices[vi] - surf.centroid;
+      box.add(q.dot(u), q.dot(v));
+    }
+  return box;
+}
+
+double overlap_area(const Rect& a, const Rect& b) {
+  const double du = std::min(a.u1, b.u1) - std::max(a.u0, b.u0);
+  const double dv = std::min(a.v1, b.v1) - std::max(a.v0, b.v0);
+  return du > 0 && dv > 0 ? du * dv : 0.0;
+}
+
+// Two surfaces are adjacent when they share a vertex.
+bool adjacent(const Mesh& mesh, const ModelSurface& a, const ModelSurface& b) {
+  std::vector<int> va, vb;
+  for (int f : a.faces) va.insert(va.end(), mesh.faces[f].v.begin(), mesh.faces[f].v.end());
+  for (int f : b.faces) vb.insert(vb.end(), mesh.faces[f].v.begin(), mesh.faces[f].v.end());
+  std::sort(va.begin(), va.end());
+  std::sort(vb.begin(), vb.end());
+  std::vector<int> common;
+  std::set_intersection(va.begin(), va.end(), vb.begin(), vb.end(), std::back_inserter(common));
+  return !common.empty();
+}
+
+// How far the corner where `plane` meets the adjacent facade's scan plane lies beyond the end
+// of that facade's points (0 when the points reach it). A wall moved onto a neighbour's wall
+// across a gap leaves the adjacent facade's scan ending well short of the new corner.
+double corner_gap(const Plane& plane, const ScanPlane& adjacent_scan, const PointCloud& cloud) {
+  const auto [u, v] = adjacent_scan.plane.basis();
+  const Vec3 dir = plane.n.cross(adjacent_scan.plane.n);
+  if (dir.norm() < 0.5) return 0.0;  // not a corner (near-parallel walls)
+  // A point on the corner line, at the height of the adjacent scan's centroid.
+  const auto corner = meet(plane, adjacent_scan.plane, Plane::through(adjacent_scan.centroid, v));
+  if (!corner) return 0.0;
+  const double uc = (*corner - adjacent_scan.centroid).dot(u);
+  double lo = 1e300, hi = -1e300;
+  for (int i : adjacent_scan.inliers) {
+    const double q = (cloud.points[i] - adjacent_scan.centroid).dot(u);
+    lo = std::min(lo, q);
+    hi = std::max(hi, q);
+  }
+  return std::max({0.0, uc - hi, lo - uc});
+}
+
+}  // namespace
+
+std::vector<ModelSurface> model_surfaces(const Mesh& mesh, double angle_deg, double distance) {
+  const int nf = int(mesh.faces.size());
+  std::map<std::pair<int, int>, std::vector<int>> edge_faces;
+  for (int f = 0; f < nf; ++f) {
+    const auto& v = mesh.faces[f].v;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const int a = v[i], b = v[(i + 1) % v.size()];
+      edge_faces[{std::min(a, b), std::max(a, b)}].push_back(f);
+    }
+  }
+  std::vector<Plane> face_plane(nf);
+  for (int f = 0; f < nf; ++f) face_plane[f] = polygon_plane(face_points(mesh, mesh.faces[f]));
+
+  std::vector<int> group(nf, -1);
+  std::vector<ModelSurface> surfaces;
+  for (int seed = 0; seed < nf; ++seed) {
+    if (group[seed] >= 0) continue;
+    const int gid = int(surfaces.size());
+    std::vector<int> stack{seed}, members;
+    group[seed] = gid;
+    while (!stack.empty()) {
+      const int f = stack.back();
+      stack.pop_back();
+      members.push_back(f);
+      const auto& v = mesh.faces[f].v;
+      for (std::size_t i = 0; i < v.size(); ++i) {
+        const int a = v[i], b = v[(i + 1) % v.size()];
+        for (int g : edge_faces[{std::min(a, b), std::max(a, b)}]) {
+          if (group[g] >= 0) continue;
+          if (face_plane[g].n.dot(face_plane[seed].n) < std::cos(radians(angle_deg))) continue;
+          bool on_plane = true;
+          for (int vi : mesh.faces[g].v)
+            on_plane = on_plane && std::abs(face_plane[seed].distance(mesh.vertices[vi])) <= distance;
+          if (!on_plane) continue;
+          group[g] = gid;
+          stack.push_back(g);
+        }
+      }
+    }
+    ModelSurface s;
+    s.faces = members;
+    std::map<Semantic, double> sem_area;
+    std::vector<Vec3> pts;
+    Vec3 nsum = Vec3::Zero(), csum = Vec3::Zero();
+    for (int f : members) {
+      const auto poly = face_points(mesh, mesh.faces[f]);
+      pts.insert(pts.end(), poly.begin(), poly.end());
+      const double a = polygon_area(poly);
+      s.area += a;
+      sem_area[mesh.faces[f].sem] += a;
+      nsum += newell_normal(poly);
+      csum += a * polygon_centroid(poly);
+    }
+    // One plane, one surface: a mislabelled piece (a repaired hole, say) takes the semantic
+    // that covers most of it.
+    s.sem = std::max_element(sem_area.begin(), sem_area.end(), [](const auto& a, const auto& b) {
+              return a.second < b.second;
+            })->first;
+    s.plane = fit_plane(pts);
+    if (s.plane.n.dot(nsum) < 0) s.plane = s.plane.flipped();
+    s.centroid = s.area > 0 ? Vec3(csum / s.area) : pts.front();
+    surfaces.push_back(std::move(s));
+  }
+  return surfaces;
+}
+
+MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& surfaces, const PointCloud& cloud,
+                           const std::vector<ScanPlane>& planes, const Params& prm) {
+  MatchResult result;
+  const double cos_max = std::cos(radians(prm.match_angle_deg));
+  // The candidate walls, each with its outline in its own plane frame.
+  struct Wall {
+    int surface;
+    Vec3 u, v;
+    Rect box;
+    std::vector<std::vector<Vec2>> outline;
+  };
+  std::vector<Wall> walls;
+  for (int s = 0; s < int(surfaces.size()); ++s) {
+    const ModelSurface& surf = surfaces[s];
+    // Slivers (e.g. hole fills) are no facades: a large scan box would "cover" them.
+    if (surf.sem != Semantic::Wall || surf.area < prm.min_plane_area) continue;
+    Wall w{s, Vec3::Zero(), Vec3::Zero(), surface_rect(mesh, surf), {}};
+    std::tie(w.u, w.v) = surf.plane.basis();
+    for (int f : surf.faces) {
+      std::vector<Vec2> poly;
+      for (int vi : mesh.faces[f].v) {
+        const Vec3 q = mesh.vertices[vi] - surf.centroid;
+        poly.emplace_back(q.dot(w.u), q.dot(w.v));
+      }
+      w.outline.push_back(std::move(poly));
+    }
+    walls.push_back(std::move(w));
+  }
+  auto in_outline = [&](const Wall& w, const Vec2& q) {
+    const double m = prm.match_margin;
+    if (q.x() < w.box.u0 - m || q.x() > w.box.u1 + m || q.y() < w.box.v0 - m || q.y() > w.box.v1 + m) return false;
+    for (const auto& poly : w.outline) {
+      if (point_in_polygon_2d(q, poly)) return true;
+      for (std::size_t k = 0; k < poly.size(); ++k)
+        if (segment_distance_2d(q, poly[k], poly[(k + 1) % poly.size()]) <= m) return true;
+    }
+    return false;
+  };
+
+  // Each facade point belongs to the nearest wall facing its way whose outline (grown by
+  // match_margin) it lies in front of: a plane spanning several walls, a setback or a flush
+  // neighbour then gives each wall only its own points, never those of a parallel wall.
+  for (int p = 0; p < int(planes.size()); ++p) {
+    const ScanPlane& sp = planes[p];
+    if (!sp.facade) continue;
+    std::vector<int> cand;
+    for (int k = 0; k < int(walls.size()); ++k)
+      if (std::abs(sp.plane.n.dot(surfaces[walls[k].surface].plane.n)) >= cos_max) cand.push_back(k);
+    if (cand.empty()) continue;
+    std::vector<Rect> owned(walls.size());
+    std::vector<int> count(walls.size(), 0);
+    std::vector<Vec3> sum(walls.size(), Vec3::Zero());
+    std::vector<std::vector<int>> owned_idx(walls.size());
+    for (int i : sp.inliers) {
+      const Vec3& x = cloud.points[i];
+      int best = -1;
+      double best_d = prm.match_distance;
+      for (int k : cand) {
+        const ModelSurface& surf = surfaces[walls[k].surface];
+        const double d = std::abs(surf.plane.distance(x));
+        if (d > best_d) continue;
+        const Vec3 q = x - surf.centroid;
+        const Vec2 q2(q.dot(walls[k].u), q.dot(walls[k].v));
+        if (!in_outline(walls[k], q2)) continue;
+        best = k;
+        best_d = d;
+      }
+      if (best < 0) continue;
+      const ModelSurface& surf = surfaces[walls[best].surface];
+      const Vec3 q = x - surf.centroid;
+      owned[best].add(q.dot(walls[best].u), q.dot(walls[best].v));
+      ++count[best];
+      sum[best] += x;
+      owned_idx[best].push_back(i);
+    }
+    for (int k : cand) {
+      if (count[k] < prm.ransac_min_points) continue;
+      const ModelSurface& surf = surfaces[walls[k].surface];
+      const Rect& model_box = walls[k].box;
+      const double inter = overlap_area(model_box, owned[k]);
+      const double uni = model_box.area() + owned[k].area() - inter;
+      const double iou = uni > 0 ? inter / uni : 0.0;
+      const double coverage = std::max({iou, inter / std::max(1e-12, owned[k].area()),
+                                        inter / std::max(1e-12, model_box.area())});
+      if (coverage < prm.match_min_overlap) {
+        result.rejected.push_back("scan plane " + std::to_string(p) + " / wall surface " + std::to_string(walls[k].surface) +
+                                  ": its points cover too little of the wall (" + std::to_string(coverage) + ")");
+        continue;
+      }
+      const double s_normal = sp.plane.n.dot(surf.plane.n);
+      const double d_c = std::abs(surf.plane.distance(sum[k] / count[k]));
+      const double score = prm.w_normal * std::abs(s_normal) + prm.w_coverage * iou;
+      result.matches.push_back(Match{p, walls[k].surface, s_normal, d_c, iou, score, std::move(owned_idx[k])});
+    }
+  }
+  // One scan plane per wall: the one with the most points in front of it.
+  {
+    std::map<int, Match> best;
+    for (const auto& m : result.matches) {
+      auto it = best.find(m.surface);
+      if (it == best.end() || m.owned.size() > it->second.owned.size()) best[m.surface] = m;
+    }
+    result.matches.clear();
+    for (const auto& [s, m] : best) result.matches.push_back(m);
+  }
+  // A scan plane sees one side of a wall: the surfaces it replaces must all face the way of
+  // the surface it fits best (else a notch's opposite wall would be pulled onto it).
+  {
+    std::vector<Match> same_side;
+    for (const auto& m : result.matches) {
+      const Match* ref = &m;
+      for (const auto& o : result.matches)
+        if (o.scan_plane == m.scan_plane && o.d_centroid < ref->d_centroid) ref = &o;
+      if (surfaces[m.surface].plane.n.dot(surfaces[ref->surface].plane.n) > 0) same_side.push_back(m);
+      else result.rejected.push_back("scan plane " + std::to_string(m.scan_plane) + " / wall surface " + std::to_string(m.surface) +
+                                     ": faces away from the wall the plane fits best");
+    }
+    result.matches = same_side;
+  }
+  // Corner consistency with the adjacent matched facades (beyond the paper: rejects walls of
+  // neighbouring buildings seen across a gap). A wrong match also makes its correct
+  // neighbours look inconsistent, so the match with the most conflicts goes first.
+  const int nm = int(result.matches.size());
+  std::vector<std::vector<char>> conflict(nm, std::vector<char>(nm, 0));
+  for (int i = 0; i < nm; ++i)
+    for (int j = 0; j < nm; ++j) {
+      const Match &m = result.matches[i], &a = result.matches[j];
+      if (i == j || a.scan_plane == m.scan_plane) continue;
+      if (unoriented_angle_deg(surfaces[a.surface].plane.n, surfaces[m.surface].plane.n) < 30.0) continue;
+      if (!adjacent(mesh, surfaces[a.surface], surfaces[m.surface])) continue;
+      if (corner_gap(planes[m.scan_plane].plane, planes[a.scan_plane], cloud) > prm.corner_gap) conflict[i][j] = conflict[j][i] = 1;
+    }
+  std::vector<char> alive(nm, 1);
+  for (;;) {
+    int worst = -1, worst_count = 0;
+    for (int i = 0; i < nm; ++i) {
+      if (!alive[i]) continue;
+      int c = 0;
+      for (int j = 0; j < nm; ++j) c += alive[j] && conflict[i][j];
+      if (c > worst_count || (c == worst_count && c > 0 && result.matches[i].s_match < result.matches[worst].s_match)) {
+        worst = i;
+        worst_count = c;
+      }
+    }
+    if (worst < 0) break;
+    alive[worst] = 0;
+    result.rejected.push_back("scan plane " + std::to_string(result.matches[worst].scan_plane) + " / wall surface " +
+                              std::to_string(result.matches[worst].surface) + ": its corner with an adjacent scanned facade lies beyond that facade's points");
+  }
+  std::vector<Match> kept;
+  for (int i = 0; i < nm; ++i)
+    if (alive[i]) {
+      kept.push_back(result.matches[i]);
+      result.q_model += result.matches[i].s_match;
+    }
+  result.matches = kept;
+  return result;
+}
+
+std::vector<int> points_in_front(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
+                                 const std::vector<ScanPlane>& planes, const MatchResult& matched,
+                                 const PointCloud& cloud, double margin) {
+  std::vector<char> take(cloud.points.size(), 0);
+  for (const auto& match : matched.matches) {
+    const ModelSurface& surf = surfaces[match.surface];
+    const auto [u, v] = surf.plane.basis();
+    const Rect box = surface_rect(mesh, surf);
+    for (int i : planes[match.scan_plane].inliers) {
+      const Vec3 q = cloud.points[i] - surf.centroid;
+      const double qu = q.dot(u), qv = q.dot(v);
+      if (qu >= box.u0 - margin && qu <= box.u1 + margin && qv >= box.v0 - margin && qv <= box.v1 + margin) take[i] = 1;
+    }
+  }
+  std::vector<int> idx;
+  for (int i = 0; i < int(take.size()); ++i)
+    if (take[i]) idx.push_back(i);
+  return idx;
+}
+
+}  // namespace lodrefine

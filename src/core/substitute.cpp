@@ -1,0 +1,135 @@
+// Stage 3 (first choice): wall substitution, see substitute.h.
+#include "lodrefine/core/substitute.h"
+
+#include "lodrefine/core/repair.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+namespace lodrefine {
+namespace {
+
+// A wall plane is used in plan view (its trace at the vertex's height); roofs tilted less
+// than this from vertical are walls here too (only walls are matched to facade scans).
+constexpr double kWallMaxNz = 0.5;
+// Regulariser of the plan-view solve: picks the nearest point on the trace when only one wall
+// direction meets at a vertex; small against any real pair of walls (sin^2 of 0.1 deg ~ 3e-6).
+constexpr double kNearestWeight = 1e-7;
+// Planes flatter than this are flat roofs or ground: a vertex never slides along them.
+constexpr double kFlatNz = 0.999;
+// Two walls cross (and fix a vertex in plan view) when their traces differ by more than
+// this (sin 15 deg): nearer to parallel, their meet runs away with any small move.
+constexpr double kMinCrossing = 0.26;
+// Moved walls at one vertex must meet there after the move; more than this apart means the move
+// changes the topology (then the arrangement takes over).
+constexpr double kMeetTolerance = 0.005;
+
+}  // namespace
+
+SubstitutionResult substitute_walls(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
+                                    const std::vector<WallMove>& moves, double planarity_tolerance) {
+  SubstitutionResult res;
+  const int nv = int(mesh.vertices.size());
+  std::vector<int> face_surface(mesh.faces.size(), -1);
+  for (int s = 0; s < int(surfaces.size()); ++s)
+    for (int f : surfaces[s].faces) face_surface[f] = s;
+  std::vector<int> moved_plane(surfaces.size(), -1);
+  for (int m = 0; m < int(moves.size()); ++m) moved_plane[moves[m].surface] = m;
+
+  std::vector<std::vector<int>> vertex_surfaces(nv);
+  for (int f = 0; f < int(mesh.faces.size()); ++f)
+    for (int v : mesh.faces[f].v) vertex_surfaces[v].push_back(face_surface[f]);
+
+  res.mesh = mesh;
+  for (int v = 0; v < nv; ++v) {
+    auto& ss = vertex_surfaces[v];
+    std::sort(ss.begin(), ss.end());
+    ss.erase(std::unique(ss.begin(), ss.end()), ss.end());
+    bool touched = false;
+    for (int s : ss) touched = touched || (s >= 0 && moved_plane[s] >= 0);
+    if (!touched) continue;
+    const Vec3 p = mesh.vertices[v];
+    // The planes that fix this vertex, in priority: the moved walls, then (where a moved wall
+    // follows its roof) the pitched roofs here, then the kept walls. Kept planes pass through
+    // the vertex itself, so a slightly warped input face never pulls it. Without a pitched
+    // roof to follow, a vertex keeps its height and only the walls' traces count.
+    struct Constraint {
+      Vec3 n;
+      double d;
+      int rank;  // 0 moved wall, 1 followed roof, 2 kept wall
+    };
+    std::vector<Constraint> cs;
+    bool follow = false;
+    for (int s : ss)
+      if (s >= 0 && moved_plane[s] >= 0) follow = follow || moves[moved_plane[s]].follow_roof;
+    for (int s : ss) {
+      if (s < 0) continue;
+      const bool moved = moved_plane[s] >= 0;
+      const Plane pl = moved ? moves[moved_plane[s]].plane : Plane::through(p, surfaces[s].plane.n);
+      const double nz = std::abs(pl.n.z());
+      if (nz <= kWallMaxNz) {
+        cs.push_back({pl.n, pl.d, moved ? 0 : 2});
+      } else if (follow && nz < kFlatNz) {
+        cs.push_back({pl.n, pl.d, 1});
+      }
+    }
+    const bool in_3d = std::any_of(cs.begin(), cs.end(), [](const Constraint& c) { return c.rank == 1; });
+    if (!in_3d)  // plan view: each wall's trace at this height
+      for (auto& c : cs) {
+        c.d += c.n.z() * p.z();
+        c.n.z() = 0.0;
+        const double len = c.n.norm();
+        c.n /= len;
+        c.d /= len;
+      }
+    // At most as many independent directions as fix a point: a kept plane (nearly) parallel to
+    // a moved one cannot follow it; its face bends to the new vertex and is split below if no
+    // longer planar.
+    std::stable_sort(cs.begin(), cs.end(), [](const Constraint& a, const Constraint& b) { return a.rank < b.rank; });
+    std::vector<Constraint> used;
+    for (const auto& c : cs) {
+      bool independent = false;
+      if (used.empty()) independent = true;
+      else if (used.size() == 1) independent = used[0].n.cross(c.n).norm() > kMinCrossing;
+      else if (used.size() == 2 && in_3d) {
+        const Vec3 m = used[0].n.cross(used[1].n);
+        independent = std::abs(m.normalized().dot(c.n)) > kMinCrossing;
+      }
+      if (independent) used.push_back(c);
+    }
+    Eigen::Matrix3d a = kNearestWeight * Eigen::Matrix3d::Identity();
+    Vec3 b = kNearestWeight * p;
+    if (!in_3d) a(2, 2) = 1.0, b.z() = p.z();  // plan view: the height stays
+    for (const auto& c : used) {
+      a += c.n * c.n.transpose();
+      b -= c.d * c.n;
+    }
+    const Vec3 x = a.ldlt().solve(b);
+    double residual = 0.0;
+    for (const auto& c : cs)
+      if (c.rank == 0) residual = std::max(residual, std::abs(c.n.dot(x) + c.d));
+    if (!x.allFinite() || residual > kMeetTolerance) {
+      res.reason = "the moved walls no longer meet at one vertex (residual " + std::to_string(residual) + " m)";
+      return res;
+    }
+    res.mesh.vertices[v] = x;
+    res.max_vertex_move = std::max(res.max_vertex_move, (res.mesh.vertices[v] - p).norm());
+    ++res.moved_vertices;
+  }
+
+  // A face that moved must keep its orientation (else a wall passed a short neighbour) and
+  // stay planar; a roof under a turned wall may not, and is split into triangles then.
+  for (const auto& f : mesh.faces) {
+    const Vec3 n0 = newell_normal(face_points(mesh, f)), n1 = newell_normal(face_points(res.mesh, f));
+    if (n1.dot(n0) <= 0.0 || n1.norm() < 1e-3 * n0.norm()) {
+      res.reason = "a moved wall passes a neighbouring face (it would turn inside out)";
+      return res;
+    }
+  }
+  res.split_faces = split_warped_faces(res.mesh, 0.5 * planarity_tolerance);
+  res.ok = true;
+  return res;
+}
+
+}  // namespace lodrefine

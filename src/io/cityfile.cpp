@@ -1,0 +1,378 @@
+// City file in, city file out (see cityfile.h).
+#include "lodrefine/io/cityfile.h"
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
+
+#include "lodrefine/io/cityjson.h"
+#include "lodrefine/io/citygml.h"
+#include "lodrefine/io/cityjson_write.h"
+#include "lodrefine/io/crop.h"
+#include "lodrefine/io/files.h"
+#include "lodrefine/core/refine.h"
+
+namespace lodrefine {
+namespace {
+
+using json = nlohmann::ordered_json;
+using Clock = std::chrono::steady_clock;
+
+// A CityJSONSeq header line holds metadata and the transform, never objects: a first line
+// longer than this is a one-line CityJSON file, not parsed twice to find out.
+constexpr std::size_t kMaxSequenceHeader = 1 << 20;
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// The outcome of one building in the three words of the report, with its reason: anything
+// refine_building does not call "refined" is kept (its original geometry stays), and a kept
+// building whose repaired original is not valid either is kept-invalid.
+CityBuildingOutcome classify(const RefineResult& r) {
+  CityBuildingOutcome o;
+  const std::string& s = r.outcome;
+  if (r.refined && r.valid && s == "refined") {
+    o.outcome = "refined";
+  } else {
+    o.outcome = (!r.valid || s.rfind("kept-invalid", 0) == 0) ? "kept-invalid" : "kept";
+    o.reason = r.report.value("reason", std::string());
+    const auto open = s.find('('), close = s.rfind(')');
+    if (o.reason.empty() && open != std::string::npos && close != std::string::npos && close > open)
+      o.reason = s.substr(open + 1, close - open - 1);
+    if (o.reason.empty()) o.reason = s;
+    if (!r.valid && s.rfind("kept-invalid", 0) != 0 && r.report.contains("output_validation"))
+      o.reason += " (not valid: " + r.report["output_validation"].value("problem", std::string("invalid")) + ")";
+  }
+  // The report lists the moved facades ("facades"); older reports only the replacement steps.
+  if (r.report.contains("facades") && r.report["facades"].is_array()) {
+    o.facades_moved = int(r.report["facades"].size());
+  } else if (r.report.contains("replacements")) {
+    for (const auto& step : r.report["replacements"]) o.facades_moved += step.value("ok", false) ? 1 : 0;
+  }
+  if (o.outcome != "refined") o.facades_moved = 0;
+  return o;
+}
+
+Eigen::AlignedBox3d model_box(const std::vector<CityJsonBuilding>& buildings) {
+  Eigen::AlignedBox3d box;
+  for (const auto& b : buildings)
+    for (const auto& v : b.mesh.vertices) box.extend(v);
+  return box;
+}
+
+// The transform of a CityJSON header (validated by the reader before this is used).
+CityJsonTransform transform_of(const json& header) {
+  CityJsonTransform t;
+  const json& j = header.at("transform");
+  t.scale = Vec3(j.at("scale")[0].get<double>(), j.at("scale")[1].get<double>(), j.at("scale")[2].get<double>());
+  t.translate = Vec3(j.at("translate")[0].get<double>(), j.at("translate")[1].get<double>(), j.at("translate")[2].get<double>());
+  return t;
+}
+
+// Refines the buildings of `doc` (a CityJSON file or one CityJSONFeature: "CityObjects" and
+// "vertices") that have points, and writes the results into `doc`. `buildings` are the doc's
+// buildings in order; `target_of[first + i]` is building i's crop target (npos: not asked for).
+void refine_document(json& doc, const CityJsonTransform& tf, const std::vector<CityJsonBuilding>& buildings,
+                     std::vector<CropTarget>& targets, const std::vector<std::size_t>& target_of, std::size_t first,
+                     const Params& params, CityRefineSummary& sum) {
+  json& objects = doc["CityObjects"];
+  for (std::size_t i = 0; i < buildings.size(); ++i) {
+    const CityJsonBuilding& b = buildings[i];
+    const std::size_t ti = target_of[first + i];
+    if (ti == std::string::npos || targets[ti].cloud.points.empty()) {
+      ++sum.untouched;
+      continue;
+    }
+    PointCloud cloud = std::move(targets[ti].cloud);
+    targets[ti].cloud = PointCloud();  // the crop is no longer needed: free it now
+    const auto t0 = Clock::now();
+    CityBuildingOutcome o;
+    RefineResult r;
+    try {
+      r = refine_building(b.mesh, cloud, params);
+      o = classify(r);
+    } catch (const std::exception& e) {  // never lose a building: keep it as read
+      o.outcome = "kept-invalid";
+      o.reason = e.what();
+    }
+    o.id = b.mesh.id;
+    o.points = cloud.points.size();
+    o.seconds = seconds_since(t0);
+    json& obj = objects[b.mesh.id];
+    if (o.outcome == "refined") {
+      const std::string lod = obj["geometry"][std::size_t(b.geometry_index)]["lod"].is_string()
+                                  ? obj["geometry"][std::size_t(b.geometry_index)]["lod"].get<std::string>()
+                                  : b.lod;
+      obj["geometry"][std::size_t(b.geometry_index)] = cityjson_solid(r.mesh, lod, tf.scale, tf.translate, doc["vertices"]);
+      ++sum.refined;
+    } else {
+      ++(o.outcome == "kept" ? sum.kept : sum.kept_invalid);
+    }
+    if (!obj.contains("attributes") || !obj["attributes"].is_object()) obj["attributes"] = json::object();
+    obj["attributes"]["lodrefine_outcome"] = o.outcome;
+    obj["attributes"]["lodrefine_reason"] = o.reason;
+    obj["attributes"]["lodrefine_facades_moved"] = o.facades_moved;
+    sum.outcomes.push_back(std::move(o));
+  }
+}
+
+// CityJSON 1.0 / 1.1 objects as 2.0 wants them: "lod" a string (1.0 wrote numbers), the
+// GenericCityObject extension type now core. A 2.0 input is not touched.
+void upgrade_objects(json& objects) {
+  for (auto& [id, obj] : objects.items()) {
+    if (obj.value("type", "") == "+GenericCityObject") obj["type"] = "GenericCityObject";
+    if (!obj.contains("geometry") || !obj["geometry"].is_array()) continue;
+    for (auto& g : obj["geometry"])
+      if (g.is_object() && g.contains("lod") && g["lod"].is_number()) {
+        std::ostringstream s;
+        s << g["lod"].get<double>();
+        g["lod"] = s.str();
+      }
+  }
+}
+
+// The 1.x header fields 2.0 changed: the CRS as a URL, a point of contact's address an object.
+void upgrade_header(json& doc) {
+  json& md = doc["metadata"];
+  if (!md.is_object()) {
+    doc.erase("metadata");
+    return;
+  }
+  if (md.contains("referenceSystem") && md["referenceSystem"].is_string())
+    md["referenceSystem"] = crs_url(md["referenceSystem"].get<std::string>());
+  if (md.contains("pointOfContact") && md["pointOfContact"].is_object()) {
+    json& poc = md["pointOfContact"];
+    if (poc.contains("address") && poc["address"].is_string()) poc["address"] = {{"addressLine", poc["address"]}};
+  }
+}
+
+// CityJSON 1.x without a transform: 2.0 needs integer vertices, so one is made (0.1 mm).
+void ensure_transform(json& doc) {
+  if (doc.contains("transform")) return;
+  Eigen::AlignedBox3d box;
+  for (const auto& v : doc["vertices"]) box.extend(Vec3(v[0].get<double>(), v[1].get<double>(), v[2].get<double>()));
+  const Vec3 translate = box.isEmpty() ? Vec3::Zero() : Vec3(box.min().array().floor());
+  const double scale = kCityGmlResolution;
+  for (auto& v : doc["vertices"])
+    for (int a = 0; a < 3; ++a) v[a] = std::llround((v[a].get<double>() - translate[a]) / scale);
+  doc["transform"] = {{"scale", {scale, scale, scale}}, {"translate", {translate.x(), translate.y(), translate.z()}}};
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open the file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Adds the buildings to refine and their crop boxes (appending to target_of).
+void add_targets(const std::vector<CityJsonBuilding>& buildings, const CityRefineOptions& o,
+                 std::vector<CropTarget>& targets, std::vector<std::size_t>& target_of) {
+  for (const auto& b : buildings) {
+    if (!o.building.empty() && b.mesh.id != o.building) {
+      target_of.push_back(std::string::npos);
+      continue;
+    }
+    target_of.push_back(targets.size());
+    targets.push_back(crop_target(b.mesh, o.crop_expand, o.crop_margin));
+  }
+}
+
+void check_targets(const std::vector<CropTarget>& targets, const std::string& model_path, const CityRefineOptions& o) {
+  if (targets.empty()) throw InputError(model_path + ": no building '" + o.building + "' with the LoD asked for");
+}
+
+[[noreturn]] void fail_no_lod(const std::string& model_path, const CityRefineOptions& o, int without) {
+  throw InputError(model_path + ": no Building/BuildingPart with " +
+                   (o.lod.empty() ? std::string("an LoD 2.x") : "an LoD " + o.lod) + " geometry (" +
+                   std::to_string(without) + " building object(s) without one); nothing to refine");
+}
+
+// Returns the number of points the crops hold; throws when the cloud reaches no building.
+std::uint64_t check_cloud_reaches(const std::vector<CropTarget>& targets, const Eigen::AlignedBox3d& cloud_box,
+                                  const Eigen::AlignedBox3d& city_box, const std::string& cloud_path) {
+  std::uint64_t held = 0;
+  for (const auto& t : targets) held += t.cloud.points.size();
+  if (held > 0) return held;
+  std::string why = overlap_problem(cloud_box, city_box, "the city model");
+  if (why.empty()) why = "the cloud has no point within " + std::to_string(targets.size()) + " building box(es)";
+  throw InputError(cloud_path + ": " + why);
+}
+
+// A CityJSONSeq feature as a CityJSON document the reader takes: the header's transform
+// with the feature's objects and vertices.
+json feature_document(const json& header, json feature) {
+  json d = {{"type", "CityJSON"}, {"version", header.value("version", "2.0")}, {"transform", header.at("transform")}};
+  d["CityObjects"] = std::move(feature["CityObjects"]);
+  d["vertices"] = std::move(feature["vertices"]);
+  return d;
+}
+
+// The first line of a file when it is a CityJSONSeq header (a "CityJSON" object on one line);
+// null otherwise.
+json sequence_header(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  if (!in || !std::getline(in, line) || line.size() > kMaxSequenceHeader) return nullptr;
+  json first = json::parse(line, nullptr, false);
+  if (!first.is_object() || first.value("type", "") != "CityJSON" ||
+      (first.contains("CityObjects") && !first["CityObjects"].empty()))
+    return nullptr;
+  while (std::getline(in, line))
+    if (line.find_first_not_of(" \t\r") != std::string::npos) return first;
+  return nullptr;
+}
+
+// CityJSONSeq in, CityJSONSeq out, streamed: pass 1 reads each feature's buildings for the
+// crop boxes (keeping only the boxes), the cloud pass fills them, pass 2 reads each feature
+// again, refines its buildings and writes the line out.
+CityRefineSummary refine_sequence(const json& header, const std::string& model_path, const std::string& cloud_path,
+                                  const std::string& out_path, const Params& params, const CityRefineOptions& options) {
+  CityRefineSummary sum;
+  sum.input_format = "CityJSONSeq " + header.value("version", std::string("?"));
+  if (!header.contains("transform")) throw InputError(model_path + ": line 1: a CityJSONSeq header needs a \"transform\"");
+  const CityJsonTransform tf = transform_of(header);
+  auto t = Clock::now();
+  std::vector<CropTarget> targets;
+  std::vector<std::size_t> target_of;
+  Eigen::AlignedBox3d city_box;
+  const auto for_each_feature = [&](const std::function<void(int, json&&)>& f) {
+    std::ifstream in(model_path, std::ios::binary);
+    std::string line;
+    std::getline(in, line);
+    for (int n = 2; std::getline(in, line); ++n) {
+      if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+      json feature = json::parse(line, nullptr, false);
+      if (!feature.is_object() || feature.value("type", "") != "CityJSONFeature")
+        throw InputError(model_path + ": line " + std::to_string(n) + ": expected a CityJSONFeature object");
+      f(n, std::move(feature));
+    }
+  };
+  for_each_feature([&](int n, json&& feature) {
+    const CityJsonFile f = read_cityjson_document(feature_document(header, std::move(feature)),
+                                                  model_path + ": line " + std::to_string(n), options.lod);
+    sum.buildings += int(f.buildings.size());
+    sum.objects_without_lod += f.objects_without_lod2;
+    city_box.extend(model_box(f.buildings));
+    add_targets(f.buildings, options, targets, target_of);
+  });
+  if (sum.buildings == 0) fail_no_lod(model_path, options, sum.objects_without_lod);
+  check_targets(targets, model_path, options);
+  sum.seconds_read = seconds_since(t);
+
+  t = Clock::now();
+  Eigen::AlignedBox3d cloud_box;
+  sum.cloud_points = crop_tile(cloud_path, targets, options.cloud, &cloud_box);
+  sum.cropped_points = check_cloud_reaches(targets, cloud_box, city_box, cloud_path);
+  sum.seconds_crop = seconds_since(t);
+
+  t = Clock::now();
+  AtomicFile out(out_path);
+  json h = header;
+  const bool upgrade = header.value("version", "") != "2.0";
+  if (upgrade) upgrade_header(h);
+  h["version"] = "2.0";
+  out.write(h.dump() + "\n");
+  std::size_t first = 0;
+  for_each_feature([&](int n, json&& feature) {
+    const CityJsonFile f = read_cityjson_document(feature_document(header, feature),
+                                                  model_path + ": line " + std::to_string(n), options.lod);
+    if (upgrade) upgrade_objects(feature["CityObjects"]);
+    refine_document(feature, tf, f.buildings, targets, target_of, first, params, sum);
+    first += f.buildings.size();
+    out.write(feature.dump() + "\n");
+  });
+  out.commit();
+  sum.seconds_refine = seconds_since(t);
+  return sum;
+}
+
+}  // namespace
+
+json cityjson_solid(const Mesh& mesh, const std::string& lod, const Vec3& scale, const Vec3& translate, json& vertices) {
+  const long long base = (long long)vertices.size();
+  for (const auto& p : mesh.vertices) {
+    json q = json::array();
+    for (int a = 0; a < 3; ++a) q.push_back(std::llround((p[a] - translate[a]) / scale[a]));
+    vertices.push_back(std::move(q));
+  }
+  json shell = json::array(), values = json::array();
+  std::map<Semantic, int> surface_of;
+  json surfaces = json::array();
+  for (const Face& f : mesh.faces) {
+    json ring = json::array();
+    for (int v : f.v) ring.push_back(base + v);
+    shell.push_back(json::array({std::move(ring)}));
+    if (f.sem == Semantic::Other) {
+      values.push_back(nullptr);
+      continue;
+    }
+    auto it = surface_of.find(f.sem);
+    if (it == surface_of.end()) {
+      it = surface_of.emplace(f.sem, int(surfaces.size())).first;
+      surfaces.push_back({{"type", semantic_name(f.sem)}});
+    }
+    values.push_back(it->second);
+  }
+  json g = {{"type", "Solid"}, {"lod", lod}, {"boundaries", json::array({std::move(shell)})}};
+  g["semantics"] = {{"surfaces", std::move(surfaces)}, {"values", json::array({std::move(values)})}};
+  return g;
+}
+
+CityRefineSummary refine_city(const std::string& model_path, const std::string& cloud_path, const std::string& out_path,
+                              const Params& params, const CityRefineOptions& options) {
+  CityRefineSummary sum;
+  auto t = Clock::now();
+  json doc;
+  std::string format;
+  if (sniff_file(model_path) != FileKind::Xml) {
+    const json header = sequence_header(model_path);
+    if (!header.is_null()) return refine_sequence(header, model_path, cloud_path, out_path, params, options);
+  }
+  if (sniff_file(model_path) == FileKind::Xml) {
+    std::string version;
+    doc = citygml_to_cityjson(model_path, &version);
+    format = "CityGML " + version;
+  } else {
+    const std::string text = read_text(model_path);
+    doc = json::parse(text, nullptr, false);
+    if (doc.is_discarded()) parse_cityjson(text, model_path);  // throws the reader's own message
+    format = "CityJSON " + (doc.contains("version") && doc["version"].is_string() ? doc["version"].get<std::string>() : "?");
+  }
+  const CityJsonFile file = read_cityjson_document(doc, model_path, options.lod);
+  sum.input_format = format;
+  sum.buildings = int(file.buildings.size());
+  sum.objects_without_lod = file.objects_without_lod2;
+  if (file.buildings.empty()) fail_no_lod(model_path, options, file.objects_without_lod2);
+  std::vector<std::size_t> target_of;
+  std::vector<CropTarget> targets;
+  add_targets(file.buildings, options, targets, target_of);
+  check_targets(targets, model_path, options);
+  sum.seconds_read = seconds_since(t);
+
+  t = Clock::now();
+  Eigen::AlignedBox3d cloud_box;
+  sum.cloud_points = crop_tile(cloud_path, targets, options.cloud, &cloud_box);
+  sum.cropped_points = check_cloud_reaches(targets, cloud_box, model_box(file.buildings), cloud_path);
+  sum.seconds_crop = seconds_since(t);
+
+  t = Clock::now();
+  if (doc.value("version", "") != "2.0") {
+    upgrade_header(doc);
+    upgrade_objects(doc["CityObjects"]);
+  }
+  ensure_transform(doc);
+  refine_document(doc, transform_of(doc), file.buildings, targets, target_of, 0, params, sum);
+  sum.seconds_refine = seconds_since(t);
+
+  t = Clock::now();
+  doc["version"] = "2.0";
+  write_file_atomic(out_path, doc.dump() + "\n");
+  sum.seconds_write = seconds_since(t);
+  return sum;
+}
+
+}  // namespace lodrefine

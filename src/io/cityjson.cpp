@@ -1,0 +1,437 @@
+// CityJSON / CityJSONSeq reader: LoD 2.x Buildings and BuildingParts as polygon soups.
+#include "lodrefine/io/cityjson.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string_view>
+
+#include <nlohmann/json.hpp>
+
+#include "lodrefine/core/geometry.h"
+#include "lodrefine/io/files.h"
+
+namespace lodrefine {
+namespace {
+
+// ordered_json keeps the CityObjects in file order (nlohmann::json would sort them by id).
+using json = nlohmann::ordered_json;
+
+// Printable, short, one line: for ids and parser messages quoted in an error.
+std::string one_line(const std::string& s, std::size_t max = 120) {
+  std::string out;
+  for (char c : s.substr(0, max)) out += (static_cast<unsigned char>(c) >= 0x20 && c != 0x7f) ? c : '?';
+  return s.size() > max ? out + "..." : out;
+}
+
+// The member `key` of an object, or a null json when it is absent (no copy, unlike value()).
+const json& member(const json& obj, const char* key) {
+  static const json null_json;
+  if (!obj.is_object()) return null_json;
+  const auto it = obj.find(key);
+  return it == obj.end() ? null_json : *it;
+}
+
+class Reader {
+ public:
+  Reader(std::string name, std::string lod) : name_(std::move(name)), lod_(std::move(lod)) {}
+
+  [[noreturn]] void fail(const std::string& fault) const {
+    throw InputError(name_ + ": " + (where_.empty() ? "" : where_ + ": ") + fault);
+  }
+
+  json parse(const std::string& text, const std::string& what) {
+    try {
+      return json::parse(text);
+    } catch (const json::parse_error& e) {
+      // e.what() is "[json.exception.parse_error.101] parse error at ...": keep the message.
+      std::string msg = e.what();
+      const auto p = msg.find("] ");
+      if (p != std::string::npos) msg = msg.substr(p + 2);
+      fail(what + " is not valid JSON: " + one_line(msg));
+    }
+  }
+
+  CityJsonFile read(const std::string& text) {
+    if (is_cityjson_sequence(text)) {
+      const auto eol = text.find('\n');
+      return read_sequence(json::parse(text.substr(0, eol)), text, eol + 1);
+    }
+    return read_document(parse(text, "the file"));
+  }
+
+  CityJsonFile read_document(const json& root) {
+    CityJsonFile out;
+    read_header(root, out);
+    const std::vector<Vec3> vertices = read_vertices(root, out);
+    read_objects(root, vertices, out);
+    finish(out);
+    return out;
+  }
+
+ private:
+  std::string name_;
+  std::string lod_;    // the LoD asked for ("" = the highest 2.x)
+  std::string where_;  // "line N" / "object ID" context for error messages
+  int degenerate_rings_ = 0, degenerate_objects_ = 0;
+
+  void finish(CityJsonFile& out) const {
+    if (degenerate_rings_ > 0)
+      out.notes.push_back(std::to_string(degenerate_rings_) + " surface(s) with < 3 distinct vertices dropped in " +
+                          std::to_string(degenerate_objects_) + " object(s)");
+  }
+
+  CityJsonFile read_sequence(const json& header, const std::string& text, std::size_t pos) {
+    CityJsonFile out;
+    out.sequence = true;
+    where_ = "line 1";
+    read_header(header, out);
+    int line_no = 1;
+    while (pos < text.size()) {
+      auto eol = text.find('\n', pos);
+      if (eol == std::string::npos) eol = text.size();
+      const std::string line = text.substr(pos, eol - pos);
+      pos = eol + 1;
+      ++line_no;
+      if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+      where_ = "line " + std::to_string(line_no);
+      const json feature = parse(line, "the line");
+      if (!feature.is_object() || member(feature, "type") != "CityJSONFeature")
+        fail("expected a CityJSONFeature object");
+      const std::vector<Vec3> vertices = read_vertices(feature, out);
+      read_objects(feature, vertices, out);
+    }
+    where_.clear();
+    finish(out);
+    return out;
+  }
+
+  void read_header(const json& root, CityJsonFile& out) {
+    if (!root.is_object() || member(root, "type") != "CityJSON") fail("not a CityJSON file (no \"type\": \"CityJSON\")");
+    const json& version = member(root, "version");
+    if (version.is_string()) out.version = version.get<std::string>();
+    if (root.contains("transform")) {
+      const json& t = root["transform"];
+      if (!t.is_object()) fail("\"transform\" is not an object");
+      out.scale = vec3(member(t, "scale"), "transform.scale");
+      out.translate = vec3(member(t, "translate"), "transform.translate");
+    }
+    const json& rs = member(member(root, "metadata"), "referenceSystem");
+    if (rs.is_string()) out.crs = rs.get<std::string>();
+  }
+
+  Vec3 vec3(const json& j, const std::string& what) const {
+    if (!j.is_array() || j.size() != 3 || !j[0].is_number() || !j[1].is_number() || !j[2].is_number())
+      fail(what + " is not an array of 3 numbers");
+    const Vec3 v(j[0].get<double>(), j[1].get<double>(), j[2].get<double>());
+    if (!v.allFinite()) fail(what + " is not finite");
+    return v;
+  }
+
+  std::vector<Vec3> read_vertices(const json& root, const CityJsonFile& out) const {
+    const auto it = root.find("vertices");
+    if (it == root.end() || !it->is_array()) fail("no \"vertices\" array");
+    std::vector<Vec3> vertices;
+    vertices.reserve(it->size());
+    for (const json& v : *it) {
+      vertices.push_back(vec3(v, "vertex " + std::to_string(vertices.size())).cwiseProduct(out.scale) + out.translate);
+    }
+    return vertices;
+  }
+
+  void read_objects(const json& root, const std::vector<Vec3>& vertices, CityJsonFile& out) {
+    const auto it = root.find("CityObjects");
+    if (it == root.end() || !it->is_object()) fail("no \"CityObjects\" object");
+    const std::string outer = where_;
+    for (const auto& [id, obj] : it->items()) {
+      where_ = (outer.empty() ? "" : outer + ": ") + "object " + one_line(id, 60);
+      if (!obj.is_object()) fail("is not a JSON object");
+      const json& type = member(obj, "type");
+      if (type != "Building" && type != "BuildingPart") continue;
+      const json* geom = best_lod2(obj);
+      if (geom == nullptr) {
+        ++out.objects_without_lod2;
+        continue;
+      }
+      CityJsonBuilding b;
+      b.mesh.id = id;
+      b.type = type.get<std::string>();
+      const json& parents = member(obj, "parents");
+      if (parents.is_array() && !parents.empty() && parents[0].is_string()) b.parent = parents[0].get<std::string>();
+      const json& lod = (*geom)["lod"];
+      b.lod = lod.is_string() ? lod.get<std::string>() : lod.dump();
+      b.geometry_type = (*geom)["type"].get<std::string>();
+      b.geometry_index = int(geom - &obj["geometry"][0]);
+      read_geometry(*geom, vertices, b);
+      if (b.skipped_holes > 0)
+        out.notes.push_back(one_line(id, 60) + ": " + std::to_string(b.skipped_holes) +
+                            " inner ring(s) dropped (surfaces keep their outer ring)");
+      if (b.skipped_shells > 0)
+        out.notes.push_back(one_line(id, 60) + ": " + std::to_string(b.skipped_shells) + " interior shell(s) dropped");
+      if (b.skipped_rings > 0) {
+        degenerate_rings_ += b.skipped_rings;
+        ++degenerate_objects_;
+      }
+      if (b.mesh.faces.empty()) {
+        out.notes.push_back(one_line(id, 60) + ": LoD " + b.lod + " geometry has no usable surface, skipped");
+        continue;
+      }
+      out.buildings.push_back(std::move(b));
+    }
+    where_ = outer;
+  }
+
+  // The highest LoD 2.x geometry of an object (the first one on ties); null if there is none.
+  const json* best_lod2(const json& obj) const {
+    const json& geoms = member(obj, "geometry");
+    if (geoms.is_null()) return nullptr;
+    if (!geoms.is_array()) fail("\"geometry\" is not an array");
+    const json* best = nullptr;
+    double best_lod = -1.0;
+    for (const json& g : geoms) {
+      if (!g.is_object()) fail("a geometry is not a JSON object");
+      const json& type = member(g, "type");
+      if (!type.is_string()) fail("a geometry has no \"type\"");
+      if (type == "GeometryInstance") continue;
+      const json& lod = member(g, "lod");
+      double value = -1.0;
+      if (lod.is_number()) {
+        value = lod.get<double>();
+      } else if (lod.is_string()) {
+        const std::string s = lod.get<std::string>();
+        char* end = nullptr;
+        value = std::strtod(s.c_str(), &end);
+        if (s.empty() || *end != '\0') fail("geometry lod \"" + one_line(s, 20) + "\" is not a number");
+      } else {
+        fail("a geometry has no \"lod\"");
+      }
+      if (!lod_.empty()) {  // an exact LoD asked for: "2.2" matches "2.2" and 2.2
+        char* end = nullptr;
+        if (best == nullptr && std::strtod(lod_.c_str(), &end) == value && *end == '\0') best = &g;
+        continue;
+      }
+      if (value >= 2.0 && value < 3.0 && value > best_lod) {
+        best = &g;
+        best_lod = value;
+      }
+    }
+    return best;
+  }
+
+  void read_geometry(const json& g, const std::vector<Vec3>& vertices, CityJsonBuilding& b) {
+    const std::string type = g["type"].get<std::string>();
+    int depth = 0;  // array levels above a surface: 1 MultiSurface, 2 Solid, 3 MultiSolid
+    if (type == "MultiSurface" || type == "CompositeSurface")
+      depth = 1;
+    else if (type == "Solid")
+      depth = 2;
+    else if (type == "MultiSolid" || type == "CompositeSolid")
+      depth = 3;
+    else
+      fail("LoD " + b.lod + " geometry type \"" + one_line(type, 30) + "\" is not a surface or solid type");
+    const json& boundaries = member(g, "boundaries");
+    if (!boundaries.is_array()) fail(type + " has no \"boundaries\" array");
+
+    // Semantics: surfaces[] and values nested like the boundaries minus the ring levels.
+    std::vector<Semantic> surface_sem;
+    const json* values = nullptr;
+    if (g.contains("semantics") && !g["semantics"].is_null()) {
+      const json& sem = g["semantics"];
+      if (!sem.is_object()) fail("\"semantics\" is not an object");
+      const json& surfaces = member(sem, "surfaces");
+      if (!surfaces.is_array()) fail("semantics has no \"surfaces\" array");
+      for (const json& s : surfaces) {
+        if (!s.is_object() || !member(s, "type").is_string()) fail("a semantic surface has no \"type\"");
+        surface_sem.push_back(semantic_from_cityjson(s["type"].get<std::string>()));
+      }
+      if (sem.contains("values") && !sem["values"].is_null()) values = &sem["values"];
+    }
+
+    int source = 0;
+    // Walks one shell (array of surfaces) with its semantic values (or null).
+    auto read_shell = [&](const json& shell, const json* shell_values) {
+      if (!shell.is_array()) fail(type + " boundaries are not nested as the type needs");
+      if (shell_values != nullptr && (!shell_values->is_array() || shell_values->size() != shell.size()))
+        fail("semantics values do not match the " + type + " boundaries");
+      for (std::size_t s = 0; s < shell.size(); ++s, ++source) {
+        Semantic sem = Semantic::Other;
+        if (shell_values != nullptr) {
+          const json& v = (*shell_values)[s];
+          if (v.is_number_integer() || v.is_number_unsigned()) {
+            const long long k = v.get<long long>();
+            if (k < 0 || k >= static_cast<long long>(surface_sem.size()))
+              fail("semantics value " + std::to_string(k) + " has no semantic surface");
+            sem = surface_sem[k];
+          } else if (!v.is_null()) {
+            fail("semantics values do not match the " + type + " boundaries");
+          }
+        }
+        read_surface(shell[s], vertices, sem, source, type, b);
+      }
+    };
+    if (depth == 1) {
+      read_shell(boundaries, values);
+      return;
+    }
+    auto read_solid = [&](const json& solid, const json* solid_values) {
+      if (!solid.is_array() || solid.empty()) fail(type + " boundaries are not nested as the type needs");
+      if (solid_values != nullptr && (!solid_values->is_array() || solid_values->size() != solid.size()))
+        fail("semantics values do not match the " + type + " boundaries");
+      read_shell(solid[0], solid_values ? &(*solid_values)[0] : nullptr);
+      b.skipped_shells += int(solid.size()) - 1;  // voids are no part of an exterior LoD2 model
+    };
+    if (depth == 2) {
+      read_solid(boundaries, values);
+      return;
+    }
+    if (values != nullptr && (!values->is_array() || values->size() != boundaries.size()))
+      fail("semantics values do not match the " + type + " boundaries");
+    for (std::size_t k = 0; k < boundaries.size(); ++k) read_solid(boundaries[k], values ? &(*values)[k] : nullptr);
+  }
+
+  // One surface: its outer ring becomes a face; inner rings are counted and dropped. An outer
+  // ring that revisits a vertex is split into simple loops first (see split_ring): loops inside
+  // the largest one are holes written the keyhole way (dropped), others become faces of their own.
+  void read_surface(const json& surface, const std::vector<Vec3>& vertices, Semantic sem, int source,
+                    const std::string& type, CityJsonBuilding& b) {
+    if (!surface.is_array() || surface.empty()) fail(type + " boundaries are not nested as the type needs");
+    std::vector<int> ring;
+    for (std::size_t r = 0; r < surface.size(); ++r) {
+      const json& jr = surface[r];
+      if (!jr.is_array()) fail(type + " boundaries are not nested as the type needs");
+      for (const json& ji : jr) {
+        if (!ji.is_number_integer() && !ji.is_number_unsigned()) fail(type + " boundaries are not nested as the type needs");
+        const long long i = ji.get<long long>();
+        if (i < 0 || i >= static_cast<long long>(vertices.size()))
+          fail("vertex index " + std::to_string(i) + " is out of range (" + std::to_string(vertices.size()) + " vertices)");
+        if (r == 0) ring.push_back(int(i));
+      }
+    }
+    b.skipped_holes += int(surface.size()) - 1;
+    std::vector<std::vector<int>> loops;
+    split_ring(std::move(ring), loops);
+    if (loops.empty()) {
+      ++b.skipped_rings;
+      return;
+    }
+    std::size_t outer = 0;
+    std::vector<Vec3> normals;
+    for (const auto& loop : loops) {
+      normals.push_back(newell_normal(points_of(loop, vertices)));
+      if (normals.back().norm() > normals[outer].norm()) outer = normals.size() - 1;
+    }
+    const std::vector<Vec3> outer_pts = points_of(loops[outer], vertices);
+    const Plane plane = Plane::through(outer_pts.front(), normals[outer].normalized());
+    const auto [u, v] = plane.basis();
+    std::vector<Vec2> outer2;
+    for (const auto& p : outer_pts) outer2.emplace_back(u.dot(p), v.dot(p));
+    for (std::size_t k = 0; k < loops.size(); ++k) {
+      const std::vector<Vec3> pts = points_of(loops[k], vertices);
+      if (k != outer && normals[k].dot(normals[outer]) < 0) {
+        const Vec3 c = polygon_centroid(pts);
+        if (point_in_polygon_2d(Vec2(u.dot(c), v.dot(c)), outer2)) {
+          ++b.skipped_holes;
+          continue;
+        }
+      }
+      Face f;
+      f.sem = sem;
+      f.source = source;
+      for (const auto& p : pts) {
+        f.v.push_back(int(b.mesh.vertices.size()));
+        b.mesh.vertices.push_back(p);
+      }
+      b.mesh.faces.push_back(std::move(f));
+    }
+  }
+
+  static std::vector<Vec3> points_of(const std::vector<int>& loop, const std::vector<Vec3>& vertices) {
+    std::vector<Vec3> pts;
+    for (int i : loop) pts.push_back(vertices[i]);
+    return pts;
+  }
+
+  // Splits a ring into simple loops of >= 3 distinct vertices (none when it is degenerate).
+  // Repeated consecutive vertices and the closing repeat are dropped; an edge u->v walked back
+  // later as v->u (a keyhole bridge, or a spike u,v,u) is cut out, leaving the loops on either
+  // side; a vertex visited twice without such a bridge (a pinch) splits the ring there.
+  static void split_ring(std::vector<int> ring, std::vector<std::vector<int>>& loops) {
+    std::vector<int> r;
+    for (int i : ring)
+      if (r.empty() || r.back() != i) r.push_back(i);
+    while (r.size() > 1 && r.front() == r.back()) r.pop_back();
+    const std::size_t n = r.size();
+    if (n < 3) return;
+    // positions a..b (cyclic, inclusive) as a new ring
+    auto sub = [&r, n](std::size_t a, std::size_t b) {
+      std::vector<int> out;
+      for (std::size_t k = a; k <= b; ++k) out.push_back(r[k % n]);
+      return out;
+    };
+    for (std::size_t k = 0; k < n; ++k)
+      for (std::size_t m = k + 1; m < n; ++m)
+        if (r[m] == r[(k + 1) % n] && r[(m + 1) % n] == r[k]) {  // bridge k->k+1 walked back at m->m+1
+          if (m > k + 1) split_ring(sub(k + 1, m - 1), loops);
+          if (k + n > m + 1) split_ring(sub(m + 1, k + n - 1), loops);
+          return;
+        }
+    for (std::size_t k = 0; k < n; ++k)
+      for (std::size_t m = k + 1; m < n; ++m)
+        if (r[m] == r[k]) {  // pinch
+          split_ring(sub(k, m - 1), loops);
+          split_ring(sub(m, k + n - 1), loops);
+          return;
+        }
+    loops.push_back(std::move(r));
+  }
+};
+
+}  // namespace
+
+bool is_cityjson_sequence(const std::string& text) {
+  // CityJSONSeq: the first line is a complete "CityJSON" object and more lines follow.
+  const auto eol = text.find('\n');
+  if (eol == std::string::npos || text.find_first_not_of(" \t\r\n", eol) == std::string::npos) return false;
+  const json first = json::parse(text.substr(0, eol), nullptr, false);
+  return first.is_object() && member(first, "type") == "CityJSON";
+}
+
+Semantic semantic_from_cityjson(const std::string& type) {
+  if (type == "WallSurface") return Semantic::Wall;
+  if (type == "RoofSurface") return Semantic::Roof;
+  if (type == "GroundSurface") return Semantic::Ground;
+  return Semantic::Other;
+}
+
+std::string file_stem_for_id(const std::string& id) {
+  std::string out;
+  for (char c : id) {
+    const auto u = static_cast<unsigned char>(c);
+    out += (u < 0x21 || u == 0x7f || std::string_view("/\\:*?\"<>|").find(c) != std::string_view::npos) ? '_' : c;
+  }
+  if (out.empty() || out.find_first_not_of('.') == std::string::npos) out = "_" + out;
+  return out;
+}
+
+CityJsonFile parse_cityjson(const std::string& text, const std::string& name, const std::string& lod) {
+  return Reader(name, lod).read(text);
+}
+
+CityJsonFile read_cityjson_document(const nlohmann::ordered_json& doc, const std::string& name, const std::string& lod) {
+  return Reader(name, lod).read_document(doc);
+}
+
+CityJsonFile read_cityjson(const std::string& path, const std::string& lod) {
+  const FileKind kind = sniff_file(path);
+  if (kind != FileKind::Json && kind != FileKind::Other)
+    throw InputError(path + ": not a CityJSON file: the file is " + file_kind_text(kind));
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open the file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw InputError(path + ": cannot read the file");
+  return parse_cityjson(ss.str(), path, lod);
+}
+
+}  // namespace lodrefine

@@ -1,0 +1,132 @@
+#include "lodrefine/io/crop.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <unordered_map>
+
+#include "lodrefine/io/ply.h"
+
+namespace lodrefine {
+
+CropTarget crop_target(const Mesh& model, double relative, double absolute) {
+  CropTarget t;
+  t.id = model.id;
+  t.lo = Vec3::Constant(1e300);
+  t.hi = Vec3::Constant(-1e300);
+  for (const auto& v : model.vertices) {
+    t.lo = t.lo.cwiseMin(v);
+    t.hi = t.hi.cwiseMax(v);
+  }
+  const Vec3 size = t.hi - t.lo;
+  const Vec3 grow(relative * size.x() + absolute, relative * size.y() + absolute, absolute);
+  t.lo -= grow;
+  t.hi += grow;
+  return t;
+}
+
+namespace {
+
+// Streams the tile (PLY or LAS, `options` filtering LAS classes) once and calls on_hit(i, p)
+// for every target i whose box holds p; a 2D grid over the targets keeps this O(points).
+// Returns the number of points read; `bounds` (optional) gets their bounding box.
+std::size_t for_each_hit(const std::string& tile, const std::vector<CropTarget>& targets, const CloudOptions& options,
+                         Eigen::AlignedBox3d* bounds, const std::function<void(std::size_t, const Vec3&)>& on_hit) {
+  if (targets.empty()) return 0;
+  // Grid cell size: about the median box size, so each box touches few cells.
+  std::vector<double> sizes;
+  for (const auto& t : targets) sizes.push_back(std::max(t.hi.x() - t.lo.x(), t.hi.y() - t.lo.y()));
+  std::nth_element(sizes.begin(), sizes.begin() + sizes.size() / 2, sizes.end());
+  const double cell = std::max(1.0, sizes[sizes.size() / 2]);
+  auto key = [cell](double x, double y) {
+    return (std::int64_t(std::floor(x / cell)) << 32) ^ (std::int64_t(std::floor(y / cell)) & 0xffffffff);
+  };
+  std::unordered_map<std::int64_t, std::vector<std::size_t>> grid;
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    const auto& t = targets[i];
+    for (double x = std::floor(t.lo.x() / cell) * cell; x <= t.hi.x(); x += cell)
+      for (double y = std::floor(t.lo.y() / cell) * cell; y <= t.hi.y(); y += cell) grid[key(x + 0.5 * cell, y + 0.5 * cell)].push_back(i);
+  }
+  std::size_t n = 0;
+  stream_cloud(tile, options, [&](const Vec3& p) {
+    ++n;
+    if (bounds) bounds->extend(p);
+    const auto it = grid.find(key(p.x(), p.y()));
+    if (it == grid.end()) return;
+    for (std::size_t i : it->second) {
+      const auto& t = targets[i];
+      if ((p.array() >= t.lo.array()).all() && (p.array() <= t.hi.array()).all()) on_hit(i, p);
+    }
+  });
+  return n;
+}
+
+// Appends points to a spill file (raw doubles), or reads them all back.
+void spill(const std::string& path, const std::vector<Vec3>& points) {
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "ab"), std::fclose);
+  const std::size_t bytes = points.size() * sizeof(Vec3);
+  if (!f || std::fwrite(points.data(), 1, bytes, f.get()) != bytes || std::fflush(f.get()) != 0)
+    throw InputError("cannot write " + path + ": " + std::strerror(errno));
+}
+
+std::vector<Vec3> unspill(const std::string& path) {
+  std::vector<Vec3> points(std::filesystem::exists(path) ? std::filesystem::file_size(path) / sizeof(Vec3) : 0);
+  if (points.empty()) return points;
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), std::fclose);
+  if (!f || std::fread(points.data(), sizeof(Vec3), points.size(), f.get()) != points.size())
+    throw InputError("cannot read back " + path);
+  return points;
+}
+
+}  // namespace
+
+std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets, const CloudOptions& options,
+                      Eigen::AlignedBox3d* bounds) {
+  return for_each_hit(tile, targets, options, bounds,
+                      [&](std::size_t i, const Vec3& p) { targets[i].cloud.points.push_back(p); });
+}
+
+std::size_t crop_tile_to_files(const std::string& tile, const std::vector<CropTarget>& targets,
+                               const std::vector<std::string>& out_paths, std::size_t buffer_points,
+                               std::vector<std::size_t>& counts, const CloudOptions& options) {
+  static_assert(sizeof(Vec3) == 3 * sizeof(double), "spill files hold Vec3 as three doubles");
+  std::vector<std::vector<Vec3>> held(targets.size());
+  std::vector<std::string> spills;
+  for (const auto& path : out_paths) spills.push_back(path + ".spill.tmp." + std::to_string(::getpid()));
+  counts.assign(targets.size(), 0);
+  std::size_t in_memory = 0;
+  auto flush_all = [&] {
+    for (std::size_t i = 0; i < held.size(); ++i)
+      if (!held[i].empty()) spill(spills[i], held[i]), std::vector<Vec3>().swap(held[i]);
+    in_memory = 0;
+  };
+  std::size_t n = 0;
+  try {
+    n = for_each_hit(tile, targets, options, nullptr, [&](std::size_t i, const Vec3& p) {
+      held[i].push_back(p);
+      ++counts[i];
+      if (++in_memory > buffer_points) flush_all();
+    });
+    for (std::size_t i = 0; i < targets.size(); ++i) {
+      PointCloud cloud;
+      cloud.points = unspill(spills[i]);
+      cloud.points.insert(cloud.points.end(), held[i].begin(), held[i].end());
+      std::vector<Vec3>().swap(held[i]);
+      write_ply(out_paths[i], cloud);
+      std::filesystem::remove(spills[i]);
+    }
+  } catch (...) {
+    for (const auto& s : spills) std::filesystem::remove(s);
+    throw;
+  }
+  return n;
+}
+
+}  // namespace lodrefine

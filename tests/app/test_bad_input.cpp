@@ -1,0 +1,945 @@
+// Robustness against the broken files a city-wide batch meets (issue "bad input"): every case
+// drives the real `lodrefine refine` binary on files written here and checks the contract:
+//   - refused: non-zero exit, exactly one stderr line "lodrefine: error: ...", no output file
+//     and no leftover temporary file;
+//   - kept: exit 0, the repaired input written and valid, the report says "kept" and why;
+//   - kept-invalid: exit 0, a model that is no solid written as read, the report says why;
+//   - refined: exit 0, valid output, report "refined".
+// Each case prints a row "| input | what lodrefine says | exit |"; running the suite in one
+// process (lodrefine_app_tests --gtest_filter='BadInput*') prints the whole table at the end.
+// The solver-fault tests drive select_faces() directly on synthetic hard/infeasible programs.
+#include <gtest/gtest.h>
+
+#include "support/ply_fixtures.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <limits>
+#include <random>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "lodrefine/core/candidates.h"
+#include "lodrefine/io/obj.h"
+#include "lodrefine/core/params.h"
+#include "lodrefine/core/refine.h"
+#include "lodrefine/core/selection.h"
+#include "lodrefine/core/validate.h"
+
+using namespace lodrefine;
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace {
+
+const Vec3 kOrigin(85000.0, 447000.0, 0.0);
+
+// ---------------------------------------------------------------------------------------------
+// Files
+
+std::string temp_dir(const std::string& name) {
+  const fs::path dir = fs::path(testing::TempDir()) / ("lodrefine_bad_" + std::to_string(::getpid())) / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir.string();
+}
+
+void write_text(const std::string& path, const std::string& content) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << content;
+  ASSERT_TRUE(out.good()) << path;
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string fmt(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.4f", v);
+  return buf;
+}
+
+// The coarse model: a 12 x 8 x 7 m box soup (one polygon per face, vertices repeated, CityGML
+// groups), georeferenced, with the front wall 0.4 m too far out (y = -0.4 instead of 0).
+const Vec3 kBox[8] = {{0, -0.4, 0}, {12, -0.4, 0}, {12, 8, 0}, {0, 8, 0},
+                      {0, -0.4, 7}, {12, -0.4, 7}, {12, 8, 7}, {0, 8, 7}};
+struct Quad {
+  int v[4];
+  const char* group;
+};
+const Quad kQuads[6] = {{{0, 3, 2, 1}, "GroundSurface"}, {{4, 5, 6, 7}, "RoofSurface"},
+                        {{0, 1, 5, 4}, "WallSurface"},   {{1, 2, 6, 5}, "WallSurface"},
+                        {{2, 3, 7, 6}, "WallSurface"},   {{3, 0, 4, 7}, "WallSurface"}};
+
+// OBJ text of the listed faces of the box (each face its own 4 vertices).
+std::string box_obj(const std::vector<int>& faces = {0, 1, 2, 3, 4, 5}, const std::string& extra = "") {
+  std::string s = "# exported per building\no bldg_0001\n";
+  int n = 0;
+  for (int f : faces) {
+    s += std::string("g ") + kQuads[f].group + "\n";
+    for (int k : kQuads[f].v) {
+      const Vec3 p = kBox[k] + kOrigin;
+      s += "v " + fmt(p.x()) + " " + fmt(p.y()) + " " + fmt(p.z()) + "\n";
+    }
+    s += "f " + std::to_string(n + 1) + " " + std::to_string(n + 2) + " " + std::to_string(n + 3) + " " +
+         std::to_string(n + 4) + "\n";
+    n += 4;
+  }
+  return s + extra;
+}
+
+// MLS-like scan of the true front wall y = 0 (x 0.5..11.5, z 0.2..5, 5 cm grid, 1 cm noise)
+// with street ground in front: the scan moves the model's front wall by 0.4 m.
+std::vector<Vec3> wall_scan(unsigned seed = 1) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  std::vector<Vec3> pts;
+  for (double x = 0.5; x <= 11.5; x += 0.05)
+    for (double z = 0.2; z <= 5.0; z += 0.05) pts.push_back(Vec3(x, noise(rng), z) + kOrigin);
+  for (double x = 0.5; x <= 11.5; x += 0.1)
+    for (double y = -6.0; y < -0.3; y += 0.1) pts.push_back(Vec3(x, y, noise(rng)) + kOrigin);
+  return pts;
+}
+
+
+std::string ply_header(const std::string& format, std::uint64_t count, const std::string& type = "double") {
+  return "ply\nformat " + format + " 1.0\ncomment test\nelement vertex " + std::to_string(count) + "\nproperty " + type +
+         " x\nproperty " + type + " y\nproperty " + type + " z\nend_header\n";
+}
+
+std::string ply_binary(const std::vector<Vec3>& pts, bool big_endian = false) {
+  std::string s = ply_header(big_endian ? "binary_big_endian" : "binary_little_endian", pts.size());
+  for (const auto& p : pts) put(s, p.x(), big_endian), put(s, p.y(), big_endian), put(s, p.z(), big_endian);
+  return s;
+}
+
+std::string ply_ascii(const std::vector<Vec3>& pts) {
+  std::string s = ply_header("ascii", pts.size());
+  for (const auto& p : pts) s += fmt(p.x()) + " " + fmt(p.y()) + " " + fmt(p.z()) + "\n";
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Running the binary
+
+struct CliRun {
+  int exit = -1;
+  std::string out, err;
+  double seconds = 0;
+};
+
+std::string shell_quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// Runs the binary under `timeout`: a hang (exit 124, or 137 after the KILL grace) fails the
+// case instead of the whole suite, and stops a runaway process before it eats the machine.
+CliRun run_cli(const std::string& args, const std::string& dir, double timeout_seconds = 300) {
+  const std::string out = dir + "/.stdout", err = dir + "/.stderr";
+  const std::string cmd = "timeout -k 5 " + std::to_string(int(std::ceil(timeout_seconds))) + " " +
+                          shell_quote(LODREFINE_BINARY) + " " + args + " >" + shell_quote(out) + " 2>" + shell_quote(err);
+  const auto t0 = std::chrono::steady_clock::now();
+  const int st = std::system(cmd.c_str());
+  CliRun r;
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.exit = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + (WIFSIGNALED(st) ? WTERMSIG(st) : 0);
+  r.out = read_text(out);
+  r.err = read_text(err);
+  fs::remove(out);
+  fs::remove(err);
+  return r;
+}
+
+std::vector<std::string> lines(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  for (std::string l; std::getline(ss, l);) out.push_back(l);
+  return out;
+}
+
+// Files left in `dir` that look like an interrupted atomic write ("<name>.tmp.<pid>").
+std::vector<std::string> temp_leftovers(const std::string& dir) {
+  std::vector<std::string> out;
+  std::error_code ec;
+  for (const auto& e : fs::recursive_directory_iterator(dir, ec))
+    if (e.path().filename().string().find(".tmp") != std::string::npos) out.push_back(e.path().string());
+  return out;
+}
+
+// The written model, checked by the project's own validator; empty string when valid.
+std::string output_problem(const std::string& path) {
+  try {
+    const Mesh m = read_obj(path);
+    const Validation v = validate_mesh(m);
+    return v.valid() ? "" : "invalid output: " + v.problem;
+  } catch (const std::exception& e) {
+    return std::string("unreadable output: ") + e.what();
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The table
+
+struct Row {
+  std::string input, says;
+  int exit;
+};
+std::vector<Row>& table() {
+  static std::vector<Row> rows;
+  return rows;
+}
+
+std::string cell(std::string s) {
+  for (auto& c : s)
+    if (c == '|' || c == '\n') c = c == '|' ? '/' : ' ';
+  return s;
+}
+
+void add_row(const std::string& input, const std::string& says, int exit) {
+  table().push_back({input, says, exit});
+  std::cout << "| " << cell(input) << " | " << cell(says) << " | " << exit << " |" << std::endl;
+}
+
+class TablePrinter : public testing::Environment {
+ public:
+  void TearDown() override {
+    if (table().size() < 2) return;  // one case per process under ctest: its row is printed already
+    std::cout << "\n| input | what lodrefine says | exit code |\n| --- | --- | --- |\n";
+    for (const auto& r : table()) std::cout << "| " << cell(r.input) << " | " << cell(r.says) << " | " << r.exit << " |\n";
+    std::cout << std::flush;
+  }
+};
+const testing::Environment* const kTablePrinter = testing::AddGlobalTestEnvironment(new TablePrinter);
+
+// ---------------------------------------------------------------------------------------------
+// Cases
+
+enum class Expect {
+  Error,          // refused with one error line, nothing written
+  Kept,           // exit 0, repaired input written, report outcome "kept" (reason in "reason")
+  KeptInvalid,    // exit 0, the input written as read, report outcome "kept-invalid"
+  Refined,        // exit 0, report outcome "refined"
+  Valid,          // exit 0, valid output, any outcome
+  ErrorOrValid,   // either of the first (refused) or a valid written building
+};
+
+struct Paths {
+  std::string dir, model, cloud, out, report;
+  std::string args;  // extra CLI arguments
+  std::string model_arg, cloud_arg, out_arg;  // override the paths on the command line
+};
+
+struct Case {
+  std::string name;       // the table's "input" column
+  std::function<void(Paths&)> make;
+  Expect expect;
+  std::string fragment;   // must appear in the error line (Error) or the report's reason (Kept*), if set
+  double max_seconds = 300;
+};
+
+std::string valid_model() { return box_obj(); }
+std::string valid_cloud() { return ply_binary(wall_scan()); }
+
+void both_valid(Paths& p) {
+  write_text(p.model, valid_model());
+  write_text(p.cloud, valid_cloud());
+}
+void model_is(Paths& p, const std::string& obj) {
+  write_text(p.model, obj);
+  write_text(p.cloud, valid_cloud());
+}
+void cloud_is(Paths& p, const std::string& ply) {
+  write_text(p.model, valid_model());
+  write_text(p.cloud, ply);
+}
+
+std::vector<Vec3> shifted(std::vector<Vec3> pts, const Vec3& d) {
+  for (auto& p : pts) p += d;
+  return pts;
+}
+
+std::vector<Case> cases() {
+  std::vector<Case> c;
+  const std::string box = valid_model();
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+
+  // --- the good path
+  c.push_back({"valid box + wall scan 0.4 m off (binary LE doubles)", both_valid, Expect::Refined});
+  c.push_back({"valid box + same scan as ASCII PLY", [](Paths& p) { cloud_is(p, ply_ascii(wall_scan())); },
+               Expect::Refined});
+  c.push_back({"valid box + same scan as big-endian PLY", [](Paths& p) { cloud_is(p, ply_binary(wall_scan(), true)); },
+               Expect::Refined});
+
+  // --- malformed models
+  c.push_back({"model: empty file (0 bytes)", [](Paths& p) { model_is(p, ""); }, Expect::Error, "empty"});
+  c.push_back({"model: only comments and blank lines", [](Paths& p) { model_is(p, "# nothing\n\n  \n"); },
+               Expect::Error});
+  c.push_back({"model: truncated inside a vertex line",
+               [box](Paths& p) { model_is(p, box.substr(0, box.find("v ", box.size() / 2) + 9)); }, Expect::Error});
+  c.push_back({"model: truncated after the vertices (faces lost)",
+               [box](Paths& p) {
+                 std::string t;
+                 for (const auto& l : lines(box))
+                   if (l.rfind("f ", 0) != 0) t += l + "\n";
+                 model_is(p, t);
+               },
+               Expect::Error, "no faces"});
+  c.push_back({"model: NaN coordinate", [box](Paths& p) { model_is(p, "v nan 0 0\n" + box); }, Expect::Error});
+  c.push_back({"model: Inf coordinate", [box](Paths& p) { model_is(p, "v 1 inf 0\n" + box); }, Expect::Error});
+  c.push_back({"model: coordinate overflowing double (1e999)", [box](Paths& p) { model_is(p, "v 1e999 0 0\n" + box); },
+               Expect::Error});
+  c.push_back({"model: face index past the last vertex (f 1 2 99)",
+               [box](Paths& p) { model_is(p, box + "f 1 2 99\n"); }, Expect::Error, "out of range"});
+  c.push_back({"model: negative index before the first vertex (f -1 -2 -99)",
+               [box](Paths& p) { model_is(p, box + "f -1 -2 -99\n"); }, Expect::Error, "out of range"});
+  c.push_back({"model: face index 0", [box](Paths& p) { model_is(p, box + "f 0 1 2\n"); }, Expect::Error});
+  c.push_back({"model: huge face index (f 1 2 99999999999999999999)",
+               [box](Paths& p) { model_is(p, box + "f 1 2 99999999999999999999\n"); }, Expect::Error});
+  c.push_back({"model: only faces with < 3 vertices", [](Paths& p) { model_is(p, "v 0 0 0\nv 1 0 0\nf 1 2\nf 1\n"); },
+               Expect::Error, "no faces"});
+  c.push_back({"model: valid box + extra 2-vertex face (skipped)", [box](Paths& p) { model_is(p, box + "f 1 2\n"); },
+               Expect::Refined});
+  c.push_back({"model: valid box + zero-area face (collinear vertices)",
+               [box](Paths& p) {
+                 const Vec3 a = kOrigin + Vec3(0, 8, 0), b = kOrigin + Vec3(6, 8, 0), d = kOrigin + Vec3(12, 8, 0);
+                 model_is(p, box + "v " + fmt(a.x()) + " " + fmt(a.y()) + " 0\nv " + fmt(b.x()) + " " + fmt(b.y()) +
+                                 " 0\nv " + fmt(d.x()) + " " + fmt(d.y()) + " 0\nf -3 -2 -1\n");
+               },
+               Expect::Refined});
+  c.push_back({"model: only zero-area faces",
+               [](Paths& p) { model_is(p, "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nf 1 2 3\nf 2 3 4\nf 1 2 4\nf 1 3 4\n"); },
+               Expect::KeptInvalid, "usable faces"});
+  c.push_back({"model: self-intersecting (bow-tie) front wall",
+               [](Paths& p) {
+                 std::string s = box_obj();
+                 // front wall 0 1 5 4 -> 0 1 4 5: the quad crosses itself
+                 const std::string front = "f 9 10 11 12\n";
+                 s.replace(s.find(front), front.size(), "f 9 10 12 11\n");
+                 model_is(p, s);
+               },
+               Expect::ErrorOrValid});
+  c.push_back({"model: just the 4 walls (no roof, no ground)", [](Paths& p) { model_is(p, box_obj({2, 3, 4, 5})); },
+               Expect::ErrorOrValid});
+  c.push_back({"model: just 2 walls", [](Paths& p) { model_is(p, box_obj({2, 3})); }, Expect::KeptInvalid, "not closable"});
+  c.push_back({"model: a single triangle", [](Paths& p) { model_is(p, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"); },
+               Expect::KeptInvalid, "usable faces"});
+  c.push_back({"model: binary garbage", [](Paths& p) { model_is(p, std::string("\x7f" "ELF\x02\x01\x01\0\0\0", 10)); },
+               Expect::Error, "binary"});
+  c.push_back({"model: a PLY file given as the model", [](Paths& p) { model_is(p, ply_ascii({{0, 0, 0}})); },
+               Expect::Error});
+
+  // --- malformed clouds
+  c.push_back({"cloud: empty file (0 bytes)", [](Paths& p) { cloud_is(p, ""); }, Expect::Error, "empty"});
+  c.push_back({"cloud: header cut before end_header",
+               [](Paths& p) { cloud_is(p, "ply\nformat binary_little_endian 1.0\nelement vertex 10\nproperty dou"); },
+               Expect::Error});
+  c.push_back({"cloud: binary data truncated mid-record",
+               [](Paths& p) {
+                 const std::string s = valid_cloud();
+                 cloud_is(p, s.substr(0, s.size() - 13));
+               },
+               Expect::Error});
+  c.push_back({"cloud: ASCII data truncated mid-line",
+               [](Paths& p) {
+                 const std::string s = ply_ascii(wall_scan());
+                 cloud_is(p, s.substr(0, s.size() / 2));
+               },
+               Expect::Error});
+  c.push_back({"cloud: header count 10x larger than the data",
+               [](Paths& p) {
+                 const auto pts = wall_scan();
+                 std::string s = ply_binary(pts);
+                 const std::string from = "element vertex " + std::to_string(pts.size()) + "\n";
+                 s.replace(s.find(from), from.size(), "element vertex " + std::to_string(pts.size() * 10) + "\n");
+                 cloud_is(p, s);
+               },
+               Expect::Error, "header declares"});
+  c.push_back({"cloud: header count smaller than the data (trailing bytes)",
+               [](Paths& p) {
+                 const auto pts = wall_scan();
+                 std::string s = ply_binary(pts);
+                 const std::string from = "element vertex " + std::to_string(pts.size()) + "\n";
+                 s.replace(s.find(from), from.size(), "element vertex " + std::to_string(pts.size() / 2) + "\n");
+                 cloud_is(p, s);
+               },
+               Expect::Valid});
+  c.push_back({"cloud: unknown property type (float128)",
+               [](Paths& p) { cloud_is(p, ply_header("ascii", 1, "float128") + "1 2 3\n"); }, Expect::Error,
+               "unknown property type"});
+  c.push_back({"cloud: unknown format (binary_middle_endian)",
+               [](Paths& p) { cloud_is(p, ply_header("binary_middle_endian", 1) + std::string(24, '\0')); },
+               Expect::Error, "unknown format"});
+  c.push_back({"cloud: header says big-endian, data is little-endian",
+               [](Paths& p) {
+                 std::string s = valid_cloud();
+                 s.replace(s.find("binary_little_endian"), 20, "binary_big_endian");
+                 cloud_is(p, s);
+               },
+               Expect::ErrorOrValid});
+  c.push_back({"cloud: no x property",
+               [](Paths& p) {
+                 cloud_is(p, "ply\nformat ascii 1.0\nelement vertex 1\nproperty float y\nproperty float z\nend_header\n1 2\n");
+               },
+               Expect::Error, "no scalar property x"});
+  c.push_back({"cloud: not a PLY (an OBJ)", [](Paths& p) { cloud_is(p, valid_model()); }, Expect::Error, "not a PLY"});
+  c.push_back({"cloud: NaN coordinate (binary)",
+               [nan](Paths& p) {
+                 auto pts = wall_scan();
+                 pts[pts.size() / 2].y() = nan;
+                 cloud_is(p, ply_binary(pts));
+               },
+               Expect::Error, "non-finite"});
+  c.push_back({"cloud: Inf coordinate (binary)",
+               [inf](Paths& p) {
+                 auto pts = wall_scan();
+                 pts[7].z() = -inf;
+                 cloud_is(p, ply_binary(pts));
+               },
+               Expect::Error, "non-finite"});
+  c.push_back({"cloud: 'nan' in an ASCII PLY",
+               [](Paths& p) { cloud_is(p, ply_header("ascii", 2) + "85001 447000 1\nnan 447000 2\n"); }, Expect::Error});
+  c.push_back({"cloud: 0 points", [](Paths& p) { cloud_is(p, ply_binary({})); }, Expect::Error, "no points"});
+  c.push_back({"cloud: 1 point", [](Paths& p) { cloud_is(p, ply_binary({kOrigin + Vec3(6, 0, 2)})); },
+               Expect::Kept});
+  c.push_back({"cloud: 10 points on the wall",
+               [](Paths& p) {
+                 std::vector<Vec3> pts;
+                 for (int i = 0; i < 10; ++i) pts.push_back(kOrigin + Vec3(1 + i, 0, 1 + 0.3 * i));
+                 cloud_is(p, ply_binary(pts));
+               },
+               Expect::Kept});
+  c.push_back({"cloud: 10 km away from the model",
+               [](Paths& p) { cloud_is(p, ply_binary(shifted(wall_scan(), Vec3(10000, 0, 0)))); }, Expect::Kept});
+  c.push_back({"cloud: pure clutter (uniform random around the building)",
+               [](Paths& p) {
+                 std::mt19937 rng(5);
+                 std::uniform_real_distribution<double> x(-2, 14), y(-3, 10), z(0, 9);
+                 std::vector<Vec3> pts;
+                 for (int i = 0; i < 6000; ++i) pts.push_back(kOrigin + Vec3(x(rng), y(rng), z(rng)));
+                 cloud_is(p, ply_binary(pts));
+               },
+               Expect::Kept});
+  c.push_back({"cloud: every point duplicated 3 times",
+               [](Paths& p) {
+                 std::vector<Vec3> pts;
+                 for (const auto& q : wall_scan()) pts.insert(pts.end(), 3, q);
+                 cloud_is(p, ply_binary(pts));
+               },
+               Expect::Valid});
+  c.push_back({"cloud: 2000 copies of one point",
+               [](Paths& p) { cloud_is(p, ply_binary(std::vector<Vec3>(2000, kOrigin + Vec3(6, 0, 2)))); },
+               Expect::Kept, "", 30.0});
+  c.push_back({"cloud: header claims 2^31 points, 1 KiB of data",
+               [](Paths& p) { cloud_is(p, ply_header("binary_little_endian", 1ull << 31) + std::string(1024, '\0')); },
+               Expect::Error, "header declares", 10.0});
+  c.push_back({"cloud: 2 GiB file (sparse, 89M points of zeros)",
+               [](Paths& p) {
+                 const std::uint64_t n = ((1ull << 31) - 200) / 24;
+                 cloud_is(p, ply_header("binary_little_endian", n));
+                 const auto header = fs::file_size(p.cloud);
+                 fs::resize_file(p.cloud, header + n * 24);  // a hole: nothing is written
+               },
+               Expect::Error, "max-points", 10.0});
+  c.push_back({"cloud: header claims 2^64-1 points",
+               [](Paths& p) {
+                 cloud_is(p, ply_header("binary_little_endian", std::numeric_limits<std::uint64_t>::max()) +
+                                 std::string(24, '\0'));
+               },
+               Expect::Error, "", 10.0});
+  c.push_back({"cloud: header count above 2^64 (overflow)",
+               [](Paths& p) {
+                 cloud_is(p, "ply\nformat ascii 1.0\nelement vertex 99999999999999999999999\nproperty float x\n"
+                             "property float y\nproperty float z\nend_header\n1 2 3\n");
+               },
+               Expect::Error, "", 10.0});
+
+  // --- paths
+  c.push_back({"model path does not exist",
+               [](Paths& p) {
+                 both_valid(p);
+                 p.model_arg = p.dir + "/missing.obj";
+               },
+               Expect::Error});
+  c.push_back({"cloud path does not exist",
+               [](Paths& p) {
+                 both_valid(p);
+                 p.cloud_arg = p.dir + "/missing.ply";
+               },
+               Expect::Error});
+  c.push_back({"model path is a directory",
+               [](Paths& p) {
+                 both_valid(p);
+                 p.model_arg = p.dir;
+               },
+               Expect::Error});
+  if (::geteuid() != 0)  // root reads anything
+    c.push_back({"model file not readable (mode 000)",
+                 [](Paths& p) {
+                   both_valid(p);
+                   ::chmod(p.model.c_str(), 0);
+                 },
+                 Expect::Error});
+  c.push_back({"output path in a missing directory",
+               [](Paths& p) {
+                 both_valid(p);
+                 p.out_arg = p.dir + "/no/such/dir/refined.obj";
+               },
+               Expect::Error});
+  c.push_back({"output path is an existing directory",
+               [](Paths& p) {
+                 both_valid(p);
+                 fs::create_directories(p.dir + "/outdir");
+                 p.out_arg = p.dir + "/outdir";
+               },
+               Expect::Error});
+  c.push_back({"report path in a missing directory",
+               [](Paths& p) {
+                 both_valid(p);
+                 p.report = p.dir + "/no/such/dir/report.json";
+               },
+               Expect::Error});
+
+  // --- every input a fuzz target ever crashed on (tests/fuzz/regressions/<target>/), replayed
+  // through the CLI: fuzz_obj inputs as the model, fuzz_ply inputs as the cloud, fuzz_refine
+  // inputs split as the target splits them (its "tiny" flag becomes the same parameters).
+  const fs::path reg = fs::path(LODREFINE_SOURCE_DIR) / "tests" / "fuzz" / "regressions";
+  std::error_code ec;
+  for (const char* target : {"fuzz_obj", "fuzz_ply", "fuzz_refine"}) {
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(reg / target, ec))
+      if (e.is_regular_file()) files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    for (const auto& f : files) {
+      const std::string t = target;
+      c.push_back({"fuzz regression " + t + "/" + f.filename().string(),
+                   [t, f](Paths& p) {
+                     const std::string bytes = read_text(f.string());
+                     if (t == "fuzz_obj") return model_is(p, bytes);
+                     if (t == "fuzz_ply") return cloud_is(p, bytes);
+                     if (bytes.size() < 3) return both_valid(p);
+                     const std::size_t rest = bytes.size() - 3;
+                     const std::size_t len =
+                         (std::size_t(std::uint8_t(bytes[0])) | std::size_t(std::uint8_t(bytes[1])) << 8) % (rest + 1);
+                     write_text(p.model, bytes.substr(3, len));
+                     write_text(p.cloud, bytes.substr(3 + len));
+                     p.args = "--mip-time-limit 1";
+                     if (bytes[2] & 1)
+                       p.args += " --ransac-min-points 20 --min-plane-area 0.2 --normal-neighbors 6 --ransac-cluster-epsilon 1";
+                   },
+                   Expect::ErrorOrValid, "", 60.0});
+    }
+  }
+
+  // --- solver limits through the CLI
+  c.push_back({"valid input, --mip-time-limit 0.01",
+               [](Paths& p) {
+                 both_valid(p);
+                 p.args = "--mip-time-limit 0.01";
+               },
+               Expect::Valid});
+  return c;
+}
+
+std::string first_line(const std::string& s) { return s.substr(0, s.find('\n')); }
+
+// Cases that still break the contract, with the diagnosis and the fix they wait for (in files
+// of other modules). They are skipped -- loudly -- so main stays green; run them all with
+// LODREFINE_BAD_INPUT_ALL=1, and delete an entry when its fix lands.
+const std::vector<std::pair<std::string, std::string>>& known_open() {
+  // All fixed so far: fuzzing findings landed in src/core/planes.cpp (repeated points), src/core/selection.cpp
+  // (repeated columns), src/io/io.cpp (coordinates beyond 1e9 m, property-less elements, printing
+  // any double) and apps/cmd_refine.cpp (output directories checked first).
+  static const std::vector<std::pair<std::string, std::string>> open = {};
+  return open;
+}
+
+// Skips a known-open case (see above) unless LODREFINE_BAD_INPUT_ALL is set.
+bool skip_known_open(const std::string& name) {
+  if (std::getenv("LODREFINE_BAD_INPUT_ALL") != nullptr) return false;
+  for (const auto& [n, why] : known_open())
+    if (n == name) {
+      add_row(name, "KNOWN OPEN (skipped): " + why, -1);
+      return true;
+    }
+  return false;
+}
+
+class BadInput : public testing::TestWithParam<std::size_t> {};
+
+TEST_P(BadInput, Contract) {
+  static const std::vector<Case> all = cases();
+  const Case& k = all[GetParam()];
+  if (skip_known_open(k.name)) GTEST_SKIP() << "known open: " << k.name;
+  Paths p;
+  p.dir = temp_dir("case_" + std::to_string(GetParam()));
+  struct Cleanup {  // keep the files of a failed case for inspection
+    std::string dir;
+    ~Cleanup() {
+      std::error_code ec;
+      if (!testing::Test::HasFailure()) fs::remove_all(dir, ec);
+    }
+  } cleanup{p.dir};
+  p.model = p.dir + "/model.obj";
+  p.cloud = p.dir + "/cloud.ply";
+  p.out = p.dir + "/refined.obj";
+  p.report = p.dir + "/report.json";
+  k.make(p);
+  const std::string model = p.model_arg.empty() ? p.model : p.model_arg;
+  const std::string cloud = p.cloud_arg.empty() ? p.cloud : p.cloud_arg;
+  const std::string out = p.out_arg.empty() ? p.out : p.out_arg;
+  const CliRun r = run_cli("refine --model " + shell_quote(model) + " --cloud " + shell_quote(cloud) + " --out " + shell_quote(out) +
+                            " --report " + shell_quote(p.report) + " " + p.args,
+                        p.dir, k.max_seconds);
+  SCOPED_TRACE(k.name + "\nstdout: " + r.out + "\nstderr: " + r.err);
+
+  // Never a crash (signal / sanitizer abort) nor a hang.
+  if (r.exit == 124 || r.exit == 137) {
+    add_row(k.name, "HANG: killed after " + fmt(r.seconds) + " s", r.exit);
+    FAIL() << "hang: still running after " << k.max_seconds << " s";
+  }
+  EXPECT_LT(r.exit, 128) << "killed by a signal";
+  EXPECT_LT(r.seconds, k.max_seconds) << "too slow";
+  EXPECT_TRUE(temp_leftovers(p.dir).empty()) << "temporary file left behind: " << temp_leftovers(p.dir)[0];
+
+  json report;
+  if (fs::exists(p.report)) {
+    try {
+      report = json::parse(read_text(p.report));
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "report is not JSON: " << e.what();
+    }
+  }
+  const std::string outcome = report.is_object() ? report.value("outcome", std::string()) : std::string();
+
+  const bool refused = r.exit != 0;
+  if (refused) {
+    const auto err = lines(r.err);
+    EXPECT_EQ(err.size(), 1u) << "expected exactly one stderr line";
+    EXPECT_EQ(r.err.rfind("lodrefine: error: ", 0), 0u) << "stderr must start with 'lodrefine: error: '";
+    EXPECT_FALSE(fs::exists(out) && fs::is_regular_file(out)) << "a failed run left an output file";
+    add_row(k.name, first_line(r.err), r.exit);
+    EXPECT_TRUE(k.expect == Expect::Error || k.expect == Expect::ErrorOrValid) << "refused, expected success";
+    if (k.expect == Expect::Error && !k.fragment.empty())
+      EXPECT_NE(r.err.find(k.fragment), std::string::npos) << "message should mention '" << k.fragment << "'";
+    return;
+  }
+
+  // Success: a complete, valid building and a report that tells what was written.
+  add_row(k.name, "exit 0, outcome: " + (outcome.empty() ? std::string("(no report)") : outcome), r.exit);
+  EXPECT_NE(k.expect, Expect::Error) << "accepted, expected a refusal";
+  EXPECT_TRUE(r.err.empty()) << "stderr on success";
+  ASSERT_TRUE(fs::is_regular_file(out)) << "exit 0 but no output: the building was dropped";
+  ASSERT_TRUE(report.is_object()) << "no report";
+  EXPECT_EQ(report.value("written", std::string()), out);
+  const std::string reason = report.value("reason", std::string());
+  if (k.expect == Expect::KeptInvalid || outcome == "kept-invalid") {
+    EXPECT_TRUE(k.expect == Expect::KeptInvalid || k.expect == Expect::ErrorOrValid) << outcome << ": " << reason;
+    EXPECT_EQ(outcome, "kept-invalid");
+    EXPECT_FALSE(reason.empty());
+    if (!k.fragment.empty()) EXPECT_NE(reason.find(k.fragment), std::string::npos) << reason;
+    EXPECT_EQ(read_obj(out).faces.size(), read_obj(p.model).faces.size()) << "kept-invalid is the input as read";
+    return;
+  }
+  EXPECT_EQ(output_problem(out), "");
+  EXPECT_TRUE(report["output_validation"].value("valid", false));
+  if (k.expect == Expect::Refined) {
+    EXPECT_EQ(outcome, "refined");
+    const Mesh m = read_obj(out);
+    double worst = 0;  // the front wall now lies on the scan (y = 0)
+    for (const auto& f : m.faces) {
+      if (f.sem != Semantic::Wall) continue;
+      std::vector<Vec3> poly;
+      for (int v : f.v) poly.push_back(m.vertices[v] - kOrigin);
+      if (newell_normal(poly).normalized().y() > -0.9) continue;
+      for (const auto& q : poly) worst = std::max(worst, std::abs(q.y()));
+    }
+    EXPECT_LT(worst, 0.03) << "front wall not moved onto the scan";
+  }
+  if (k.expect == Expect::Kept) {
+    EXPECT_EQ(outcome, "kept") << reason;
+    EXPECT_FALSE(report.value("refined", true));
+    if (!k.fragment.empty()) EXPECT_NE(reason.find(k.fragment), std::string::npos) << reason;
+  }
+}
+
+std::string case_name(const testing::TestParamInfo<std::size_t>& info) {
+  static const std::vector<Case> all = cases();
+  std::string s;
+  for (char ch : all[info.param].name) {
+    if (std::isalnum(static_cast<unsigned char>(ch))) s += ch;
+    else if (!s.empty() && s.back() != '_') s += '_';
+  }
+  while (!s.empty() && s.back() == '_') s.pop_back();
+  return std::to_string(info.param) + "_" + s.substr(0, 60);
+}
+
+INSTANTIATE_TEST_SUITE_P(Cases, BadInput, testing::Range<std::size_t>(0, cases().size()), case_name);
+
+// ---------------------------------------------------------------------------------------------
+// Atomic output under SIGKILL: whenever the process dies, the target path holds either the old
+// content or a complete valid model, never a partial one.
+
+TEST(BadInputAtomic, KillAtAnyTimeLeavesNoPartialModel) {
+  const std::string dir = temp_dir("kill");
+  const std::string model = dir + "/model.obj", cloud = dir + "/cloud.ply", out = dir + "/refined.obj";
+  write_text(model, valid_model());
+  write_text(cloud, valid_cloud());
+  // First measure a whole run, then kill at fractions of it.
+  const CliRun full = run_cli("refine --model " + shell_quote(model) + " --cloud " + shell_quote(cloud) + " --out " + shell_quote(out), dir);
+  ASSERT_EQ(full.exit, 0) << full.err;
+  const std::string complete = read_text(out);
+  std::string says;
+  for (double frac : {0.05, 0.3, 0.6, 0.9, 0.97, 1.0}) {
+    write_text(out, "old content\n");
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      const int devnull = ::open("/dev/null", O_WRONLY);
+      ::dup2(devnull, 1), ::dup2(devnull, 2);
+      ::execl(LODREFINE_BINARY, LODREFINE_BINARY, "refine", "--model", model.c_str(), "--cloud", cloud.c_str(), "--out",
+              out.c_str(), static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+    ::usleep(useconds_t(frac * full.seconds * 1e6));
+    ::kill(pid, SIGKILL);
+    int st = 0;
+    ::waitpid(pid, &st, 0);
+    const std::string now = read_text(out);
+    EXPECT_TRUE(now == "old content\n" || now == complete) << "partial output after SIGKILL at " << frac;
+    says += (now == complete ? "new " : "old ");
+  }
+  add_row("SIGKILL at 5..100% of a run (6 runs)", "target held old/new model: " + says, 0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Library-level regressions of fuzz findings
+
+// tests/fuzz/regressions/fuzz_obj/writer_huge_coordinate.obj: read_obj accepts any finite
+// coordinate, so write_obj must print any finite coordinate readably.
+TEST(BadInputRegression, ObjWriterRoundTripsHugeCoordinates) {
+  // The writer prints any finite double readably; the reader refuses such a file in one line.
+  if (skip_known_open("write_obj round trip of |coordinate| >= 1e57")) GTEST_SKIP() << "known open";
+  const std::string dir = temp_dir("huge_coordinate");
+  Mesh m;
+  m.id = "huge";
+  m.vertices = {{1e60, 0, 0}, {0, 1, 0}, {0, 0, -1.7e308}};
+  Face f;
+  f.v = {0, 1, 2};
+  m.faces = {f};
+  write_obj(dir + "/h.obj", m);
+  std::ifstream in(dir + "/h.obj", std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (unsigned char c : text) EXPECT_TRUE(c == '\n' || (c >= 32 && c < 127)) << "byte " << int(c);
+  EXPECT_GT(text.size(), 309u);  // -1.7e308 printed in full (309 digits)
+  try {
+    read_obj(dir + "/h.obj");
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("beyond 1e9 m"), std::string::npos) << e.what();
+  }
+}
+
+// tests/fuzz/regressions/fuzz_refine/glpk_duplicate_index_warped_ground: build_candidates
+// produced an edge listing one face twice; select_faces put the column twice in one row and
+// glp_load_matrix aborted the process ("duplicate indices not allowed"). Run in a child, so a
+// regression kills the child, not the test binary.
+TEST(BadInputRegression, FaceListedTwiceOnAnEdgeDoesNotAbortTheSolver) {
+  if (skip_known_open("select_faces with a face listed twice on one edge")) GTEST_SKIP() << "known open";
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::close(2);  // GLPK prints its error before aborting
+    CandidateSet cs;
+    Candidate c;
+    c.plane = 0;
+    c.area = 1.0;
+    cs.faces = {c, c};
+    CandidateEdge e;
+    e.faces = {0, 0, 1};
+    cs.edges = {e};
+    const SelectionResult r = select_faces(cs, {-1.0, -1.0}, {0}, Params{});
+    ::_exit(r.status == SolveStatus::NotRun ? 1 : 0);
+  }
+  int st = 0;
+  ::waitpid(pid, &st, 0);
+  EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0)
+      << "select_faces killed the process (signal " << (WIFSIGNALED(st) ? WTERMSIG(st) : 0) << ")";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Solver faults: select_faces() on synthetic programs GLPK cannot solve.
+
+// Random parity constraints (sum of 3 x's + outside = 2 y per edge) over many faces: GLPK's
+// LP relaxation is trivially fractional and branch and bound explodes.
+CandidateSet hard_program(int faces, int edges, unsigned seed, std::vector<double>& cost, std::vector<int>& outside) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> pick(0, faces - 1);
+  CandidateSet cs;
+  for (int f = 0; f < faces; ++f) {
+    Candidate c;
+    c.plane = f % 7;
+    c.area = 1.0 + f % 5;
+    cs.faces.push_back(c);
+    cost.push_back((f % 3) - 1.0);
+  }
+  for (int e = 0; e < edges; ++e) {
+    CandidateEdge ce;
+    while (ce.faces.size() < 3) {
+      const int f = pick(rng);
+      if (std::find(ce.faces.begin(), ce.faces.end(), f) == ce.faces.end()) ce.faces.push_back(f);
+    }
+    cs.edges.push_back(ce);
+    outside.push_back(int(rng() % 2));
+  }
+  return cs;
+}
+
+TEST(BadInputSolver, InfeasibleProgramIsReportedNotSelected) {
+  // Face 0 alone on two edges: once with the outside surface (x0 + 1 = 2 y0 -> x0 = 1), once
+  // without (x0 = 2 y1 -> x0 = 0). No selection satisfies both.
+  CandidateSet cs;
+  Candidate c;
+  c.plane = 0;
+  c.area = 1.0;
+  cs.faces = {c};
+  CandidateEdge e0, e1;
+  e0.faces = {0};
+  e1.faces = {0};
+  cs.edges = {e0, e1};
+  const SelectionResult r = select_faces(cs, {-1.0}, {1, 0}, Params{});
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.status_text(), "infeasible");
+  EXPECT_EQ(r.selected, std::vector<char>(1, 0));
+  add_row("select_faces: infeasible program", "ok=false, status '" + r.status_text() + "'", 0);
+}
+
+TEST(BadInputSolver, NoCandidatesIsReported) {
+  const SelectionResult r = select_faces(CandidateSet{}, {}, {}, Params{});
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.status_text(), "no candidates");
+}
+
+TEST(BadInputSolver, TimeLimitWithoutSolutionIsReported) {
+  std::vector<double> cost;
+  std::vector<int> outside;
+  const CandidateSet cs = hard_program(3000, 4000, 3, cost, outside);
+  Params prm;
+  prm.mip_time_limit = 0.01;
+  const SelectionResult r = select_faces(cs, cost, outside, prm);
+  EXPECT_NE(r.status_text().find("time limit"), std::string::npos) << r.status_text();
+  if (!r.ok) {
+    EXPECT_EQ(r.status_text(), "time limit (no solution)");
+    EXPECT_EQ(r.selected, std::vector<char>(cs.faces.size(), 0));
+  } else {
+    EXPECT_EQ(r.status_text(), "feasible (time limit)");
+  }
+  EXPECT_LT(r.seconds, 5.0) << "the time limit was not honoured";
+  add_row("select_faces: 3000-face parity program, 10 ms limit",
+          "ok=" + std::string(r.ok ? "true" : "false") + ", status '" + r.status_text() + "', " + fmt(r.seconds) + " s", 0);
+}
+
+// A real, easy program: the arrangement of a cube's six planes in a larger region (54
+// candidates); rewarding the pieces on the cube selects exactly its six faces.
+CandidateSet cube_program(std::vector<double>& cost, std::vector<int>& outside) {
+  std::vector<SupportPlane> planes;
+  for (int k = 0; k < 3; ++k)
+    for (double sign : {1.0, -1.0}) {
+      SupportPlane sp;
+      sp.plane = Plane(sign * Vec3::Unit(k), -1.0);
+      sp.sem = k == 2 ? (sign > 0 ? Semantic::Roof : Semantic::Ground) : Semantic::Wall;
+      planes.push_back(sp);
+    }
+  Region region;
+  region.half = Vec3::Constant(2.0);
+  CandidateSet cs = build_candidates(planes, region);
+  for (const auto& f : cs.faces)
+    cost.push_back(f.centroid.lpNorm<Eigen::Infinity>() <= 1.0 + 1e-9 ? -f.area : f.area);
+  outside.assign(cs.edges.size(), 0);
+  return cs;
+}
+
+TEST(BadInputSolver, OneMillisecondLimitFailsEvenAnEasyProgram) {
+  std::vector<double> cost;
+  std::vector<int> outside;
+  const CandidateSet cs = cube_program(cost, outside);
+  ASSERT_GE(cs.faces.size(), 6u);
+  const SelectionResult easy = select_faces(cs, cost, outside, Params{});
+  ASSERT_TRUE(easy.ok) << easy.status_text();
+  EXPECT_EQ(easy.status_text(), "optimal");
+  EXPECT_EQ(std::count(easy.selected.begin(), easy.selected.end(), 1), 6);
+  // GLPK stops at its first time check when tm_lim <= 1 ms: a deterministic solver fault.
+  Params prm;
+  prm.mip_time_limit = 0.001;
+  const SelectionResult r = select_faces(cs, cost, outside, prm);
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.status_text(), "time limit (no solution)");
+  EXPECT_EQ(std::count(r.selected.begin(), r.selected.end(), 1), 0);
+  add_row("select_faces: cube arrangement (" + std::to_string(cs.faces.size()) + " candidates), 1 ms limit",
+          "ok=false, status '" + r.status_text() + "' (30 s limit: '" + easy.status_text() + "')", 0);
+}
+
+// The whole pipeline under a failing solver (the arrangement path forced): refine_building must
+// keep the repaired input, valid, with the solver status as the reason. Needs Params to accept a 1 ms limit
+// (params.h: mip_time_limit min 0.001); skipped while the bound is higher.
+TEST(BadInputSolver, RefineFallsBackToTheOriginalWhenSelectionTimesOut) {
+  double min_limit = 0;
+  for (const auto& info : param_table())
+    if (info.name == "mip_time_limit") min_limit = info.min;
+  if (min_limit > 0.001)
+    GTEST_SKIP() << "mip_time_limit cannot go below " << min_limit
+                 << " s: set its minimum to 0.001 in params.h to inject the GLPK time-limit fault";
+  const std::string dir = temp_dir("solver_fallback");
+  write_text(dir + "/m.obj", valid_model());
+  const Mesh model = read_obj(dir + "/m.obj");
+  PointCloud cloud;
+  cloud.points = wall_scan();
+  Params prm;
+  prm.mip_time_limit = 0.001;
+  prm.arrangement_only = 1;
+  const RefineResult r = refine_building(model, cloud, prm);
+  ASSERT_TRUE(r.valid) << r.report.dump(1);
+  EXPECT_FALSE(r.refined);
+  EXPECT_EQ(r.outcome, "kept");
+  EXPECT_EQ(r.reason, "face selection time limit (no solution)");
+  EXPECT_EQ(r.report.value("outcome", std::string()), r.outcome);
+  ASSERT_FALSE(r.report["replacements"].empty());
+  EXPECT_EQ(r.report["replacements"][0]["mip"].value("status", std::string()), "time limit (no solution)");
+  EXPECT_TRUE(validate_mesh(r.mesh).valid());
+  EXPECT_EQ(r.mesh.faces.size(), 6u);  // the repaired box, front wall where it was
+  add_row("refine_building, mip_time_limit 0.001", "outcome '" + r.outcome + "'", 0);
+
+  // And through the CLI: exit 0, the original written, the reason in the report.
+  write_text(dir + "/c.ply", valid_cloud());
+  const CliRun cli = run_cli("refine --model " + shell_quote(dir + "/m.obj") + " --cloud " + shell_quote(dir + "/c.ply") +
+                              " --out " + shell_quote(dir + "/r.obj") + " --report " + shell_quote(dir + "/r.json") +
+                              " --mip-time-limit 0.001 --arrangement-only 1",
+                          dir);
+  EXPECT_EQ(cli.exit, 0) << cli.err;
+  EXPECT_EQ(output_problem(dir + "/r.obj"), "");
+  const json rep = json::parse(read_text(dir + "/r.json"));
+  EXPECT_EQ(rep.value("outcome", std::string()), "kept");
+  EXPECT_EQ(rep.value("reason", std::string()), "face selection time limit (no solution)");
+  add_row("valid input, --mip-time-limit 0.001", first_line(cli.out), cli.exit);
+}
+
+}  // namespace

@@ -1,0 +1,242 @@
+// scripts/batch.mk over a small generated tile: resumable (a removed or older output redoes that
+// building, and only that one), a summary that follows every change, one run per folder (lock),
+// and SIGKILL at any point followed by a rerun giving exactly the outputs of an uninterrupted run.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
+
+#include "support/batch_fixtures.h"
+
+using namespace lodrefine::batch_fixtures;
+
+namespace {
+
+class Batch : public testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    TileRun t = tile_and_batch("batch", 4);
+    inputs_ = new fs::path(t.inputs);
+    done_ = new fs::path(t.done);
+    reference_ = new std::map<std::string, std::string>(std::move(t.outputs));
+    seconds_ = t.seconds;
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*inputs_);
+    fs::remove_all(*done_);
+  }
+
+  // Runs the batch; returns the building ids it refined (its "ok <id>:" / "FAILED <id>:" lines).
+  static std::vector<std::string> rerun(const fs::path& run) {
+    const fs::path log = run.parent_path() / (run.filename().string() + ".log");
+    EXPECT_EQ(shell(batch_command(run) + " > " + shell_quoted(log) + " 2>&1"), 0) << read_text(log);
+    std::vector<std::string> ids;
+    std::istringstream in(read_text(log));
+    for (std::string line; std::getline(in, line);) {
+      for (const std::string tag : {"ok ", "FAILED "})
+        if (line.rfind(tag, 0) == 0) ids.push_back(line.substr(tag.size(), line.find(':') - tag.size()));
+    }
+    std::sort(ids.begin(), ids.end());
+    return ids;
+  }
+
+  static std::vector<std::string> ids(const fs::path& run) {
+    std::vector<std::string> out;
+    for (const auto& e : fs::directory_iterator(run))
+      if (fs::exists(e.path() / "coarse.obj")) out.push_back(e.path().filename().string());
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+
+  static fs::path* inputs_;
+  static fs::path* done_;
+  static std::map<std::string, std::string>* reference_;
+  static double seconds_;
+};
+fs::path* Batch::inputs_ = nullptr;
+fs::path* Batch::done_ = nullptr;
+std::map<std::string, std::string>* Batch::reference_ = nullptr;
+double Batch::seconds_ = 0.0;
+
+TEST_F(Batch, ReferenceRunRefinedEveryBuilding) {
+  const auto building_ids = ids(*done_);
+  ASSERT_EQ(building_ids.size(), 4u);
+  for (const auto& id : building_ids) {
+    EXPECT_EQ(reference_->count(id + "/refined.obj"), 1u) << id;
+    EXPECT_EQ(reference_->count(id + "/report.json"), 1u) << id;
+  }
+  EXPECT_TRUE(fs::exists(*done_ / "summary.txt") && fs::exists(*done_ / "summary.json"));
+  EXPECT_TRUE(temporaries(*done_).empty());
+}
+
+TEST_F(Batch, RemovedOrOlderOutputRedoesOnlyThatBuilding) {
+  const fs::path run = fresh_dir("batch_resume");
+  copy_run(*done_, run);
+  EXPECT_TRUE(rerun(run).empty()) << "an up-to-date run must do nothing";
+  const auto summary_time = fs::last_write_time(run / "summary.json");
+
+  const auto building_ids = ids(run);
+  fs::remove(run / building_ids[0] / "refined.obj");
+  ASSERT_EQ(shell("touch -d 2000-01-01 " + shell_quoted(run / building_ids[2] / "report.json")), 0);
+  EXPECT_EQ(rerun(run), (std::vector<std::string>{building_ids[0], building_ids[2]}));
+  EXPECT_EQ(outcome_files(run), *reference_);
+  EXPECT_GT(fs::last_write_time(run / "summary.json"), summary_time) << "summary not refreshed";
+  EXPECT_TRUE(rerun(run).empty());
+  fs::remove_all(run);
+}
+
+TEST_F(Batch, SummaryFollowsAFailureAndARemovedBuilding) {
+  const fs::path run = fresh_dir("batch_summary");
+  copy_run(*done_, run);
+  const auto building_ids = ids(run);
+  // A new, unreadable cloud: the building is redone, fails, and the summary says why.
+  std::ofstream(run / building_ids[1] / "cloud.ply") << "not a ply\n";
+  EXPECT_EQ(rerun(run), std::vector<std::string>{building_ids[1]});
+  const std::string reason = read_text(run / building_ids[1] / "FAILED");
+  EXPECT_NE(reason.find("lodrefine: error:"), std::string::npos) << reason;
+  EXPECT_FALSE(fs::exists(run / building_ids[1] / "refined.obj"));
+  json summary = json::parse(read_text(run / "summary.json"));
+  EXPECT_EQ(summary["pooled"]["buildings"], 4);
+  EXPECT_EQ(summary["pooled"]["failed"], 1);
+  const std::string csv = read_text(run / "summary.csv");
+  EXPECT_NE(csv.find(reason.substr(0, reason.size() - 1)), std::string::npos) << "csv lacks the FAILED reason:\n" << csv;
+  EXPECT_EQ(csv.find("refined model missing"), std::string::npos) << csv;
+  EXPECT_TRUE(rerun(run).empty()) << "a recorded failure is not retried until FAILED is removed";
+
+  // A removed building leaves the summary.
+  fs::remove_all(run / building_ids[3]);
+  EXPECT_TRUE(rerun(run).empty());
+  summary = json::parse(read_text(run / "summary.json"));
+  EXPECT_EQ(summary["pooled"]["buildings"], 3);
+  fs::remove_all(run);
+}
+
+TEST_F(Batch, SecondConcurrentRunIsRefusedWithOneLine) {
+  const fs::path run = fresh_dir("batch_lock");
+  copy_run(*inputs_, run);
+  // A slow binary keeps the first run busy.
+  const fs::path slow = run.parent_path() / (run.filename().string() + "_slow.sh");
+  std::ofstream(slow) << "#!/bin/sh\nsleep 1\nexec '" << kBinary << "' \"$@\"\n";
+  fs::permissions(slow, fs::perms::owner_all);
+  const pid_t first = spawn_group(batch_command(run, "LODREFINE=" + shell_quoted(slow)) + " > /dev/null 2>&1");
+  for (int i = 0; i < 200 && !fs::exists(run / ".batch.pid"); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  ASSERT_TRUE(fs::exists(run / ".batch.pid"));
+  const fs::path err = run.parent_path() / (run.filename().string() + "_second.err");
+  const int second = shell(batch_command(run) + " > /dev/null 2> " + shell_quoted(err));
+  const std::string message = read_text(err);
+  EXPECT_NE(second, 0);
+  EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
+  EXPECT_NE(message.find("in use by another batch run"), std::string::npos) << message;
+  EXPECT_EQ(wait_exit(first), 0);
+  EXPECT_EQ(outcome_files(run), *reference_);
+  fs::remove_all(run);
+}
+
+TEST_F(Batch, SigkillAnywhereThenRerunEqualsUninterruptedRun) {
+  const fs::path run = fresh_dir("batch_kill");
+  copy_run(*inputs_, run);
+  // Kills spread over a whole run (measured on the reference), each followed by a restart.
+  for (double at : {0.05, 0.15, 0.3, 0.45, 0.6, 0.75, 0.9}) {
+    const pid_t pid = spawn_group(batch_command(run) + " > /dev/null 2>&1");
+    std::this_thread::sleep_for(std::chrono::duration<double>(at * seconds_));
+    ::kill(-pid, SIGKILL);
+    wait_exit(pid);
+  }
+  rerun(run);
+  EXPECT_EQ(outcome_files(run), *reference_);
+  EXPECT_TRUE(temporaries(run).empty()) << temporaries(run).front();
+  const json summary = json::parse(read_text(run / "summary.json"));
+  EXPECT_EQ(summary["pooled"]["buildings"], 4);
+  EXPECT_EQ(summary["pooled"]["failed"], 0);
+  EXPECT_TRUE(rerun(run).empty());
+  fs::remove_all(run);
+}
+
+}  // namespace
+
+namespace {
+
+// The tile table (summary.json / summary.csv): worst first, outcome and moved facades as the
+// refine reports say, and a lead-style "facades" list (surface ids) used when present.
+TEST_F(Batch, TileTableWorstFirstWithOutcomesAndMovedFacades) {
+  const json summary = json::parse(read_text(*done_ / "summary.json"));
+  const json& rows = summary["buildings"];
+  ASSERT_EQ(rows.size(), 4u);
+  double last_rmse = 1e300;
+  std::size_t moved_total = 0;
+  for (const auto& row : rows) {
+    const std::string id = row["id"];
+    const json report = json::parse(read_text(*done_ / id / "report.json"));
+    // Worst first among watertight, evaluated buildings: refined C2M RMSE descending.
+    ASSERT_TRUE(row["watertight"]["refined"].get<bool>()) << id;
+    const double rmse = row["c2m"]["refined"]["rmse"];
+    EXPECT_LE(rmse, last_rmse) << id;
+    last_rmse = rmse;
+    const std::string outcome = report["outcome"];
+    EXPECT_EQ(row["outcome"], outcome.rfind("refined", 0) == 0 ? "refined" : "kept") << id;
+    // The report's moved facades: its "facades" list, or (older reports) its successful replacements.
+    std::size_t moved = 0;
+    double max_move = 0.0;
+    const bool refined = outcome.rfind("refined", 0) == 0;
+    if (refined && report.contains("facades")) {
+      for (const auto& f : report["facades"])
+        ++moved, max_move = std::max(max_move, std::abs(f.value("displacement", f.value("max_move", 0.0))));
+    } else if (refined) {
+      for (const auto& r : report["replacements"])
+        if (r.value("ok", false)) ++moved, max_move = std::max(max_move, std::abs(r["moved_by"].get<double>()));
+    }
+    EXPECT_EQ(row["facades_moved"]["count"], moved) << id;
+    if (moved) EXPECT_NEAR(row["facades_moved"]["max"].get<double>(), max_move, 1e-9) << id;
+    for (const auto& f : row["facades_moved"]["facades"]) EXPECT_FALSE(f["surface"].is_null()) << id;
+    EXPECT_GT(row["refine_seconds"].get<double>(), 0.0);
+    moved_total += moved;
+  }
+  EXPECT_GT(moved_total, 0u) << "the generated buildings have misplaced scanned walls";
+  EXPECT_EQ(summary["pooled"]["facades_moved"]["count"], moved_total);
+  EXPECT_EQ(summary["pooled"]["outcomes"]["failed"], 0);
+  // The CSV lists the same buildings in the same order.
+  std::istringstream csv(read_text(*done_ / "summary.csv"));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line.rfind("id,outcome,reason,facades_moved,displacement_max,displacement_mean,", 0), 0u) << line;
+  for (const auto& row : rows) {
+    ASSERT_TRUE(std::getline(csv, line));
+    EXPECT_EQ(line.substr(0, line.find(',')), row["id"].get<std::string>());
+  }
+
+  // A report's "facades" list is read as such: surface ids with signed displacements, or input
+  // faces with their largest move; a kept building moved nothing whatever the list says.
+  const fs::path run = fresh_dir("batch_facades");
+  copy_run(*done_, run);
+  const std::string a = rows[0]["id"], b = rows[1]["id"], c = rows[2]["id"];
+  auto edit_report = [&](const std::string& id, const std::string& outcome, const json& facades) {
+    json report = json::parse(read_text(run / id / "report.json"));
+    report["outcome"] = outcome;
+    report["facades"] = facades;
+    std::ofstream(run / id / "report.json") << report.dump(2);
+  };
+  edit_report(a, "refined", {{{"surface", "wall-7"}, {"displacement", 0.5}}, {{"surface", "wall-8"}, {"displacement", -0.25}}});
+  edit_report(b, "refined", {{{"input_faces", {3, 4}}, {"evidence", "scan"}, {"max_move", 0.6}, {"mean_move", 0.4}}});
+  edit_report(c, "kept", {{{"input_faces", {1}}, {"evidence", "scan"}, {"max_move", 0.9}, {"mean_move", 0.9}}});
+  EXPECT_TRUE(rerun(run).empty());
+  const json updated = json::parse(read_text(run / "summary.json"));
+  for (const auto& row : updated["buildings"]) {
+    const json& m = row["facades_moved"];
+    if (row["id"] == a) {
+      EXPECT_EQ(m["count"], 2);
+      EXPECT_DOUBLE_EQ(m["max"].get<double>(), 0.5);
+      EXPECT_DOUBLE_EQ(m["mean"].get<double>(), 0.375);
+      EXPECT_EQ(m["facades"][1]["surface"], "wall-8");
+    } else if (row["id"] == b) {
+      EXPECT_EQ(m["count"], 1);
+      EXPECT_DOUBLE_EQ(m["max"].get<double>(), 0.6);
+      EXPECT_EQ(m["facades"][0]["surface"], json({3, 4}));
+    } else if (row["id"] == c) {
+      EXPECT_EQ(row["outcome"], "kept");
+      EXPECT_EQ(m["count"], 0);
+    }
+  }
+  fs::remove_all(run);
+}
+
+}  // namespace

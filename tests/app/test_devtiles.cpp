@@ -1,0 +1,78 @@
+// The dev tiles (../shared/devtiles: buildings from an independent generator and real Rotterdam
+// LoD2 geometry, with ground truth) as a regression gate: every building gets a valid output,
+// none fits its truth worse than its coarse model, and the pooled truth-facade RMSE stays low.
+// The project's judge is the tiles' own score.py; this is the same kind of measure in-process
+// (truth walls the scan saw, sampled, to the model). Skips where ../shared is absent.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "lodrefine/eval/eval.h"
+#include "lodrefine/core/geometry.h"
+#include "lodrefine/io/obj.h"
+#include "lodrefine/io/ply.h"
+#include "lodrefine/core/refine.h"
+#include "lodrefine/core/validate.h"
+
+using namespace lodrefine;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path tiles_dir() { return fs::path(LODREFINE_SOURCE_DIR) / ".." / "shared" / "devtiles"; }
+
+struct Sums {
+  double before = 0, after = 0;
+  std::size_t n = 0;
+};
+
+void run_tile(const std::string& tile, double max_pooled_rmse) {
+  const fs::path dir = tiles_dir() / tile;
+  if (!fs::is_directory(dir / "models")) GTEST_SKIP() << dir << " absent";
+  Sums pooled;
+  int buildings = 0;
+  std::vector<fs::path> models;
+  for (const auto& e : fs::directory_iterator(dir / "models")) models.push_back(e.path());
+  std::sort(models.begin(), models.end());
+  for (const auto& path : models) {
+    const std::string id = path.stem().string();
+    const Mesh coarse = read_obj(path.string());
+    const Mesh truth = read_obj((dir / "truth" / (id + ".obj")).string());
+    const PointCloud cloud = read_ply((dir / "clouds" / (id + ".ply")).string());
+    const RefineResult r = refine_building(coarse, cloud, Params{});
+    SCOPED_TRACE(id + ": " + r.outcome + " (" + r.reason + ")");
+    ++buildings;
+    EXPECT_NE(r.outcome, "kept-invalid");
+    const Vec3 o = local_origin(truth);
+    const Mesh t = translated(truth, -o), c = translated(coarse, -o), m = translated(r.mesh, -o);
+    EXPECT_TRUE(validate_mesh(m).valid()) << validate_mesh(m).problem;
+    std::vector<Vec3> pts;
+    for (const auto& p : cloud.points) pts.push_back(p - o);
+    const auto samples = sample_faces(t, scanned_walls(t, pts, 0.05, 50), 0.25);
+    if (samples.empty()) continue;
+    double sb = 0, sa = 0;
+    for (double d : cloud_to_mesh(c, samples)) sb += d * d;
+    for (double d : cloud_to_mesh(m, samples)) sa += d * d;
+    const double rb = std::sqrt(sb / samples.size()), ra = std::sqrt(sa / samples.size());
+    std::printf("%s %-18s %-10s facade %.3f -> %.3f m\n", tile.c_str(), id.c_str(), r.outcome.c_str(), rb, ra);
+    EXPECT_LE(ra, rb + 0.005) << "made worse";
+    pooled.before += sb;
+    pooled.after += sa;
+    pooled.n += samples.size();
+  }
+  ASSERT_GT(pooled.n, 0u);
+  const double before = std::sqrt(pooled.before / pooled.n), after = std::sqrt(pooled.after / pooled.n);
+  std::printf("%s: %d buildings, truth facade RMSE %.3f -> %.3f m\n", tile.c_str(), buildings, before, after);
+  EXPECT_LT(after, max_pooled_rmse);
+}
+
+}  // namespace
+
+// Bounds a little above what the current method reaches by this measure (2026-12-01: synth 0.003 m,
+// real 0.067 m; every truth wall with cloud points on it counts, neighbours' included, so the
+// figures differ from score.py's 0.019 / 0.029 m): a regression in matching, corners or
+// substitution shows here before it reaches a user.
+TEST(DevTiles, Synth) { run_tile("synth", 0.01); }
+TEST(DevTiles, Real) { run_tile("real", 0.08); }

@@ -1,0 +1,92 @@
+// Corners from the scan's extent: an unscanned side wall moves to where the scanned facade
+// ends, but only where the scanner saw the building end there.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "lodrefine/core/corners.h"
+#include "lodrefine/core/repair.h"
+
+using namespace lodrefine;
+
+namespace {
+
+// A closed box [0,12] x [0,8] x [0,6] (front wall y = 0 faces -y).
+Mesh box() {
+  Mesh soup;
+  soup.id = "box";
+  const Vec3 c[8] = {{0, 0, 0}, {12, 0, 0}, {12, 8, 0}, {0, 8, 0}, {0, 0, 6}, {12, 0, 6}, {12, 8, 6}, {0, 8, 6}};
+  const int quads[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+  const Semantic sem[6] = {Semantic::Ground, Semantic::Roof, Semantic::Wall, Semantic::Wall, Semantic::Wall, Semantic::Wall};
+  for (int f = 0; f < 6; ++f) {
+    Face face;
+    face.sem = sem[f];
+    for (int k = 0; k < 4; ++k) {
+      face.v.push_back(int(soup.vertices.size()));
+      soup.vertices.push_back(c[quads[f][k]]);
+    }
+    soup.faces.push_back(face);
+  }
+  return repair_model(soup, 0.01);
+}
+
+struct Scene {
+  Mesh mesh;
+  std::vector<ModelSurface> surfaces;
+  PointCloud cloud;
+  std::vector<ScanPlane> planes;
+  std::vector<ScannedWall> scanned;
+};
+
+// The front facade scanned from x = 0 to x = `end`; optionally the right side wall seen
+// obliquely for `side` metres behind the facade at x = `end`.
+Scene scene(double end, double side) {
+  Scene s;
+  s.mesh = box();
+  s.surfaces = model_surfaces(s.mesh);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.005);
+  ScanPlane sp;
+  for (double x = 0.02; x < end; x += 0.05)
+    for (double z = 0.1; z < 5.9; z += 0.05) {
+      sp.inliers.push_back(int(s.cloud.points.size()));
+      s.cloud.points.emplace_back(x, noise(rng), z);
+    }
+  for (double y = 0.05; y < side; y += 0.05)
+    for (double z = 0.1; z < 5.9; z += 0.05) s.cloud.points.emplace_back(end + noise(rng), y, z);
+  sp.plane = Plane(Vec3(0, -1, 0), 0.0);
+  sp.facade = true;
+  s.planes.push_back(sp);
+  for (int k = 0; k < int(s.surfaces.size()); ++k)
+    if (s.surfaces[k].plane.n.y() < -0.99) s.scanned.push_back({k, 0, sp.plane});
+  return s;
+}
+
+}  // namespace
+
+TEST(Corners, SideWallMovesToWhereTheFacadeEnds) {
+  Scene s = scene(11.3, 1.0);  // the building really ends at x = 11.3
+  const auto moves = corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{});
+  ASSERT_EQ(moves.size(), 1u);
+  const Plane& p = moves[0].move.plane;
+  EXPECT_GT(s.surfaces[moves[0].move.surface].plane.n.x(), 0.99) << "the right side wall";
+  EXPECT_NEAR(p.distance(Vec3(11.3, 0, 0)), 0.0, 0.06);
+  EXPECT_NEAR(moves[0].shift, -0.7, 0.06);
+}
+
+TEST(Corners, AScanThatJustStopsIsNoEvidence) {
+  Scene s = scene(11.3, 0.0);  // nothing seen where the facade's points end
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
+}
+
+TEST(Corners, AFacadeRunningPastTheCornerMovesItOut) {
+  Scene s = scene(12.5, 0.0);
+  const auto moves = corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{});
+  ASSERT_EQ(moves.size(), 1u);
+  EXPECT_NEAR(moves[0].shift, 0.5, 0.06);
+}
+
+TEST(Corners, AFacadeRunningOnIntoANeighbourIsNoEvidence) {
+  Scene s = scene(20.0, 0.0);  // a flush neighbour: the plane runs far past the corner
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
+}

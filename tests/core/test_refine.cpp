@@ -1,0 +1,103 @@
+// End to end on hand-made buildings with known truth (the generator's richer cases are in
+// test_end_to_end.cpp).
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "lodrefine/core/refine.h"
+#include "lodrefine/core/validate.h"
+
+using namespace lodrefine;
+
+namespace {
+
+const Vec3 kOrigin(85000.0, 447000.0, 0.0);
+
+// A polygon soup box [x0,x1]x[y0,y1]x[0,h] with semantics, georeferenced.
+Mesh box_soup(double x0, double x1, double y0, double y1, double h) {
+  const Vec3 c[8] = {{x0, y0, 0}, {x1, y0, 0}, {x1, y1, 0}, {x0, y1, 0},
+                     {x0, y0, h}, {x1, y0, h}, {x1, y1, h}, {x0, y1, h}};
+  const int quads[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+  const Semantic sem[6] = {Semantic::Ground, Semantic::Roof, Semantic::Wall, Semantic::Wall, Semantic::Wall, Semantic::Wall};
+  Mesh m;
+  m.id = "box";
+  for (int f = 0; f < 6; ++f) {
+    Face face;
+    face.sem = sem[f];
+    for (int k = 0; k < 4; ++k) {
+      face.v.push_back(int(m.vertices.size()));
+      m.vertices.push_back(c[quads[f][k]] + kOrigin);
+    }
+    m.faces.push_back(face);
+  }
+  return m;
+}
+
+// MLS-like points on the wall y = y_wall (x in [xa,xb], z up to zmax), with a recessed window
+// and street ground in front.
+PointCloud scan_front(double y_wall, double xa, double xb, double zmax, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  PointCloud pc;
+  for (double x = xa; x <= xb; x += 0.05)
+    for (double z = 0.2; z <= zmax; z += 0.05) {
+      const bool window = x > 3 && x < 4.2 && z > 1.5 && z < 3;
+      const double y = y_wall - (window ? -0.15 : 0.0) + noise(rng);
+      pc.points.push_back(Vec3(x, y, z) + kOrigin);
+    }
+  for (double x = xa; x <= xb; x += 0.1)
+    for (double y = y_wall - 6; y < y_wall - 0.3; y += 0.1) pc.points.push_back(Vec3(x, y, noise(rng)) + kOrigin);
+  return pc;
+}
+
+double max_abs_y_of_front(const Mesh& m, double expect_y) {
+  double worst = 0.0;
+  for (const auto& f : m.faces) {
+    if (f.sem != Semantic::Wall) continue;
+    std::vector<Vec3> poly;
+    for (int v : f.v) poly.push_back(m.vertices[v] - kOrigin);
+    const Vec3 n = (poly[1] - poly[0]).cross(poly[2] - poly[0]).normalized();
+    if (n.y() > -0.9) continue;
+    for (const auto& p : poly) worst = std::max(worst, std::abs(p.y() - expect_y));
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST(Refine, MovesAnOutdatedFacadeOntoTheScan) {
+  const Mesh coarse = box_soup(0, 12, -0.5, 8, 7);  // front wall 0.5 m too far out
+  const PointCloud cloud = scan_front(0.0, 0.5, 11.5, 5.0, 1);
+  Params prm;
+  const RefineResult r = refine_building(coarse, cloud, prm);
+  ASSERT_TRUE(r.valid) << r.report.dump(1);
+  EXPECT_TRUE(r.refined) << r.outcome;
+  EXPECT_EQ(r.outcome, "refined");
+  EXPECT_LT(max_abs_y_of_front(r.mesh, 0.0), 0.02);
+  const Validation v = validate_mesh(r.mesh);  // georeferenced frame: still valid
+  EXPECT_TRUE(v.valid()) << v.problem;
+  EXPECT_NEAR(v.volume, 12 * 8 * 7, 12 * 7 * 0.03);
+  for (const auto& p : r.mesh.vertices) EXPECT_LE(p.z() - kOrigin.z(), 7.0 + 1e-6);  // roof kept
+}
+
+TEST(Refine, MovesAFacadeInwardsAndKeepsTheRest) {
+  const Mesh coarse = box_soup(0, 12, 0.6, 8, 7);  // front wall 0.6 m too far in
+  const PointCloud cloud = scan_front(0.0, 0.5, 11.5, 5.0, 2);
+  const RefineResult r = refine_building(coarse, cloud, Params{});
+  ASSERT_TRUE(r.valid);
+  EXPECT_TRUE(r.refined) << r.outcome;
+  EXPECT_LT(max_abs_y_of_front(r.mesh, 0.0), 0.02) << r.report["replacements"].dump(1);
+  EXPECT_EQ(r.mesh.faces.size(), 6u);  // still a box: coplanar pieces merged back
+}
+
+TEST(Refine, NoScanFallsBackToTheRepairedOriginal) {
+  const Mesh coarse = box_soup(0, 12, 0, 8, 7);
+  PointCloud cloud;
+  cloud.points.push_back(kOrigin + Vec3(100, 100, 0));
+  const RefineResult r = refine_building(coarse, cloud, Params{});
+  ASSERT_TRUE(r.valid);
+  EXPECT_FALSE(r.refined);
+  EXPECT_EQ(r.outcome, "kept");
+  EXPECT_EQ(r.reason, "no planes found in the cloud near the model");
+  EXPECT_EQ(r.mesh.faces.size(), 6u);
+}

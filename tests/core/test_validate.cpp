@@ -1,0 +1,169 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+
+#include "lodrefine/core/geometry.h"
+#include "lodrefine/core/validate.h"
+
+using namespace lodrefine;
+
+namespace {
+
+// A closed prism with shared vertices over a counter-clockwise footprint, faces outward:
+// walls 0..n-1 (wall i along footprint edge i), then roof n, then ground n+1.
+Mesh prism(const std::vector<Vec2>& foot, double z0, double z1) {
+  Mesh m;
+  const int n = int(foot.size());
+  for (const Vec2& p : foot) m.vertices.emplace_back(p.x(), p.y(), z0);
+  for (const Vec2& p : foot) m.vertices.emplace_back(p.x(), p.y(), z1);
+  Face roof{{}, Semantic::Roof, n}, ground{{}, Semantic::Ground, n + 1};
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    m.faces.push_back({{i, j, n + j, n + i}, Semantic::Wall, i});
+    roof.v.push_back(n + i);
+    ground.v.insert(ground.v.begin(), i);
+  }
+  m.faces.push_back(roof);
+  m.faces.push_back(ground);
+  return m;
+}
+
+Mesh unit_cube() { return prism({{0, 0}, {1, 0}, {1, 1}, {0, 1}}, 0, 1); }
+
+void reverse_face(Face& f) { std::reverse(f.v.begin(), f.v.end()); }
+
+// Appends `b` to `a`, sharing vertices at identical coordinates.
+Mesh combined(const Mesh& a, const Mesh& b) {
+  Mesh m = a;
+  std::vector<int> map;
+  for (const Vec3& p : b.vertices) {
+    const auto it = std::find(m.vertices.begin(), m.vertices.end(), p);
+    map.push_back(int(it - m.vertices.begin()));
+    if (it == m.vertices.end()) m.vertices.push_back(p);
+  }
+  for (Face f : b.faces) {
+    for (int& i : f.v) i = map[i];
+    m.faces.push_back(f);
+  }
+  return m;
+}
+
+bool mentions(const Validation& v, const std::string& what) { return v.problem.find(what) != std::string::npos; }
+
+}  // namespace
+
+TEST(Validate, ClosedCubeIsValid) {
+  const Validation v = validate_mesh(unit_cube());
+  EXPECT_TRUE(v.valid()) << v.problem;
+  EXPECT_TRUE(v.watertight());
+  EXPECT_EQ(v.boundary_edges, 0);
+  EXPECT_EQ(v.nonmanifold_edges, 0);
+  EXPECT_EQ(v.nonmanifold_vertices, 0);
+  EXPECT_EQ(v.inconsistent_edges, 0);
+  EXPECT_EQ(v.components, 1);
+  EXPECT_TRUE(v.outward);
+  EXPECT_NEAR(v.volume, 1.0, 1e-12);
+  EXPECT_NEAR(v.max_planarity_error, 0.0, 1e-12);
+  EXPECT_FALSE(v.self_intersecting);  // triangles sharing vertices and edges do not count
+}
+
+TEST(Validate, GeoreferencedNonConvexPrismIsValid) {
+  const Mesh l =
+      translated(prism({{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}}, 0, 3), {85123.4567, 447987.6543, 2});
+  const Validation v = validate_mesh(l);
+  EXPECT_TRUE(v.valid()) << v.problem;
+  EXPECT_NEAR(v.volume, 9.0, 1e-6);
+  EXPECT_FALSE(v.self_intersecting);
+}
+
+TEST(Validate, MissingFaceGivesFourBoundaryEdges) {
+  Mesh m = unit_cube();
+  m.faces.pop_back();
+  const Validation v = validate_mesh(m);
+  EXPECT_EQ(v.boundary_edges, 4);
+  EXPECT_FALSE(v.watertight());
+  EXPECT_EQ(v.problem, "4 boundary edges (mesh not closed)");
+}
+
+TEST(Validate, FlippedFaceGivesInconsistentEdges) {
+  Mesh m = unit_cube();
+  reverse_face(m.faces[2]);
+  const Validation v = validate_mesh(m);
+  EXPECT_TRUE(v.watertight());
+  EXPECT_EQ(v.inconsistent_edges, 4);
+  EXPECT_TRUE(mentions(v, "4 inconsistently oriented edges")) << v.problem;
+}
+
+TEST(Validate, InvertedCubeIsNotOutward) {
+  Mesh m = unit_cube();
+  for (Face& f : m.faces) reverse_face(f);
+  const Validation v = validate_mesh(m);
+  EXPECT_EQ(v.inconsistent_edges, 0);
+  EXPECT_FALSE(v.outward);
+  EXPECT_NEAR(v.volume, -1.0, 1e-12);
+  EXPECT_TRUE(mentions(v, "inward")) << v.problem;
+}
+
+TEST(Validate, NonPlanarQuadIsReported) {
+  Mesh m = unit_cube();
+  m.vertices[6].z() += 0.05;  // a roof corner: the roof twists, its two walls stay planar
+  const Validation v = validate_mesh(m, 0.01);
+  EXPECT_NEAR(v.max_planarity_error, 0.05 / 4, 1e-4);
+  EXPECT_TRUE(mentions(v, "planarity error 0.0125 m exceeds 0.01 m")) << v.problem;
+  EXPECT_TRUE(validate_mesh(m, 0.02).valid());
+}
+
+TEST(Validate, CubesSharingAnEdgeAreNonManifold) {
+  const Validation v = validate_mesh(combined(unit_cube(), translated(unit_cube(), {1, 1, 0})));
+  EXPECT_EQ(v.nonmanifold_edges, 1);
+  EXPECT_EQ(v.boundary_edges, 0);
+  EXPECT_FALSE(v.watertight());
+  EXPECT_TRUE(mentions(v, "1 non-manifold edges")) << v.problem;
+}
+
+TEST(Validate, CubesSharingAVertexHaveANonManifoldVertexAndTwoComponents) {
+  const Validation v = validate_mesh(combined(unit_cube(), translated(unit_cube(), {1, 1, 1})));
+  EXPECT_EQ(v.nonmanifold_edges, 0);
+  EXPECT_EQ(v.nonmanifold_vertices, 1);
+  EXPECT_EQ(v.components, 2);
+  EXPECT_NEAR(v.volume, 2.0, 1e-12);
+  EXPECT_FALSE(v.self_intersecting);  // touching at the shared vertex only
+  EXPECT_TRUE(mentions(v, "1 non-manifold vertices")) << v.problem;
+}
+
+TEST(Validate, SeparateCubesAreTwoComponents) {
+  const Validation v = validate_mesh(combined(unit_cube(), translated(unit_cube(), {3, 0, 0})));
+  EXPECT_TRUE(v.watertight());
+  EXPECT_EQ(v.components, 2);
+  EXPECT_EQ(v.problem, "2 connected components (expected one)");
+}
+
+TEST(Validate, VertexPushedThroughTheOppositeFaceSelfIntersects) {
+  Mesh m = unit_cube();
+  m.vertices[6] = Vec3(0.8, 0.8, -0.5);  // roof corner (1,1,1) pushed out through the ground
+  const Validation v = validate_mesh(m, 10.0);
+  EXPECT_TRUE(v.watertight());
+  EXPECT_TRUE(v.self_intersecting);
+  EXPECT_EQ(v.problem, "faces intersect each other");
+  EXPECT_FALSE(validate_mesh(m, 10.0, false).self_intersecting);  // the check can be skipped
+}
+
+TEST(Validate, MalformedFacesAreReportedNotCrashed) {
+  Mesh m = unit_cube();
+  m.faces[0].v.push_back(42);
+  EXPECT_EQ(validate_mesh(m).problem, "face 0 references missing vertex 42");
+  m = unit_cube();
+  m.faces[1].v = {0, 1};
+  EXPECT_EQ(validate_mesh(m).problem, "face 1 has fewer than 3 vertices");
+  EXPECT_EQ(validate_mesh(Mesh{}).problem, "no faces");
+}
+
+TEST(Validate, EdgeUsesRecordDirection) {
+  const EdgeUses uses = edge_uses(unit_cube().faces);
+  EXPECT_EQ(uses.size(), 12u);
+  for (const auto& [e, u] : uses) {
+    ASSERT_EQ(u.size(), 2u);
+    EXPECT_NE(u[0].forward, u[1].forward) << e.first << "-" << e.second;
+  }
+}

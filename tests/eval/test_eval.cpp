@@ -1,0 +1,223 @@
+// Metrics of the paper's evaluation: C2M signs and values, statistics, ΔD, watertightness,
+// pooling, and the SVG plots.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "lodrefine/eval/eval.h"
+#include "lodrefine/eval/plots.h"
+#include "support/eval_fixtures.h"
+
+using namespace lodrefine;
+using namespace lodrefine::fixtures;
+
+namespace {
+
+Mesh unit_cube() { return box(Vec3::Zero(), Vec3::Ones()); }
+
+// Every face with its own copies of its vertices, as exported from CityGML.
+Mesh as_soup(const Mesh& m) {
+  Mesh s;
+  s.id = m.id;
+  for (const Face& f : m.faces) {
+    Face g = f;
+    g.v.clear();
+    for (int v : f.v) {
+      g.v.push_back(int(s.vertices.size()));
+      s.vertices.push_back(m.vertices[std::size_t(v)]);
+    }
+    s.faces.push_back(g);
+  }
+  return s;
+}
+
+BuildingEval fake_building(std::vector<double> before, std::vector<double> after, bool wt_after) {
+  BuildingEval b;
+  b.c2m_before = std::move(before), b.c2m_after = std::move(after);
+  b.facade_points = b.c2m_before.size();
+  b.before = summarize_distances(b.c2m_before), b.after = summarize_distances(b.c2m_after);
+  b.watertight_after = wt_after;
+  b.delta_d = 0.1;
+  return b;
+}
+
+}  // namespace
+
+TEST(EvalC2M, UnitCubeFaceEdgeVertexAndInside) {
+  const std::vector<Vec3> pts = {
+      {0.5, 0.5, 1.3},  // above the roof
+      {0.5, 0.5, 0.8},  // inside, nearest the roof
+      {0.5, 0.5, 0.5},  // centre: all six faces tie
+      {1.2, 0.5, 1.2},  // nearest an edge
+      {1.2, 1.2, 1.2},  // nearest a vertex
+      {-0.3, 0.5, 0.1}, // outside a wall
+      {0.9, 0.5, 0.9},  // inside, equidistant to two faces
+      {1.0, 0.3, 0.7},  // on the surface
+  };
+  const std::vector<double> want = {0.3, -0.2, -0.5, std::sqrt(0.08), std::sqrt(0.12), 0.3, -0.1, 0.0};
+  const auto got = cloud_to_mesh(unit_cube(), pts);
+  ASSERT_EQ(got.size(), want.size());
+  for (std::size_t i = 0; i < want.size(); ++i) EXPECT_NEAR(got[i], want[i], 1e-12) << "point " << i;
+}
+
+TEST(EvalC2M, SoupAndGeoreferencedFrameGiveTheSameDistances) {
+  const std::vector<Vec3> pts = {{1.2, 0.5, 1.2}, {1.2, 1.2, 1.2}, {0.5, 0.5, 0.8}, {-0.1, -0.1, 0.5}};
+  const auto ref = cloud_to_mesh(unit_cube(), pts);
+  const Vec3 shift(85000.0, 447000.0, 12.0);
+  Mesh geo = as_soup(unit_cube());
+  for (auto& v : geo.vertices) v += shift;
+  std::vector<Vec3> geo_pts = pts;
+  for (auto& p : geo_pts) p += shift;
+  const auto got = cloud_to_mesh(geo, geo_pts);
+  for (std::size_t i = 0; i < pts.size(); ++i) EXPECT_NEAR(got[i], ref[i], 1e-9) << "point " << i;
+}
+
+TEST(EvalC2M, NeedleApexUsesThePseudonormal) {
+  const auto d = cloud_to_mesh(needle(), {{-0.5, 0.0, 10.5}, {0.5, 0.0, 10.5}, {0.0, 0.5, 10.5}, {0.0, 0.0, 9.5}});
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(d[std::size_t(i)], std::sqrt(0.5), 1e-12) << "point " << i;
+  EXPECT_NEAR(d[3], -0.5 / std::sqrt(101.0), 1e-12);  // inside, nearest a side face
+}
+
+TEST(EvalC2M, EmptyMeshIsAnInputError) { EXPECT_THROW(cloud_to_mesh(Mesh{}, {{0, 0, 0}}), InputError); }
+
+TEST(EvalStats, KnownVectors) {
+  const DistanceStats a = summarize_distances({1, -1, 2, -2, 0});
+  EXPECT_EQ(a.count, 5u);
+  EXPECT_NEAR(a.mean, 0.0, 1e-12);
+  EXPECT_NEAR(a.rmse, std::sqrt(2.0), 1e-12);
+  EXPECT_NEAR(a.mae, 1.2, 1e-12);
+  EXPECT_NEAR(a.std, std::sqrt(2.0), 1e-12);
+  EXPECT_NEAR(a.median, 0.0, 1e-12);
+  EXPECT_NEAR(a.p95, 2.0, 1e-12);
+  EXPECT_NEAR(a.max_abs, 2.0, 1e-12);
+
+  const DistanceStats b = summarize_distances({0.4, 0.1, -0.3, 0.2});
+  EXPECT_NEAR(b.mean, 0.1, 1e-12);
+  EXPECT_NEAR(b.rmse, std::sqrt(0.075), 1e-12);
+  EXPECT_NEAR(b.mae, 0.25, 1e-12);
+  EXPECT_NEAR(b.std, std::sqrt(0.065), 1e-12);     // population std: rmse² = mean² + std²
+  EXPECT_NEAR(b.median, 0.15, 1e-12);
+  EXPECT_NEAR(b.p95, 0.3 + 0.85 * 0.1, 1e-12);     // of |d| = {0.1, 0.2, 0.3, 0.4}
+
+  EXPECT_EQ(summarize_distances({}).count, 0u);
+  EXPECT_EQ(summarize_distances({}).rmse, 0.0);
+}
+
+TEST(EvalCentroid, VolumeCentroidOfTranslatedBoxAndAreaFallback) {
+  const Vec3 c = mesh_centroid(box({2, 3, 4}, {4, 7, 5}));
+  EXPECT_NEAR((c - Vec3(3, 5, 4.5)).norm(), 0.0, 1e-12);
+  // A box without its ground is open: area centroid, pulled up by the roof.
+  Mesh open = box({0, 0, 0}, {2, 2, 2});
+  open.faces.erase(open.faces.begin());
+  const Vec3 a = mesh_centroid(open);
+  EXPECT_NEAR(a.z(), (4 * 4 * 1.0 + 4 * 2.0) / 20.0, 1e-12);
+}
+
+TEST(EvalWatertight, ClosedSoupOpenFlippedAndGapped) {
+  EXPECT_TRUE(is_watertight(unit_cube()));
+  EXPECT_TRUE(is_watertight(as_soup(unit_cube())));  // identical coordinates are welded
+
+  Mesh open = unit_cube();
+  open.faces.pop_back();
+  EXPECT_FALSE(is_watertight(open));
+
+  Mesh flipped = unit_cube();
+  std::reverse(flipped.faces[2].v.begin(), flipped.faces[2].v.end());
+  EXPECT_FALSE(is_watertight(flipped));
+
+  Mesh gapped = as_soup(unit_cube());
+  gapped.vertices[0].x() += 0.002;  // a 2 mm gap is not welded away
+  EXPECT_FALSE(is_watertight(gapped));
+}
+
+TEST(EvalSampling, GridEveryTenCentimetres) {
+  const Mesh cube = unit_cube();
+  const auto s = sample_faces(cube, {1}, 0.1);  // the 1 m² roof
+  EXPECT_EQ(s.size(), 100u);
+  for (const auto& p : s) EXPECT_NEAR(p.z(), 1.0, 1e-12);
+  // Points on two walls (and a stray one) mark exactly those walls as scanned.
+  std::vector<Vec3> pts;
+  for (int i = 1; i < 10; ++i)
+    for (int j = 1; j < 10; ++j) pts.push_back({0.1 * i, 0.01, 0.1 * j}), pts.push_back({-0.02, 0.1 * i, 0.1 * j});
+  pts.push_back({1.01, 0.5, 0.5});
+  EXPECT_EQ(scanned_walls(cube, pts), (std::vector<int>{2, 5}));
+}
+
+TEST(EvalPool, PooledOverPointsVersusMeanOfBuildings) {
+  std::vector<BuildingEval> run = {fake_building({0.1, 0.1, 0.1, 0.1}, {0, 0, 0, 0}, true),
+                                   fake_building({1.0}, {0.5}, true)};
+  BuildingEval failed;
+  failed.error = "refined.obj missing";
+  failed.watertight_before = true;
+  run.push_back(failed);
+  const PooledEval p = pool_evaluations(run);
+  EXPECT_EQ(p.buildings, 3u);
+  EXPECT_EQ(p.failed, 1u);
+  EXPECT_EQ(p.evaluated, 2u);
+  EXPECT_EQ(p.before.count, 5u);
+  EXPECT_NEAR(p.before.rmse, std::sqrt((4 * 0.01 + 1.0) / 5), 1e-12);
+  EXPECT_NEAR(p.mean_before.rmse, (0.1 + 1.0) / 2, 1e-12);
+  EXPECT_NEAR(p.after.rmse, std::sqrt(0.25 / 5), 1e-12);
+  EXPECT_NEAR(p.mean_after.mae, 0.25, 1e-12);
+  EXPECT_NEAR(p.delta_d_mean, 0.1, 1e-12);
+  EXPECT_NEAR(p.watertight_rate_before, 1.0 / 3, 1e-12);
+  EXPECT_NEAR(p.watertight_rate_after, 2.0 / 3, 1e-12);  // the failure counts as not watertight
+}
+
+TEST(EvalPlots, SvgDocuments) {
+  const std::vector<double> before = {-0.3, -0.1, 0.0, 0.2, 0.25, 1.5}, after = {-0.02, 0.0, 0.01, 0.03};
+  for (const std::string& svg : {svg_histogram(before, after, "C2M"), svg_boxplot(before, after, "C2M")}) {
+    EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+    EXPECT_NE(svg.find("</svg>"), std::string::npos);
+    EXPECT_EQ(svg.find("nan"), std::string::npos);
+  }
+  std::vector<Vec3> pts(12000, Vec3(0.5, 0.0, 0.5));
+  const std::string fp = svg_footprint(box({0, 0, 0}, {10, 8, 6}), box({0.2, 0, 0}, {10, 8, 6}), pts, "b & <1>");
+  std::size_t circles = 0;
+  for (std::size_t at = fp.find("<circle"); at != std::string::npos; at = fp.find("<circle", at + 1)) ++circles;
+  EXPECT_LE(circles, 5000u);
+  EXPECT_GE(circles, 4000u);
+  EXPECT_NE(fp.find("b &amp; &lt;1&gt;"), std::string::npos);
+  EXPECT_NE(fp.find(" m</text>"), std::string::npos);  // the scale bar
+}
+
+// End to end on a building-sized box: the coarse model is shifted 30 cm in x and 20 cm in y,
+// away from the two densely scanned walls; the refined one is the truth.
+TEST(EvalBuilding, ShiftedBoxBeforeAndAfter) {
+  const Mesh truth = box({0, 0, 0}, {10, 8, 6});
+  Mesh original = as_soup(box({0.3, 0.2, 0}, {10.3, 8.2, 6}));
+  original.id = "b1";
+  PointCloud cloud;
+  for (double u = 0.025; u < 10; u += 0.05)
+    for (double z = 0.025; z < 6; z += 0.05) cloud.points.push_back({u, 0.0, z});
+  for (double u = 0.025; u < 8; u += 0.05)
+    for (double z = 0.025; z < 6; z += 0.05) cloud.points.push_back({0.0, u, z});
+  const BuildingEval e = evaluate_building(original, truth, cloud, &truth, Params{});
+  ASSERT_TRUE(e.ok()) << e.error;
+  ASSERT_GT(e.facade_points, cloud.points.size() * 9 / 10);
+  EXPECT_EQ(e.id, "b1");
+  EXPECT_NEAR(e.after.rmse, 0.0, 1e-9);
+  EXPECT_GT(e.before.mean, 0.15);  // the facade points lie outside the shifted model
+  EXPECT_GT(e.before.rmse, 0.15);
+  EXPECT_TRUE(e.watertight_before);
+  EXPECT_TRUE(e.watertight_after);
+  Vec3 c_mls = Vec3::Zero();
+  for (int i : e.facade_index) c_mls += cloud.points[std::size_t(i)];
+  c_mls /= double(e.facade_index.size());
+  const double want = (c_mls - Vec3(5.3, 4.2, 3)).norm() - (c_mls - Vec3(5, 4, 3)).norm();
+  EXPECT_NEAR(e.delta_d, want, 1e-9);
+  EXPECT_GT(e.delta_d, 0.0);
+  ASSERT_TRUE(e.truth_facade_after && e.truth_roof_after);
+  EXPECT_EQ(e.scanned_truth_faces, (std::vector<int>{2, 5}));
+  EXPECT_NEAR(e.truth_facade_after->max_abs, 0.0, 1e-9);
+  EXPECT_GT(e.truth_facade_before->rmse, 0.15);
+  EXPECT_NEAR(e.truth_roof_before->median, 0.0, 1e-9);  // same roof plane, shifted outline
+}
+
+TEST(EvalBuilding, EmptyRefinedModelIsAFailureRow) {
+  const Mesh truth = box({0, 0, 0}, {10, 8, 6});
+  const BuildingEval e = evaluate_building(truth, Mesh{}, PointCloud{}, nullptr, Params{});
+  EXPECT_FALSE(e.ok());
+  EXPECT_FALSE(e.watertight_after);
+  EXPECT_TRUE(e.watertight_before);
+}

@@ -1,0 +1,514 @@
+// A city file in, a city file out: generated buildings in a CityJSON file, the Rotterdam
+// CityJSON and the Den Haag CityGML (when ../shared is present) refined with a cloud; every
+// building accounted for, the untouched ones byte-identical, the output schema-valid (CityJSON
+// 2.0.2, python3-jsonschema) and its refined geometry valid by the project's own check.
+#include <gtest/gtest.h>
+
+#include "support/cli_fixtures.h"
+
+#include <chrono>
+#include <functional>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+
+#include "lodrefine/io/cityfile.h"
+#include "lodrefine/io/cityjson.h"
+#include "lodrefine/io/citygml.h"
+#include "lodrefine/core/geometry.h"
+#include "lodrefine/io/obj.h"
+#include "lodrefine/io/ply.h"
+#include "lodrefine/io/files.h"
+#include "lodrefine/io/las.h"
+#include "lodrefine/core/refine.h"
+#include "lodrefine/synth/synth.h"
+#include "lodrefine/core/validate.h"
+
+using namespace lodrefine;
+namespace fs = std::filesystem;
+using json = nlohmann::ordered_json;
+
+namespace {
+
+using cli_fixtures::Cli;
+using cli_fixtures::run_cli;
+
+std::string test_dir() { return cli_fixtures::test_dir("lodrefine_city"); }
+
+json load(const std::string& path) {
+  std::ifstream in(path);
+  return json::parse(in);
+}
+
+fs::path shared_dir() { return fs::path(LODREFINE_SOURCE_DIR) / ".." / "shared"; }
+
+// "valid", or the validator's complaint; "" when the schemas or python3-jsonschema are absent.
+std::string schema_verdict(const std::string& path) {
+  const fs::path schemas = shared_dir() / "schemas" / "cityjson-2.0.2";
+  if (!fs::exists(schemas) || !fs::exists("/usr/bin/python3")) return "";
+  const std::string out = path + ".verdict";
+  const std::string cmd = "/usr/bin/python3 " + std::string(LODREFINE_SOURCE_DIR) + "/scripts/validate_cityjson.py " +
+                          schemas.string() + " " + path + " >" + out + " 2>&1";
+  const int st = std::system(cmd.c_str());
+  std::ifstream in(out);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  if (WIFEXITED(st) && WEXITSTATUS(st) == 2) return "";
+  while (!text.empty() && text.back() == '\n') text.pop_back();
+  return text;
+}
+
+// The building's faces welded on identical coordinates (the file's integers), then checked.
+std::string geometry_problem(const Mesh& soup) {
+  Mesh m;
+  m.id = soup.id;
+  std::map<std::array<double, 3>, int> index;
+  for (const Face& f : soup.faces) {
+    Face g = f;
+    g.v.clear();
+    for (int v : f.v) {
+      const Vec3& p = soup.vertices[std::size_t(v)];
+      const auto [it, added] = index.emplace(std::array<double, 3>{p.x(), p.y(), p.z()}, int(m.vertices.size()));
+      if (added) m.vertices.push_back(p);
+      g.v.push_back(it->second);
+    }
+    m.faces.push_back(g);
+  }
+  const Vec3 o = local_origin(m);
+  const Validation v = validate_mesh(translated(m, -o));
+  return v.valid() ? "" : v.problem;
+}
+
+// A CityJSON 2.0 document of generated buildings: the coarse soup as an LoD 2.2 MultiSurface
+// with semantics, plus an LoD 1 block and attributes, so the test sees both kept exactly.
+json synth_city(const std::vector<SynthBuilding>& bs, const Vec3& translate) {
+  json doc = {{"type", "CityJSON"}, {"version", "2.0"},
+              {"transform", {{"scale", {0.001, 0.001, 0.001}}, {"translate", {translate.x(), translate.y(), translate.z()}}}},
+              {"metadata", {{"referenceSystem", "https://www.opengis.net/def/crs/EPSG/0/7415"}, {"title", "synth"}}},
+              {"CityObjects", json::object()}, {"vertices", json::array()}};
+  for (const auto& b : bs) {
+    json boundaries = json::array(), values = json::array();
+    for (const Face& f : b.coarse.faces) {
+      json ring = json::array();
+      for (int v : f.v) {
+        const Vec3 q = (b.coarse.vertices[std::size_t(v)] - translate) / 0.001;
+        ring.push_back(doc["vertices"].size());
+        doc["vertices"].push_back({std::llround(q.x()), std::llround(q.y()), std::llround(q.z())});
+      }
+      boundaries.push_back(json::array({ring}));
+      values.push_back(f.sem == Semantic::Wall ? 0 : f.sem == Semantic::Roof ? 1 : f.sem == Semantic::Ground ? 2 : -1);
+      if (values.back() == -1) values.back() = nullptr;
+    }
+    json lod2 = {{"type", "MultiSurface"}, {"lod", "2.2"}, {"boundaries", boundaries},
+                 {"semantics", {{"surfaces", {{{"type", "WallSurface"}}, {{"type", "RoofSurface"}}, {{"type", "GroundSurface"}}}},
+                                {"values", values}}}};
+    json lod1 = {{"type", "MultiSurface"}, {"lod", "1"}, {"boundaries", json::array({boundaries[0]})}};
+    doc["CityObjects"][b.id] = {{"type", "Building"},
+                                {"attributes", {{"yearOfConstruction", 1931}, {"function", "residential"}}},
+                                {"geometry", {lod1, lod2}}};
+  }
+  return doc;
+}
+
+// Checks the contract on an output: counts add up, untouched and kept buildings identical to
+// the input (objects and their vertices), refined ones a valid Solid with semantics, schema.
+void check_city_output(const json& in, const std::string& out_path, const CityRefineSummary& s) {
+  const json out = load(out_path);
+  EXPECT_EQ(out["version"], "2.0");
+  EXPECT_EQ(out["metadata"], in["metadata"]);
+  EXPECT_EQ(out["transform"], in["transform"]);
+  ASSERT_EQ(out["CityObjects"].size(), in["CityObjects"].size());
+  EXPECT_EQ(s.refined + s.kept + s.kept_invalid + s.untouched, s.buildings);
+  std::map<std::string, std::string> outcome;
+  for (const auto& o : s.outcomes) outcome[o.id] = o.outcome;
+  int identical = 0;
+  std::size_t vertex_mismatches = 0;
+  for (const auto& [id, obj] : in["CityObjects"].items()) {
+    ASSERT_TRUE(out["CityObjects"].contains(id)) << id;
+    json o = out["CityObjects"][id];
+    const auto it = outcome.find(id);
+    if (it != outcome.end()) {
+      EXPECT_EQ(o["attributes"]["lodrefine_outcome"], it->second) << id;
+      for (const char* k : {"lodrefine_outcome", "lodrefine_reason", "lodrefine_facades_moved"}) o["attributes"].erase(k);
+      if (o["attributes"].empty() && !obj.contains("attributes")) o.erase("attributes");
+    }
+    if (it != outcome.end() && it->second == "refined") {
+      EXPECT_EQ(o.value("attributes", json()), obj.value("attributes", json())) << id;
+      EXPECT_EQ(o.value("geometry", json()).size(), obj.value("geometry", json()).size()) << id;
+      continue;
+    }
+    // Kept and untouched: the object and every vertex it uses exactly as read.
+    if (o != obj) ADD_FAILURE() << id << " changed";
+    std::function<void(const json&)> same_vertices = [&](const json& j) {
+      if (j.is_array()) {
+        for (const auto& e : j) same_vertices(e);
+      } else if (j.is_number_integer()) {
+        vertex_mismatches += out["vertices"][j.get<std::size_t>()] != in["vertices"][j.get<std::size_t>()];
+      }
+    };
+    if (obj.contains("geometry"))
+      for (const auto& g : obj["geometry"]) same_vertices(g["boundaries"]);
+    ++identical;
+  }
+  EXPECT_EQ(vertex_mismatches, 0u);
+  EXPECT_EQ(identical, s.buildings - s.refined + int(in["CityObjects"].size()) - s.buildings);
+  // Refined geometry passes the project's validity check.
+  const CityJsonFile back = read_cityjson(out_path);
+  for (const auto& b : back.buildings) {
+    const auto it = outcome.find(b.mesh.id);
+    if (it == outcome.end() || it->second != "refined") continue;
+    EXPECT_EQ(b.geometry_type, "Solid") << b.mesh.id;
+    EXPECT_EQ(geometry_problem(b.mesh), "") << b.mesh.id;
+    int walls = 0, roofs = 0, grounds = 0;
+    for (const Face& f : b.mesh.faces) walls += f.sem == Semantic::Wall, roofs += f.sem == Semantic::Roof, grounds += f.sem == Semantic::Ground;
+    EXPECT_GE(walls, 4) << b.mesh.id;
+    EXPECT_GE(roofs, 1) << b.mesh.id;
+    EXPECT_GE(grounds, 1) << b.mesh.id;
+  }
+  const std::string verdict = schema_verdict(out_path);
+  if (!verdict.empty()) EXPECT_EQ(verdict, "valid");
+  std::printf("  %s: %d building(s): %d refined, %d kept, %d kept-invalid, %d untouched; schema: %s\n", out_path.c_str(),
+              s.buildings, s.refined, s.kept, s.kept_invalid, s.untouched,
+              verdict.empty() ? "not checked (validator or schemas absent)" : verdict.c_str());
+}
+
+// Generated buildings 80 m apart along x and the clouds of the first `scanned` of them.
+std::vector<SynthBuilding> synth_street(const std::vector<BuildingType>& types, std::uint64_t first_seed, int points,
+                                        std::size_t scanned, PointCloud& cloud) {
+  std::vector<SynthBuilding> bs;
+  SynthOptions so;
+  so.target_points = points;
+  so.scanned_facades = 2;
+  for (std::size_t k = 0; k < types.size(); ++k) {
+    so.origin = Vec3(93000.0 + 80.0 * double(k), 436000.0, 0.0);
+    bs.push_back(make_building(types[k], first_seed + k, so));
+    if (k < scanned) cloud.points.insert(cloud.points.end(), bs.back().cloud.points.begin(), bs.back().cloud.points.end());
+  }
+  return bs;
+}
+
+// Points on a wall face moved `offset` along its normal, every `step` metres, with noise.
+void sample_face(const std::vector<Vec3>& poly, double offset, double step, std::mt19937& rng, PointCloud& out) {
+  const Plane pl = polygon_plane(poly);
+  const auto [u, v] = pl.basis();
+  std::vector<Vec2> p2;
+  double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
+  for (const auto& p : poly) {
+    p2.emplace_back(u.dot(p), v.dot(p));
+    u0 = std::min(u0, p2.back().x()), u1 = std::max(u1, p2.back().x());
+    v0 = std::min(v0, p2.back().y()), v1 = std::max(v1, p2.back().y());
+  }
+  std::normal_distribution<double> noise(0.0, 0.005);
+  const Vec3 base = pl.project(Vec3::Zero());
+  for (double a = u0 + step / 2; a < u1; a += step)
+    for (double b = v0 + step / 2; b < v1; b += step)
+      if (point_in_polygon_2d(Vec2(a, b), p2)) out.points.push_back(base + a * u + b * v + (offset + noise(rng)) * pl.n);
+}
+
+}  // namespace
+
+TEST(CityFile, GeneratedCityRefinedIntoCityJson2) {
+  const std::string dir = test_dir();
+  PointCloud cloud;
+  const std::vector<SynthBuilding> bs = synth_street(
+      {BuildingType::Gable, BuildingType::LShape, BuildingType::Flat, BuildingType::Hip}, 11, 8000, 3, cloud);
+  const json in = synth_city(bs, Vec3(93000, 436000, 0));
+  write_file_atomic(dir + "/city.json", in.dump());
+  write_ply(dir + "/cloud.ply", cloud);
+
+  const CityRefineSummary s = refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/out.city.json", Params{}, {});
+  EXPECT_EQ(s.buildings, 4);
+  EXPECT_EQ(s.untouched, 1);  // the Hip building has no points
+  EXPECT_EQ(s.outcomes.size(), 3u);
+  EXPECT_GE(s.refined, 2);
+  EXPECT_EQ(s.cloud_points, cloud.points.size());
+  for (const auto& o : s.outcomes)
+    if (o.outcome == "refined") EXPECT_GE(o.facades_moved, 1) << o.id;
+  check_city_output(in, dir + "/out.city.json", s);
+  // The refined LoD 2.2 geometry replaced in place; the LoD 1 geometry before it kept.
+  const json out = load(dir + "/out.city.json");
+  for (const auto& o : s.outcomes) {
+    if (o.outcome != "refined") continue;
+    EXPECT_EQ(out["CityObjects"][o.id]["geometry"][0], in["CityObjects"][o.id]["geometry"][0]);
+    EXPECT_EQ(out["CityObjects"][o.id]["geometry"][1]["lod"], "2.2");
+    EXPECT_EQ(out["CityObjects"][o.id]["geometry"][1]["type"], "Solid");
+  }
+
+  // --building picks one; the others are untouched.
+  CityRefineOptions one;
+  one.building = bs[1].id;
+  const CityRefineSummary s1 = refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/one.city.json", Params{}, one);
+  ASSERT_EQ(s1.outcomes.size(), 1u);
+  EXPECT_EQ(s1.outcomes[0].id, bs[1].id);
+  EXPECT_EQ(s1.untouched, 3);
+  check_city_output(in, dir + "/one.city.json", s1);
+}
+
+TEST(CityFile, ErrorsAndBuildingsThatCannotBeRefined) {
+  const std::string dir = test_dir();
+  SynthOptions so;
+  so.target_points = 4000;
+  so.origin = Vec3(93000.0, 436000.0, 0.0);
+  std::vector<SynthBuilding> bs = {make_building(BuildingType::Gable, 5, so)};
+  json in = synth_city(bs, Vec3(93000, 436000, 0));
+  // A second building of two triangles: no repair can close it, so refine_building throws.
+  json& v = in["vertices"];
+  const std::size_t n = v.size();
+  for (const auto& q : {json{5000, 5000, 0}, json{6000, 5000, 0}, json{5000, 6000, 0}, json{5000, 5000, 1000}}) v.push_back(q);
+  in["CityObjects"]["broken"] = {{"type", "Building"},
+                                 {"geometry", {{{"type", "MultiSurface"}, {"lod", "2"},
+                                                {"boundaries", {{{n, n + 1, n + 2}}, {{n, n + 1, n + 3}}}}}}}};
+  write_file_atomic(dir + "/city.json", in.dump());
+  PointCloud cloud = bs[0].cloud;
+  for (int i = 0; i < 500; ++i) cloud.points.push_back(Vec3(93005.0 + 0.002 * i, 436005.5, 0.5));
+  write_ply(dir + "/cloud.ply", cloud);
+  const CityRefineSummary s = refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/out.city.json", Params{}, {});
+  ASSERT_EQ(s.outcomes.size(), 2u);
+  EXPECT_EQ(s.outcomes[1].id, "broken");
+  EXPECT_EQ(s.outcomes[1].outcome, "kept-invalid");
+  EXPECT_FALSE(s.outcomes[1].reason.empty());
+  check_city_output(in, dir + "/out.city.json", s);
+
+  const auto expect_error = [&](const std::string& args, const std::string& fault) {
+    const Cli r = run_cli(args, dir);
+    EXPECT_NE(r.exit, 0) << args;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(fault), std::string::npos) << r.err;
+  };
+  PointCloud far = bs[0].cloud;
+  for (auto& p : far.points) p += Vec3(-50000, 70000, 0);  // e.g. another CRS
+  write_ply(dir + "/far.ply", far);
+  expect_error("refine --model " + dir + "/city.json --cloud " + dir + "/far.ply --out " + dir + "/x.city.json",
+               "does not overlap the city model x 92");
+  expect_error("refine --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir + "/x.city.json --building nope",
+               "no building 'nope'");
+  expect_error("refine --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir + "/x.city.json --lod 3",
+               "no Building/BuildingPart with an LoD 3 geometry");
+  EXPECT_FALSE(fs::exists(dir + "/x.city.json"));
+  // --lod 1 picks the LoD 1 blocks (one face each: kept-invalid, kept exactly).
+  const Cli lod1 = run_cli("refine --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir +
+                               "/lod1.city.json --lod 1",
+                           dir);
+  EXPECT_EQ(lod1.exit, 0) << lod1.err;
+  EXPECT_NE(lod1.out.find("0 refined"), std::string::npos) << lod1.out;
+}
+
+TEST(CityFile, RotterdamDelfshaven) {
+  const fs::path path = shared_dir() / "realdata/val3dity/data/rotterdam/3-20-DELFSHAVEN.city.json";
+  if (!fs::exists(path)) GTEST_SKIP() << path << " absent";
+  const std::string dir = test_dir();
+  const CityJsonFile city = read_cityjson(path.string());
+  ASSERT_EQ(city.buildings.size(), 853u);
+  // A scan of three buildings: every wall sampled, the largest one 0.4 m out of place.
+  std::mt19937 rng(3);
+  PointCloud cloud;
+  int chosen = 0;
+  for (const auto& b : city.buildings) {
+    if (chosen == 3) break;
+    if (b.mesh.faces.size() < 6 || b.mesh.faces.size() > 14) continue;
+    std::size_t largest = 0;
+    double area = 0;
+    for (std::size_t k = 0; k < b.mesh.faces.size(); ++k) {
+      if (b.mesh.faces[k].sem != Semantic::Wall) continue;
+      const double a = polygon_area(face_points(b.mesh, b.mesh.faces[k]));
+      if (a > area) area = a, largest = k;
+    }
+    if (area < 40) continue;
+    for (std::size_t k = 0; k < b.mesh.faces.size(); ++k)
+      if (b.mesh.faces[k].sem == Semantic::Wall)
+        sample_face(face_points(b.mesh, b.mesh.faces[k]), k == largest ? 0.4 : 0.0, 0.1, rng, cloud);
+    ++chosen;
+  }
+  ASSERT_EQ(chosen, 3);
+  write_ply(dir + "/scan.ply", cloud);
+  const Cli r = run_cli("refine --model " + path.string() + " --cloud " + dir + "/scan.ply --out " + dir +
+                            "/rotterdam.city.json --report " + dir + "/report.json",
+                        dir);
+  ASSERT_EQ(r.exit, 0) << r.err;
+  std::printf("  %s  (%.1f s wall clock)\n", r.out.substr(0, r.out.find('\n')).c_str(), r.seconds);
+  const json rep = load(dir + "/report.json");
+  CityRefineSummary s;
+  s.buildings = rep["buildings"], s.refined = rep["refined"], s.kept = rep["kept"];
+  s.kept_invalid = rep["kept_invalid"], s.untouched = rep["untouched"];
+  for (const auto& o : rep["outcomes"]) s.outcomes.push_back({o["id"], o["outcome"], o["reason"], o["facades_moved"]});
+  EXPECT_EQ(s.buildings, 853);
+  EXPECT_GE(s.refined, 1);
+  check_city_output(load(path.string()), dir + "/rotterdam.city.json", s);
+}
+
+TEST(CityFile, DenHaagCityGml) {
+  const fs::path path = shared_dir() / "realdata/val3dity/data/gml/DenHaag_1BwBP.gml";
+  if (!fs::exists(path)) GTEST_SKIP() << path << " absent";
+  const std::string dir = test_dir();
+  const CityJsonFile city = read_citygml(path.string());
+  std::mt19937 rng(4);
+  PointCloud cloud;
+  const Mesh& m = city.buildings[0].mesh;
+  bool moved = false;
+  for (const Face& f : m.faces)
+    if (f.sem == Semantic::Wall) {
+      const auto poly = face_points(m, f);
+      const bool big = !moved && polygon_area(poly) > 20;
+      sample_face(poly, big ? 0.4 : 0.0, 0.08, rng, cloud);
+      moved = moved || big;
+    }
+  write_ply(dir + "/scan.ply", cloud);
+  const CityRefineSummary s = refine_city(path.string(), dir + "/scan.ply", dir + "/denhaag.city.json", Params{}, {});
+  EXPECT_EQ(s.input_format, "CityGML 1.0");
+  EXPECT_EQ(s.buildings, 6);
+  EXPECT_GE(s.outcomes.size(), 1u);
+  check_city_output(citygml_to_cityjson(path.string()), dir + "/denhaag.city.json", s);
+  const json out = load(dir + "/denhaag.city.json");
+  EXPECT_EQ(out["metadata"]["referenceSystem"], "https://www.opengis.net/def/crs/EPSG/0/28992");
+  for (const auto& [id, obj] : out["CityObjects"].items()) EXPECT_EQ(id.find("genID"), std::string::npos) << id;
+}
+
+TEST(CityFile, CityJsonSeqStreamedThrough) {
+  const std::string dir = test_dir();
+  PointCloud cloud;
+  const std::vector<SynthBuilding> bs =
+      synth_street({BuildingType::Gable, BuildingType::Shed, BuildingType::Gable}, 31, 6000, 2, cloud);
+  // One feature per building, each with its own vertices (as cjseq writes them).
+  std::vector<json> lines;
+  json header = synth_city({}, Vec3(93000, 436000, 0));
+  lines.push_back(header);
+  for (const auto& b : bs) {
+    json one = synth_city({b}, Vec3(93000, 436000, 0));
+    lines.push_back({{"type", "CityJSONFeature"}, {"id", b.id}, {"CityObjects", one["CityObjects"]}, {"vertices", one["vertices"]}});
+  }
+  std::string text;
+  for (const auto& l : lines) text += l.dump() + "\n";
+  write_file_atomic(dir + "/city.city.jsonl", text);
+  write_ply(dir + "/cloud.ply", cloud);
+  const CityRefineSummary s = refine_city(dir + "/city.city.jsonl", dir + "/cloud.ply", dir + "/out.city.jsonl", Params{}, {});
+  EXPECT_EQ(s.input_format, "CityJSONSeq 2.0");
+  EXPECT_EQ(s.buildings, 3);
+  EXPECT_EQ(s.untouched, 1);
+  EXPECT_GE(s.refined, 1);
+  EXPECT_EQ(s.refined + s.kept + s.kept_invalid + s.untouched, 3);
+  std::ifstream in(dir + "/out.city.jsonl");
+  std::vector<json> out;
+  for (std::string l; std::getline(in, l);) out.push_back(json::parse(l));
+  ASSERT_EQ(out.size(), 4u);
+  EXPECT_EQ(out[0], lines[0]);
+  EXPECT_EQ(out[3], lines[3]);  // no cloud points: the feature exactly as read
+  const CityJsonFile back = read_cityjson(dir + "/out.city.jsonl");
+  ASSERT_EQ(back.buildings.size(), 3u);
+  for (const auto& o : s.outcomes)
+    for (const auto& b : back.buildings)
+      if (b.mesh.id == o.id && o.outcome == "refined") EXPECT_EQ(geometry_problem(b.mesh), "") << b.mesh.id;
+  const fs::path schemas = shared_dir() / "schemas" / "cityjson-2.0.2";
+  if (fs::exists(schemas) && fs::exists("/usr/bin/python3")) {
+    const int st = std::system(("/usr/bin/python3 " + std::string(LODREFINE_SOURCE_DIR) + "/scripts/validate_cityjson.py " +
+                                schemas.string() + " " + dir + "/out.city.jsonl --seq >" + dir + "/v.txt 2>&1").c_str());
+    std::ifstream v(dir + "/v.txt");
+    const std::string verdict((std::istreambuf_iterator<char>(v)), {});
+    if (!(WIFEXITED(st) && WEXITSTATUS(st) == 2)) EXPECT_EQ(verdict, "valid\n");
+  }
+}
+
+TEST(CityFile, CityJson1xUpgradedTo2) {
+  const std::string dir = test_dir();
+  PointCloud cloud;
+  const std::vector<SynthBuilding> bs = synth_street({BuildingType::Gable, BuildingType::Flat}, 41, 6000, 1, cloud);
+  json in = synth_city(bs, Vec3(93000, 436000, 0));
+  in["version"] = "1.1";
+  in["metadata"]["referenceSystem"] = "urn:ogc:def:crs:EPSG::7415";
+  in["metadata"]["pointOfContact"] = {
+      {"contactName", "someone"}, {"emailAddress", "someone@example.org"}, {"address", "Julianalaan 134, Delft"}};
+  for (auto& [id, obj] : in["CityObjects"].items()) obj["geometry"][1]["lod"] = 2.2;  // a number, as 1.0 wrote it
+  write_file_atomic(dir + "/city.json", in.dump());
+  write_ply(dir + "/cloud.ply", cloud);
+  const CityRefineSummary s = refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/out.city.json", Params{}, {});
+  EXPECT_EQ(s.input_format, "CityJSON 1.1");
+  EXPECT_EQ(s.untouched, 1);
+  const json out = load(dir + "/out.city.json");
+  EXPECT_EQ(out["version"], "2.0");
+  EXPECT_EQ(out["metadata"]["referenceSystem"], "https://www.opengis.net/def/crs/EPSG/0/7415");
+  EXPECT_EQ(out["metadata"]["pointOfContact"]["address"]["addressLine"], "Julianalaan 134, Delft");
+  for (const auto& [id, obj] : out["CityObjects"].items()) EXPECT_EQ(obj["geometry"][1]["lod"], "2.2") << id;
+  const std::string verdict = schema_verdict(dir + "/out.city.json");
+  if (!verdict.empty()) EXPECT_EQ(verdict, "valid");
+}
+
+TEST(CityFile, LodPicksTheGeometryToRefine) {
+  const fs::path path = shared_dir() / "realdata/val3dity/data/test_cityjson/several_lods_valid.json";
+  if (!fs::exists(path)) GTEST_SKIP() << path << " absent";
+  const std::string dir = test_dir();
+  const json in = load(path.string());
+  std::map<std::string, int> lods;  // the building part's solids (LoD 1.2, 1.3, 2.2) -> geometry index
+  std::string id;
+  for (const auto& [oid, obj] : in["CityObjects"].items()) {
+    if (obj["type"] != "BuildingPart" || !obj.contains("geometry")) continue;
+    for (std::size_t k = 0; k < obj["geometry"].size(); ++k) lods[obj["geometry"][k]["lod"]] = int(k), id = oid;
+  }
+  ASSERT_EQ(lods.size(), 3u);
+  std::mt19937 rng(6);
+  for (const auto& [lod, index] : lods) {
+    const CityJsonFile f = read_cityjson(path.string(), lod);
+    ASSERT_EQ(f.buildings.size(), 1u);
+    EXPECT_EQ(f.buildings[0].geometry_index, index);
+    PointCloud cloud;
+    const Mesh& m = f.buildings[0].mesh;
+    double largest = 0;
+    std::size_t big = 0;
+    const auto vertical = [&](std::size_t k) { return std::abs(newell_normal(face_points(m, m.faces[k])).normalized().z()) < 0.1; };
+    for (std::size_t k = 0; k < m.faces.size(); ++k)
+      if (vertical(k) && polygon_area(face_points(m, m.faces[k])) > largest)
+        largest = polygon_area(face_points(m, m.faces[k])), big = k;
+    for (std::size_t k = 0; k < m.faces.size(); ++k)
+      if (vertical(k)) sample_face(face_points(m, m.faces[k]), k == big ? 0.3 : 0.0, 0.1, rng, cloud);
+    write_ply(dir + "/c.ply", cloud);
+    CityRefineOptions o;
+    o.lod = lod;
+    const CityRefineSummary s = refine_city(path.string(), dir + "/c.ply", dir + "/out.city.json", Params{}, o);
+    ASSERT_EQ(s.outcomes.size(), 1u);
+    const json out = load(dir + "/out.city.json");
+    for (std::size_t k = 0; k < in["CityObjects"][id]["geometry"].size(); ++k) {
+      const json& before = in["CityObjects"][id]["geometry"][k];
+      const json& after = out["CityObjects"][id]["geometry"][k];
+      EXPECT_EQ(after["lod"], before["lod"]);
+      if (int(k) != index || s.outcomes[0].outcome != "refined") EXPECT_EQ(after, before) << "LoD " << before["lod"];
+      else EXPECT_EQ(after["type"], "Solid");
+    }
+    std::printf("  --lod %s: %s (%s)\n", lod.c_str(), s.outcomes[0].outcome.c_str(), s.outcomes[0].reason.c_str());
+    // convert --lod writes that LoD's faces.
+    const Cli c = run_cli("convert --cityjson " + path.string() + " --lod " + lod + " --out-dir " + dir + "/obj_" + lod, dir);
+    ASSERT_EQ(c.exit, 0) << c.err;
+    EXPECT_EQ(read_obj(dir + "/obj_" + lod + "/" + id + ".obj").faces.size(), m.faces.size()) << lod;
+  }
+}
+
+TEST(CityFile, LasTileWithClassesThroughTheCli) {
+  const std::string dir = test_dir();
+  PointCloud cloud;
+  const std::vector<SynthBuilding> bs = synth_street({BuildingType::Gable, BuildingType::LShape}, 51, 6000, 2, cloud);
+  write_file_atomic(dir + "/city.json", synth_city(bs, Vec3(93000, 436000, 0)).dump());
+  write_ply(dir + "/cloud.ply", cloud);
+  // The same points as class 6, and as many class-1 points scattered through the buildings' boxes.
+  PointCloud tile = cloud;
+  std::vector<int> classes(cloud.points.size(), 6);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> jitter(-4.0, 4.0);
+  for (const auto& p : cloud.points) {
+    tile.points.push_back(p + Vec3(jitter(rng), jitter(rng), jitter(rng)));
+    classes.push_back(1);
+  }
+  LasWriteOptions lo;
+  lo.version_minor = 4, lo.point_format = 6, lo.scale = Vec3::Constant(1e-4), lo.offset = Vec3(93000, 436000, 0);
+  write_las(dir + "/tile.las", tile, classes, lo);
+  const Cli ply = run_cli("refine --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir +
+                              "/a.city.json --report " + dir + "/a.json", dir);
+  const Cli las = run_cli("refine --model " + dir + "/city.json --cloud " + dir + "/tile.las --classes 6 --out " + dir +
+                              "/b.city.json --report " + dir + "/b.json", dir);
+  ASSERT_EQ(ply.exit, 0) << ply.err;
+  ASSERT_EQ(las.exit, 0) << las.err;
+  const json a = load(dir + "/a.json"), b = load(dir + "/b.json");
+  EXPECT_EQ(b["cloud_points"], cloud.points.size());
+  ASSERT_EQ(a["outcomes"].size(), b["outcomes"].size());
+  for (std::size_t i = 0; i < a["outcomes"].size(); ++i) {
+    EXPECT_EQ(a["outcomes"][i]["outcome"], b["outcomes"][i]["outcome"]);
+    EXPECT_EQ(a["outcomes"][i]["facades_moved"], b["outcomes"][i]["facades_moved"]);
+  }
+  EXPECT_GE(b["refined"].get<int>(), 1);
+}

@@ -1,0 +1,182 @@
+// CityGML in through libcitygml: the same per-building meshes the CityJSON reader gives, ids
+// from gml:id (never the generated ones), semantics from the boundary surfaces, the CRS.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include "lodrefine/io/citygml.h"
+
+using namespace lodrefine;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string write_temp(const std::string& name, const std::string& text) {
+  const auto* info = testing::UnitTest::GetInstance()->current_test_info();
+  const fs::path dir = fs::path(testing::TempDir()) / ("lodrefine_citygml_" + std::to_string(::getpid())) / info->name();
+  fs::create_directories(dir);
+  std::ofstream((dir / name).string()) << text;
+  return (dir / name).string();
+}
+
+std::string pos_list(const std::vector<Vec3>& ring) {
+  std::string s;
+  for (std::size_t i = 0; i <= ring.size(); ++i) {
+    const Vec3& p = ring[i % ring.size()];
+    s += std::to_string(p.x()) + " " + std::to_string(p.y()) + " " + std::to_string(p.z()) + " ";
+  }
+  return s;
+}
+
+std::string polygon(const std::vector<Vec3>& ring, const std::string& id) {
+  return "<gml:Polygon" + (id.empty() ? std::string() : " gml:id=\"" + id + "\"") +
+         "><gml:exterior><gml:LinearRing><gml:posList srsDimension=\"3\">" + pos_list(ring) +
+         "</gml:posList></gml:LinearRing></gml:exterior></gml:Polygon>";
+}
+
+// The six faces of a box (outward), walls first, then roof, then ground.
+std::vector<std::vector<Vec3>> box_faces(const Vec3& o, double w, double d, double h) {
+  const Vec3 a = o, b = o + Vec3(w, 0, 0), c = o + Vec3(w, d, 0), e = o + Vec3(0, d, 0), z(0, 0, h);
+  return {{a, b, b + z, a + z}, {b, c, c + z, b + z}, {c, e, e + z, c + z}, {e, a, a + z, e + z},
+          {a + z, b + z, c + z, e + z}, {a, e, c, b}};
+}
+
+const char* kHeader = R"(<?xml version="1.0" encoding="UTF-8"?>
+<CityModel xmlns="http://www.opengis.net/citygml/2.0" xmlns:bldg="http://www.opengis.net/citygml/building/2.0"
+ xmlns:gen="http://www.opengis.net/citygml/generics/2.0" xmlns:gml="http://www.opengis.net/gml">
+<gml:boundedBy><gml:Envelope srsName="EPSG:25832" srsDimension="3"><gml:lowerCorner>0 0 0</gml:lowerCorner><gml:upperCorner>1 1 1</gml:upperCorner></gml:Envelope></gml:boundedBy>
+)";
+
+// Building "thematic": boundedBy Wall/Roof/GroundSurface (polygons with and without ids);
+// Building "solid": an lod2Solid only; Building "lod1": lod1Solid only.
+std::string sample_citygml() {
+  const Vec3 o(512000.125, 5403000.5, 100.0);
+  std::string s = kHeader;
+  const auto f1 = box_faces(o, 10, 8, 6);
+  s += "<cityObjectMember><bldg:Building gml:id=\"thematic\">"
+       "<gen:doubleAttribute name=\"height\"><gen:value>6.0</gen:value></gen:doubleAttribute>"
+       "<gen:stringAttribute name=\"street\"><gen:value>Hauptstr.</gen:value></gen:stringAttribute>";
+  const char* kinds[] = {"WallSurface", "WallSurface", "WallSurface", "WallSurface", "RoofSurface", "GroundSurface"};
+  for (int k = 0; k < 6; ++k)
+    s += std::string("<bldg:boundedBy><bldg:") + kinds[k] + "><bldg:lod2MultiSurface><gml:MultiSurface><gml:surfaceMember>" +
+         polygon(f1[std::size_t(k)], k % 2 ? "" : "poly" + std::to_string(k)) +
+         "</gml:surfaceMember></gml:MultiSurface></bldg:lod2MultiSurface></bldg:" + kinds[k] + "></bldg:boundedBy>";
+  s += "</bldg:Building></cityObjectMember>";
+  const auto f2 = box_faces(o + Vec3(30, 0, 0), 6, 6, 9);
+  s += "<cityObjectMember><bldg:Building gml:id=\"solid\"><bldg:lod2Solid><gml:Solid><gml:exterior><gml:CompositeSurface>";
+  for (const auto& f : f2) s += "<gml:surfaceMember>" + polygon(f, "") + "</gml:surfaceMember>";
+  s += "</gml:CompositeSurface></gml:exterior></gml:Solid></bldg:lod2Solid></bldg:Building></cityObjectMember>";
+  s += "<cityObjectMember><bldg:Building gml:id=\"lod1\"><bldg:lod1Solid><gml:Solid><gml:exterior><gml:CompositeSurface>";
+  for (const auto& f : box_faces(o + Vec3(60, 0, 0), 5, 5, 5)) s += "<gml:surfaceMember>" + polygon(f, "") + "</gml:surfaceMember>";
+  s += "</gml:CompositeSurface></gml:exterior></gml:Solid></bldg:lod1Solid></bldg:Building></cityObjectMember>";
+  return s + "</CityModel>\n";
+}
+
+std::map<Semantic, int> semantics(const Mesh& m) {
+  std::map<Semantic, int> n;
+  for (const auto& f : m.faces) ++n[f.sem];
+  return n;
+}
+
+}  // namespace
+
+TEST(CityGml, BoundarySurfacesSolidsIdsAttributesCrs) {
+  const std::string path = write_temp("sample.gml", sample_citygml());
+  const CityJsonFile f = read_citygml(path);
+  EXPECT_EQ(f.format, "CityGML");
+  EXPECT_EQ(f.version, "2.0");
+  EXPECT_EQ(f.crs, "https://www.opengis.net/def/crs/EPSG/0/25832");
+  ASSERT_EQ(f.buildings.size(), 2u);
+  EXPECT_EQ(f.objects_without_lod2, 1);  // "lod1"
+  const CityJsonBuilding& t = f.buildings[0];
+  EXPECT_EQ(t.mesh.id, "thematic");
+  EXPECT_EQ(t.type, "Building");
+  ASSERT_EQ(t.mesh.faces.size(), 6u);
+  EXPECT_EQ(semantics(t.mesh), (std::map<Semantic, int>{{Semantic::Wall, 4}, {Semantic::Roof, 1}, {Semantic::Ground, 1}}));
+  EXPECT_EQ(t.attributes.value("height", 0.0), 6.0);
+  EXPECT_EQ(t.attributes.value("street", std::string()), "Hauptstr.");
+  // Coordinates exact to 0.1 mm (the CityJSON transform of the conversion) at UTM magnitudes.
+  double worst = 0;
+  const auto faces = box_faces(Vec3(512000.125, 5403000.5, 100.0), 10, 8, 6);
+  for (std::size_t k = 0; k < 6; ++k)
+    for (std::size_t i = 0; i < 4; ++i)
+      worst = std::max(worst, (t.mesh.vertices[std::size_t(t.mesh.faces[k].v[i])] - faces[k][i]).norm());
+  EXPECT_LT(worst, 1e-6);
+  const CityJsonBuilding& s = f.buildings[1];
+  EXPECT_EQ(s.mesh.id, "solid");
+  EXPECT_EQ(s.mesh.faces.size(), 6u);
+  EXPECT_EQ(semantics(s.mesh), (std::map<Semantic, int>{{Semantic::Other, 6}}));
+  // read_city_file picks the reader by content.
+  EXPECT_EQ(read_city_file(path).buildings.size(), 2u);
+}
+
+TEST(CityGml, CrsNamesBecomeCityJsonUrls) {
+  const std::string url = "https://www.opengis.net/def/crs/EPSG/0/";
+  const std::vector<std::pair<std::string, std::string>> names = {
+      {"urn:ogc:def:crs:EPSG::28992", url + "28992"},      {"EPSG:25832", url + "25832"},
+      {"urn:ogc:def:crs:EPSG:6.12:31467", url + "31467"}, {"http://www.opengis.net/def/crs/EPSG/0/7415", url + "7415"},
+      {"local", "local"}};
+  for (const auto& [name, expected] : names) EXPECT_EQ(crs_url(name), expected) << name;
+}
+
+TEST(CityGml, BadFilesAreOneClearError) {
+  const auto expect = [](const std::string& path, const std::string& fault) {
+    try {
+      read_citygml(path);
+      ADD_FAILURE() << "accepted " << path;
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind(path, 0), 0u) << msg;
+      EXPECT_NE(msg.find(fault), std::string::npos) << msg;
+      EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    }
+  };
+  expect(write_temp("v3.gml", "<?xml version=\"1.0\"?><CityModel xmlns=\"http://www.opengis.net/citygml/3.0\"/>"),
+         "CityGML 3.0 is not supported");
+  expect(write_temp("x.gml", "<?xml version=\"1.0\"?><html/>"), "XML but not CityGML");
+  expect(write_temp("j.gml", "{\"type\":\"CityJSON\"}"), "not a CityGML file: the file is JSON");
+  std::string cut = sample_citygml();
+  expect(write_temp("cut.gml", cut.substr(0, cut.size() / 2)), "CityGML parse error");
+}
+
+TEST(CityGml, DenHaagBuildingParts) {
+  const fs::path p = fs::path(LODREFINE_SOURCE_DIR) / ".." / "shared/realdata/val3dity/data/gml/DenHaag_1BwBP.gml";
+  if (!fs::exists(p)) GTEST_SKIP() << p << " absent";
+  const CityJsonFile f = read_citygml(p.string());
+  EXPECT_EQ(f.version, "1.0");
+  EXPECT_EQ(f.crs, "https://www.opengis.net/def/crs/EPSG/0/28992");
+  ASSERT_EQ(f.buildings.size(), 6u);
+  EXPECT_EQ(f.objects_without_lod2, 1);  // the Building itself: its geometry is in its parts
+  for (std::size_t k = 0; k < 6; ++k) {
+    const auto& b = f.buildings[k];
+    EXPECT_EQ(b.mesh.id, "GUID_7F91F413-F839-48F6-A36A-E0F2F090C6B0_" + std::to_string(k + 1));
+    EXPECT_EQ(b.type, "BuildingPart");
+    EXPECT_EQ(b.parent, "GUID_7F91F413-F839-48F6-A36A-E0F2F090C6B0");
+    const auto n = semantics(b.mesh);
+    EXPECT_GE(n.count(Semantic::Wall) ? n.at(Semantic::Wall) : 0, 4) << b.mesh.id;
+    EXPECT_GE(n.count(Semantic::Roof) ? n.at(Semantic::Roof) : 0, 1) << b.mesh.id;
+    EXPECT_EQ(n.count(Semantic::Ground) ? n.at(Semantic::Ground) : 0, 1) << b.mesh.id;
+    EXPECT_EQ(n.count(Semantic::Other), 0u) << b.mesh.id;
+    EXPECT_TRUE(b.attributes.contains("RelativeEavesHeight")) << b.mesh.id;
+  }
+  EXPECT_DOUBLE_EQ(f.buildings[0].attributes["RelativeEavesHeight"].get<double>(), 6.197);
+  EXPECT_EQ(semantics(f.buildings[0].mesh),
+            (std::map<Semantic, int>{{Semantic::Wall, 6}, {Semantic::Roof, 2}, {Semantic::Ground, 1}}));
+}
+
+// Found by fuzz_citygml (UBSan, signed overflow in the vertex hash): coordinates 1800 km apart
+// are 1.8e10 units of 0.1 mm; they must read back, not overflow.
+TEST(CityGml, CoordinatesFarApart) {
+  std::string s = kHeader;
+  s += "<cityObjectMember><bldg:Building gml:id=\"far\"><bldg:lod2MultiSurface><gml:MultiSurface><gml:surfaceMember>" +
+       polygon({{-9e8, 0, 0}, {9e8, 0, 0}, {9e8, 5e8, 0}}, "") +
+       "</gml:surfaceMember></gml:MultiSurface></bldg:lod2MultiSurface></bldg:Building></cityObjectMember></CityModel>\n";
+  const CityJsonFile f = read_citygml(write_temp("far.gml", s));
+  ASSERT_EQ(f.buildings.size(), 1u);
+  ASSERT_EQ(f.buildings[0].mesh.faces.size(), 1u);
+  EXPECT_EQ(f.buildings[0].mesh.vertices[1], Vec3(9e8, 0, 0));
+}
