@@ -48,16 +48,18 @@ void run(const BenchArgs& a) {
     for (int k = 0; k < a.count; ++k) {
       const SynthBuilding b = make_building(type, std::uint64_t(a.seed + k), opt);
       const RefineResult r = refine_building(b.coarse, b.cloud, a.params);
-      const auto& s = r.report["seconds"];
+      const RefineTrace& t = r.trace;
       int cand = 0, vars = 0;
       double mip = 0.0;
-      for (const auto& st : r.report.value("replacements", nlohmann::json::array())) {
-        cand += st.value("candidates", 0);
-        if (st.contains("mip")) {
-          vars += st["mip"].value("variables", 0);
-          mip += st["mip"].value("seconds", 0.0);
+      if (t.replacements)
+        for (const auto& st : *t.replacements) {
+          if (!st.arrangement) continue;
+          cand += st.arrangement->candidates.value_or(0);
+          if (st.arrangement->selection) {
+            vars += st.arrangement->selection->variables;
+            mip += st.arrangement->selection->seconds;
+          }
         }
-      }
       // Accuracy in a local frame: points on the truth's scanned walls to each model.
       const Vec3 o = local_origin(b.truth);
       PointCloud local_cloud = b.cloud;
@@ -73,13 +75,13 @@ void run(const BenchArgs& a) {
         n_after += ev.truth_facade_after->count;
       }
       std::printf("%-24s %7zu %6zu %5d %6d %6.3f | %7.3f %7.3f %7.3f %7.3f %7.3f | %8.4f %8.4f | %s\n", b.id.c_str(),
-                  b.cloud.points.size(), r.report["planes"].size(), cand, vars, mip, s.value("repair", 0.0),
-                  s.value("planes", 0.0), s.value("matching", 0.0), s.value("replacement", 0.0), s.value("total", 0.0),
-                  f0, f1, r.outcome.c_str());
+                  b.cloud.points.size(), t.planes ? t.planes->size() : std::size_t(0), cand, vars, mip,
+                  t.stage_seconds("repair"), t.stage_seconds("planes"), t.stage_seconds("matching"),
+                  t.stage_seconds("replacement"), t.stage_seconds("total"), f0, f1, outcome_name(r.outcome));
       std::fflush(stdout);
-      total_time += s.value("total", 0.0);
+      total_time += t.stage_seconds("total");
       ++n;
-      refined += r.refined;
+      refined += r.refined();
       valid += r.valid && ev.watertight_after;
     }
   struct rusage ru {};

@@ -8,6 +8,7 @@
 #include "lodrefine/io/obj.h"
 #include "lodrefine/io/files.h"
 #include "lodrefine/core/refine.h"
+#include "lodrefine/io/refine_report.h"
 #include "options.h"
 
 namespace lodrefine::app {
@@ -96,16 +97,17 @@ void run(const RefineArgs& a) {
                                                             " (of " + std::to_string(declared) + ")"));
   // Said on stdout and in the report (stderr is for the one error line of a failed run).
   const std::string overlap = overlap_problem(bounding_box(cloud.points), bounding_box(model.vertices));
-  RefineResult r = refine_building(model, cloud, a.params);
-  if (!overlap.empty()) r.report["warnings"].push_back(overlap);
-  r.report["model"] = a.model;
-  r.report["cloud"]["path"] = a.cloud;
-  r.report["params"] = params_json(a.params);
-  r.report["written"] = a.out;
-  if (!a.report.empty()) write_file_atomic(a.report, r.report.dump(2) + "\n");
+  const RefineResult r = refine_building(model, cloud, a.params);
+  nlohmann::json report = refine_report(r);
+  if (!overlap.empty()) report["warnings"].push_back(overlap);
+  report["model"] = a.model;
+  report["cloud"]["path"] = a.cloud;
+  report["params"] = params_json(a.params);
+  report["written"] = a.out;
+  if (!a.report.empty()) write_file_atomic(a.report, report.dump(2) + "\n");
   write_obj(a.out, r.mesh);
-  std::printf("%s: %s (%s) -> %s (%.2f s)%s\n", model.id.c_str(), r.outcome.c_str(), r.reason.c_str(), a.out.c_str(),
-              r.report["seconds"].value("total", 0.0), overlap.empty() ? "" : ("; warning: " + overlap).c_str());
+  std::printf("%s: %s (%s) -> %s (%.2f s)%s\n", model.id.c_str(), outcome_name(r.outcome), r.reason.c_str(),
+              a.out.c_str(), r.trace.stage_seconds("total"), overlap.empty() ? "" : ("; warning: " + overlap).c_str());
 }
 
 }  // namespace

@@ -157,6 +157,13 @@ std::vector<double> unsigned_distances(const Mesh& mesh, const std::vector<Vec3>
   return d;
 }
 
+double rms_distance(const Mesh& mesh, const std::vector<Vec3>& pts) {
+  if (pts.empty()) return 0.0;
+  double s = 0.0;
+  for (double d : cloud_to_mesh(mesh, pts)) s += d * d;
+  return std::sqrt(s / double(pts.size()));
+}
+
 std::vector<Vec3> sample_faces(const Mesh& mesh, const std::vector<int>& faces, double spacing) {
   std::vector<Vec3> out;
   for (int f : faces) {

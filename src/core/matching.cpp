@@ -296,6 +296,13 @@ MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& su
   return result;
 }
 
+double surface_deviation(const Mesh& mesh, const ModelSurface& s, const Plane& pl) {
+  double d = 0.0;
+  for (int f : s.faces)
+    for (int v : mesh.faces[f].v) d = std::max(d, std::abs(pl.distance(mesh.vertices[v])));
+  return d;
+}
+
 std::vector<int> points_in_front(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
                                  const std::vector<ScanPlane>& planes, const MatchResult& matched,
                                  const PointCloud& cloud, double margin) {

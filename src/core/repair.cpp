@@ -12,6 +12,7 @@
 #include <unordered_map>
 
 #include "lodrefine/core/geometry.h"
+#include "lodrefine/core/params.h"
 #include "lodrefine/core/validate.h"
 
 namespace lodrefine {
@@ -585,6 +586,38 @@ Mesh merge_coplanar_faces(const Mesh& mesh, double angle_deg, double distance) {
   }
   drop_straight_vertices(mesh.vertices, faces, distance);
   return compact(mesh.vertices, std::move(faces), mesh.id);
+}
+
+Mesh repair_input(const Mesh& local_model, const Params& prm, RepairReport& rr) {
+  // Welds tried in turn, relative to weld_tolerance: the tolerance itself; gaps between faces
+  // up to 1.5x and 2x it (corners jittered a little more than the tolerance); then 10x and 100x
+  // finer for detailed models whose features are shorter than it.
+  struct Step {
+    double weld, gap;
+  };
+  constexpr Step kSteps[] = {{1.0, 1.0}, {1.0, 1.5}, {1.0, 2.0}, {0.1, 0.1}, {0.01, 0.01}};
+  std::optional<std::pair<Mesh, RepairReport>> first;
+  std::string error;
+  for (const auto& [weld, gap] : kSteps) {
+    RepairReport r;
+    try {
+      Mesh m = repair_model(local_model, prm.weld_tolerance * weld, &r, prm.weld_tolerance * gap);
+      if (weld != 1.0 || gap != 1.0)
+        r.notes.push_back("welded at " + std::to_string(prm.weld_tolerance * weld) + " m, gaps up to " +
+                          std::to_string(prm.weld_tolerance * gap) + " m");
+      r.split_warped_faces = split_warped_faces(m, prm.planarity_tolerance);
+      if (validate_mesh(m, prm.planarity_tolerance).valid()) {
+        rr = r;
+        return m;
+      }
+      if (!first) first.emplace(std::move(m), r);
+    } catch (const InputError& e) {
+      if (error.empty()) error = e.what();
+    }
+  }
+  if (!first) throw InputError(error);
+  rr = first->second;
+  return first->first;
 }
 
 }  // namespace lodrefine

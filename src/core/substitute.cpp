@@ -132,4 +132,35 @@ SubstitutionResult substitute_walls(const Mesh& mesh, const std::vector<ModelSur
   return res;
 }
 
+// Whether the scan shows a moved wall's eave where its pitched roof's plane meets the new wall
+// (the roof plane was right) rather than at the old eave height (the roof outline was right):
+// the top of the wall's own points decides, and only where it clearly does.
+bool eave_follows_roof(const Mesh& mesh, const std::vector<ModelSurface>& surfaces, const Match& m, const Plane& plane,
+                       const PointCloud& cloud) {
+  // m: the two eaves must differ by kDiffer; the scan's top must lie within kAgree of the
+  // followed one and closer to it than to the kept one by kMargin (a scan may stop short of
+  // the eave under an overhang).
+  constexpr double kDiffer = 0.2, kAgree = 0.3, kMargin = 0.15;
+  constexpr double kTopQuantile = 0.99;          // the wall's points' top, robust to a few strays
+  if (m.owned.empty()) return false;
+  constexpr double kNoSplit = 1e300;  // planarity tolerance: only the wall's top matters here
+  auto top = [&](bool follow) {
+    const auto sub = substitute_walls(mesh, surfaces, {{m.surface, plane, follow}}, kNoSplit);
+    double z = -1e300;
+    if (!sub.ok) return z;
+    for (int f : surfaces[m.surface].faces)
+      for (int v : mesh.faces[f].v) z = std::max(z, sub.mesh.vertices[v].z());
+    return z;
+  };
+  const double keep = top(false), follow = top(true);
+  if (std::abs(keep - follow) < kDiffer) return false;
+  std::vector<double> z;
+  for (int i : m.owned) z.push_back(cloud.points[i].z());
+  const std::size_t k = std::size_t(kTopQuantile * double(z.size() - 1));
+  std::nth_element(z.begin(), z.begin() + long(k), z.end());
+  const double scan_top = z[k];
+  return std::abs(scan_top - follow) <= kAgree && std::abs(scan_top - follow) + kMargin < std::abs(scan_top - keep);
+}
+
+
 }  // namespace lodrefine

@@ -32,26 +32,15 @@ double seconds_since(Clock::time_point t) { return std::chrono::duration<double>
 // building whose repaired original is not valid either is kept-invalid.
 CityBuildingOutcome classify(const RefineResult& r) {
   CityBuildingOutcome o;
-  const std::string& s = r.outcome;
-  if (r.refined && r.valid && s == "refined") {
+  if (r.refined() && r.valid) {
     o.outcome = "refined";
-  } else {
-    o.outcome = (!r.valid || s.rfind("kept-invalid", 0) == 0) ? "kept-invalid" : "kept";
-    o.reason = r.report.value("reason", std::string());
-    const auto open = s.find('('), close = s.rfind(')');
-    if (o.reason.empty() && open != std::string::npos && close != std::string::npos && close > open)
-      o.reason = s.substr(open + 1, close - open - 1);
-    if (o.reason.empty()) o.reason = s;
-    if (!r.valid && s.rfind("kept-invalid", 0) != 0 && r.report.contains("output_validation"))
-      o.reason += " (not valid: " + r.report["output_validation"].value("problem", std::string("invalid")) + ")";
+    o.facades_moved = int(r.trace.facades.size());
+    return o;
   }
-  // The report lists the moved facades ("facades"); older reports only the replacement steps.
-  if (r.report.contains("facades") && r.report["facades"].is_array()) {
-    o.facades_moved = int(r.report["facades"].size());
-  } else if (r.report.contains("replacements")) {
-    for (const auto& step : r.report["replacements"]) o.facades_moved += step.value("ok", false) ? 1 : 0;
-  }
-  if (o.outcome != "refined") o.facades_moved = 0;
+  o.outcome = (!r.valid || r.outcome == Outcome::KeptInvalid) ? "kept-invalid" : "kept";
+  o.reason = r.reason.empty() ? std::string(outcome_name(r.outcome)) : r.reason;
+  if (!r.valid && r.outcome != Outcome::KeptInvalid)
+    o.reason += " (not valid: " + r.trace.output_validation.problem + ")";
   return o;
 }
 

@@ -42,9 +42,9 @@ void run_tile(const std::string& tile, double max_pooled_rmse) {
     const Mesh truth = read_obj((dir / "truth" / (id + ".obj")).string());
     const PointCloud cloud = read_ply((dir / "clouds" / (id + ".ply")).string());
     const RefineResult r = refine_building(coarse, cloud, Params{});
-    SCOPED_TRACE(id + ": " + r.outcome + " (" + r.reason + ")");
+    SCOPED_TRACE(id + ": " + outcome_name(r.outcome) + " (" + r.reason + ")");
     ++buildings;
-    EXPECT_NE(r.outcome, "kept-invalid");
+    EXPECT_NE(r.outcome, Outcome::KeptInvalid);
     const Vec3 o = local_origin(truth);
     const Mesh t = translated(truth, -o), c = translated(coarse, -o), m = translated(r.mesh, -o);
     EXPECT_TRUE(validate_mesh(m).valid()) << validate_mesh(m).problem;
@@ -56,7 +56,7 @@ void run_tile(const std::string& tile, double max_pooled_rmse) {
     for (double d : cloud_to_mesh(c, samples)) sb += d * d;
     for (double d : cloud_to_mesh(m, samples)) sa += d * d;
     const double rb = std::sqrt(sb / samples.size()), ra = std::sqrt(sa / samples.size());
-    std::printf("%s %-18s %-10s facade %.3f -> %.3f m\n", tile.c_str(), id.c_str(), r.outcome.c_str(), rb, ra);
+    std::printf("%s %-18s %-10s facade %.3f -> %.3f m\n", tile.c_str(), id.c_str(), outcome_name(r.outcome), rb, ra);
     EXPECT_LE(ra, rb + 0.005) << "made worse";
     pooled.before += sb;
     pooled.after += sa;

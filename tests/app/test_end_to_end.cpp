@@ -42,7 +42,7 @@ TEST_P(EndToEnd, ScannedFacadesLandOnTheTruthAndTheShellIsValid) {
     opt.target_points = 20000;
     const SynthBuilding b = make_building(GetParam(), seed, opt);
     const RefineResult r = refine_building(b.coarse, b.cloud, Params{});
-    SCOPED_TRACE(b.id + ": " + r.outcome);
+    SCOPED_TRACE(b.id + ": " + outcome_name(r.outcome));
     ASSERT_TRUE(r.valid);
     const Vec3 o = local_origin(b.truth);
     const Mesh refined = translated(r.mesh, -o), truth = translated(b.truth, -o), coarse = translated(b.coarse, -o);

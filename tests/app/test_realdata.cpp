@@ -419,13 +419,15 @@ void dump_case(const Mesh& soup, const PointCloud& scan, const Mesh& refined) {
   write_obj((d / "refined.obj").string(), refined);
 }
 
-void record_report(const nlohmann::json& report, Row& row) {
-  row.planes = int(report.value("planes", nlohmann::json::array()).size());
-  for (const auto& step : report.value("replacements", nlohmann::json::array())) {
-    row.candidates += step.value("candidates", 0);
-    if (step.contains("mip")) {
-      row.mip_vars = std::max(row.mip_vars, step["mip"].value("variables", 0));
-      row.mip_rows = std::max(row.mip_rows, step["mip"].value("constraints", 0));
+void record_trace(const RefineTrace& t, Row& row) {
+  row.planes = t.planes ? int(t.planes->size()) : 0;
+  if (!t.replacements) return;
+  for (const auto& step : *t.replacements) {
+    if (!step.arrangement) continue;
+    row.candidates += step.arrangement->candidates.value_or(0);
+    if (const auto& mip = step.arrangement->selection) {
+      row.mip_vars = std::max(row.mip_vars, mip->variables);
+      row.mip_rows = std::max(row.mip_rows, mip->constraints);
     }
   }
 }
@@ -454,7 +456,7 @@ Row run_building(const Mesh& soup) {
   // "unchanged". Its coplanar faces merged give whole walls to scan.
   const RefineResult base = refine_building(soup, PointCloud{}, prm);
   if (!base.valid) {
-    row.outcome = "repaired model invalid: " + base.report["output_validation"].value("problem", std::string());
+    row.outcome = "repaired model invalid: " + base.trace.output_validation.problem;
     return row;
   }
   const Mesh before = merge_coplanar_faces(translated(base.mesh, -origin));
@@ -490,15 +492,15 @@ Row run_building(const Mesh& soup) {
     return row;
   }
   row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  row.outcome = r.outcome;
-  record_report(r.report, row);
+  row.outcome = outcome_name(r.outcome);
+  record_trace(r.trace, row);
   dump_case(soup, scan, r.mesh);
 
   const Mesh refined = translated(r.mesh, -origin);
   const Validation val = validate_mesh(refined, 0.01);
   if (!r.valid || !val.valid())
     row.failures.push_back("invalid result: " + (val.problem.empty() ? std::string("r.valid false") : val.problem));
-  if (!r.refined) row.failures.push_back("not refined: " + r.outcome + " (" + r.reason + ")");
+  if (!r.refined()) row.failures.push_back(std::string("not refined: ") + outcome_name(r.outcome) + " (" + r.reason + ")");
 
   // Scan facade points to the nearest refined face parallel to the wall (within 5 degrees).
   std::vector<std::vector<Vec3>> parallel;
@@ -605,11 +607,11 @@ TEST(RealData, RotterdamEveryBuildingKeptOrKeptInvalid) {
   double worst = 0.0;
   for (const auto& b : f.buildings) {
     const RefineResult r = refine_building(b.mesh, far, prm);
-    ++outcomes[r.outcome];
+    ++outcomes[outcome_name(r.outcome)];
     ASSERT_EQ(r.mesh.id, b.mesh.id);
     ASSERT_FALSE(r.mesh.faces.empty()) << b.mesh.id;
-    ASSERT_NE(r.outcome, "refined") << b.mesh.id;
-    if (r.outcome != "kept") continue;
+    ASSERT_NE(r.outcome, Outcome::Refined) << b.mesh.id;
+    if (r.outcome != Outcome::Kept) continue;
     EXPECT_TRUE(r.valid) << b.mesh.id << ": " << r.reason;
     for (const auto& v : r.mesh.vertices) worst = std::max(worst, nearest_vertex_distance(v, b.mesh));
   }

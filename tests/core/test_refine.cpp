@@ -70,9 +70,9 @@ TEST(Refine, MovesAnOutdatedFacadeOntoTheScan) {
   const PointCloud cloud = scan_front(0.0, 0.5, 11.5, 5.0, 1);
   Params prm;
   const RefineResult r = refine_building(coarse, cloud, prm);
-  ASSERT_TRUE(r.valid) << r.report.dump(1);
-  EXPECT_TRUE(r.refined) << r.outcome;
-  EXPECT_EQ(r.outcome, "refined");
+  ASSERT_TRUE(r.valid) << r.reason;
+  EXPECT_TRUE(r.refined()) << r.reason;
+  EXPECT_EQ(r.outcome, Outcome::Refined);
   EXPECT_LT(max_abs_y_of_front(r.mesh, 0.0), 0.02);
   const Validation v = validate_mesh(r.mesh);  // georeferenced frame: still valid
   EXPECT_TRUE(v.valid()) << v.problem;
@@ -85,8 +85,8 @@ TEST(Refine, MovesAFacadeInwardsAndKeepsTheRest) {
   const PointCloud cloud = scan_front(0.0, 0.5, 11.5, 5.0, 2);
   const RefineResult r = refine_building(coarse, cloud, Params{});
   ASSERT_TRUE(r.valid);
-  EXPECT_TRUE(r.refined) << r.outcome;
-  EXPECT_LT(max_abs_y_of_front(r.mesh, 0.0), 0.02) << r.report["replacements"].dump(1);
+  EXPECT_TRUE(r.refined()) << r.reason;
+  EXPECT_LT(max_abs_y_of_front(r.mesh, 0.0), 0.02) << r.reason;
   EXPECT_EQ(r.mesh.faces.size(), 6u);  // still a box: coplanar pieces merged back
 }
 
@@ -96,8 +96,8 @@ TEST(Refine, NoScanFallsBackToTheRepairedOriginal) {
   cloud.points.push_back(kOrigin + Vec3(100, 100, 0));
   const RefineResult r = refine_building(coarse, cloud, Params{});
   ASSERT_TRUE(r.valid);
-  EXPECT_FALSE(r.refined);
-  EXPECT_EQ(r.outcome, "kept");
+  EXPECT_FALSE(r.refined());
+  EXPECT_EQ(r.outcome, Outcome::Kept);
   EXPECT_EQ(r.reason, "no planes found in the cloud near the model");
   EXPECT_EQ(r.mesh.faces.size(), 6u);
 }

@@ -13,6 +13,7 @@
 #include "lodrefine/io/obj.h"
 #include "lodrefine/io/ply.h"
 #include "lodrefine/core/refine.h"
+#include "lodrefine/io/refine_report.h"
 
 using namespace lodrefine;
 
@@ -55,11 +56,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   if (std::getenv("FUZZ_VERBOSE"))  // replaying an input by hand: how far did it get?
     std::fprintf(stderr, "model %zu faces, cloud %zu points: %s\n", model.faces.size(), cloud.points.size(),
-                 r.outcome.c_str());
-  FUZZ_CHECK(!r.outcome.empty(), "empty outcome");
-  FUZZ_CHECK(r.refined == (r.outcome == "refined"), "refined=%d but outcome '%s'", int(r.refined), r.outcome.c_str());
-  FUZZ_CHECK(r.refined || r.outcome.rfind("original", 0) == 0, "outcome '%s'", r.outcome.c_str());
-  FUZZ_CHECK(r.report.contains("outcome"), "report without outcome");
+                 outcome_name(r.outcome));
+  FUZZ_CHECK(!r.reason.empty(), "outcome '%s' without a reason", outcome_name(r.outcome));
+  FUZZ_CHECK(!r.refined() || r.valid, "refined but not valid");
+  FUZZ_CHECK(refine_report(r).value("outcome", std::string()) == outcome_name(r.outcome), "report disagrees on the outcome");
   if (r.valid) {
     FUZZ_CHECK(!r.mesh.faces.empty(), "valid result without faces");
     for (const auto& v : r.mesh.vertices) FUZZ_CHECK(v.allFinite(), "non-finite vertex in a valid result");

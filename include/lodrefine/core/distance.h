@@ -37,6 +37,9 @@ std::vector<double> cloud_to_mesh(const Mesh& mesh, const std::vector<Vec3>& poi
 // The same, unsigned.
 std::vector<double> unsigned_distances(const Mesh& mesh, const std::vector<Vec3>& points);
 
+// Root mean square of the unsigned distances (0 without points).
+double rms_distance(const Mesh& mesh, const std::vector<Vec3>& points);
+
 // Deterministic samples every `spacing` metres on the given faces: a grid in each face's plane
 // (cell centres inside the polygon), or the face centroid if no cell centre falls inside.
 std::vector<Vec3> sample_faces(const Mesh& mesh, const std::vector<int>& faces, double spacing);

@@ -24,6 +24,9 @@ struct ModelSurface {
 
 std::vector<ModelSurface> model_surfaces(const Mesh& mesh, double angle_deg = 1.0, double distance = 0.02);
 
+// Largest distance of a surface's vertices from `plane` (how far the wall moves onto it).
+double surface_deviation(const Mesh& mesh, const ModelSurface& surface, const Plane& plane);
+
 struct Match {
   int scan_plane = -1;   // index into the scan planes
   int surface = -1;      // index into the model surfaces

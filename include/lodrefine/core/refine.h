@@ -1,30 +1,102 @@
-// The whole method: repair the coarse model, detect scan planes, match them to walls, and
-// replace each outdated wall through a local candidate arrangement + GLPK face selection.
+// The whole method for one building: repair the coarse model, detect scan planes, match them to
+// walls, move the outdated walls (substitution first, the local candidate arrangement + GLPK as
+// the fallback), validate, and keep the input unless the result fits the scan better.
 #pragma once
+#include <optional>
+#include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
-#include <nlohmann/json.hpp>
-
+#include "lodrefine/core/arrangement.h"
+#include "lodrefine/core/matching.h"
 #include "lodrefine/core/params.h"
+#include "lodrefine/core/planes.h"
+#include "lodrefine/core/repair.h"
 #include "lodrefine/core/types.h"
+#include "lodrefine/core/validate.h"
 
 namespace lodrefine {
 
+// "refined": walls moved, validated, and the matched walls' points fit better than before;
+// "kept": the repaired input (nothing to change, or no refinement fitted better);
+// "kept-invalid": the input cannot be made a valid solid and the output is it as read.
+enum class Outcome { Refined, Kept, KeptInvalid };
+const char* outcome_name(Outcome outcome);
+
+// What each stage found, kept for the report (built outside the core: io/refine_report.h).
+// A stage the building did not reach leaves its member empty.
+struct RefineTrace {
+  struct MatchedWall {
+    Match match;
+    double deviation = 0.0;  // largest distance of the wall's vertices from its scan plane (m)
+    std::vector<int> faces;  // the wall's faces in the repaired input
+  };
+  struct Matching {
+    std::vector<MatchedWall> walls;
+    std::vector<std::string> rejected;
+    double q_model = 0.0;
+  };
+  struct Substitution {  // one substitution of several walls at once
+    int walls = 0;
+    bool ok = false;
+    std::string reason;  // when !ok
+    int moved_vertices = 0, split_faces = 0;
+    double max_vertex_move = 0.0;
+  };
+  struct Step {  // one wall of the one-at-a-time fallback
+    int scan_plane = -1;
+    std::vector<int> wall_faces;
+    double moved_by = 0.0;
+    std::string method;  // "substitution", "arrangement"; empty when not tried
+    bool ok = false;
+    std::string reason;  // when !ok
+    std::optional<ArrangementStats> arrangement;
+  };
+  struct FacadeMove {  // a moved wall, described on the mesh it was moved on
+    std::set<int> input_faces;  // Face::source of its faces
+    std::string evidence;       // "scan" or "corner"
+    double max_move = 0.0, mean_move = 0.0;
+  };
+  struct FacadeFit {  // the never-worse check on the matched walls' own points
+    std::size_t points = 0;
+    double rms_before = 0.0, rms_after = 0.0;
+  };
+
+  std::string id;
+  Vec3 origin = Vec3::Zero();  // of the local frame
+  std::vector<std::pair<std::string, double>> seconds;  // per stage, then "total"
+  std::optional<RepairReport> repair;
+  std::optional<Validation> input_validation;
+  Validation output_validation;
+  std::size_t faces = 0;  // of the output
+  std::optional<std::pair<std::size_t, std::size_t>> cloud;  // points, points near the model
+  std::optional<std::vector<ScanPlane>> planes;
+  std::optional<Matching> matching;
+  std::optional<Substitution> substitution, substitution_without_corners;
+  std::optional<std::vector<Step>> replacements;  // set together with `facades`
+  std::vector<FacadeMove> facades;
+  std::optional<FacadeFit> facade_fit;
+
+  double stage_seconds(const std::string& stage) const {  // 0 for a stage not reached
+    for (const auto& [name, s] : seconds)
+      if (name == stage) return s;
+    return 0.0;
+  }
+};
+
 struct RefineResult {
-  Mesh mesh;               // in the input (georeferenced) frame; valid closed polyhedron
-  bool refined = false;    // outcome == "refined"
-  // "refined": walls moved, validated, and the matched walls' points fit better than before;
-  // "kept": the repaired input (nothing to change, or no refinement fitted better);
-  // "kept-invalid": the input cannot be made a valid solid and `mesh` is it as read.
-  std::string outcome;
-  std::string reason;      // one line: why this outcome
-  bool valid = false;      // `mesh` passed validate_mesh
-  nlohmann::json report;   // matches, planes, candidates, MIP, timings, validation
+  Mesh mesh;  // in the input (georeferenced) frame
+  Outcome outcome = Outcome::KeptInvalid;
+  std::string reason;  // one line: why this outcome
+  bool valid = false;  // `mesh` passed validate_mesh
+  RefineTrace trace;
+  bool refined() const { return outcome == Outcome::Refined; }
 };
 
 // Every model gets an output: the refined building, the repaired input, or the input as read,
-// with the outcome and its reason in the result and the report. Never throws for a bad model
-// (only for parameters out of range).
+// with the outcome and its reason. Never throws for a bad model (only for parameters out of
+// range).
 RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const Params& params);
 
 // The local origin used for a model: its bounding-box minimum rounded down to 100 m, so

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "lodrefine/core/params.h"
 #include "lodrefine/core/types.h"
 
 namespace lodrefine {
@@ -30,6 +31,12 @@ struct RepairReport {
 // max(weld_tolerance, gap_tolerance) (export gaps, jittered corners), two vertices of one face
 // only within weld_tolerance, so a face's own short edges never collapse.
 Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report = nullptr, double gap_tolerance = 0.0);
+
+// The repair of a building's input for the pipeline: a ladder of welds (see repair.cpp), the
+// first whose shell is valid (validate_mesh at params.planarity_tolerance) wins, else the first
+// that closed at all; warped faces come back split into triangles (counted in `report`).
+// Throws InputError (the first weld's) when no weld closes a shell.
+Mesh repair_input(const Mesh& soup, const Params& params, RepairReport& report);
 
 // Splits every face farther than `tolerance` from planar into triangles, keeping its semantic
 // and source; no vertex moves. Ear clipping, unless one of its diagonals is already an edge of

@@ -37,4 +37,11 @@ struct SubstitutionResult {
 SubstitutionResult substitute_walls(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
                                     const std::vector<WallMove>& moves, double planarity_tolerance);
 
+// Whether the scan shows a moved wall's eave where its pitched roof's plane meets the new wall
+// `plane` (the roof plane was right: WallMove::follow_roof) rather than at the old eave height
+// (the roof outline was right): the top of the wall's own points (`m.owned`, indices into
+// `cloud`) decides, and only where it clearly does.
+bool eave_follows_roof(const Mesh& mesh, const std::vector<ModelSurface>& surfaces, const Match& m, const Plane& plane,
+                       const PointCloud& cloud);
+
 }  // namespace lodrefine

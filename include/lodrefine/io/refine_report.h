@@ -1,0 +1,19 @@
+// The JSON report of one refined building (`lodrefine refine --report`), built from the
+// pipeline's result after the fact: what every stage found, the outcome and its reason.
+#pragma once
+#include <nlohmann/json.hpp>
+
+#include "lodrefine/core/refine.h"
+#include "lodrefine/core/validate.h"
+
+namespace lodrefine {
+
+// Keys: id, origin, outcome, reason, refined, faces, seconds, output_validation, and as far as
+// the building got: repair, input_validation, cloud, planes, matches, rejected_matches,
+// q_model, substitution, replacements, facades, facade_fit. The command adds model, cloud.path,
+// params, written and warnings.
+nlohmann::json refine_report(const RefineResult& result);
+
+nlohmann::json validation_json(const Validation& v);
+
+}  // namespace lodrefine

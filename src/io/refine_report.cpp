@@ -1,0 +1,117 @@
+// The refine report: RefineResult's trace as JSON (see refine_report.h).
+#include "lodrefine/io/refine_report.h"
+
+namespace lodrefine {
+namespace {
+
+using json = nlohmann::json;
+
+json substitution_json(const RefineTrace::Substitution& s) {
+  json j = {{"method", "substitution"}, {"walls", s.walls}, {"ok", s.ok}};
+  if (!s.ok) {
+    j["reason"] = s.reason;
+  } else {
+    j["moved_vertices"] = s.moved_vertices;
+    j["max_vertex_move"] = s.max_vertex_move;
+    j["split_faces"] = s.split_faces;
+  }
+  return j;
+}
+
+json step_json(const RefineTrace::Step& s) {
+  json j = {{"scan_plane", s.scan_plane}, {"wall_faces", s.wall_faces}, {"moved_by", s.moved_by}, {"ok", s.ok}};
+  if (!s.method.empty()) j["method"] = s.method;
+  if (!s.ok) j["reason"] = s.reason;
+  if (!s.arrangement) return j;
+  const ArrangementStats& a = *s.arrangement;
+  if (a.supporting_planes) j["supporting_planes"] = *a.supporting_planes;
+  if (a.candidates) j["candidates"] = *a.candidates;
+  if (a.edges) j["edges"] = *a.edges;
+  if (a.fixing_dropped) j["fixing_dropped"] = true;
+  if (a.selection) {
+    const SelectionResult& m = *a.selection;
+    j["mip"] = {{"variables", m.variables}, {"constraints", m.constraints}, {"nonzeros", m.nonzeros},
+                {"fixed_candidates", m.fixed}, {"status", m.status_text()}, {"objective", m.objective},
+                {"seconds", m.seconds}};
+  }
+  if (a.selected) j["selected"] = *a.selected;
+  if (a.seconds) j["seconds"] = *a.seconds;
+  return j;
+}
+
+}  // namespace
+
+json validation_json(const Validation& v) {
+  return {{"watertight", v.watertight()}, {"valid", v.valid()}, {"problem", v.problem},
+          {"boundary_edges", v.boundary_edges}, {"nonmanifold_edges", v.nonmanifold_edges},
+          {"outward", v.outward}, {"volume", v.volume}, {"max_planarity_error", v.max_planarity_error},
+          {"self_intersecting", v.self_intersecting}};
+}
+
+json refine_report(const RefineResult& r) {
+  const RefineTrace& t = r.trace;
+  json rep;
+  rep["id"] = t.id;
+  rep["origin"] = {t.origin.x(), t.origin.y(), t.origin.z()};
+  rep["outcome"] = outcome_name(r.outcome);
+  rep["reason"] = r.reason;
+  rep["refined"] = r.refined();
+  rep["output_validation"] = validation_json(t.output_validation);
+  rep["faces"] = t.faces;
+  json seconds = json::object();
+  for (const auto& [stage, s] : t.seconds) seconds[stage] = s;
+  rep["seconds"] = seconds;
+  if (t.repair) {
+    const RepairReport& rr = *t.repair;
+    rep["repair"] = {{"welded_vertices", rr.welded_vertices},
+                     {"removed_degenerate_faces", rr.removed_degenerate_faces},
+                     {"removed_duplicate_faces", rr.removed_duplicate_faces},
+                     {"split_t_junctions", rr.split_t_junctions},
+                     {"flipped_faces", rr.flipped_faces},
+                     {"filled_holes", rr.filled_holes},
+                     {"split_warped_faces", rr.split_warped_faces},
+                     {"notes", rr.notes}};
+  }
+  if (t.input_validation) rep["input_validation"] = validation_json(*t.input_validation);
+  if (t.cloud) rep["cloud"] = {{"points", t.cloud->first}, {"points_near_model", t.cloud->second}};
+  if (t.planes) {
+    json planes = json::array();
+    for (const auto& p : *t.planes)
+      planes.push_back({{"normal", {p.plane.n.x(), p.plane.n.y(), p.plane.n.z()}}, {"d", p.plane.d},
+                        {"inliers", p.inliers.size()}, {"rms", p.rms}, {"area", p.hull_area}, {"facade", p.facade}});
+    rep["planes"] = planes;
+  }
+  if (t.matching) {
+    json matches = json::array();
+    for (const auto& w : t.matching->walls) {
+      const Match& m = w.match;
+      matches.push_back({{"scan_plane", m.scan_plane}, {"surface", m.surface}, {"s_normal", m.s_normal},
+                         {"d_centroid", m.d_centroid}, {"c_bbox", m.c_bbox}, {"s_match", m.s_match},
+                         {"points", m.owned.size()}, {"deviation", w.deviation}, {"faces", w.faces}});
+    }
+    rep["matches"] = matches;
+    rep["rejected_matches"] = t.matching->rejected;
+    rep["q_model"] = t.matching->q_model;
+  }
+  if (t.substitution) {
+    json sub = substitution_json(*t.substitution);
+    if (t.substitution_without_corners) sub["without_corners"] = substitution_json(*t.substitution_without_corners);
+    rep["substitution"] = sub;
+  }
+  if (t.replacements) {
+    json steps = json::array();
+    for (const auto& s : *t.replacements) steps.push_back(step_json(s));
+    rep["replacements"] = steps;
+    json facades = json::array();
+    for (const auto& f : t.facades)
+      facades.push_back({{"input_faces", f.input_faces}, {"evidence", f.evidence}, {"max_move", f.max_move},
+                         {"mean_move", f.mean_move}});
+    rep["facades"] = facades;
+  }
+  if (t.facade_fit)
+    rep["facade_fit"] = {{"points", t.facade_fit->points}, {"rms_before", t.facade_fit->rms_before},
+                         {"rms_after", t.facade_fit->rms_after}};
+  return rep;
+}
+
+}  // namespace lodrefine
