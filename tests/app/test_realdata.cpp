@@ -1,10 +1,11 @@
-// The CityJSON reader, and the whole method on real LoD2 models (val3dity's Rotterdam, 3DBAG
+// The whole method on real LoD2 models (val3dity's Rotterdam, 3DBAG
 // and Den Haag CityJSON, City3D's AHN3 reconstructions). No MLS scan of these buildings exists,
 // so each building gets a synthetic scan of its longest wall moved outward by 0.30 m; the
 // refined model must be valid, follow the scan and keep the roof away from that wall.
 //
 // The real data is GPL-3.0 and lives outside the repository, in ../shared/realdata beside the
-// checkout; the RealData tests skip when it is absent.
+// checkout; the RealData tests skip when it is absent. The CityJSON reader's own tests are in
+// tests/io/test_cityjson.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -16,9 +17,6 @@
 #include <map>
 #include <random>
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include "lodrefine/io/cityjson.h"
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/io/obj.h"
@@ -27,235 +25,12 @@
 #include "lodrefine/core/refine.h"
 #include "lodrefine/core/repair.h"
 #include "lodrefine/core/validate.h"
+#include "support/realdata.h"
 
 using namespace lodrefine;
 namespace fs = std::filesystem;
 
 namespace {
-
-// ---------------------------------------------------------------------------------------
-// CityJSON reader on small inline documents.
-
-// A unit cube [0,1]^3 (in transformed units) as one Solid shell; faces: ground, roof, 4 walls.
-const char* kCubeBoundaries =
-    R"([[[[0,3,2,1]],[[4,5,6,7]],[[0,1,5,4]],[[1,2,6,5]],[[2,3,7,6]],[[3,0,4,7]]]])";
-const char* kCubeVertices =
-    R"([[0,0,0],[1000,0,0],[1000,1000,0],[0,1000,0],[0,0,1000],[1000,0,1000],[1000,1000,1000],[0,1000,1000]])";
-
-std::string cube_solid(const std::string& lod) {
-  return std::string(R"({"type":"Solid","lod":)") + lod + R"(,"boundaries":)" + kCubeBoundaries +
-         R"(,"semantics":{"surfaces":[{"type":"GroundSurface"},{"type":"RoofSurface"},{"type":"WallSurface"}],)"
-         R"("values":[[0,1,2,2,null,2]]}})";
-}
-
-std::string cube_document(const std::string& version, const std::string& objects) {
-  return R"({"type":"CityJSON","version":")" + version +
-         R"(","transform":{"scale":[0.001,0.001,0.001],"translate":[85000,447000,2]},"CityObjects":{)" + objects +
-         R"(},"vertices":)" + kCubeVertices + "}";
-}
-
-TEST(CityJson, ReadsHighestLod2SolidWithTransformAndSemantics) {
-  const std::string objects =
-      R"("B1":{"type":"Building","children":["B1-0"],"geometry":[{"type":"MultiSurface","lod":"0","boundaries":[[[0,1,2,3]]]}]},)"
-      R"("B1-0":{"type":"BuildingPart","parents":["B1"],"geometry":[)" +
-      cube_solid("\"1.2\"") + "," + cube_solid("\"2.2\"") + "," + cube_solid("\"2\"") + "]}";
-  const CityJsonFile f = parse_cityjson(cube_document("2.0", objects));
-  EXPECT_EQ(f.version, "2.0");
-  EXPECT_FALSE(f.sequence);
-  EXPECT_EQ(f.objects_without_lod2, 1);  // B1 has LoD 0 only
-  ASSERT_EQ(f.buildings.size(), 1u);
-  const CityJsonBuilding& b = f.buildings[0];
-  EXPECT_EQ(b.mesh.id, "B1-0");
-  EXPECT_EQ(b.type, "BuildingPart");
-  EXPECT_EQ(b.parent, "B1");
-  EXPECT_EQ(b.lod, "2.2");
-  EXPECT_EQ(b.geometry_type, "Solid");
-  ASSERT_EQ(b.mesh.faces.size(), 6u);
-  EXPECT_EQ(b.mesh.vertices.size(), 24u);  // polygon soup: every face its own vertices
-  const Semantic expect[6] = {Semantic::Ground, Semantic::Roof, Semantic::Wall,
-                              Semantic::Wall,   Semantic::Other, Semantic::Wall};
-  for (int i = 0; i < 6; ++i) {
-    EXPECT_EQ(b.mesh.faces[i].sem, expect[i]) << i;
-    EXPECT_EQ(b.mesh.faces[i].source, i);
-  }
-  const Vec3 roof0 = b.mesh.vertices[b.mesh.faces[1].v[0]];
-  EXPECT_NEAR((roof0 - Vec3(85000, 447000, 3)).norm(), 0.0, 1e-9);
-  const Vec3 far = b.mesh.vertices[b.mesh.faces[1].v[2]];
-  EXPECT_NEAR((far - Vec3(85001, 447001, 3)).norm(), 0.0, 1e-9);
-}
-
-TEST(CityJson, ReadsMultiSurfaceWithHolesKeyholesPinchesAndNoTransform) {
-  // CityJSON 1.0 style: numeric lod, no transform (real coordinates). Surfaces: a hole ring plus a
-  // repeated vertex and a closing vertex written out; a degenerate ring; a ClosureSurface; a
-  // keyhole ring (hole bridged to the outer ring); a figure-8 ring (two loops sharing vertex 1).
-  const std::string doc = R"({"type":"CityJSON","version":"1.0","CityObjects":{"X":{"type":"Building","geometry":[
-      {"type":"MultiSurface","lod":2,"boundaries":[[[0,1,1,2,3,0],[4,5,6]],[[0,1,0]],[[4,5,6]],
-        [[0,1,2,3,0,4,6,5,4]],[[0,1,7,8,1,2,3]]],
-       "semantics":{"surfaces":[{"type":"WallSurface"},{"type":"ClosureSurface"}],"values":[0,0,1,0,0]}}]}},
-      "vertices":[[0.5,0,0],[10,0,0],[10,0,5],[0,0,5],[2,0,1],[3,0,1],[3,0,2],[20,0,0],[20,0,5]]})";
-  const CityJsonFile f = parse_cityjson(doc);
-  ASSERT_EQ(f.buildings.size(), 1u);
-  const CityJsonBuilding& b = f.buildings[0];
-  EXPECT_EQ(b.lod, "2");
-  EXPECT_EQ(b.skipped_holes, 2);
-  EXPECT_EQ(b.skipped_rings, 1);
-  ASSERT_EQ(b.mesh.faces.size(), 5u);
-  const int sources[5] = {0, 2, 3, 4, 4};
-  const std::size_t sizes[5] = {4, 3, 4, 3, 4};
-  for (int i = 0; i < 5; ++i) {
-    EXPECT_EQ(b.mesh.faces[i].source, sources[i]) << i;
-    EXPECT_EQ(b.mesh.faces[i].v.size(), sizes[i]) << i;
-    EXPECT_EQ(b.mesh.faces[i].sem, i == 1 ? Semantic::Other : Semantic::Wall) << i;
-  }
-  EXPECT_DOUBLE_EQ(b.mesh.vertices[0].x(), 0.5);
-  EXPECT_EQ(f.notes.size(), 2u);  // the holes, the degenerate surface
-}
-
-TEST(CityJson, ReadsCityJsonSeqWithPerFeatureVertices) {
-  const std::string header =
-      R"({"type":"CityJSON","version":"2.0","CityObjects":{},"vertices":[],)"
-      R"("transform":{"scale":[0.01,0.01,0.01],"translate":[100,200,0]},"metadata":{"referenceSystem":"EPSG:7415"}})";
-  auto feature = [](const std::string& id) {
-    return R"({"type":"CityJSONFeature","id":")" + id + R"(","CityObjects":{")" + id +
-           R"(":{"type":"Building","geometry":[)" + cube_solid("\"2.2\"") + R"(]}},"vertices":)" + kCubeVertices + "}";
-  };
-  const CityJsonFile f = parse_cityjson(header + "\n" + feature("A") + "\r\n\n" + feature("B") + "\n");
-  EXPECT_TRUE(f.sequence);
-  EXPECT_EQ(f.crs, "EPSG:7415");
-  ASSERT_EQ(f.buildings.size(), 2u);
-  EXPECT_EQ(f.buildings[1].mesh.id, "B");
-  const Vec3 p = f.buildings[1].mesh.vertices[f.buildings[1].mesh.faces[1].v[2]];
-  EXPECT_NEAR((p - Vec3(110, 210, 10)).norm(), 0.0, 1e-9);
-}
-
-TEST(CityJson, RejectsMalformedInputWithOneLineMessages) {
-  const std::string ok_solid = cube_solid("\"2\"");
-  const std::vector<std::pair<std::string, std::string>> bad = {
-      {"{not json", "not valid JSON"},
-      {R"({"type":"FeatureCollection"})", "not a CityJSON file"},
-      {R"({"type":"CityJSON","CityObjects":{}})", "no \"vertices\""},
-      {R"({"type":"CityJSON","vertices":[]})", "no \"CityObjects\""},
-      {cube_document("2.0", R"("A":{"type":"Building","geometry":[{"type":"Solid","lod":"2","boundaries":[[[[0,1,99]]]]}]})"),
-       "vertex index 99 is out of range"},
-      {cube_document("2.0", R"("A":{"type":"Building","geometry":[{"type":"Solid","lod":"2","boundaries":[[0,1,2]]}]})"),
-       "not nested"},
-      {cube_document("2.0", R"("A":{"type":"Building","geometry":[{"type":"Solid","lod":"2","boundaries":)" +
-                                std::string(kCubeBoundaries) +
-                                R"(,"semantics":{"surfaces":[{"type":"RoofSurface"}],"values":[[0,0,0,0,0,3]]}}]})"),
-       "semantics value 3"},
-      {cube_document("2.0", R"("A":{"type":"Building","geometry":[{"type":"Solid","lod":"2","boundaries":)" +
-                                std::string(kCubeBoundaries) +
-                                R"(,"semantics":{"surfaces":[{"type":"RoofSurface"}],"values":[[0,0]]}}]})"),
-       "semantics values do not match"},
-      {cube_document("2.0", R"("A":{"type":"Building","geometry":[{"type":"Solid","lod":"two","boundaries":[]}]})"),
-       "lod"},
-      {R"({"type":"CityJSON","transform":{"scale":[1,1]},"CityObjects":{},"vertices":[]})", "transform.scale"},
-      {R"({"type":"CityJSON","CityObjects":{},"vertices":[[1,2]]})", "vertex 0"},
-      {R"({"type":"CityJSON","version":"2.0","CityObjects":{},"vertices":[]})"
-       "\n{\"type\":\"CityJSONFeature\",\"CityObjects\":{},\"vertices\":[]}\n{\"type\":\"CityJSON\"}\n",
-       "line 3: expected a CityJSONFeature"},
-      {cube_document("2.0", R"("A":{"type":"Building","geometry":[)" + ok_solid + R"(]},"B":{"type":"Building","geometry":{}})"),
-       "object B: \"geometry\" is not an array"},
-  };
-  for (const auto& [text, expect] : bad) {
-    try {
-      parse_cityjson(text, "bad.json");
-      ADD_FAILURE() << "accepted: " << text.substr(0, 200);
-    } catch (const InputError& e) {
-      const std::string msg = e.what();
-      EXPECT_EQ(msg.rfind("bad.json: ", 0), 0u) << msg;
-      EXPECT_NE(msg.find(expect), std::string::npos) << msg;
-      EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
-    }
-  }
-  EXPECT_THROW(read_cityjson("/nonexistent/file.city.json"), InputError);
-}
-
-TEST(CityJson, FileStemsAreSafe) {
-  EXPECT_EQ(file_stem_for_id("{10A31B7E-8FC2}"), "{10A31B7E-8FC2}");
-  EXPECT_EQ(file_stem_for_id("NL.IMBAG.Pand.0503100000031927-0"), "NL.IMBAG.Pand.0503100000031927-0");
-  EXPECT_EQ(file_stem_for_id("a/b c\\d:e\n"), "a_b_c_d_e_");
-  EXPECT_EQ(file_stem_for_id(".."), "_..");
-  EXPECT_EQ(file_stem_for_id(""), "_");
-}
-
-// `lodrefine convert` writes one OBJ per building that reads back as the same soup.
-TEST(CityJson, ConvertCommandWritesOneObjPerBuilding) {
-  const fs::path dir = fs::temp_directory_path() / ("lodrefine_convert_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  const std::string objects = std::string(R"("B/1":{"type":"Building","geometry":[)") + cube_solid("\"2\"") +
-                              R"(]},"B2":{"type":"Building","geometry":[)" + cube_solid("\"2.2\"") + "]}";
-  write_file_atomic((dir / "in.city.json").string(), cube_document("1.1", objects));
-  const std::string cmd = std::string(LODREFINE_BINARY) + " convert --cityjson '" + (dir / "in.city.json").string() +
-                          "' --out-dir '" + (dir / "out").string() + "'";
-  ASSERT_EQ(std::system((cmd + " > /dev/null").c_str()), 0) << cmd;
-  const Mesh m = read_obj((dir / "out" / "B_1.obj").string());
-  EXPECT_EQ(m.id, "B/1");
-  ASSERT_EQ(m.faces.size(), 6u);
-  const Mesh expect = parse_cityjson(cube_document("1.1", objects)).buildings[0].mesh;
-  std::map<Semantic, int> got, want;
-  for (std::size_t f = 0; f < 6; ++f) {
-    EXPECT_EQ(m.faces[f].v.size(), 4u);
-    ++got[m.faces[f].sem];
-    ++want[expect.faces[f].sem];
-  }
-  EXPECT_EQ(got, want);
-  Vec3 lo = Vec3::Constant(1e300);
-  for (const auto& v : m.vertices) lo = lo.cwiseMin(v);
-  EXPECT_NEAR((lo - Vec3(85000, 447000, 2)).norm(), 0.0, 1e-6);
-  EXPECT_TRUE(fs::exists(dir / "out" / "B2.obj"));
-  // An id that is not in the file is an input error (exit code 2).
-  EXPECT_EQ(WEXITSTATUS(std::system((cmd + " --id nope 2> /dev/null").c_str())), 2);
-  fs::remove_all(dir);
-}
-
-// ---------------------------------------------------------------------------------------
-// Real data.
-
-fs::path realdata_dir() { return fs::path(LODREFINE_SOURCE_DIR) / ".." / "shared" / "realdata"; }
-
-#define REQUIRE_REALDATA(rel)                                                          \
-  const fs::path data_path = realdata_dir() / (rel);                                   \
-  if (!fs::exists(data_path)) GTEST_SKIP() << "real data not found: " << data_path.string()
-
-TEST(CityJson, ReadsTheRealFiles) {
-  REQUIRE_REALDATA("val3dity/data");
-  const CityJsonFile rotterdam = read_cityjson((data_path / "rotterdam/3-20-DELFSHAVEN.city.json").string());
-  EXPECT_EQ(rotterdam.version, "2.0");
-  EXPECT_EQ(rotterdam.buildings.size(), 853u);
-  // metadata.geographicalExtent of the file
-  const Vec3 lo(90409.32, 435440.44, 0.0), hi(91453.879, 436089.946, 41.158);
-  int walls = 0, roofs = 0, grounds = 0;
-  for (const auto& b : rotterdam.buildings) {
-    EXPECT_EQ(b.geometry_type, "MultiSurface");
-    for (const auto& v : b.mesh.vertices)
-      ASSERT_TRUE((v.array() >= lo.array() - 1e-6).all() && (v.array() <= hi.array() + 1e-6).all()) << b.mesh.id;
-    for (const auto& f : b.mesh.faces) {
-      walls += f.sem == Semantic::Wall;
-      roofs += f.sem == Semantic::Roof;
-      grounds += f.sem == Semantic::Ground;
-    }
-  }
-  EXPECT_GT(walls, 5 * 853);
-  EXPECT_GE(roofs, 853);
-  EXPECT_GE(grounds, 853);
-
-  const CityJsonFile bag = read_cityjson((data_path / "cityjsonseq/3dbag_b2.city.jsonl").string());
-  EXPECT_TRUE(bag.sequence);
-  ASSERT_EQ(bag.buildings.size(), 2u);  // the two BuildingParts; their Buildings have LoD 0 only
-  EXPECT_EQ(bag.buildings[0].mesh.id, "NL.IMBAG.Pand.0503100000031927-0");
-  EXPECT_EQ(bag.buildings[0].lod, "2.2");
-  EXPECT_NEAR(bag.buildings[0].mesh.vertices[0].x(), 85006.254, 1e-3);
-
-  const CityJsonFile dh = read_cityjson((data_path / "test_cjseq/denhaag_random_5.city.jsonl").string());
-  EXPECT_EQ(dh.version, "1.1");
-  EXPECT_EQ(dh.buildings.size(), 14u);  // 12 parts + 2 buildings without parts
-  for (const auto& b : dh.buildings) EXPECT_EQ(b.geometry_type, "Solid");
-
-  const CityJsonFile lods = read_cityjson((data_path / "test_cityjson/several_lods_valid.json").string());
-  ASSERT_EQ(lods.buildings.size(), 1u);
-  EXPECT_EQ(lods.buildings[0].lod, "2.2");
-}
 
 // One building of a real data set with its moved-wall experiment.
 struct Row {

@@ -15,7 +15,7 @@
 
 #include "lodrefine/eval/eval.h"
 #include "lodrefine/core/geometry.h"
-#include "support/eval_fixtures.h"
+#include "support/mesh_fixtures.h"
 
 using namespace lodrefine;
 using namespace lodrefine::fixtures;

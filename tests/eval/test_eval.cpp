@@ -1,12 +1,12 @@
-// Metrics of the paper's evaluation: C2M signs and values, statistics, ΔD, watertightness,
-// pooling, and the SVG plots.
+// Metrics of the paper's evaluation: statistics, ΔD, watertightness, scanned walls, pooling, and
+// the SVG plots (the C2M distances themselves: tests/core/test_distance.cpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "lodrefine/eval/eval.h"
 #include "lodrefine/eval/plots.h"
-#include "support/eval_fixtures.h"
+#include "support/mesh_fixtures.h"
 
 using namespace lodrefine;
 using namespace lodrefine::fixtures;
@@ -14,22 +14,6 @@ using namespace lodrefine::fixtures;
 namespace {
 
 Mesh unit_cube() { return box(Vec3::Zero(), Vec3::Ones()); }
-
-// Every face with its own copies of its vertices, as exported from CityGML.
-Mesh as_soup(const Mesh& m) {
-  Mesh s;
-  s.id = m.id;
-  for (const Face& f : m.faces) {
-    Face g = f;
-    g.v.clear();
-    for (int v : f.v) {
-      g.v.push_back(int(s.vertices.size()));
-      s.vertices.push_back(m.vertices[std::size_t(v)]);
-    }
-    s.faces.push_back(g);
-  }
-  return s;
-}
 
 BuildingEval fake_building(std::vector<double> before, std::vector<double> after, bool wt_after) {
   BuildingEval b;
@@ -42,43 +26,6 @@ BuildingEval fake_building(std::vector<double> before, std::vector<double> after
 }
 
 }  // namespace
-
-TEST(EvalC2M, UnitCubeFaceEdgeVertexAndInside) {
-  const std::vector<Vec3> pts = {
-      {0.5, 0.5, 1.3},  // above the roof
-      {0.5, 0.5, 0.8},  // inside, nearest the roof
-      {0.5, 0.5, 0.5},  // centre: all six faces tie
-      {1.2, 0.5, 1.2},  // nearest an edge
-      {1.2, 1.2, 1.2},  // nearest a vertex
-      {-0.3, 0.5, 0.1}, // outside a wall
-      {0.9, 0.5, 0.9},  // inside, equidistant to two faces
-      {1.0, 0.3, 0.7},  // on the surface
-  };
-  const std::vector<double> want = {0.3, -0.2, -0.5, std::sqrt(0.08), std::sqrt(0.12), 0.3, -0.1, 0.0};
-  const auto got = cloud_to_mesh(unit_cube(), pts);
-  ASSERT_EQ(got.size(), want.size());
-  for (std::size_t i = 0; i < want.size(); ++i) EXPECT_NEAR(got[i], want[i], 1e-12) << "point " << i;
-}
-
-TEST(EvalC2M, SoupAndGeoreferencedFrameGiveTheSameDistances) {
-  const std::vector<Vec3> pts = {{1.2, 0.5, 1.2}, {1.2, 1.2, 1.2}, {0.5, 0.5, 0.8}, {-0.1, -0.1, 0.5}};
-  const auto ref = cloud_to_mesh(unit_cube(), pts);
-  const Vec3 shift(85000.0, 447000.0, 12.0);
-  Mesh geo = as_soup(unit_cube());
-  for (auto& v : geo.vertices) v += shift;
-  std::vector<Vec3> geo_pts = pts;
-  for (auto& p : geo_pts) p += shift;
-  const auto got = cloud_to_mesh(geo, geo_pts);
-  for (std::size_t i = 0; i < pts.size(); ++i) EXPECT_NEAR(got[i], ref[i], 1e-9) << "point " << i;
-}
-
-TEST(EvalC2M, NeedleApexUsesThePseudonormal) {
-  const auto d = cloud_to_mesh(needle(), {{-0.5, 0.0, 10.5}, {0.5, 0.0, 10.5}, {0.0, 0.5, 10.5}, {0.0, 0.0, 9.5}});
-  for (int i = 0; i < 3; ++i) EXPECT_NEAR(d[std::size_t(i)], std::sqrt(0.5), 1e-12) << "point " << i;
-  EXPECT_NEAR(d[3], -0.5 / std::sqrt(101.0), 1e-12);  // inside, nearest a side face
-}
-
-TEST(EvalC2M, EmptyMeshIsAnInputError) { EXPECT_THROW(cloud_to_mesh(Mesh{}, {{0, 0, 0}}), InputError); }
 
 TEST(EvalStats, KnownVectors) {
   const DistanceStats a = summarize_distances({1, -1, 2, -2, 0});
@@ -130,12 +77,9 @@ TEST(EvalWatertight, ClosedSoupOpenFlippedAndGapped) {
   EXPECT_FALSE(is_watertight(gapped));
 }
 
-TEST(EvalSampling, GridEveryTenCentimetres) {
+// Points on two walls (and a stray one) mark exactly those walls as scanned.
+TEST(EvalScannedWalls, PointsOnTwoWallsMarkThoseWalls) {
   const Mesh cube = unit_cube();
-  const auto s = sample_faces(cube, {1}, 0.1);  // the 1 m² roof
-  EXPECT_EQ(s.size(), 100u);
-  for (const auto& p : s) EXPECT_NEAR(p.z(), 1.0, 1e-12);
-  // Points on two walls (and a stray one) mark exactly those walls as scanned.
   std::vector<Vec3> pts;
   for (int i = 1; i < 10; ++i)
     for (int j = 1; j < 10; ++j) pts.push_back({0.1 * i, 0.01, 0.1 * j}), pts.push_back({-0.02, 0.1 * i, 0.1 * j});

