@@ -161,6 +161,10 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm)
   rp.normal_threshold = std::cos(radians(prm.ransac_normal_deg));
   ransac.detect(rp);
 
+  // Efficient RANSAC reorders `pts`: a representative is found by its cloud index, not by k.
+  std::unordered_map<int, int> rep_position;
+  if (!voxel_rep.empty())
+    for (int r = 0; r < int(reps.size()); ++r) rep_position.emplace(reps[r], r);
   std::vector<int> rep_shape(reps.size(), -1);
   int shape_id = 0;
   std::vector<std::vector<int>> shape_inliers;
@@ -168,7 +172,7 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm)
     std::vector<int> inl;
     for (std::size_t k : shape->indices_of_assigned_points()) {
       inl.push_back(std::get<2>(pts[k]));
-      rep_shape[k] = shape_id;
+      if (!voxel_rep.empty()) rep_shape[rep_position.at(std::get<2>(pts[k]))] = shape_id;
     }
     shape_inliers.push_back(std::move(inl));
     ++shape_id;
@@ -180,7 +184,7 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm)
       std::vector<Vec3> q;
       for (int i : inl) q.push_back(cloud.points[i]);
       fitted.push_back(q.size() >= 3 ? fit_plane(q) : Plane());
-      }
+    }
     for (auto& inl : shape_inliers) inl.clear();
     for (int i = 0; i < int(n); ++i) {
       const auto it = voxel_rep.find(key(cloud.points[i]));

@@ -37,7 +37,10 @@ struct Match {
 struct MatchResult {
   std::vector<Match> matches;   // the accepted one-to-one matches (one scan plane per surface)
   double q_model = 0.0;         // sum of S_match
-  std::vector<std::string> rejected;  // one line per match a check turned down, and why
+  // One line per match turned down after a wall was found in reach of the plane (coverage,
+  // facing, a corner conflict), and why; a plane no wall is near (match_distance,
+  // match_angle_deg) has no candidate and no line.
+  std::vector<std::string> rejected;
 };
 
 MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
