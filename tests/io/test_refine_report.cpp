@@ -1,0 +1,83 @@
+// The refine report: built from RefineResult after the fact, with a key per stage reached.
+#include <gtest/gtest.h>
+
+#include "lodrefine/core/refine.h"
+#include "lodrefine/io/refine_report.h"
+#include "support/mesh_fixtures.h"
+#include "support/scan_fixtures.h"
+
+using namespace lodrefine;
+using namespace lodrefine::fixtures;
+
+namespace {
+
+// A georeferenced box 12 × 8 × 6 m and an MLS scan of its front wall 0.4 m further out.
+struct Scene {
+  Vec3 origin{85000.0, 447000.0, 0.0};
+  Mesh model;
+  PointCloud scan;
+  Scene() {
+    model = as_soup(box(Vec3(0, 0, 0), Vec3(12, 8, 6)));
+    model.id = "box";
+    add_grid(scan, wall_patch(Vec3(0, -0.4, 0), Vec3::UnitX(), 12.0, 0.0, 6.0), 0.1, 0.005);
+    for (auto& v : model.vertices) v += origin;
+    for (auto& p : scan.points) p += origin;
+  }
+};
+
+}  // namespace
+
+TEST(RefineReport, RefinedBuildingHasEveryStage) {
+  const Scene s;
+  const RefineResult r = refine_building(s.model, s.scan, Params{});
+  ASSERT_EQ(r.outcome, Outcome::Refined) << r.reason;
+  const nlohmann::json j = refine_report(r);
+  EXPECT_EQ(j["id"], "box");
+  EXPECT_EQ(j["outcome"], "refined");
+  EXPECT_EQ(j["refined"], true);
+  EXPECT_EQ(j["origin"], nlohmann::json({85000.0, 447000.0, 0.0}));
+  for (const char* key : {"repair", "input_validation", "output_validation", "cloud", "planes", "matches",
+                          "rejected_matches", "q_model", "substitution", "replacements", "facades", "facade_fit"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["cloud"]["points"], s.scan.points.size());
+  ASSERT_EQ(j["matches"].size(), 1u);
+  EXPECT_NEAR(j["matches"][0]["deviation"].get<double>(), 0.4, 0.02);
+  EXPECT_EQ(j["substitution"]["ok"], true);
+  EXPECT_EQ(j["substitution"]["walls"], 1);
+  EXPECT_TRUE(j["replacements"].empty());
+  ASSERT_EQ(j["facades"].size(), 1u);
+  EXPECT_EQ(j["facades"][0]["evidence"], "scan");
+  EXPECT_NEAR(j["facades"][0]["max_move"].get<double>(), 0.4, 0.02);
+  EXPECT_LT(j["facade_fit"]["rms_after"].get<double>(), 0.02);
+  EXPECT_GT(j["facade_fit"]["rms_before"].get<double>(), 0.3);
+  EXPECT_EQ(j["output_validation"]["valid"], true);
+  EXPECT_EQ(j["faces"], r.trace.faces);
+  for (const char* stage : {"repair", "planes", "matching", "substitution", "replacement", "total"})
+    EXPECT_TRUE(j["seconds"].contains(stage)) << stage;
+}
+
+TEST(RefineReport, ABuildingStoppedAtRepairHasOnlyWhatItReached) {
+  Scene s;
+  s.model.faces.resize(2);  // two faces: no weld closes a shell
+  const RefineResult r = refine_building(s.model, s.scan, Params{});
+  ASSERT_EQ(r.outcome, Outcome::KeptInvalid);
+  const nlohmann::json j = refine_report(r);
+  EXPECT_EQ(j["outcome"], "kept-invalid");
+  EXPECT_EQ(j["reason"], r.reason);
+  EXPECT_FALSE(r.reason.empty());
+  for (const char* key : {"repair", "cloud", "planes", "matches", "substitution", "replacements", "facade_fit"})
+    EXPECT_FALSE(j.contains(key)) << key;
+  EXPECT_EQ(j["seconds"].size(), 2u);  // repair, total
+  EXPECT_EQ(j["faces"], 2u);
+}
+
+TEST(RefineReport, ValidationJsonNamesTheProblem) {
+  Validation v;
+  v.boundary_edges = 3;
+  v.problem = "3 boundary edges";
+  const nlohmann::json j = validation_json(v);
+  EXPECT_EQ(j["valid"], false);
+  EXPECT_EQ(j["watertight"], false);
+  EXPECT_EQ(j["boundary_edges"], 3);
+  EXPECT_EQ(j["problem"], "3 boundary edges");
+}
