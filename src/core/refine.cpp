@@ -15,6 +15,13 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// m: local frames have their origin on this grid (the model's box minimum rounded down), so all
+// computation runs on coordinates of a few hundred metres and reports show a readable origin.
+constexpr double kOriginGrid = 100.0;
+// A wall's position for "tried already" in the fallback: its centroid's squared norm in 1/this m²
+// steps (the same wall re-found after another moved has the same position within rounding).
+constexpr double kPositionSteps = 100.0;
+
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // The cloud near the model, in its local frame (crops may carry whole streets): the model's
@@ -86,7 +93,7 @@ std::optional<Mesh> one_wall_at_a_time(const Mesh& start, const PointCloud& loca
   Mesh step_mesh = start;
   bool any = false;
   std::set<std::pair<int, long long>> tried;  // (scan plane, rounded wall position)
-  auto position = [](const ModelSurface& s) { return (long long)std::llround(s.centroid.squaredNorm() * 100); };
+  auto position = [](const ModelSurface& s) { return (long long)std::llround(s.centroid.squaredNorm() * kPositionSteps); };
   double mip_seconds = 0.0;
   for (int iter = 0; iter < max_steps; ++iter) {
     const auto ss = model_surfaces(step_mesh);
@@ -160,7 +167,7 @@ Vec3 local_origin(const Mesh& model) {
   Vec3 lo = Vec3::Constant(1e300);
   for (const auto& v : model.vertices) lo = lo.cwiseMin(v);
   if (!lo.allFinite() || model.vertices.empty()) return Vec3::Zero();
-  return Vec3(std::floor(lo.x() / 100.0) * 100.0, std::floor(lo.y() / 100.0) * 100.0, std::floor(lo.z() / 100.0) * 100.0);
+  return (lo / kOriginGrid).array().floor().matrix() * kOriginGrid;
 }
 
 RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const Params& prm) {
