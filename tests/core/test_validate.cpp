@@ -4,6 +4,7 @@
 #include <map>
 
 #include "lodrefine/core/geometry.h"
+#include "lodrefine/core/topology.h"
 #include "lodrefine/core/validate.h"
 
 using namespace lodrefine;
