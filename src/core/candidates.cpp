@@ -4,7 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <unordered_map>
+
+#include "lodrefine/core/topology.h"
 
 namespace lodrefine {
 
@@ -118,39 +119,6 @@ WorkPolygon section(int self, const PlaneBank& bank, const Region& region, int f
   return w;
 }
 
-// Welds points closer than `tol` through a hash grid; returns the index of each point.
-class Welder {
- public:
-  explicit Welder(double tol) : tol_(tol) {}
-  int add(const Vec3& p) {
-    const auto key = cell(p);
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          auto it = grid_.find(hash({key[0] + dx, key[1] + dy, key[2] + dz}));
-          if (it == grid_.end()) continue;
-          for (int i : it->second)
-            if ((points[i] - p).norm() <= tol_) return i;
-        }
-    points.push_back(p);
-    grid_[hash(key)].push_back(int(points.size()) - 1);
-    return int(points.size()) - 1;
-  }
-  std::vector<Vec3> points;
-
- private:
-  using Key = std::array<long long, 3>;
-  Key cell(const Vec3& p) const {
-    return {(long long)std::floor(p.x() / (4 * tol_)), (long long)std::floor(p.y() / (4 * tol_)),
-            (long long)std::floor(p.z() / (4 * tol_))};
-  }
-  static std::size_t hash(const Key& k) {
-    return std::size_t(k[0] * 73856093LL) ^ std::size_t(k[1] * 19349663LL) ^ std::size_t(k[2] * 83492791LL);
-  }
-  double tol_;
-  std::unordered_map<std::size_t, std::vector<int>> grid_;
-};
-
 }  // namespace
 
 std::vector<Vec3> region_section(const Plane& plane, const Region& region) {
@@ -172,7 +140,7 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
   const int first_box = int(bank.all.size());
   for (const auto& b : region.planes()) bank.all.push_back(b);
 
-  Welder welder(1e-6);
+  PointWelder welder(1e-6);
   for (int i = 0; i < int(planes.size()); ++i) {
     std::vector<WorkPolygon> pieces{section(i, bank, region, first_box)};
     if (pieces[0].p.size() < 3) continue;
@@ -190,21 +158,18 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
       if (polygon_area(w.p) < min_area) continue;
       Candidate c;
       c.plane = i;
-      for (const auto& x : w.p) {
-        const int id = welder.add(x);
-        if (c.v.empty() || c.v.back() != id) c.v.push_back(id);
-      }
-      while (c.v.size() > 1 && c.v.front() == c.v.back()) c.v.pop_back();
+      for (const auto& x : w.p) c.v.push_back(welder.add(x));
+      drop_repeats(c.v);
       if (c.v.size() < 3) continue;
       std::vector<Vec3> poly;
-      for (int id : c.v) poly.push_back(welder.points[id]);
+      for (int id : c.v) poly.push_back(welder.points()[id]);
       if (newell_normal(poly).dot(planes[i].plane.n) < 0) std::reverse(c.v.begin(), c.v.end());
       c.area = polygon_area(poly);
       c.centroid = polygon_centroid(poly);
       cs.faces.push_back(std::move(c));
     }
   }
-  cs.vertices = welder.points;
+  cs.vertices = welder.points();
 
   // Where a vertex of one face lies inside another face's edge (several planes meeting at a
   // point along the line), split that edge so that adjacency is exact.
@@ -213,17 +178,7 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
     for (std::size_t k = 0; k < f.v.size(); ++k) {
       const int a = f.v[k], b = f.v[(k + 1) % f.v.size()];
       out.push_back(a);
-      const Vec3 pa = cs.vertices[a], ab = cs.vertices[b] - pa;
-      const double len2 = ab.squaredNorm();
-      std::vector<std::pair<double, int>> inner;
-      for (int x = 0; x < int(cs.vertices.size()); ++x) {
-        if (x == a || x == b) continue;
-        const double t = (cs.vertices[x] - pa).dot(ab) / len2;
-        if (t <= 1e-9 || t >= 1 - 1e-9) continue;
-        if ((pa + t * ab - cs.vertices[x]).norm() <= 1e-6) inner.emplace_back(t, x);
-      }
-      std::sort(inner.begin(), inner.end());
-      for (const auto& [t, x] : inner) out.push_back(x);
+      for (int x : vertices_on_segment(cs.vertices, a, b, SegmentRule{1e-6, false, 1e-9})) out.push_back(x);
     }
     f.v = out;
   }
