@@ -25,14 +25,10 @@ bool Region::contains(const Vec3& p, double tol) const {
 }
 
 Region Region::around(const std::vector<Vec3>& pts, double relative, double absolute) {
-  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-  for (const auto& p : pts) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
+  const Eigen::AlignedBox3d box = bounding_box(pts);
   Region r;
-  r.center = 0.5 * (lo + hi);
-  r.half = 0.5 * (hi - lo) * (1.0 + 2.0 * relative) + Vec3::Constant(absolute);
+  r.center = 0.5 * (box.min() + box.max());
+  r.half = 0.5 * (box.max() - box.min()) * (1.0 + 2.0 * relative) + Vec3::Constant(absolute);
   return r;
 }
 

@@ -16,22 +16,15 @@ std::vector<Vec2> to_2d(const std::vector<Vec3>& pts, const Plane& pl, const Vec
   return out;
 }
 
-struct Box2 {
-  Vec2 lo = Vec2::Constant(1e300), hi = Vec2::Constant(-1e300);
-  explicit Box2(const std::vector<Vec2>& pts) {
-    for (const auto& p : pts) { lo = lo.cwiseMin(p); hi = hi.cwiseMax(p); }
-  }
-  double area() const { return std::max(0.0, hi.x() - lo.x()) * std::max(0.0, hi.y() - lo.y()); }
-};
-
 // Bounding-box overlap in the reference's plane: IoU, or the share of either box covered
 // (the "bidirectional coverage ratio"), whichever is larger.
 double box_overlap(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
-  const Box2 ba(a), bb(b);
-  const double w = std::min(ba.hi.x(), bb.hi.x()) - std::max(ba.lo.x(), bb.lo.x());
-  const double h = std::min(ba.hi.y(), bb.hi.y()) - std::max(ba.lo.y(), bb.lo.y());
+  const Eigen::AlignedBox2d ba = bounding_box(a), bb = bounding_box(b);
+  const double w = std::min(ba.max().x(), bb.max().x()) - std::max(ba.min().x(), bb.min().x());
+  const double h = std::min(ba.max().y(), bb.max().y()) - std::max(ba.min().y(), bb.min().y());
   if (w <= 0 || h <= 0) return 0.0;
-  const double inter = w * h, ua = ba.area(), ub = bb.area();
+  // Both boxes overlap with positive width and height here, so neither is empty.
+  const double inter = w * h, ua = ba.volume(), ub = bb.volume();
   const double iou = inter / std::max(1e-12, ua + ub - inter);
   return std::max({iou, inter / std::max(1e-12, ua), inter / std::max(1e-12, ub)});
 }

@@ -112,11 +112,8 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm)
   order.erase(std::unique(order.begin(), order.end(), [&](int a, int b) { return cloud.points[a] == cloud.points[b]; }),
               order.end());
   if (order.size() < std::size_t(std::max(prm.ransac_min_points, prm.normal_neighbors + 1))) return result;
-  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-  for (int i : order) {
-    lo = lo.cwiseMin(cloud.points[i]);
-    hi = hi.cwiseMax(cloud.points[i]);
-  }
+  const Eigen::AlignedBox3d box = bounding_box(cloud.points, order);
+  const Vec3 lo = box.min(), hi = box.max();
   if ((hi - lo).norm() < 10.0 * prm.ransac_epsilon) return result;
   std::sort(order.begin(), order.end());  // file order: keeps runs reproducible as before
   // Detection runs on one point per voxel (its cost grows with the points, not the facade

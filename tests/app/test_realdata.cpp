@@ -200,9 +200,7 @@ TEST(CityJson, ConvertCommandWritesOneObjPerBuilding) {
     ++want[expect.faces[f].sem];
   }
   EXPECT_EQ(got, want);
-  Vec3 lo = Vec3::Constant(1e300);
-  for (const auto& v : m.vertices) lo = lo.cwiseMin(v);
-  EXPECT_NEAR((lo - Vec3(85000, 447000, 2)).norm(), 0.0, 1e-6);
+  EXPECT_NEAR((bounding_box(m.vertices).min() - Vec3(85000, 447000, 2)).norm(), 0.0, 1e-6);
   EXPECT_TRUE(fs::exists(dir / "out" / "B2.obj"));
   // An id that is not in the file is an input error (exit code 2).
   EXPECT_EQ(WEXITSTATUS(std::system((cmd + " --id nope 2> /dev/null").c_str())), 2);
