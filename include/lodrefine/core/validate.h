@@ -24,10 +24,11 @@ struct Validation {
 };
 
 // Checks closed, 2-manifold (edges and vertices), consistently and outward oriented, planar
-// faces within `planarity_tolerance`, one component, no self-intersections (CGAL PMP on the
-// triangulated faces). Expects shared vertices. `single_component` false accepts a building of
-// several closed shells (a multi-part export).
-Validation validate_mesh(const Mesh& mesh, double planarity_tolerance = 0.01,
+// faces within `planarity_tolerance` (Params::planarity_tolerance; no default here, the
+// parameter table holds it), one component, no self-intersections (CGAL PMP on the triangulated
+// faces). Expects shared vertices. `single_component` false accepts a building of several closed
+// shells (a multi-part export).
+Validation validate_mesh(const Mesh& mesh, double planarity_tolerance,
                          bool check_self_intersections = true, bool single_component = true);
 
 // Enclosed volume of `faces` (all indices valid), positive when they point outward; exact for
