@@ -8,6 +8,21 @@
 #include "lodrefine/core/topology.h"
 
 namespace lodrefine {
+namespace {
+
+// Tolerances of the arrangement, in the local frame (metres), where rounding is ~1e-12:
+// Three planes whose pivoted solve meets a pivot below this are dependent: they share no point.
+constexpr double kMeetMinPivot = 1e-12;
+// A polygon vertex this close to a cutting plane lies on it (rounding of the plane meets).
+constexpr double kOnCutPlane = 1e-9;
+// Vertices this close are one (candidates.h): far above the meets' rounding, far below any
+// feature of a building.
+constexpr double kVertexWeld = 1e-6;
+// A vertex splits another face's edge when within kVertexWeld of it and farther than this share
+// of the edge from either end (nearer, it is that end).
+constexpr double kEdgeEndShare = 1e-9;
+
+}  // namespace
 
 std::array<Plane, 6> Region::planes() const {
   std::array<Plane, 6> out;
@@ -53,7 +68,7 @@ struct PlaneBank {
     if (a < 0 || b < 0 || c < 0) return fallback;  // a side of the initial square
     std::array<int, 3> t{a, b, c};
     std::sort(t.begin(), t.end());  // same triple -> bit-identical point, whatever the caller
-    const auto x = meet(all[t[0]], all[t[1]], all[t[2]], 1e-12);
+    const auto x = meet(all[t[0]], all[t[1]], all[t[2]], kMeetMinPivot);
     return x ? *x : fallback;
   }
 };
@@ -61,14 +76,13 @@ struct PlaneBank {
 // Splits `poly` (on plane `self`) by plane `cut`; returns the pieces on the negative and the
 // positive side (either may be empty).
 std::pair<WorkPolygon, WorkPolygon> split(const WorkPolygon& poly, int self, int cut, const PlaneBank& bank) {
-  constexpr double eps = 1e-9;
   const Plane& pl = bank.all[cut];
   const int n = int(poly.p.size());
   std::vector<double> d(n);
   bool neg = false, pos = false;
   for (int i = 0; i < n; ++i) {
     d[i] = pl.distance(poly.p[i]);
-    if (std::abs(d[i]) <= eps) d[i] = 0.0;
+    if (std::abs(d[i]) <= kOnCutPlane) d[i] = 0.0;
     neg |= d[i] < 0;
     pos |= d[i] > 0;
   }
@@ -136,7 +150,7 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
   const int first_box = int(bank.all.size());
   for (const auto& b : region.planes()) bank.all.push_back(b);
 
-  PointWelder welder(1e-6);
+  PointWelder welder(kVertexWeld);
   for (int i = 0; i < int(planes.size()); ++i) {
     std::vector<WorkPolygon> pieces{section(i, bank, region, first_box)};
     if (pieces[0].p.size() < 3) continue;
@@ -174,7 +188,7 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
     for (std::size_t k = 0; k < f.v.size(); ++k) {
       const int a = f.v[k], b = f.v[(k + 1) % f.v.size()];
       out.push_back(a);
-      for (int x : vertices_on_segment(cs.vertices, a, b, SegmentRule{1e-6, false, 1e-9})) out.push_back(x);
+      for (int x : vertices_on_segment(cs.vertices, a, b, SegmentRule{kVertexWeld, false, kEdgeEndShare})) out.push_back(x);
     }
     f.v = out;
   }
@@ -193,7 +207,8 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
         e.b = key.second;
         e.length = (cs.vertices[a] - cs.vertices[b]).norm();
         for (int bp = 0; bp < 6; ++bp)
-          if (std::abs(box[bp].distance(cs.vertices[a])) < 1e-6 && std::abs(box[bp].distance(cs.vertices[b])) < 1e-6)
+          if (std::abs(box[bp].distance(cs.vertices[a])) < kVertexWeld &&
+              std::abs(box[bp].distance(cs.vertices[b])) < kVertexWeld)
             e.box_plane = bp;
         cs.edges.push_back(e);
       }

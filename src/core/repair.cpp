@@ -19,6 +19,11 @@ namespace {
 
 constexpr double kHolePlanarity = 0.02;  // m: a boundary loop flatter than this becomes one face
 constexpr double kHorizontalDeg = 10.0;  // filled holes this close to horizontal are ground/roof
+// weld_tolerance may be 0 (Params allows it): welding, degenerate faces and T-junctions then
+// work at this floor, well above the rounding of coordinates in a local frame (m).
+constexpr double kMinWeldTolerance = 1e-9;
+// The fewest faces of a closed polyhedron (a tetrahedron).
+constexpr std::size_t kMinClosedFaces = 4;
 
 [[noreturn]] void reject(const Mesh& m, const std::string& why) {
   throw InputError("building " + (m.id.empty() ? std::string("(no id)") : m.id) + ": " + why);
@@ -444,7 +449,7 @@ Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report,
   r.input_vertices = int(soup.vertices.size());
   r.input_faces = int(soup.faces.size());
   check_input(soup);
-  const double tol = std::max(weld_tolerance, 1e-9);
+  const double tol = std::max(weld_tolerance, kMinWeldTolerance);
 
   std::vector<Vec3> V;
   const std::vector<int> cluster = weld(soup, tol, gap_tolerance, V);
@@ -465,9 +470,9 @@ Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report,
 
   Mesh out = compact(V, std::move(faces), soup.id);
   const Validation val = validate_mesh(out, std::numeric_limits<double>::infinity(), false);
-  r.closed = out.faces.size() >= 4 && val.watertight() && val.inconsistent_edges == 0 && val.volume > 0;
+  r.closed = out.faces.size() >= kMinClosedFaces && val.watertight() && val.inconsistent_edges == 0 && val.volume > 0;
   if (report) *report = r;
-  if (out.faces.size() < 4) reject(soup, "only " + std::to_string(out.faces.size()) + " usable faces after repair");
+  if (out.faces.size() < kMinClosedFaces) reject(soup, "only " + std::to_string(out.faces.size()) + " usable faces after repair");
   if (!r.closed) reject(soup, "not closable: " + (val.problem.empty() ? "zero volume" : val.problem));
   return out;
 }

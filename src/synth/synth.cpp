@@ -41,6 +41,9 @@ namespace {
 constexpr double kWeldTol = 1e-6;  // building frame, metres
 // A vertex strictly inside a segment, closer than kWeldTol to it, lies on it.
 constexpr SegmentRule kOnEdge{kWeldTol, true};
+// Generated faces of one plane agree up to rounding: normals within this cosine, offsets within
+// kWeldTol (building frame).
+constexpr double kCoplanarCos = 1 - 1e-9;
 
 // The footprint lines or roof planes do not describe a valid building (e.g. after extreme moves).
 struct ShapeError : std::runtime_error {
@@ -393,7 +396,7 @@ void merge_coplanar(Mesh& m) {
     if (fs.size() != 2) continue;
     const int f = fs[0].face, g = fs[1].face;
     if (m.faces[f].sem != m.faces[g].sem) continue;
-    if (planes[f].n.dot(planes[g].n) < 1 - 1e-9 || std::abs(planes[f].d - planes[g].d) > 1e-6) continue;
+    if (planes[f].n.dot(planes[g].n) < kCoplanarCos || std::abs(planes[f].d - planes[g].d) > kWeldTol) continue;
     sets.unite(f, g);
   }
   std::map<int, std::vector<int>> groups;
