@@ -4,9 +4,25 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <unordered_map>
+
+#include "lodrefine/core/topology.h"
 
 namespace lodrefine {
+namespace {
+
+// Tolerances of the arrangement, in the local frame (metres), where rounding is ~1e-12:
+// Three planes whose pivoted solve meets a pivot below this are dependent: they share no point.
+constexpr double kMeetMinPivot = 1e-12;
+// A polygon vertex this close to a cutting plane lies on it (rounding of the plane meets).
+constexpr double kOnCutPlane = 1e-9;
+// Vertices this close are one (candidates.h): far above the meets' rounding, far below any
+// feature of a building.
+constexpr double kVertexWeld = 1e-6;
+// A vertex splits another face's edge when within kVertexWeld of it and farther than this share
+// of the edge from either end (nearer, it is that end).
+constexpr double kEdgeEndShare = 1e-9;
+
+}  // namespace
 
 std::array<Plane, 6> Region::planes() const {
   std::array<Plane, 6> out;
@@ -24,14 +40,10 @@ bool Region::contains(const Vec3& p, double tol) const {
 }
 
 Region Region::around(const std::vector<Vec3>& pts, double relative, double absolute) {
-  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-  for (const auto& p : pts) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
+  const Eigen::AlignedBox3d box = bounding_box(pts);
   Region r;
-  r.center = 0.5 * (lo + hi);
-  r.half = 0.5 * (hi - lo) * (1.0 + 2.0 * relative) + Vec3::Constant(absolute);
+  r.center = 0.5 * (box.min() + box.max());
+  r.half = 0.5 * (box.max() - box.min()) * (1.0 + 2.0 * relative) + Vec3::Constant(absolute);
   return r;
 }
 
@@ -56,7 +68,7 @@ struct PlaneBank {
     if (a < 0 || b < 0 || c < 0) return fallback;  // a side of the initial square
     std::array<int, 3> t{a, b, c};
     std::sort(t.begin(), t.end());  // same triple -> bit-identical point, whatever the caller
-    const auto x = meet(all[t[0]], all[t[1]], all[t[2]], 1e-12);
+    const auto x = meet(all[t[0]], all[t[1]], all[t[2]], kMeetMinPivot);
     return x ? *x : fallback;
   }
 };
@@ -64,14 +76,13 @@ struct PlaneBank {
 // Splits `poly` (on plane `self`) by plane `cut`; returns the pieces on the negative and the
 // positive side (either may be empty).
 std::pair<WorkPolygon, WorkPolygon> split(const WorkPolygon& poly, int self, int cut, const PlaneBank& bank) {
-  constexpr double eps = 1e-9;
   const Plane& pl = bank.all[cut];
   const int n = int(poly.p.size());
   std::vector<double> d(n);
   bool neg = false, pos = false;
   for (int i = 0; i < n; ++i) {
     d[i] = pl.distance(poly.p[i]);
-    if (std::abs(d[i]) <= eps) d[i] = 0.0;
+    if (std::abs(d[i]) <= kOnCutPlane) d[i] = 0.0;
     neg |= d[i] < 0;
     pos |= d[i] > 0;
   }
@@ -118,39 +129,6 @@ WorkPolygon section(int self, const PlaneBank& bank, const Region& region, int f
   return w;
 }
 
-// Welds points closer than `tol` through a hash grid; returns the index of each point.
-class Welder {
- public:
-  explicit Welder(double tol) : tol_(tol) {}
-  int add(const Vec3& p) {
-    const auto key = cell(p);
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          auto it = grid_.find(hash({key[0] + dx, key[1] + dy, key[2] + dz}));
-          if (it == grid_.end()) continue;
-          for (int i : it->second)
-            if ((points[i] - p).norm() <= tol_) return i;
-        }
-    points.push_back(p);
-    grid_[hash(key)].push_back(int(points.size()) - 1);
-    return int(points.size()) - 1;
-  }
-  std::vector<Vec3> points;
-
- private:
-  using Key = std::array<long long, 3>;
-  Key cell(const Vec3& p) const {
-    return {(long long)std::floor(p.x() / (4 * tol_)), (long long)std::floor(p.y() / (4 * tol_)),
-            (long long)std::floor(p.z() / (4 * tol_))};
-  }
-  static std::size_t hash(const Key& k) {
-    return std::size_t(k[0] * 73856093LL) ^ std::size_t(k[1] * 19349663LL) ^ std::size_t(k[2] * 83492791LL);
-  }
-  double tol_;
-  std::unordered_map<std::size_t, std::vector<int>> grid_;
-};
-
 }  // namespace
 
 std::vector<Vec3> region_section(const Plane& plane, const Region& region) {
@@ -172,7 +150,7 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
   const int first_box = int(bank.all.size());
   for (const auto& b : region.planes()) bank.all.push_back(b);
 
-  Welder welder(1e-6);
+  PointWelder welder(kVertexWeld);
   for (int i = 0; i < int(planes.size()); ++i) {
     std::vector<WorkPolygon> pieces{section(i, bank, region, first_box)};
     if (pieces[0].p.size() < 3) continue;
@@ -190,21 +168,18 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
       if (polygon_area(w.p) < min_area) continue;
       Candidate c;
       c.plane = i;
-      for (const auto& x : w.p) {
-        const int id = welder.add(x);
-        if (c.v.empty() || c.v.back() != id) c.v.push_back(id);
-      }
-      while (c.v.size() > 1 && c.v.front() == c.v.back()) c.v.pop_back();
+      for (const auto& x : w.p) c.v.push_back(welder.add(x));
+      drop_repeats(c.v);
       if (c.v.size() < 3) continue;
       std::vector<Vec3> poly;
-      for (int id : c.v) poly.push_back(welder.points[id]);
+      for (int id : c.v) poly.push_back(welder.points()[id]);
       if (newell_normal(poly).dot(planes[i].plane.n) < 0) std::reverse(c.v.begin(), c.v.end());
       c.area = polygon_area(poly);
       c.centroid = polygon_centroid(poly);
       cs.faces.push_back(std::move(c));
     }
   }
-  cs.vertices = welder.points;
+  cs.vertices = welder.points();
 
   // Where a vertex of one face lies inside another face's edge (several planes meeting at a
   // point along the line), split that edge so that adjacency is exact.
@@ -213,17 +188,7 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
     for (std::size_t k = 0; k < f.v.size(); ++k) {
       const int a = f.v[k], b = f.v[(k + 1) % f.v.size()];
       out.push_back(a);
-      const Vec3 pa = cs.vertices[a], ab = cs.vertices[b] - pa;
-      const double len2 = ab.squaredNorm();
-      std::vector<std::pair<double, int>> inner;
-      for (int x = 0; x < int(cs.vertices.size()); ++x) {
-        if (x == a || x == b) continue;
-        const double t = (cs.vertices[x] - pa).dot(ab) / len2;
-        if (t <= 1e-9 || t >= 1 - 1e-9) continue;
-        if ((pa + t * ab - cs.vertices[x]).norm() <= 1e-6) inner.emplace_back(t, x);
-      }
-      std::sort(inner.begin(), inner.end());
-      for (const auto& [t, x] : inner) out.push_back(x);
+      for (int x : vertices_on_segment(cs.vertices, a, b, SegmentRule{kVertexWeld, false, kEdgeEndShare})) out.push_back(x);
     }
     f.v = out;
   }
@@ -242,7 +207,8 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
         e.b = key.second;
         e.length = (cs.vertices[a] - cs.vertices[b]).norm();
         for (int bp = 0; bp < 6; ++bp)
-          if (std::abs(box[bp].distance(cs.vertices[a])) < 1e-6 && std::abs(box[bp].distance(cs.vertices[b])) < 1e-6)
+          if (std::abs(box[bp].distance(cs.vertices[a])) < kVertexWeld &&
+              std::abs(box[bp].distance(cs.vertices[b])) < kVertexWeld)
             e.box_plane = bp;
         cs.edges.push_back(e);
       }

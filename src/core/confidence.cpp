@@ -7,6 +7,9 @@
 namespace lodrefine {
 namespace {
 
+// Areas in ratios are at least this (m^2): a degenerate box or candidate divides by no zero.
+constexpr double kMinArea = 1e-12;
+
 // Coordinates of points in a plane's (u, v) basis around `origin`.
 std::vector<Vec2> to_2d(const std::vector<Vec3>& pts, const Plane& pl, const Vec3& origin) {
   const auto [u, v] = pl.basis();
@@ -16,24 +19,17 @@ std::vector<Vec2> to_2d(const std::vector<Vec3>& pts, const Plane& pl, const Vec
   return out;
 }
 
-struct Box2 {
-  Vec2 lo = Vec2::Constant(1e300), hi = Vec2::Constant(-1e300);
-  explicit Box2(const std::vector<Vec2>& pts) {
-    for (const auto& p : pts) { lo = lo.cwiseMin(p); hi = hi.cwiseMax(p); }
-  }
-  double area() const { return std::max(0.0, hi.x() - lo.x()) * std::max(0.0, hi.y() - lo.y()); }
-};
-
 // Bounding-box overlap in the reference's plane: IoU, or the share of either box covered
 // (the "bidirectional coverage ratio"), whichever is larger.
 double box_overlap(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
-  const Box2 ba(a), bb(b);
-  const double w = std::min(ba.hi.x(), bb.hi.x()) - std::max(ba.lo.x(), bb.lo.x());
-  const double h = std::min(ba.hi.y(), bb.hi.y()) - std::max(ba.lo.y(), bb.lo.y());
+  const Eigen::AlignedBox2d ba = bounding_box(a), bb = bounding_box(b);
+  const double w = std::min(ba.max().x(), bb.max().x()) - std::max(ba.min().x(), bb.min().x());
+  const double h = std::min(ba.max().y(), bb.max().y()) - std::max(ba.min().y(), bb.min().y());
   if (w <= 0 || h <= 0) return 0.0;
-  const double inter = w * h, ua = ba.area(), ub = bb.area();
-  const double iou = inter / std::max(1e-12, ua + ub - inter);
-  return std::max({iou, inter / std::max(1e-12, ua), inter / std::max(1e-12, ub)});
+  // Both boxes overlap with positive width and height here, so neither is empty.
+  const double inter = w * h, ua = ba.volume(), ub = bb.volume();
+  const double iou = inter / std::max(kMinArea, ua + ub - inter);
+  return std::max({iou, inter / std::max(kMinArea, ua), inter / std::max(kMinArea, ub)});
 }
 
 double model_score(const std::vector<Vec3>& cand, const Plane& cplane, double carea, const ModelReference& ref,
@@ -46,7 +42,7 @@ double model_score(const std::vector<Vec3>& cand, const Plane& cplane, double ca
   const auto c2 = to_2d(cand, rplane, o);
   const auto r2 = to_2d(ref.polygon, rplane, o);
   if (box_overlap(c2, r2) < prm.conf_bbox_iou) return 0.0;
-  return std::min(1.0, polygon_convex_intersection_area(r2, c2) / std::max(1e-12, carea));
+  return std::min(1.0, polygon_convex_intersection_area(r2, c2) / std::max(kMinArea, carea));
 }
 
 struct CloudInfo {
@@ -84,7 +80,7 @@ CloudView view_cloud(const Plane& cplane, const CloudInfo& ref, const Params& pr
 double cloud_score(const std::vector<Vec3>& cand, const Plane& cplane, double carea, const CloudView& view) {
   if (!view.valid) return 0.0;
   return std::min(1.0, polygon_convex_intersection_area(to_2d(cand, cplane, view.origin), view.hull) /
-                           std::max(1e-12, carea));
+                           std::max(kMinArea, carea));
 }
 
 }  // namespace

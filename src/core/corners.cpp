@@ -26,6 +26,9 @@ constexpr double kLowBand = 0.25;
 constexpr int kStrayPoints = 10;
 // Adjacent walls turned less than this from the scanned one are no corner (cos 45 deg).
 constexpr double kMaxCornerCos = 0.707;
+// Off the facade's plane means farther than this many RANSAC epsilons (its inliers lie within
+// one; two keep the plane's own noisy points out).
+constexpr double kOffPlaneEpsilons = 2.0;
 
 // How far along +t the run of points starting at t = 0 reaches (-1 when it does not start).
 double run_end(std::vector<double> t) {
@@ -124,7 +127,7 @@ std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSu
         for (const auto& p : cloud.points) {
           if (p.z() < z0 + kLowBand * (z1 - z0) || p.z() > z1) continue;
           const double depth = std::abs(w.plane.distance(p));
-          if (depth <= 2.0 * prm.ransac_epsilon || depth > prm.match_distance + kLookPast) continue;
+          if (depth <= kOffPlaneEpsilons * prm.ransac_epsilon || depth > prm.match_distance + kLookPast) continue;
           const double x = s * ((p - o).dot(u) - u_mid);
           seen += x >= end - kCornerTolerance && x <= end + kLookPast;
         }

@@ -172,11 +172,9 @@ std::vector<Vec3> sample_faces(const Mesh& mesh, const std::vector<int>& faces, 
     if (poly.size() < 3 || polygon_area(poly) <= 0) continue;
     const auto [u, v] = polygon_plane(poly).basis();
     std::vector<Vec2> p2;
-    Vec2 lo = Vec2::Constant(std::numeric_limits<double>::max()), hi = -lo;
-    for (const auto& p : poly) {
-      p2.emplace_back((p - poly[0]).dot(u), (p - poly[0]).dot(v));
-      lo = lo.cwiseMin(p2.back()), hi = hi.cwiseMax(p2.back());
-    }
+    for (const auto& p : poly) p2.emplace_back((p - poly[0]).dot(u), (p - poly[0]).dot(v));
+    const Eigen::AlignedBox2d box = bounding_box(p2);
+    const Vec2 lo = box.min(), hi = box.max();
     const std::size_t before = out.size();
     for (double x = lo.x() + 0.5 * spacing; x < hi.x(); x += spacing)
       for (double y = lo.y() + 0.5 * spacing; y < hi.y(); y += spacing)

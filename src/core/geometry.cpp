@@ -71,6 +71,24 @@ Vec3 newell_normal(const std::vector<Vec3>& poly) {
 
 double polygon_area(const std::vector<Vec3>& poly) { return 0.5 * newell_normal(poly).norm(); }
 
+Eigen::AlignedBox3d bounding_box(const std::vector<Vec3>& pts) {
+  Eigen::AlignedBox3d box;
+  for (const Vec3& p : pts) box.extend(p);
+  return box;
+}
+
+Eigen::AlignedBox3d bounding_box(const std::vector<Vec3>& pts, const std::vector<int>& subset) {
+  Eigen::AlignedBox3d box;
+  for (int i : subset) box.extend(pts[i]);
+  return box;
+}
+
+Eigen::AlignedBox2d bounding_box(const std::vector<Vec2>& pts) {
+  Eigen::AlignedBox2d box;
+  for (const Vec2& p : pts) box.extend(p);
+  return box;
+}
+
 Vec3 polygon_centroid(const std::vector<Vec3>& poly) {
   if (poly.empty()) return Vec3::Zero();
   const Vec3 o = poly[0];

@@ -9,6 +9,13 @@
 namespace lodrefine {
 namespace {
 
+// Walls meeting at less than this angle make no corner (their meet runs away with any small
+// move); kMinCornerSin is its sine, the length of the cross product of two unit normals.
+constexpr double kMinCornerAngleDeg = 30.0;
+constexpr double kMinCornerSin = 0.5;
+// Areas in ratios are at least this (m^2): an empty or flat box divides by no zero.
+constexpr double kMinArea = 1e-12;
+
 // In-plane extent [min u, max u] x [min v, max v] of points in a surface's frame.
 struct Rect {
   double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
@@ -55,7 +62,7 @@ bool adjacent(const Mesh& mesh, const ModelSurface& a, const ModelSurface& b) {
 double corner_gap(const Plane& plane, const ScanPlane& adjacent_scan, const PointCloud& cloud) {
   const auto [u, v] = adjacent_scan.plane.basis();
   const Vec3 dir = plane.n.cross(adjacent_scan.plane.n);
-  if (dir.norm() < 0.5) return 0.0;  // not a corner (near-parallel walls)
+  if (dir.norm() < kMinCornerSin) return 0.0;  // not a corner (near-parallel walls)
   // A point on the corner line, at the height of the adjacent scan's centroid.
   const auto corner = meet(plane, adjacent_scan.plane, Plane::through(adjacent_scan.centroid, v));
   if (!corner) return 0.0;
@@ -219,8 +226,8 @@ MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& su
       const double inter = overlap_area(model_box, owned[k]);
       const double uni = model_box.area() + owned[k].area() - inter;
       const double iou = uni > 0 ? inter / uni : 0.0;
-      const double coverage = std::max({iou, inter / std::max(1e-12, owned[k].area()),
-                                        inter / std::max(1e-12, model_box.area())});
+      const double coverage = std::max({iou, inter / std::max(kMinArea, owned[k].area()),
+                                        inter / std::max(kMinArea, model_box.area())});
       if (coverage < prm.match_min_overlap) {
         result.rejected.push_back("scan plane " + std::to_string(p) + " / wall surface " + std::to_string(walls[k].surface) +
                                   ": its points cover too little of the wall (" + std::to_string(coverage) + ")");
@@ -265,7 +272,7 @@ MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& su
     for (int j = 0; j < nm; ++j) {
       const Match &m = result.matches[i], &a = result.matches[j];
       if (i == j || a.scan_plane == m.scan_plane) continue;
-      if (unoriented_angle_deg(surfaces[a.surface].plane.n, surfaces[m.surface].plane.n) < 30.0) continue;
+      if (unoriented_angle_deg(surfaces[a.surface].plane.n, surfaces[m.surface].plane.n) < kMinCornerAngleDeg) continue;
       if (!adjacent(mesh, surfaces[a.surface], surfaces[m.surface])) continue;
       if (corner_gap(planes[m.scan_plane].plane, planes[a.scan_plane], cloud) > prm.corner_gap) conflict[i][j] = conflict[j][i] = 1;
     }

@@ -28,6 +28,16 @@ using Traits = CGAL::Shape_detection::Efficient_RANSAC_traits<Kernel, PointList,
 using Ransac = CGAL::Shape_detection::Efficient_RANSAC<Traits>;
 using RansacPlane = CGAL::Shape_detection::Plane<Traits>;
 
+// RANSAC pieces of one facade are merged when their normals are within kMergeAngleDeg and each
+// one's points lie on average within kMergeEpsilons RANSAC epsilons of the other's plane (one
+// epsilon bounds an inlier; two allow for both planes' fitting error).
+constexpr double kMergeAngleDeg = 2.0;
+constexpr double kMergeEpsilons = 2.0;
+// A cloud spanning fewer RANSAC epsilons than this has no planes to find.
+constexpr double kMinExtentEpsilons = 10.0;
+// Bits per axis of a voxel key (three in a 64-bit key).
+constexpr int kVoxelKeyBits = 21;
+
 // Vertical least-squares plane: PCA of the horizontal coordinates only.
 Plane fit_vertical_plane(const std::vector<Vec3>& pts) {
   Vec2 c = Vec2::Zero();
@@ -71,7 +81,7 @@ ScanPlane describe(const std::vector<Vec3>& all, std::vector<int> inliers, const
 // RANSAC's connectivity split one facade into pieces wherever a gap (a window column, an
 // occluding tree) is wider than the cluster epsilon: the pieces of one plane are one surface.
 std::vector<ScanPlane> merge_coplanar(std::vector<ScanPlane> planes, const std::vector<Vec3>& all, const Params& prm) {
-  const double tol = 2.0 * prm.ransac_epsilon;
+  const double tol = kMergeEpsilons * prm.ransac_epsilon;
   auto mean_distance = [&](const ScanPlane& a, const Plane& b) {
     double s = 0.0;
     for (int i : a.inliers) s += std::abs(b.distance(all[i]));
@@ -81,7 +91,7 @@ std::vector<ScanPlane> merge_coplanar(std::vector<ScanPlane> planes, const std::
     merged = false;
     for (std::size_t i = 0; i < planes.size() && !merged; ++i)
       for (std::size_t j = i + 1; j < planes.size() && !merged; ++j) {
-        if (unoriented_angle_deg(planes[i].plane.n, planes[j].plane.n) > 2.0) continue;
+        if (unoriented_angle_deg(planes[i].plane.n, planes[j].plane.n) > kMergeAngleDeg) continue;
         if (mean_distance(planes[j], planes[i].plane) > tol || mean_distance(planes[i], planes[j].plane) > tol) continue;
         std::vector<int> inl = planes[i].inliers;
         inl.insert(inl.end(), planes[j].inliers.begin(), planes[j].inliers.end());
@@ -112,12 +122,9 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm)
   order.erase(std::unique(order.begin(), order.end(), [&](int a, int b) { return cloud.points[a] == cloud.points[b]; }),
               order.end());
   if (order.size() < std::size_t(std::max(prm.ransac_min_points, prm.normal_neighbors + 1))) return result;
-  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-  for (int i : order) {
-    lo = lo.cwiseMin(cloud.points[i]);
-    hi = hi.cwiseMax(cloud.points[i]);
-  }
-  if ((hi - lo).norm() < 10.0 * prm.ransac_epsilon) return result;
+  const Eigen::AlignedBox3d box = bounding_box(cloud.points, order);
+  const Vec3 lo = box.min(), hi = box.max();
+  if ((hi - lo).norm() < kMinExtentEpsilons * prm.ransac_epsilon) return result;
   std::sort(order.begin(), order.end());  // file order: keeps runs reproducible as before
   // Detection runs on one point per voxel (its cost grows with the points, not the facade
   // area); every point of a voxel whose representative a plane took, and that lies within
@@ -126,11 +133,11 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm)
   auto key = [&](const Vec3& p) -> std::uint64_t {
     if (voxel <= 0) return 0;
     const Vec3 q = (p - lo) / voxel;
-    return (std::uint64_t(q.x()) << 42) | (std::uint64_t(q.y()) << 21) | std::uint64_t(q.z());
+    return (std::uint64_t(q.x()) << (2 * kVoxelKeyBits)) | (std::uint64_t(q.y()) << kVoxelKeyBits) | std::uint64_t(q.z());
   };
   std::vector<int> reps;  // indices into the cloud
   std::unordered_map<std::uint64_t, int> voxel_rep;
-  if (voxel > 0 && ((hi - lo) / voxel).maxCoeff() < double(1 << 21)) {
+  if (voxel > 0 && ((hi - lo) / voxel).maxCoeff() < double(1 << kVoxelKeyBits)) {
     for (int i : order)
       if (voxel_rep.emplace(key(cloud.points[i]), int(reps.size())).second) reps.push_back(i);
   } else {

@@ -9,10 +9,10 @@
 #include <optional>
 #include <queue>
 #include <set>
-#include <unordered_map>
 
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/core/params.h"
+#include "lodrefine/core/topology.h"
 #include "lodrefine/core/validate.h"
 
 namespace lodrefine {
@@ -20,6 +20,11 @@ namespace {
 
 constexpr double kHolePlanarity = 0.02;  // m: a boundary loop flatter than this becomes one face
 constexpr double kHorizontalDeg = 10.0;  // filled holes this close to horizontal are ground/roof
+// weld_tolerance may be 0 (Params allows it): welding, degenerate faces and T-junctions then
+// work at this floor, well above the rounding of coordinates in a local frame (m).
+constexpr double kMinWeldTolerance = 1e-9;
+// The fewest faces of a closed polyhedron (a tetrahedron).
+constexpr std::size_t kMinClosedFaces = 4;
 
 [[noreturn]] void reject(const Mesh& m, const std::string& why) {
   throw InputError("building " + (m.id.empty() ? std::string("(no id)") : m.id) + ": " + why);
@@ -37,16 +42,6 @@ void check_input(const Mesh& soup) {
 // ---------------------------------------------------------------------------------------------
 // Welding
 
-struct Cell {
-  long long x, y, z;
-  bool operator==(const Cell& o) const { return x == o.x && y == o.y && z == o.z; }
-};
-struct CellHash {
-  std::size_t operator()(const Cell& c) const {
-    return std::size_t(c.x * 73856093LL ^ c.y * 19349663LL ^ c.z * 83492791LL);
-  }
-};
-
 // Clusters the soup's vertices: the closest pairs first (Kruskal), vertices of different faces
 // within `gap`, two vertices of one face only within `tol` (a repeated corner, a sliver's tip).
 // Jittered exports (a corner a few mm off in each face) weld whole, while a face's own short
@@ -63,39 +58,26 @@ std::vector<int> weld(const Mesh& soup, double tol, double gap, std::vector<Vec3
     fs.erase(std::unique(fs.begin(), fs.end()), fs.end());
   }
   gap = std::max(gap, tol);
-  std::unordered_map<Cell, std::vector<int>, CellHash> grid;
-  const auto cell = [gap](double x) { return (long long)std::floor(x / gap); };
-  for (int i = 0; i < n; ++i) grid[{cell(pts[i].x()), cell(pts[i].y()), cell(pts[i].z())}].push_back(i);
+  PointGrid grid(gap);
+  for (int i = 0; i < n; ++i) grid.insert(pts[i], i);
   struct Pair {
     double d;
     int i, j;
   };
   std::vector<Pair> pairs;
-  for (int i = 0; i < n; ++i) {
-    const Cell c{cell(pts[i].x()), cell(pts[i].y()), cell(pts[i].z())};
-    for (long long dx = -1; dx <= 1; ++dx)
-      for (long long dy = -1; dy <= 1; ++dy)
-        for (long long dz = -1; dz <= 1; ++dz) {
-          const auto it = grid.find({c.x + dx, c.y + dy, c.z + dz});
-          if (it == grid.end()) continue;
-          for (int j : it->second) {
-            if (j <= i) continue;
-            const double d = (pts[j] - pts[i]).norm();
-            if (d <= gap) pairs.push_back({d, i, j});
-          }
-        }
-  }
+  for (int i = 0; i < n; ++i)
+    grid.visit_near(pts[i], [&](int j) {
+      if (j <= i) return false;
+      const double d = (pts[j] - pts[i]).norm();
+      if (d <= gap) pairs.push_back({d, i, j});
+      return false;
+    });
   std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
     return a.d != b.d ? a.d < b.d : std::make_pair(a.i, a.j) < std::make_pair(b.i, b.j);
   });
-  std::vector<int> parent(n);
-  std::iota(parent.begin(), parent.end(), 0);
-  const auto find = [&parent](int a) {
-    while (parent[a] != a) a = parent[a] = parent[parent[a]];
-    return a;
-  };
+  DisjointSets sets(n);
   for (const auto& [d, i, j] : pairs) {
-    int a = find(i), b = find(j);
+    int a = sets.find(i), b = sets.find(j);
     if (a == b) continue;
     if (faces_of[a].size() < faces_of[b].size()) std::swap(a, b);
     const auto& big = faces_of[a];
@@ -106,12 +88,12 @@ std::vector<int> weld(const Mesh& soup, double tol, double gap, std::vector<Vec3
     std::set_union(big.begin(), big.end(), faces_of[b].begin(), faces_of[b].end(), std::back_inserter(merged));
     faces_of[a] = std::move(merged);
     faces_of[b].clear();
-    parent[b] = a;
+    sets.link(b, a);
   }
   std::vector<int> cluster(n), id(n, -1), count;
   centres.clear();
   for (int i = 0; i < n; ++i) {
-    const int r = find(i);
+    const int r = sets.find(i);
     if (id[r] < 0) {
       id[r] = int(centres.size());
       centres.push_back(Vec3::Zero());
@@ -127,11 +109,6 @@ std::vector<int> weld(const Mesh& soup, double tol, double gap, std::vector<Vec3
 
 // ---------------------------------------------------------------------------------------------
 // Face cleaning
-
-void drop_repeats(std::vector<int>& v) {
-  v.erase(std::unique(v.begin(), v.end()), v.end());
-  while (v.size() > 1 && v.front() == v.back()) v.pop_back();
-}
 
 std::vector<Vec3> positions(const std::vector<Vec3>& V, const std::vector<int>& idx) {
   std::vector<Vec3> pts;
@@ -173,39 +150,20 @@ std::vector<Face> clean_faces(const Mesh& soup, const std::vector<int>& cluster,
   return faces;
 }
 
-// Vertices (of `candidates`, not already in `face`) lying on segment a-b within `tol` and
-// strictly between its ends, ordered from a to b.
-std::vector<int> vertices_on_edge(const std::vector<Vec3>& V, const std::vector<int>& candidates, int a, int b,
-                                  const std::vector<int>& face, double tol) {
-  const Vec3 d = V[b] - V[a];
-  const double len2 = d.squaredNorm();
-  std::vector<std::pair<double, int>> hits;
-  for (int w : candidates) {
-    const Vec3 q = V[w] - V[a];
-    const double t = q.dot(d) / len2;
-    if (t <= 0.0 || t >= 1.0 || (q - t * d).norm() >= tol) continue;
-    if ((V[w] - V[a]).norm() <= tol || (V[w] - V[b]).norm() <= tol) continue;
-    if (std::find(face.begin(), face.end(), w) != face.end()) continue;
-    hits.emplace_back(t, w);
-  }
-  std::sort(hits.begin(), hits.end());
-  std::vector<int> out;
-  for (const auto& h : hits) out.push_back(h.second);
-  return out;
-}
-
 // Inserts every vertex lying on a face edge into that edge, so a long edge meeting several
 // shorter ones (a T-junction) shares their vertices and each edge ends up with two faces.
 int split_t_junctions(const std::vector<Vec3>& V, std::vector<Face>& faces, double tol) {
   std::set<int> used_set;
   for (const Face& f : faces) used_set.insert(f.v.begin(), f.v.end());
   const std::vector<int> used(used_set.begin(), used_set.end());
+  // Strictly within `tol` of the edge, farther than `tol` from its ends, not in the face yet.
+  const SegmentRule on_edge{tol, true, 0.0, tol};
   int inserted = 0;
   for (Face& f : faces) {
     std::vector<int> out;
     for (std::size_t i = 0; i < f.v.size(); ++i) {
       out.push_back(f.v[i]);
-      for (int w : vertices_on_edge(V, used, f.v[i], f.v[(i + 1) % f.v.size()], f.v, tol)) {
+      for (int w : vertices_on_segment(V, f.v[i], f.v[(i + 1) % f.v.size()], on_edge, &used, &f.v)) {
         if (std::find(out.begin(), out.end(), w) != out.end()) continue;  // already on another edge
         out.push_back(w);
         ++inserted;
@@ -460,10 +418,7 @@ std::optional<std::vector<int>> region_outline(const std::vector<Face>& faces, c
 bool passes_straight(const std::vector<Vec3>& V, const Face& f, int v, double distance) {
   const auto it = std::find(f.v.begin(), f.v.end(), v);
   const std::size_t i = std::size_t(it - f.v.begin()), n = f.v.size();
-  const Vec3 &p = V[f.v[(i + n - 1) % n]], &q = V[f.v[(i + 1) % n]], &x = V[v];
-  const Vec3 d = q - p;
-  const double t = (x - p).dot(d) / d.squaredNorm();
-  return t > 0.0 && t < 1.0 && (p + t * d - x).norm() <= distance;
+  return inside_segment(V[f.v[(i + n - 1) % n]], V[f.v[(i + 1) % n]], V[v], SegmentRule{distance}).has_value();
 }
 
 // Removes vertices used by exactly two faces that both pass straight through them. Both faces
@@ -495,7 +450,7 @@ Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report,
   r.input_vertices = int(soup.vertices.size());
   r.input_faces = int(soup.faces.size());
   check_input(soup);
-  const double tol = std::max(weld_tolerance, 1e-9);
+  const double tol = std::max(weld_tolerance, kMinWeldTolerance);
 
   std::vector<Vec3> V;
   const std::vector<int> cluster = weld(soup, tol, gap_tolerance, V);
@@ -516,9 +471,9 @@ Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report,
 
   Mesh out = compact(V, std::move(faces), soup.id);
   const Validation val = validate_mesh(out, std::numeric_limits<double>::infinity(), false);
-  r.closed = out.faces.size() >= 4 && val.watertight() && val.inconsistent_edges == 0 && val.volume > 0;
+  r.closed = out.faces.size() >= kMinClosedFaces && val.watertight() && val.inconsistent_edges == 0 && val.volume > 0;
   if (report) *report = r;
-  if (out.faces.size() < 4) reject(soup, "only " + std::to_string(out.faces.size()) + " usable faces after repair");
+  if (out.faces.size() < kMinClosedFaces) reject(soup, "only " + std::to_string(out.faces.size()) + " usable faces after repair");
   if (!r.closed) reject(soup, "not closable: " + (val.problem.empty() ? "zero volume" : val.problem));
   return out;
 }

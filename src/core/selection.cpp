@@ -11,6 +11,11 @@
 namespace lodrefine {
 namespace {
 
+// GLPK returns binary columns as 0 or 1 up to its integrality tolerance: above this is chosen.
+constexpr double kChosen = 0.5;
+// glp_iocp::tm_lim is an int of milliseconds: longer limits are cut to this (~23 days).
+constexpr double kMaxTimeLimitMs = 2.0e9;
+
 SolveStatus classify(int ret, int status) {
   if (status == GLP_OPT) return SolveStatus::Optimal;
   if (status == GLP_FEAS) return ret == GLP_ETMLIM ? SolveStatus::FeasibleTimeLimit : SolveStatus::Feasible;
@@ -121,7 +126,7 @@ SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& 
   parm.cov_cuts = GLP_ON;
   parm.clq_cuts = GLP_ON;
   parm.mip_gap = prm.mip_gap;
-  parm.tm_lim = int(std::min(2.0e9, std::ceil(prm.mip_time_limit * 1000.0)));
+  parm.tm_lim = int(std::min(kMaxTimeLimitMs, std::ceil(prm.mip_time_limit * 1000.0)));
   parm.msg_lev = GLP_MSG_OFF;
   const int ret = glp_intopt(lp, &parm);
   const int status = glp_mip_status(lp);
@@ -131,7 +136,7 @@ SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& 
   res.ok = status == GLP_OPT || status == GLP_FEAS;
   if (res.ok) {
     res.objective = glp_mip_obj_val(lp);
-    for (int f = 0; f < nf; ++f) res.selected[f] = glp_mip_col_val(lp, f + 1) > 0.5;
+    for (int f = 0; f < nf; ++f) res.selected[f] = glp_mip_col_val(lp, f + 1) > kChosen;
   }
   glp_delete_prob(lp);
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

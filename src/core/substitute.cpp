@@ -24,6 +24,12 @@ constexpr double kMinCrossing = 0.26;
 // Moved walls at one vertex must meet there after the move; more than this apart means the move
 // changes the topology (then the arrangement takes over).
 constexpr double kMeetTolerance = 0.005;
+// A moved face whose area (Newell normal length) shrinks below this share of its old one has
+// collapsed: a wall passed its neighbour.
+constexpr double kCollapsedShare = 1e-3;
+// Faces bent by the move more than this share of the planarity tolerance are split; the rest is
+// margin for the coplanar merge that follows (it accepts vertices 5 mm off a merged plane).
+constexpr double kSplitShare = 0.5;
 
 }  // namespace
 
@@ -122,12 +128,12 @@ SubstitutionResult substitute_walls(const Mesh& mesh, const std::vector<ModelSur
   // stay planar; a roof under a turned wall may not, and is split into triangles then.
   for (const auto& f : mesh.faces) {
     const Vec3 n0 = newell_normal(face_points(mesh, f)), n1 = newell_normal(face_points(res.mesh, f));
-    if (n1.dot(n0) <= 0.0 || n1.norm() < 1e-3 * n0.norm()) {
+    if (n1.dot(n0) <= 0.0 || n1.norm() < kCollapsedShare * n0.norm()) {
       res.reason = "a moved wall passes a neighbouring face (it would turn inside out)";
       return res;
     }
   }
-  res.split_faces = split_warped_faces(res.mesh, 0.5 * planarity_tolerance);
+  res.split_faces = split_warped_faces(res.mesh, kSplitShare * planarity_tolerance);
   res.ok = true;
   return res;
 }

@@ -1,5 +1,5 @@
 // Mesh validation. The only translation unit of io/repair/validate that pulls in CGAL's
-// self-intersection machinery (slow to compile); the topology helpers live here too.
+// self-intersection machinery (slow to compile).
 #include "lodrefine/core/validate.h"
 
 // Self-overlapping face outlines reach CDT_2 (and fall back, see face_triangles): no warning spam.
@@ -13,11 +13,12 @@
 #include <algorithm>
 #include <array>
 #include <iterator>
-#include <numeric>
+#include <map>
 #include <set>
 #include <sstream>
 
 #include "lodrefine/core/geometry.h"
+#include "lodrefine/core/topology.h"
 
 namespace lodrefine {
 namespace {
@@ -26,16 +27,6 @@ using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using SurfaceMesh = CGAL::Surface_mesh<Kernel::Point_3>;
 using SmVertex = SurfaceMesh::Vertex_index;
 using SmFace = SurfaceMesh::Face_index;
-
-struct DisjointSets {
-  std::vector<int> parent;
-  explicit DisjointSets(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  int find(int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  void unite(int a, int b) { parent[find(a)] = find(b); }
-};
 
 std::string format_number(double x) {
   std::ostringstream s;
@@ -83,15 +74,6 @@ int count_nonmanifold_vertices(const Mesh& m, const EdgeUses& uses) {
   std::map<int, std::set<int>> fans_of;
   for (const auto& [vf, id] : corner) fans_of[vf.first].insert(fans.find(id));
   return int(std::count_if(fans_of.begin(), fans_of.end(), [](const auto& e) { return e.second.size() > 1; }));
-}
-
-int count_components(const Mesh& m, const EdgeUses& uses) {
-  DisjointSets ds(m.faces.size());
-  for (const auto& entry : uses)
-    for (const EdgeUse& u : entry.second) ds.unite(entry.second[0].face, u.face);
-  std::set<int> roots;
-  for (std::size_t f = 0; f < m.faces.size(); ++f) roots.insert(ds.find(int(f)));
-  return int(roots.size());
 }
 
 double max_planarity_error(const Mesh& m) {
@@ -196,18 +178,6 @@ std::string first_problem(const Validation& v, double planarity_tolerance, bool 
 
 }  // namespace
 
-EdgeUses edge_uses(const std::vector<Face>& faces) {
-  EdgeUses uses;
-  for (std::size_t f = 0; f < faces.size(); ++f) {
-    const auto& v = faces[f].v;
-    for (std::size_t i = 0; i < v.size(); ++i) {
-      const int a = v[i], b = v[(i + 1) % v.size()];
-      if (a != b) uses[{std::min(a, b), std::max(a, b)}].push_back({int(f), a < b});
-    }
-  }
-  return uses;
-}
-
 double signed_volume(const std::vector<Vec3>& vertices, const std::vector<Face>& faces) {
   // Pyramids from a reference point near the mesh: small lever arms keep georeferenced
   // coordinates precise.
@@ -235,7 +205,7 @@ Validation validate_mesh(const Mesh& mesh, double planarity_tolerance, bool chec
   const EdgeUses uses = edge_uses(mesh.faces);
   count_edge_defects(uses, v);
   v.nonmanifold_vertices = count_nonmanifold_vertices(mesh, uses);
-  v.components = count_components(mesh, uses);
+  v.components = count_components(mesh.faces.size(), uses);
   v.volume = signed_volume(mesh.vertices, mesh.faces);
   v.outward = v.volume > 0;
   v.max_planarity_error = max_planarity_error(mesh);

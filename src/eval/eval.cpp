@@ -13,6 +13,7 @@
 #include "lodrefine/core/matching.h"
 #include "lodrefine/core/planes.h"
 #include "lodrefine/core/repair.h"
+#include "lodrefine/core/topology.h"
 #include "lodrefine/core/validate.h"
 
 namespace lodrefine {
@@ -33,10 +34,8 @@ Mesh weld_identical(const Mesh& mesh) {
   }
   for (const Face& f : mesh.faces) {
     Face g = f;
-    g.v.clear();
-    for (int v : f.v)
-      if (g.v.empty() || g.v.back() != remap.at(v)) g.v.push_back(remap.at(v));
-    while (g.v.size() > 1 && g.v.front() == g.v.back()) g.v.pop_back();
+    for (int& v : g.v) v = remap.at(v);
+    drop_repeats(g.v);
     if (g.v.size() >= 3) out.faces.push_back(std::move(g));
   }
   return out;

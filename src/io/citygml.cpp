@@ -18,6 +18,7 @@
 #include <set>
 #include <unordered_map>
 
+#include "lodrefine/core/topology.h"
 #include "lodrefine/io/cityjson_write.h"
 #include "lodrefine/io/files.h"
 
@@ -194,17 +195,10 @@ class Converter {
     return out;
   }
 
-  struct Hash {
-    std::size_t operator()(const std::array<long long, 3>& q) const {
-      // Unsigned: wraps instead of overflowing (coordinates reach 1e13 units).
-      return std::size_t(std::uint64_t(q[0]) * 73856093u ^ std::uint64_t(q[1]) * 19349663u ^ std::uint64_t(q[2]) * 83492791u);
-    }
-  };
-
   std::string path_;
   CityJsonTransform transform_;
   std::unordered_map<const CityObject*, std::string> ids_;
-  std::unordered_map<std::array<long long, 3>, int, Hash> index_;
+  std::unordered_map<GridKey, int, GridKeyHash> index_;  // quantised coordinates reach 1e13 units
   std::vector<std::array<long long, 3>> vertices_;
 };
 

@@ -41,12 +41,6 @@ PointCloud read_cloud(const std::string& path, const CloudOptions& options) {
   return cloud;
 }
 
-Eigen::AlignedBox3d bounding_box(const std::vector<Vec3>& points) {
-  Eigen::AlignedBox3d box;
-  for (const auto& p : points) box.extend(p);
-  return box;
-}
-
 std::string overlap_problem(const Eigen::AlignedBox3d& cloud, const Eigen::AlignedBox3d& model, const std::string& what,
                             double margin) {
   if (cloud.isEmpty() || model.isEmpty()) return {};

@@ -12,6 +12,7 @@
 #include <memory>
 #include <unordered_map>
 
+#include "lodrefine/core/geometry.h"
 #include "lodrefine/io/ply.h"
 
 namespace lodrefine {
@@ -19,12 +20,9 @@ namespace lodrefine {
 CropTarget crop_target(const Mesh& model, double relative, double absolute) {
   CropTarget t;
   t.id = model.id;
-  t.lo = Vec3::Constant(1e300);
-  t.hi = Vec3::Constant(-1e300);
-  for (const auto& v : model.vertices) {
-    t.lo = t.lo.cwiseMin(v);
-    t.hi = t.hi.cwiseMax(v);
-  }
+  const Eigen::AlignedBox3d box = bounding_box(model.vertices);
+  t.lo = box.min();
+  t.hi = box.max();
   const Vec3 size = t.hi - t.lo;
   const Vec3 grow(relative * size.x() + absolute, relative * size.y() + absolute, absolute);
   t.lo -= grow;

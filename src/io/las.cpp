@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "lodrefine/core/geometry.h"
 #include "lodrefine/io/files.h"
 
 namespace lodrefine {
@@ -224,8 +225,9 @@ void write_las(const std::string& path, const PointCloud& cloud, const std::vect
   const std::uint64_t n = cloud.points.size();
   Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();
   if (n > 0) {
-    lo = hi = cloud.points[0];
-    for (const auto& p : cloud.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    const Eigen::AlignedBox3d box = bounding_box(cloud.points);
+    lo = box.min();
+    hi = box.max();
   }
   std::string out;
   out += "LASF";

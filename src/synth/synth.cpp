@@ -29,6 +29,7 @@
 #include <set>
 
 #include "lodrefine/core/geometry.h"
+#include "lodrefine/core/topology.h"
 #include "lodrefine/io/obj.h"
 #include "lodrefine/io/ply.h"
 #include "lodrefine/io/files.h"
@@ -38,6 +39,11 @@ namespace lodrefine {
 namespace {
 
 constexpr double kWeldTol = 1e-6;  // building frame, metres
+// A vertex strictly inside a segment, closer than kWeldTol to it, lies on it.
+constexpr SegmentRule kOnEdge{kWeldTol, true};
+// Generated faces of one plane agree up to rounding: normals within this cosine, offsets within
+// kWeldTol (building frame).
+constexpr double kCoplanarCos = 1 - 1e-9;
 
 // The footprint lines or roof planes do not describe a valid building (e.g. after extreme moves).
 struct ShapeError : std::runtime_error {
@@ -339,56 +345,17 @@ int weld(std::vector<Vec3>& verts, const Vec3& p) {
   return int(verts.size()) - 1;
 }
 
-void drop_repeats(std::vector<int>& v) {
-  v.erase(std::unique(v.begin(), v.end()), v.end());
-  while (v.size() > 1 && v.front() == v.back()) v.pop_back();
-}
-
-// Vertices strictly inside segment a-b, ordered from a to b.
-std::vector<int> vertices_inside(const Mesh& m, int a, int b) {
-  const Vec3 A = m.vertices[a], AB = m.vertices[b] - A;
-  std::vector<std::pair<double, int>> hits;
-  for (int k = 0; k < int(m.vertices.size()); ++k) {
-    const double t = (m.vertices[k] - A).dot(AB) / AB.squaredNorm();
-    if (k != a && k != b && t > 0 && t < 1 && (A + t * AB - m.vertices[k]).norm() < kWeldTol) hits.emplace_back(t, k);
-  }
-  std::sort(hits.begin(), hits.end());
-  std::vector<int> out;
-  for (const auto& h : hits) out.push_back(h.second);
-  return out;
-}
-
 // Inserts every vertex lying inside a face edge into that edge, so faces meet vertex to vertex.
 void split_t_junctions(Mesh& m) {
   for (auto& f : m.faces) {
     std::vector<int> out;
     for (std::size_t i = 0; i < f.v.size(); ++i) {
       out.push_back(f.v[i]);
-      const auto inside = vertices_inside(m, f.v[i], f.v[(i + 1) % f.v.size()]);
+      const auto inside = vertices_on_segment(m.vertices, f.v[i], f.v[(i + 1) % f.v.size()], kOnEdge);
       out.insert(out.end(), inside.begin(), inside.end());
     }
     f.v = out;
   }
-}
-
-// Undirected edge -> faces using it (restricted to `faces` when given).
-std::map<std::pair<int, int>, std::vector<int>> edge_faces(const Mesh& m, const std::vector<int>* faces = nullptr) {
-  std::map<std::pair<int, int>, std::vector<int>> out;
-  const int n = faces ? int(faces->size()) : int(m.faces.size());
-  for (int k = 0; k < n; ++k) {
-    const int fi = faces ? (*faces)[k] : k;
-    const auto& v = m.faces[fi].v;
-    for (std::size_t i = 0; i < v.size(); ++i) {
-      const int a = v[i], b = v[(i + 1) % v.size()];
-      out[{std::min(a, b), std::max(a, b)}].push_back(fi);
-    }
-  }
-  return out;
-}
-
-int find_root(std::vector<int>& parent, int i) {
-  while (parent[i] != i) i = parent[i] = parent[parent[i]];
-  return i;
 }
 
 // The outline of a group of faces (shared edges cancel); nullopt unless it is one simple loop.
@@ -424,23 +391,22 @@ void merge_coplanar(Mesh& m) {
   const int nf = int(m.faces.size());
   std::vector<Plane> planes;
   for (const auto& f : m.faces) planes.push_back(polygon_plane(face_points(m, f)));
-  std::vector<int> parent(nf);
-  std::iota(parent.begin(), parent.end(), 0);
-  for (const auto& [e, fs] : edge_faces(m)) {
+  DisjointSets sets(nf);
+  for (const auto& [e, fs] : edge_uses(m.faces)) {
     if (fs.size() != 2) continue;
-    const int f = fs[0], g = fs[1];
+    const int f = fs[0].face, g = fs[1].face;
     if (m.faces[f].sem != m.faces[g].sem) continue;
-    if (planes[f].n.dot(planes[g].n) < 1 - 1e-9 || std::abs(planes[f].d - planes[g].d) > 1e-6) continue;
-    parent[find_root(parent, f)] = find_root(parent, g);
+    if (planes[f].n.dot(planes[g].n) < kCoplanarCos || std::abs(planes[f].d - planes[g].d) > kWeldTol) continue;
+    sets.unite(f, g);
   }
   std::map<int, std::vector<int>> groups;
-  for (int fi = 0; fi < nf; ++fi) groups[find_root(parent, fi)].push_back(fi);
+  for (int fi = 0; fi < nf; ++fi) groups[sets.find(fi)].push_back(fi);
   std::map<int, std::optional<std::vector<int>>> outlines;  // per group root; nullopt: keep members
   for (const auto& [root, g] : groups)
     if (g.size() > 1) outlines[root] = outline(m, g);
   std::vector<Face> faces;
   for (int fi = 0; fi < nf; ++fi) {
-    const int root = find_root(parent, fi);
+    const int root = sets.find(fi);
     const auto it = outlines.find(root);
     if (it == outlines.end() || !it->second)
       faces.push_back(m.faces[fi]);
@@ -462,10 +428,7 @@ void drop_collinear_vertices(Mesh& m) {
   std::vector<bool> drop(m.vertices.size(), false);
   for (std::size_t v = 0; v < nb.size(); ++v) {
     if (nb[v].size() != 2) continue;
-    const Vec3 a = m.vertices[*nb[v].begin()], b = m.vertices[*nb[v].rbegin()], p = m.vertices[v];
-    const Vec3 ab = b - a;
-    const double t = (p - a).dot(ab) / ab.squaredNorm();
-    drop[v] = t > 0 && t < 1 && (a + t * ab - p).norm() < kWeldTol;
+    drop[v] = inside_segment(m.vertices[*nb[v].begin()], m.vertices[*nb[v].rbegin()], m.vertices[v], kOnEdge).has_value();
   }
   std::vector<int> remap(m.vertices.size(), -1);
   std::vector<Vec3> verts;
@@ -686,18 +649,18 @@ int pick_weighted(const std::vector<double>& w, Rng& r) {
 std::vector<int> choose_scanned(const Mesh& m, const std::vector<WallInfo>& walls, int k, Rng& r) {
   std::vector<int> wall_of(m.faces.size(), -1), faces;
   for (std::size_t w = 0; w < walls.size(); ++w) wall_of[walls[w].face] = int(w), faces.push_back(walls[w].face);
-  const auto edge_walls = edge_faces(m, &faces);
+  const auto edge_walls = edge_uses(m.faces, faces);
   std::vector<double> weight;
   for (const auto& w : walls) weight.push_back(w.length >= 3 ? w.length : 0.0);
   std::vector<int> chosen{pick_weighted(weight, r)};
   while (int(chosen.size()) < k) {
     std::set<int> cand;
-    for (const auto& [e, fs] : edge_walls)
-      for (int fa : fs)
-        if (std::count(chosen.begin(), chosen.end(), wall_of[fa]))
-          for (int fb : fs)
-            if (!std::count(chosen.begin(), chosen.end(), wall_of[fb]) && walls[wall_of[fb]].length >= 2)
-              cand.insert(wall_of[fb]);
+    for (const auto& [e, uses] : edge_walls)
+      for (const EdgeUse& a : uses)
+        if (std::count(chosen.begin(), chosen.end(), wall_of[a.face]))
+          for (const EdgeUse& b : uses)
+            if (!std::count(chosen.begin(), chosen.end(), wall_of[b.face]) && walls[wall_of[b.face]].length >= 2)
+              cand.insert(wall_of[b.face]);
     if (cand.empty()) break;
     chosen.push_back(*std::next(cand.begin(), r.integer(0, int(cand.size()) - 1)));
   }

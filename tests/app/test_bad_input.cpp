@@ -42,6 +42,10 @@
 #include "lodrefine/core/validate.h"
 
 using namespace lodrefine;
+
+// Validation at the parameter table's planarity tolerance.
+const double kPlanarity = Params{}.planarity_tolerance;
+
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
@@ -191,7 +195,7 @@ std::vector<std::string> temp_leftovers(const std::string& dir) {
 std::string output_problem(const std::string& path) {
   try {
     const Mesh m = read_obj(path);
-    const Validation v = validate_mesh(m);
+    const Validation v = validate_mesh(m, kPlanarity);
     return v.valid() ? "" : "invalid output: " + v.problem;
   } catch (const std::exception& e) {
     return std::string("unreadable output: ") + e.what();
@@ -926,7 +930,7 @@ TEST(BadInputSolver, RefineFallsBackToTheOriginalWhenSelectionTimesOut) {
   EXPECT_EQ(report.value("outcome", std::string()), "kept");
   ASSERT_FALSE(report["replacements"].empty());
   EXPECT_EQ(report["replacements"][0]["mip"].value("status", std::string()), "time limit (no solution)");
-  EXPECT_TRUE(validate_mesh(r.mesh).valid());
+  EXPECT_TRUE(validate_mesh(r.mesh, kPlanarity).valid());
   EXPECT_EQ(r.mesh.faces.size(), 6u);  // the repaired box, front wall where it was
   add_row("refine_building, mip_time_limit 0.001", std::string("outcome '") + outcome_name(r.outcome) + "'", 0);
 

@@ -14,9 +14,14 @@
 #include "lodrefine/io/obj.h"
 #include "lodrefine/io/ply.h"
 #include "lodrefine/core/refine.h"
+#include "lodrefine/core/params.h"
 #include "lodrefine/core/validate.h"
 
 using namespace lodrefine;
+
+// Validation at the parameter table's planarity tolerance.
+const double kPlanarity = Params{}.planarity_tolerance;
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -47,7 +52,7 @@ void run_tile(const std::string& tile, double max_pooled_rmse) {
     EXPECT_NE(r.outcome, Outcome::KeptInvalid);
     const Vec3 o = local_origin(truth);
     const Mesh t = translated(truth, -o), c = translated(coarse, -o), m = translated(r.mesh, -o);
-    EXPECT_TRUE(validate_mesh(m).valid()) << validate_mesh(m).problem;
+    EXPECT_TRUE(validate_mesh(m, kPlanarity).valid()) << validate_mesh(m, kPlanarity).problem;
     std::vector<Vec3> pts;
     for (const auto& p : cloud.points) pts.push_back(p - o);
     const auto samples = sample_faces(t, scanned_walls(t, pts, 0.05, 50), 0.25);

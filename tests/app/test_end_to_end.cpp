@@ -9,9 +9,13 @@
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/synth/synth.h"
+#include "lodrefine/core/params.h"
 #include "lodrefine/core/validate.h"
 
 using namespace lodrefine;
+
+// Validation at the parameter table's planarity tolerance.
+const double kPlanarity = Params{}.planarity_tolerance;
 
 namespace {
 
@@ -46,7 +50,7 @@ TEST_P(EndToEnd, ScannedFacadesLandOnTheTruthAndTheShellIsValid) {
     ASSERT_TRUE(r.valid);
     const Vec3 o = local_origin(b.truth);
     const Mesh refined = translated(r.mesh, -o), truth = translated(b.truth, -o), coarse = translated(b.coarse, -o);
-    const Validation v = validate_mesh(refined);
+    const Validation v = validate_mesh(refined, kPlanarity);
     EXPECT_TRUE(v.valid()) << v.problem;
     EXPECT_EQ(r.mesh.id, b.coarse.id);
 

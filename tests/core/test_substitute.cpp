@@ -5,9 +5,13 @@
 #include "lodrefine/core/matching.h"
 #include "lodrefine/core/repair.h"
 #include "lodrefine/core/substitute.h"
+#include "lodrefine/core/params.h"
 #include "lodrefine/core/validate.h"
 
 using namespace lodrefine;
+
+// Validation at the parameter table's planarity tolerance.
+const double kPlanarity = Params{}.planarity_tolerance;
 
 namespace {
 
@@ -55,7 +59,7 @@ TEST(Substitute, MovedWallTakesItsPlaneAndNothingElseMoves) {
   const auto r = substitute_walls(m, ss, {{front, moved}}, 0.01);
   ASSERT_TRUE(r.ok) << r.reason;
   EXPECT_EQ(r.moved_vertices, 4);
-  EXPECT_TRUE(validate_mesh(r.mesh).valid()) << validate_mesh(r.mesh).problem;
+  EXPECT_TRUE(validate_mesh(r.mesh, kPlanarity).valid()) << validate_mesh(r.mesh, kPlanarity).problem;
   for (std::size_t v = 0; v < m.vertices.size(); ++v) {
     const Vec3 &p = m.vertices[v], &q = r.mesh.vertices[v];
     EXPECT_EQ(p.z(), q.z()) << "heights are kept";
@@ -88,8 +92,8 @@ TEST(Substitute, EaveKeepsItsHeightOrFollowsTheRoofPlane) {
     EXPECT_NEAR(follow.mesh.vertices[v].z(), 6.75, 1e-6);  // slope 3/4 over 1 m
     EXPECT_NEAR(follow.mesh.vertices[v].y(), 1.0, 1e-6);
   }
-  EXPECT_TRUE(validate_mesh(keep.mesh).valid());
-  EXPECT_TRUE(validate_mesh(follow.mesh).valid());
+  EXPECT_TRUE(validate_mesh(keep.mesh, kPlanarity).valid());
+  EXPECT_TRUE(validate_mesh(follow.mesh, kPlanarity).valid());
 }
 
 TEST(Substitute, RefusesAMoveThatTurnsAFaceInsideOut) {

@@ -4,9 +4,14 @@
 #include <map>
 
 #include "lodrefine/core/geometry.h"
+#include "lodrefine/core/topology.h"
+#include "lodrefine/core/params.h"
 #include "lodrefine/core/validate.h"
 
 using namespace lodrefine;
+
+// Validation at the parameter table's planarity tolerance.
+const double kPlanarity = Params{}.planarity_tolerance;
 
 namespace {
 
@@ -54,7 +59,7 @@ bool mentions(const Validation& v, const std::string& what) { return v.problem.f
 }  // namespace
 
 TEST(Validate, ClosedCubeIsValid) {
-  const Validation v = validate_mesh(unit_cube());
+  const Validation v = validate_mesh(unit_cube(), kPlanarity);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_TRUE(v.watertight());
   EXPECT_EQ(v.boundary_edges, 0);
@@ -71,7 +76,7 @@ TEST(Validate, ClosedCubeIsValid) {
 TEST(Validate, GeoreferencedNonConvexPrismIsValid) {
   const Mesh l =
       translated(prism({{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}}, 0, 3), {85123.4567, 447987.6543, 2});
-  const Validation v = validate_mesh(l);
+  const Validation v = validate_mesh(l, kPlanarity);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_NEAR(v.volume, 9.0, 1e-6);
   EXPECT_FALSE(v.self_intersecting);
@@ -80,7 +85,7 @@ TEST(Validate, GeoreferencedNonConvexPrismIsValid) {
 TEST(Validate, MissingFaceGivesFourBoundaryEdges) {
   Mesh m = unit_cube();
   m.faces.pop_back();
-  const Validation v = validate_mesh(m);
+  const Validation v = validate_mesh(m, kPlanarity);
   EXPECT_EQ(v.boundary_edges, 4);
   EXPECT_FALSE(v.watertight());
   EXPECT_EQ(v.problem, "4 boundary edges (mesh not closed)");
@@ -89,7 +94,7 @@ TEST(Validate, MissingFaceGivesFourBoundaryEdges) {
 TEST(Validate, FlippedFaceGivesInconsistentEdges) {
   Mesh m = unit_cube();
   reverse_face(m.faces[2]);
-  const Validation v = validate_mesh(m);
+  const Validation v = validate_mesh(m, kPlanarity);
   EXPECT_TRUE(v.watertight());
   EXPECT_EQ(v.inconsistent_edges, 4);
   EXPECT_TRUE(mentions(v, "4 inconsistently oriented edges")) << v.problem;
@@ -98,7 +103,7 @@ TEST(Validate, FlippedFaceGivesInconsistentEdges) {
 TEST(Validate, InvertedCubeIsNotOutward) {
   Mesh m = unit_cube();
   for (Face& f : m.faces) reverse_face(f);
-  const Validation v = validate_mesh(m);
+  const Validation v = validate_mesh(m, kPlanarity);
   EXPECT_EQ(v.inconsistent_edges, 0);
   EXPECT_FALSE(v.outward);
   EXPECT_NEAR(v.volume, -1.0, 1e-12);
@@ -115,7 +120,7 @@ TEST(Validate, NonPlanarQuadIsReported) {
 }
 
 TEST(Validate, CubesSharingAnEdgeAreNonManifold) {
-  const Validation v = validate_mesh(combined(unit_cube(), translated(unit_cube(), {1, 1, 0})));
+  const Validation v = validate_mesh(combined(unit_cube(), translated(unit_cube(), {1, 1, 0})), kPlanarity);
   EXPECT_EQ(v.nonmanifold_edges, 1);
   EXPECT_EQ(v.boundary_edges, 0);
   EXPECT_FALSE(v.watertight());
@@ -123,7 +128,7 @@ TEST(Validate, CubesSharingAnEdgeAreNonManifold) {
 }
 
 TEST(Validate, CubesSharingAVertexHaveANonManifoldVertexAndTwoComponents) {
-  const Validation v = validate_mesh(combined(unit_cube(), translated(unit_cube(), {1, 1, 1})));
+  const Validation v = validate_mesh(combined(unit_cube(), translated(unit_cube(), {1, 1, 1})), kPlanarity);
   EXPECT_EQ(v.nonmanifold_edges, 0);
   EXPECT_EQ(v.nonmanifold_vertices, 1);
   EXPECT_EQ(v.components, 2);
@@ -133,7 +138,7 @@ TEST(Validate, CubesSharingAVertexHaveANonManifoldVertexAndTwoComponents) {
 }
 
 TEST(Validate, SeparateCubesAreTwoComponents) {
-  const Validation v = validate_mesh(combined(unit_cube(), translated(unit_cube(), {3, 0, 0})));
+  const Validation v = validate_mesh(combined(unit_cube(), translated(unit_cube(), {3, 0, 0})), kPlanarity);
   EXPECT_TRUE(v.watertight());
   EXPECT_EQ(v.components, 2);
   EXPECT_EQ(v.problem, "2 connected components (expected one)");
@@ -152,11 +157,11 @@ TEST(Validate, VertexPushedThroughTheOppositeFaceSelfIntersects) {
 TEST(Validate, MalformedFacesAreReportedNotCrashed) {
   Mesh m = unit_cube();
   m.faces[0].v.push_back(42);
-  EXPECT_EQ(validate_mesh(m).problem, "face 0 references missing vertex 42");
+  EXPECT_EQ(validate_mesh(m, kPlanarity).problem, "face 0 references missing vertex 42");
   m = unit_cube();
   m.faces[1].v = {0, 1};
-  EXPECT_EQ(validate_mesh(m).problem, "face 1 has fewer than 3 vertices");
-  EXPECT_EQ(validate_mesh(Mesh{}).problem, "no faces");
+  EXPECT_EQ(validate_mesh(m, kPlanarity).problem, "face 1 has fewer than 3 vertices");
+  EXPECT_EQ(validate_mesh(Mesh{}, kPlanarity).problem, "no faces");
 }
 
 TEST(Validate, EdgeUsesRecordDirection) {

@@ -57,9 +57,8 @@ void write_ascii_ply(const std::string& path, const std::vector<Vec3>& pts) {
 std::vector<Vec3> points_around(const Mesh& m, const Triangles& tris, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  Vec3 lo = m.vertices[0], hi = lo;
-  for (const auto& v : m.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-  lo -= Vec3::Constant(1.5), hi += Vec3::Constant(1.5);
+  const Eigen::AlignedBox3d box = bounding_box(m.vertices);
+  const Vec3 lo = box.min() - Vec3::Constant(1.5), hi = box.max() + Vec3::Constant(1.5);
   std::vector<Vec3> pts;
   for (int i = 0; i < 2000; ++i)
     pts.emplace_back(lo.x() + unit(rng) * (hi.x() - lo.x()), lo.y() + unit(rng) * (hi.y() - lo.y()),

@@ -23,9 +23,14 @@
 #include "lodrefine/io/las.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/synth/synth.h"
+#include "lodrefine/core/params.h"
 #include "lodrefine/core/validate.h"
 
 using namespace lodrefine;
+
+// Validation at the parameter table's planarity tolerance.
+const double kPlanarity = Params{}.planarity_tolerance;
+
 namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
 
@@ -75,7 +80,7 @@ std::string geometry_problem(const Mesh& soup) {
     m.faces.push_back(g);
   }
   const Vec3 o = local_origin(m);
-  const Validation v = validate_mesh(translated(m, -o));
+  const Validation v = validate_mesh(translated(m, -o), kPlanarity);
   return v.valid() ? "" : v.problem;
 }
 

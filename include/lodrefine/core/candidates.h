@@ -57,8 +57,10 @@ struct CandidateSet {
 std::vector<Vec3> region_section(const Plane& plane, const Region& region);
 
 // Splits every plane (cropped to `region`) by every other plane. Pieces smaller than
-// `min_area` (m^2) are dropped.
+// `min_area` (m^2) are dropped: by default those under a square millimetre, slivers between
+// nearly coincident planes that no face of a building is.
+constexpr double kMinCandidateArea = 1e-6;  // m^2
 CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Region& region,
-                              double min_area = 1e-6);
+                              double min_area = kMinCandidateArea);
 
 }  // namespace lodrefine

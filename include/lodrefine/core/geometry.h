@@ -30,6 +30,12 @@ std::vector<Vec3> face_points(const Mesh& mesh, const Face& face);
 // The mesh moved by `offset` (e.g. into or out of a local frame).
 Mesh translated(Mesh mesh, const Vec3& offset);
 
+// Axis-aligned bounding box of the points (of those listed in `subset`); an empty box (min
+// above max) for none.
+Eigen::AlignedBox3d bounding_box(const std::vector<Vec3>& pts);
+Eigen::AlignedBox3d bounding_box(const std::vector<Vec3>& pts, const std::vector<int>& subset);
+Eigen::AlignedBox2d bounding_box(const std::vector<Vec2>& pts);
+
 // Least-squares (PCA) plane; the normal's sign is arbitrary. Needs >= 3 non-collinear points.
 Plane fit_plane(const std::vector<Vec3>& pts);
 // PCA plane oriented along the polygon's Newell normal (i.e. the face's outward side).

@@ -22,7 +22,14 @@ struct ModelSurface {
   Vec3 centroid = Vec3::Zero();
 };
 
-std::vector<ModelSurface> model_surfaces(const Mesh& mesh, double angle_deg = 1.0, double distance = 0.02);
+// A face joins a surface when its normal is within kSurfaceAngleDeg of the surface's first face
+// and all its vertices lie within kSurfaceDistance of that face's plane. Twice the default
+// planarity tolerance: faces that pass validation each (1 cm off their own plane) still join
+// their coplanar neighbours, while a real step or kink between walls (decimetres) does not.
+constexpr double kSurfaceAngleDeg = 1.0;
+constexpr double kSurfaceDistance = 0.02;  // m
+std::vector<ModelSurface> model_surfaces(const Mesh& mesh, double angle_deg = kSurfaceAngleDeg,
+                                         double distance = kSurfaceDistance);
 
 // Largest distance of a surface's vertices from `plane` (how far the wall moves onto it).
 double surface_deviation(const Mesh& mesh, const ModelSurface& surface, const Plane& plane);

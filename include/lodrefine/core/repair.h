@@ -47,6 +47,11 @@ int split_warped_faces(Mesh& mesh, double tolerance);
 // Merges edge-adjacent coplanar faces of the same semantic into single polygons (within
 // `angle_deg` / `distance`), removing the then-redundant collinear vertices. Input must be a
 // closed oriented mesh with shared vertices; so is the output.
-Mesh merge_coplanar_faces(const Mesh& mesh, double angle_deg = 0.5, double distance = 0.005);
+// The defaults merge only what is coplanar up to the rounding of a refined model: half a degree
+// and 5 mm, half the default planarity tolerance, so a merged polygon still validates.
+constexpr double kCoplanarMergeAngleDeg = 0.5;
+constexpr double kCoplanarMergeDistance = 0.005;  // m
+Mesh merge_coplanar_faces(const Mesh& mesh, double angle_deg = kCoplanarMergeAngleDeg,
+                          double distance = kCoplanarMergeDistance);
 
 }  // namespace lodrefine

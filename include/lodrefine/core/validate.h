@@ -1,8 +1,6 @@
 // The project's own validator: every model is checked before it is written as refined.
 #pragma once
-#include <map>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "lodrefine/core/types.h"
@@ -26,20 +24,12 @@ struct Validation {
 };
 
 // Checks closed, 2-manifold (edges and vertices), consistently and outward oriented, planar
-// faces within `planarity_tolerance`, one component, no self-intersections (CGAL PMP on the
-// triangulated faces). Expects shared vertices. `single_component` false accepts a building of
-// several closed shells (a multi-part export).
-Validation validate_mesh(const Mesh& mesh, double planarity_tolerance = 0.01,
+// faces within `planarity_tolerance` (Params::planarity_tolerance; no default here, the
+// parameter table holds it), one component, no self-intersections (CGAL PMP on the triangulated
+// faces). Expects shared vertices. `single_component` false accepts a building of several closed
+// shells (a multi-part export).
+Validation validate_mesh(const Mesh& mesh, double planarity_tolerance,
                          bool check_self_intersections = true, bool single_component = true);
-
-// Edge topology, shared with repair: each undirected edge (lower vertex index first) with the
-// faces using it, `forward` when the face runs from the lower to the higher vertex.
-struct EdgeUse {
-  int face;
-  bool forward;
-};
-using EdgeUses = std::map<std::pair<int, int>, std::vector<EdgeUse>>;
-EdgeUses edge_uses(const std::vector<Face>& faces);
 
 // Enclosed volume of `faces` (all indices valid), positive when they point outward; exact for
 // closed meshes of planar faces.

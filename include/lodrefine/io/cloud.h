@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "lodrefine/core/geometry.h"  // bounding_box, for overlap_problem
 #include "lodrefine/core/types.h"
 
 namespace lodrefine {
@@ -32,9 +33,6 @@ void stream_cloud(const std::string& path, const CloudOptions& options,
 
 // Reads the whole cloud.
 PointCloud read_cloud(const std::string& path, const CloudOptions& options = {});
-
-// Axis-aligned bounding box of points (empty for none).
-Eigen::AlignedBox3d bounding_box(const std::vector<Vec3>& points);
 
 // CRS / tile sanity: one line "cloud x a..b y c..d does not overlap <what> x e..f y g..h: wrong
 // CRS or tile?" when the boxes are disjoint in XY (the model grown by `margin` metres); empty
