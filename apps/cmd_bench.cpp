@@ -99,10 +99,10 @@ void add_bench_command(CLI::App& app) {
   static BenchArgs args;
   auto* cmd = app.add_subcommand("bench", "Benchmark: refine a generated tile, print time per stage and accuracy");
   cmd->add_option("--type", args.types, "Building types (or all)")->capture_default_str();
-  cmd->add_option("--count", args.count, "Buildings per type")->capture_default_str()->check(CLI::Range(1, 100000));
+  add_ranged_option(cmd, "--count", args.count, "Buildings per type", 1, 100000);
   cmd->add_option("--first-seed", args.seed, "First building seed (the RANSAC seed is --seed)")->capture_default_str();
-  cmd->add_option("--points", args.points, "Target facade points per building")->capture_default_str()->check(CLI::Range(100, 10000000));
-  cmd->add_option("--facades", args.facades, "Scanned facades per building (0: random 1..3, as in the generator)")->capture_default_str()->check(CLI::Range(0, 20));
+  add_ranged_option(cmd, "--points", args.points, "Target facade points per building", 100, 10000000);
+  add_ranged_option(cmd, "--facades", args.facades, "Scanned facades per building (0: random 1..3, as in the generator)", 0, 20);
   add_param_options(cmd, args.params);
   cmd->callback([] { run(args); });
 }

@@ -80,10 +80,9 @@ void add_crop_command(CLI::App& app) {
   cmd->add_option("--tile", args.tile, "Large point cloud tile (PLY or LAS)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--models", args.models, "Folder of models: *.obj or <id>/coarse.obj")->required();
   cmd->add_option("--out", args.out, "Run folder: writes <id>/cloud.ply and <id>/coarse.obj")->required();
-  cmd->add_option("--expand", args.expand, "Relative box growth on each side")->capture_default_str()->check(CLI::Range(0.0, 10.0));
-  cmd->add_option("--margin", args.margin, "Absolute box growth on each side (m)")->capture_default_str()->check(CLI::Range(0.0, 1000.0));
-  cmd->add_option("--buffer-points", args.buffer_points, "Points held in memory before spilling to disk (memory bound)")
-      ->capture_default_str()->check(CLI::Range(std::size_t(1), std::size_t(1) << 40));
+  add_ranged_option(cmd, "--expand", args.expand, "Relative box growth on each side", 0.0, 10.0);
+  add_ranged_option(cmd, "--margin", args.margin, "Absolute box growth on each side (m)", 0.0, 1000.0);
+  add_ranged_option(cmd, "--buffer-points", args.buffer_points, "Points held in memory before spilling to disk (memory bound)", std::size_t(1), std::size_t(1) << 40);
   add_cloud_options(cmd, args.cloud_options);
   cmd->callback([] { run(args); });
 }

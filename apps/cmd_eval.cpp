@@ -684,8 +684,7 @@ void add_eval_command(CLI::App& app) {
   cmd->add_option("--svg-dir", a.svg_dir, "Write C2M histogram + boxplot and a footprint per building (SVG)");
   auto* html = cmd->add_option("--html", a.html_out, "With --dir: write one self-contained HTML report page (tables, "
                                                      "plots, footprints and 3D views; three.js embedded)");
-  cmd->add_option("--html-views", a.html_views, "Buildings shown in 3D in the HTML report, worst first")
-      ->capture_default_str()->check(CLI::Range(0, 100000));
+  add_ranged_option(cmd, "--html-views", a.html_views, "Buildings shown in 3D in the HTML report, worst first", 0, 100000);
   html->needs(dir);
   cmd->add_option("--jobs", a.jobs, "With --dir: buildings evaluated at once (default: all cores)")
       ->check(CLI::Range(1, 1024));

@@ -4,6 +4,7 @@
 
 #include "commands.h"
 #include "lodrefine/synth/synth.h"
+#include "options.h"
 
 namespace lodrefine::app {
 
@@ -69,31 +70,19 @@ void add_synth_command(CLI::App& app) {
                                  "cloud.ply, meta.json per building");
   cmd->add_option("--type", a.type, "flat|gable|hip|shed|stepped|lshape|tshape|polygon|all")->capture_default_str();
   cmd->add_option("--seed", a.seed, "first seed (seeds seed..seed+count-1)")->capture_default_str();
-  cmd->add_option("--count", a.count, "buildings per type")->capture_default_str()->check(CLI::Range(1, 100000));
+  add_ranged_option(cmd, "--count", a.count, "buildings per type", 1, 100000);
   cmd->add_option("--out", a.out, "output directory (one subdirectory per building)")->required();
   cmd->add_option("--tile", a.tile, "city tile: --count buildings in all (types cycling) on a grid, their clouds "
                                     "streamed into this one PLY instead of <id>/cloud.ply (cut with `lodrefine crop`)");
-  cmd->add_option("--grid", a.grid, "with --tile: grid spacing between buildings (m)")->capture_default_str()->check(CLI::Range(10.0, 10000.0));
+  add_ranged_option(cmd, "--grid", a.grid, "with --tile: grid spacing between buildings (m)", 10.0, 10000.0);
   auto& o = a.opt;
-  cmd->add_option("--shift-min", o.min_shift, "min facade offset (m)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 3.0));
-  cmd->add_option("--shift-max", o.max_shift, "max facade offset (m)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 3.0));
-  cmd->add_option("--rotation-max", o.max_rotation_deg, "max facade rotation about a vertical axis (deg)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 15.0));
-  cmd->add_option("--global-shift", o.global_shift, "max shift of the whole coarse model (m)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 10.0));
-  cmd->add_option("--facades", o.scanned_facades, "scanned facades (0: random 1..3)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 20));
-  cmd->add_option("--noise", o.noise, "MLS range noise sigma (m)")->capture_default_str()->check(CLI::Range(0.0, 0.5));
-  cmd->add_option("--points", o.target_points, "points on the scanned facades before nuisances")
-      ->capture_default_str()
-      ->check(CLI::Range(100, 10000000));
+  add_ranged_option(cmd, "--shift-min", o.min_shift, "min facade offset (m)", 0.0, 3.0);
+  add_ranged_option(cmd, "--shift-max", o.max_shift, "max facade offset (m)", 0.0, 3.0);
+  add_ranged_option(cmd, "--rotation-max", o.max_rotation_deg, "max facade rotation about a vertical axis (deg)", 0.0, 15.0);
+  add_ranged_option(cmd, "--global-shift", o.global_shift, "max shift of the whole coarse model (m)", 0.0, 10.0);
+  add_ranged_option(cmd, "--facades", o.scanned_facades, "scanned facades (0: random 1..3)", 0, 20);
+  add_ranged_option(cmd, "--noise", o.noise, "MLS range noise sigma (m)", 0.0, 0.5);
+  add_ranged_option(cmd, "--points", o.target_points, "points on the scanned facades before nuisances", 100, 10000000);
   cmd->add_option("--origin-x", o.origin.x(), "georeferenced origin x")->capture_default_str();
   cmd->add_option("--origin-y", o.origin.y(), "georeferenced origin y")->capture_default_str();
   cmd->add_flag("--no-defects", a.no_defects, "coarse model without export defects");

@@ -16,14 +16,18 @@ inline std::string option_name(const std::string& field) {
   return s;
 }
 
+// An option with its default shown and a closed range checked.
+template <class T>
+CLI::Option* add_ranged_option(CLI::App* cmd, const std::string& name, T& value, const std::string& help, T lo, T hi) {
+  return cmd->add_option(name, value, help)->capture_default_str()->check(CLI::Range(lo, hi));
+}
+
 // Adds one option per parameter to `cmd`, bound to `params` (which must outlive parsing).
 inline void add_param_options(CLI::App* cmd, Params& params) {
   const auto& table = param_table();
   std::size_t i = 0;
 #define LODREFINE_PARAM_OPTION(type, name, def, lo, hi, help)                                            \
-  cmd->add_option(option_name(#name), params.name, table[i].description)                                  \
-      ->capture_default_str()                                                                             \
-      ->check(CLI::Range(type(lo), type(hi)))                                                             \
+  add_ranged_option(cmd, option_name(#name), params.name, table[i].description, type(lo), type(hi))        \
       ->group("Method parameters");                                                                       \
   ++i;
   LODREFINE_PARAMS(LODREFINE_PARAM_OPTION)

@@ -1119,25 +1119,17 @@ void check_options(const SynthOptions& o) {
 
 // ---------------------------------------------------------------------------------------------
 
+namespace {
+// Every building type with its name, in the order `--type all` generates them.
+constexpr std::pair<BuildingType, const char*> kBuildingTypes[] = {
+    {BuildingType::Flat, "flat"},       {BuildingType::Gable, "gable"},   {BuildingType::Hip, "hip"},
+    {BuildingType::Shed, "shed"},       {BuildingType::Stepped, "stepped"}, {BuildingType::LShape, "lshape"},
+    {BuildingType::TShape, "tshape"}, {BuildingType::Polygon, "polygon"}};
+}  // namespace
+
 const char* building_type_name(BuildingType t) {
-  switch (t) {
-    case BuildingType::Flat:
-      return "flat";
-    case BuildingType::Gable:
-      return "gable";
-    case BuildingType::Hip:
-      return "hip";
-    case BuildingType::Shed:
-      return "shed";
-    case BuildingType::Stepped:
-      return "stepped";
-    case BuildingType::LShape:
-      return "lshape";
-    case BuildingType::TShape:
-      return "tshape";
-    case BuildingType::Polygon:
-      return "polygon";
-  }
+  for (const auto& [type, name] : kBuildingTypes)
+    if (type == t) return name;
   return "unknown";
 }
 
@@ -1145,14 +1137,18 @@ BuildingType building_type_from_name(const std::string& name) {
   std::string n;
   for (char c : name)
     if (c != '-' && c != '_') n += char(std::tolower(static_cast<unsigned char>(c)));
-  for (auto t : all_building_types())
-    if (n == building_type_name(t)) return t;
-  throw InputError("unknown building type '" + name + "' (flat, gable, hip, shed, stepped, lshape, tshape, polygon)");
+  std::string known;
+  for (const auto& [type, type_name] : kBuildingTypes) {
+    if (n == type_name) return type;
+    known += (known.empty() ? "" : ", ") + std::string(type_name);
+  }
+  throw InputError("unknown building type '" + name + "' (" + known + ")");
 }
 
 std::vector<BuildingType> all_building_types() {
-  return {BuildingType::Flat,    BuildingType::Gable,  BuildingType::Hip,    BuildingType::Shed,
-          BuildingType::Stepped, BuildingType::LShape, BuildingType::TShape, BuildingType::Polygon};
+  std::vector<BuildingType> all;
+  for (const auto& entry : kBuildingTypes) all.push_back(entry.first);
+  return all;
 }
 
 SynthBuilding make_building(BuildingType type, std::uint64_t seed, const SynthOptions& opt) {
