@@ -1,6 +1,7 @@
-// Stage 3: PolyFit-style candidate faces. Supporting planes are merged (within 5 degrees and a
-// distance), then every plane, cropped to a convex region, is split by every other plane;
-// the convex pieces are the candidates, with their edge adjacency for the manifold constraint.
+// Stage 3 (fallback, used by the arrangement): PolyFit-style candidate faces. Every supporting
+// plane (the arrangement has already swept walls coplanar with the scan plane into it), cropped
+// to a convex region, is split by every other plane; the convex pieces are the candidates, with
+// their edge adjacency for the manifold constraint.
 // Vertices are plane-triple meets (solved with pivoting) welded at 1e-6 m, so identity does
 // not depend on coordinate magnitude (callers work in a local frame).
 #pragma once
