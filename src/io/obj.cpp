@@ -160,8 +160,6 @@ void append_fixed(std::string& out, double v) {
   out.append(buf, r.ptr);
 }
 
-// One-line OBJ names: whitespace runs become '_' so `o` stays a single token for other tools.
-
 std::string obj_text(const Mesh& mesh, const Vec3& origin, AtomicFile& file) {
   std::string out = "# lodrefine\n";
   if (!mesh.id.empty()) out += "o " + one_token(mesh.id) + "\n";
