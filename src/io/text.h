@@ -25,10 +25,11 @@ std::string_view trim(std::string_view s);
 std::vector<std::string_view> split_ws(std::string_view s);
 
 // Whole-token number parsing (double or integer); nullopt on any trailing junk or overflow.
-// <charconv>, so a C locale change cannot break files.
+// <charconv>, so a C locale change cannot break files. from_chars takes no '+', so one is
+// dropped here, but not in front of a '-': "+-5" is no number.
 template <class T>
 std::optional<T> parse_number(std::string_view t) {
-  if (t.size() > 1 && t[0] == '+') t.remove_prefix(1);
+  if (t.size() > 1 && t[0] == '+' && t[1] != '-') t.remove_prefix(1);
   T v = 0;
   const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
   if (r.ec != std::errc() || r.ptr != t.data() + t.size()) return std::nullopt;

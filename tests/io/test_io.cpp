@@ -164,6 +164,8 @@ TEST(IoObj, MalformedInputsThrowOneLineInputErrors) {
   expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", "face index -4 out of range");
   expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "face index 0");
   expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", "bad face vertex 'x'");
+  expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 +-1 2\n", "line 4: bad face vertex '+-1'");  // two signs
+  expect_obj_error("v 0 0 0\nv +-1 0 0\nv 0 1 0\nf 1 2 3\n", "line 2: bad number '+-1'");
   expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nhello world\nf 1 2 3\n", "line 4: unknown statement 'hello'");
   expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nv 1.5 2.", "line 5: vertex with fewer than 3");
   expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nv 1.5 2.0 3.0e", "line 5: bad number");
@@ -282,6 +284,9 @@ TEST(IoPly, MalformedInputsThrowOneLineInputErrors) {
   expect_ply_error("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
                    "end_header\n1 2 3abc\n",
                    "bad ASCII value '3abc'");
+  expect_ply_error("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+                   "end_header\n1 +-2 3\n",
+                   "bad ASCII value '+-2'");
   std::string inf = good;
   const double bad = std::numeric_limits<double>::infinity();
   std::memcpy(&inf[inf.size() - 8], &bad, 8);
