@@ -5,14 +5,13 @@
 #include <algorithm>
 #include <array>
 #include <bitset>
-#include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/io/files.h"
+#include "text.h"
 
 namespace lodrefine {
 namespace {
@@ -26,7 +25,8 @@ constexpr int kCompressedBits = 0xC0;
 // Reading happens in chunks of about this many bytes (whole records).
 constexpr std::size_t kChunkBytes = 1 << 20;
 
-[[noreturn]] void fail(const std::string& path, const std::string& fault) { throw InputError(path + ": " + fault); }
+using io_text::fail;
+using io_text::open_input;
 
 [[noreturn]] void fail_laz(const std::string& path) {
   fail(path,
@@ -57,16 +57,6 @@ void put_le(std::string& out, T v) {
 
 Vec3 get_vec(const unsigned char* p, int stride) {
   return {get_le<double>(p), get_le<double>(p + stride), get_le<double>(p + 2 * stride)};
-}
-
-std::ifstream open_file(const std::string& path, std::uint64_t& size) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) fail(path, "is a directory, not a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, std::string("cannot open (") + std::strerror(errno) + ")");
-  size = std::filesystem::file_size(path, ec);
-  if (ec) fail(path, "cannot determine file size");
-  return in;
 }
 
 bool read_at(std::ifstream& in, std::uint64_t pos, unsigned char* dst, std::size_t n) {
@@ -170,14 +160,14 @@ std::uint32_t las_min_record_length(int point_format) {
 
 LasHeader read_las_header(const std::string& path) {
   std::uint64_t size = 0;
-  std::ifstream in = open_file(path, size);
+  std::ifstream in = open_input(path, &size);
   return parse_header(path, in, size);
 }
 
 std::uint64_t stream_las(const std::string& path, const std::vector<int>& classes,
                          const std::function<void(const Vec3&)>& on_point) {
   std::uint64_t size = 0;
-  std::ifstream in = open_file(path, size);
+  std::ifstream in = open_input(path, &size);
   const LasHeader h = parse_header(path, in, size);
   std::bitset<256> keep;
   for (int c : classes) {

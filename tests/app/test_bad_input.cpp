@@ -572,7 +572,7 @@ std::string first_line(const std::string& s) { return s.substr(0, s.find('\n'));
 // LODREFINE_BAD_INPUT_ALL=1, and delete an entry when its fix lands.
 const std::vector<std::pair<std::string, std::string>>& known_open() {
   // All fixed so far: fuzzing findings landed in src/core/planes.cpp (repeated points), src/core/selection.cpp
-  // (repeated columns), src/io/io.cpp (coordinates beyond 1e9 m, property-less elements, printing
+  // (repeated columns), src/io/ (coordinates beyond 1e9 m, property-less elements, printing
   // any double) and apps/cmd_refine.cpp (output directories checked first).
   static const std::vector<std::pair<std::string, std::string>> open = {};
   return open;

@@ -6,9 +6,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 
 #include "lodrefine/io/obj.h"
@@ -142,11 +144,67 @@ TEST(IoObj, IdFallsBackToCommentThenFileStem) {
 
 TEST(IoObj, ShortFacesAreSkippedAndCounted) {
   int skipped = -1;
-  const Mesh m = read_obj(write_bytes("short.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\nf 1 2 3\nf 3\n"), &skipped);
-  EXPECT_EQ(skipped, 2);
+  const Mesh m = read_obj(write_bytes("short.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\nf 1 2 3\nf 3\nf\n"), &skipped);
+  EXPECT_EQ(skipped, 3);  // the bare `f` too
   ASSERT_EQ(m.faces.size(), 1u);
   EXPECT_EQ(m.faces[0].source, 0);
   expect_obj_error("v 0 0 0\nv 1 0 0\nf 1 2\n", "no faces with 3 or more vertices (1 skipped)");
+}
+
+TEST(IoObj, GeoreferencedCoordinatesReadBackExactly) {
+  // The nearest double to each decimal, bit for bit: 7-digit northings, and values that a
+  // digit-by-digit parser (tinyobjloader's own) gets 1-2 ulp wrong.
+  const double xs[] = {5779123.4567, 435685.799, 85123.4567, 14.056, 5801234.567, -0.1};
+  std::string obj;
+  for (double x : xs) {
+    char line[96];
+    std::snprintf(line, sizeof line, "v %.4f %.4f %.3f\n", x, -x, x);
+    obj += line;
+  }
+  obj += "v 5779123.4567 5779123.4567e0 +5779123.4567\nf 1 2 3\n";
+  const Mesh m = read_obj(write_bytes("geo.obj", obj));
+  ASSERT_EQ(m.vertices.size(), std::size(xs) + 1);
+  for (std::size_t i = 0; i < std::size(xs); ++i) {
+    EXPECT_EQ(m.vertices[i].x(), xs[i]) << i;
+    EXPECT_EQ(m.vertices[i].y(), -xs[i]) << i;
+  }
+  EXPECT_EQ(m.vertices.back(), Vec3(5779123.4567, 5779123.4567, 5779123.4567));
+}
+
+TEST(IoObj, BlanksPolygonsAndBareStatements) {
+  // Any whitespace separates (tabs, \v, \f, a lone \r inside a line); polygons stay polygons; a
+  // bare `g` or `usemtl` clears its semantic; `mtllib` files are never opened; the `o` name is
+  // kept as written.
+  const Mesh m = read_obj(write_bytes("blanks.obj",
+                                      "mtllib /no/such/file.mtl\no  bldg\t7 \n"
+                                      "v\v0 0 0\nv 4\t0 0\r\nv 4 3\f0\nv 2 4 0\nv 0 3 0\n"
+                                      "g\tRoofSurface\nf 1 2\r3 4 5\n"
+                                      "usemtl WallSurface\ng\nf 5 4 3\n"
+                                      "usemtl\nf 1 2 3\n"));
+  EXPECT_EQ(m.id, "bldg\t7");
+  ASSERT_EQ(m.vertices.size(), 5u);
+  EXPECT_EQ(m.vertices[2], Vec3(4, 3, 0));
+  ASSERT_EQ(m.faces.size(), 3u);
+  EXPECT_EQ(m.faces[0].v, (std::vector<int>{0, 1, 2, 3, 4}));  // not triangulated
+  EXPECT_EQ(m.faces[0].sem, Semantic::Roof);
+  EXPECT_EQ(m.faces[1].sem, Semantic::Wall);   // the bare `g` cleared Roof: the material decides
+  EXPECT_EQ(m.faces[2].sem, Semantic::Other);  // and the bare `usemtl` cleared that
+}
+
+TEST(IoObj, FaceIndicesBeyondTheVerticesNameTheLine) {
+  // Forward references are fine as long as the vertex comes; one that never does is refused on
+  // the face's line, whatever tinyobjloader would make of it.
+  EXPECT_EQ(read_obj(write_bytes("fwd.obj", "f 1 2 4\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n")).faces[0].v,
+            (std::vector<int>{0, 1, 3}));
+  const std::string path = write_bytes("far.obj", "f 1 2 5\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n");
+  try {
+    read_obj(path);
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": line 1: face index 5 out of range (4 vertices)");
+  }
+  expect_obj_error("v 0 0 0\nf -1 -2 -3\n", "line 2: face index -2 out of range (1 vertices so far)");
+  expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1/1 2 3\n", "line 4: bad face vertex '1/1/1/1'");
 }
 
 TEST(IoObj, MalformedInputsThrowOneLineInputErrors) {
@@ -164,6 +222,8 @@ TEST(IoObj, MalformedInputsThrowOneLineInputErrors) {
   expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", "face index -4 out of range");
   expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "face index 0");
   expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", "bad face vertex 'x'");
+  expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 +-1 2\n", "line 4: bad face vertex '+-1'");  // two signs
+  expect_obj_error("v 0 0 0\nv +-1 0 0\nv 0 1 0\nf 1 2 3\n", "line 2: bad number '+-1'");
   expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nhello world\nf 1 2 3\n", "line 4: unknown statement 'hello'");
   expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nv 1.5 2.", "line 5: vertex with fewer than 3");
   expect_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nv 1.5 2.0 3.0e", "line 5: bad number");
@@ -282,6 +342,9 @@ TEST(IoPly, MalformedInputsThrowOneLineInputErrors) {
   expect_ply_error("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
                    "end_header\n1 2 3abc\n",
                    "bad ASCII value '3abc'");
+  expect_ply_error("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+                   "end_header\n1 +-2 3\n",
+                   "bad ASCII value '+-2'");
   std::string inf = good;
   const double bad = std::numeric_limits<double>::infinity();
   std::memcpy(&inf[inf.size() - 8], &bad, 8);

@@ -1,220 +1,19 @@
-// OBJ and PLY reading and writing.
-//
-// The OBJ reader is our own line parser, not tinyobjloader: the library the build links
-// (tinyobjloader::tinyobjloader) stores coordinates as float, which loses centimetres at
-// georeferenced magnitudes (5801234.567), and it tolerates zero indices and garbage lines that
-// we must reject. The subset CityGML exports use (v, f, g, o, usemtl, comments) is small.
-// Numbers are parsed and printed with <charconv>, so a C locale change cannot break files.
-#include "lodrefine/io/obj.h"
+// PLY reading (ascii, binary little/big endian, streamed) and writing.
 #include "lodrefine/io/ply.h"
-#include "lodrefine/io/files.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
+#include <algorithm>
 #include <array>
 #include <cctype>
-#include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <limits>
-#include <optional>
-#include <sstream>
-#include <string_view>
+
+#include "text.h"
 
 namespace lodrefine {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& path, const std::string& fault) {
-  throw InputError(path + ": " + fault);
-}
-
-// Quotes file content safely: printable, short, so messages stay on one line.
-std::string quote(std::string_view s) {
-  std::string out = "'";
-  for (char c : s.substr(0, 40)) out += (static_cast<unsigned char>(c) >= 0x20 && c != 0x7f) ? c : '?';
-  return out + (s.size() > 40 ? "...'" : "'");
-}
-
-std::string_view trim(std::string_view s) {
-  const auto b = s.find_first_not_of(" \t\r\n\f\v");
-  if (b == std::string_view::npos) return {};
-  return s.substr(b, s.find_last_not_of(" \t\r\n\f\v") - b + 1);
-}
-
-std::vector<std::string_view> split_ws(std::string_view s) {
-  std::vector<std::string_view> out;
-  std::size_t i = 0;
-  while (i < s.size()) {
-    while (i < s.size() && std::isspace(static_cast<unsigned char>(s[i]))) ++i;
-    const std::size_t b = i;
-    while (i < s.size() && !std::isspace(static_cast<unsigned char>(s[i]))) ++i;
-    if (i > b) out.push_back(s.substr(b, i - b));
-  }
-  return out;
-}
-
-// Whole-token number parsing (double or integer); nullopt on any trailing junk or overflow.
-template <class T>
-std::optional<T> parse_number(std::string_view t) {
-  if (t.size() > 1 && t[0] == '+') t.remove_prefix(1);
-  T v = 0;
-  const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
-  if (r.ec != std::errc() || r.ptr != t.data() + t.size()) return std::nullopt;
-  return v;
-}
-
-std::string read_whole_file(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) fail(path, "is a directory, not a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, std::string("cannot open (") + std::strerror(errno) + ")");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) fail(path, "read error");
-  return ss.str();
-}
-
-// ---------------------------------------------------------------------------------------------
-// OBJ reading
-
-class ObjParser {
- public:
-  explicit ObjParser(const std::string& path) : path_(path) {}
-
-  Mesh parse(std::string text, int* skipped_faces) {
-    if (trim(text).empty()) fail(path_, "empty file");
-    if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);  // UTF-8 byte order mark
-    reject_binary(text);
-    std::size_t start = 0;
-    while (start < text.size()) {
-      std::size_t end = text.find('\n', start);
-      if (end == std::string::npos) end = text.size();
-      ++line_;
-      statement(std::string_view(text).substr(start, end - start));
-      start = end + 1;
-    }
-    finish();
-    if (skipped_faces) *skipped_faces = skipped_;
-    return std::move(mesh_);
-  }
-
- private:
-  [[noreturn]] void fail_line(const std::string& fault) const {
-    fail(path_, "line " + std::to_string(line_) + ": " + fault);
-  }
-
-  void reject_binary(const std::string& text) const {
-    int line = 1;
-    for (char c : text) {
-      const auto u = static_cast<unsigned char>(c);
-      if (c == '\n') ++line;
-      else if ((u < 0x20 && !std::isspace(u)) || u == 0x7f)
-        fail(path_, "line " + std::to_string(line) + ": binary data in a text OBJ");
-    }
-  }
-
-  void statement(std::string_view line) {
-    line = trim(line);
-    if (line.empty()) return;
-    if (line[0] == '#') return comment(trim(line.substr(1)));
-    const auto tok = split_ws(line);
-    const std::string_view kw = tok[0];
-    const std::string_view rest = trim(line.substr(kw.size()));
-    if (kw == "v") vertex(tok);
-    else if (kw == "f") face(tok);
-    else if (kw == "g") group_sem_ = semantic_from_name(std::string(rest));
-    else if (kw == "usemtl") mtl_sem_ = semantic_from_name(std::string(rest));
-    else if (kw == "o") { if (object_.empty()) object_ = rest; }
-    else if (!ignored(kw)) fail_line("unknown statement " + quote(kw));
-  }
-
-  static bool ignored(std::string_view kw) {
-    static const std::array<std::string_view, 10> kws = {"vt", "vn", "vp",  "s",  "mtllib",
-                                                         "l",  "p",  "mg", "lod", "usemap"};
-    for (auto k : kws)
-      if (kw == k) return true;
-    return false;
-  }
-
-  void comment(std::string_view c) {
-    if (c.size() > 3 && (c.substr(0, 3) == "id:" || c.substr(0, 3) == "ID:") && comment_id_.empty())
-      comment_id_ = trim(c.substr(3));
-  }
-
-  void vertex(const std::vector<std::string_view>& tok) {
-    // x y z, optionally w or r g b (colour extension); we keep x y z.
-    if (tok.size() < 4) fail_line("vertex with fewer than 3 coordinates (truncated?)");
-    if (tok.size() > 8) fail_line("vertex with too many values");
-    Vec3 p;
-    for (std::size_t i = 1; i < tok.size(); ++i) {
-      const auto v = parse_number<double>(tok[i]);
-      if (!v) fail_line("bad number " + quote(tok[i]));
-      if (!std::isfinite(*v)) fail_line("non-finite coordinate " + quote(tok[i]));
-      if (i <= 3 && std::abs(*v) > kMaxCoordinate) fail_line("coordinate " + quote(tok[i]) + " is beyond 1e9 m");
-      if (i <= 3) p[int(i - 1)] = *v;
-    }
-    mesh_.vertices.push_back(p);
-  }
-
-  void face(const std::vector<std::string_view>& tok) {
-    Face f;
-    for (std::size_t i = 1; i < tok.size(); ++i) f.v.push_back(vertex_ref(tok[i]));
-    if (f.v.size() < 3) {  // a point or a line is no polygon; counted, not fatal
-      ++skipped_;
-      return;
-    }
-    f.sem = group_sem_ != Semantic::Other ? group_sem_ : mtl_sem_;
-    f.source = int(mesh_.faces.size());
-    mesh_.faces.push_back(std::move(f));
-    face_line_.push_back(line_);
-  }
-
-  // "v", "v/vt", "v//vn" or "v/vt/vn"; returns the 0-based vertex index (checked in finish()
-  // for positive indices, since a vertex may legally follow its first use).
-  int vertex_ref(std::string_view t) {
-    const std::string_view head = t.substr(0, t.find('/'));
-    if (t.find_first_not_of("0123456789/-+", head.size()) != std::string_view::npos)
-      fail_line("bad face vertex " + quote(t));
-    const auto idx = parse_number<long long>(head);
-    if (!idx) fail_line("bad face vertex " + quote(t));
-    if (*idx == 0) fail_line("face index 0 (OBJ indices start at 1)");
-    const long long n = (long long)mesh_.vertices.size();
-    const long long i = *idx > 0 ? *idx - 1 : n + *idx;
-    if (i < 0 || i >= (long long)std::numeric_limits<int>::max())
-      fail_line("face index " + std::to_string(*idx) + " out of range (" + std::to_string(n) + " vertices so far)");
-    return int(i);
-  }
-
-  void finish() {
-    const std::size_t n = mesh_.vertices.size();
-    for (std::size_t k = 0; k < mesh_.faces.size(); ++k)
-      for (int i : mesh_.faces[k].v)
-        if (std::size_t(i) >= n) {
-          line_ = face_line_[k];
-          fail_line("face index " + std::to_string(i + 1) + " out of range (" + std::to_string(n) + " vertices)");
-        }
-    if (mesh_.faces.empty())
-      fail(path_, skipped_ ? "no faces with 3 or more vertices (" + std::to_string(skipped_) + " skipped)"
-                           : "no faces");
-    mesh_.id = !object_.empty() ? object_ : !comment_id_.empty() ? comment_id_
-                                                                 : std::filesystem::path(path_).stem().string();
-  }
-
-  const std::string& path_;
-  Mesh mesh_;
-  std::vector<int> face_line_;
-  int line_ = 0, skipped_ = 0;
-  Semantic group_sem_ = Semantic::Other, mtl_sem_ = Semantic::Other;
-  std::string object_, comment_id_;
-};
-
-// ---------------------------------------------------------------------------------------------
-// PLY reading
+using namespace io_text;
 
 enum class PlyType { I8, U8, I16, U16, I32, U32, F32, F64 };
 enum class PlyFormat { Ascii, BinaryLE, BinaryBE };
@@ -337,13 +136,7 @@ class PlyData {
 
 class PlyReader {
  public:
-  explicit PlyReader(const std::string& path) : path_(path) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec)) fail(path, "is a directory, not a file");
-    in_.open(path, std::ios::binary);
-    if (!in_) fail(path, std::string("cannot open (") + std::strerror(errno) + ")");
-    file_size_ = std::filesystem::file_size(path, ec);
-    if (ec) fail(path, "cannot determine file size");
+  explicit PlyReader(const std::string& path) : path_(path), in_(open_input(path, &file_size_)) {
     if (file_size_ == 0) fail(path, "empty file");
     parse_header();
   }
@@ -523,60 +316,14 @@ class PlyReader {
   }
 
   const std::string& path_;
+  std::uint64_t file_size_ = 0;  // before in_, whose initialisation sets it
   std::ifstream in_;
-  std::uint64_t file_size_ = 0;
   PlyFormat format_ = PlyFormat::Ascii;
   std::vector<PlyElement> elements_;
   std::size_t vertex_ = 0;
   std::array<std::size_t, 3> xyz_{};
   std::string tok_;
 };
-
-// ---------------------------------------------------------------------------------------------
-// Writing
-
-void append_fixed(std::string& out, double v) {
-  char buf[400];  // any finite double in fixed notation with 6 decimals fits
-  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed, 6);  // µm
-  if (r.ec != std::errc()) throw std::runtime_error("cannot print coordinate");
-  out.append(buf, r.ptr);
-}
-
-// One-line OBJ names: whitespace runs become '_' so `o` stays a single token for other tools.
-std::string obj_name(const std::string& id) {
-  std::string s;
-  for (char c : id) s += std::isspace(static_cast<unsigned char>(c)) || static_cast<unsigned char>(c) < 0x20 ? '_' : c;
-  return s;
-}
-
-std::string obj_text(const Mesh& mesh, const Vec3& origin, AtomicFile& file) {
-  std::string out = "# lodrefine\n";
-  if (!mesh.id.empty()) out += "o " + obj_name(mesh.id) + "\n";
-  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
-    const Vec3 p = mesh.vertices[i] + origin;
-    if (!p.allFinite()) file.fail("vertex " + std::to_string(i) + " is not finite");
-    out += "v ";
-    append_fixed(out, p.x()), out += ' ', append_fixed(out, p.y()), out += ' ', append_fixed(out, p.z());
-    out += '\n';
-  }
-  for (Semantic sem : {Semantic::Wall, Semantic::Roof, Semantic::Ground, Semantic::Other}) {
-    bool header = false;
-    for (std::size_t k = 0; k < mesh.faces.size(); ++k) {
-      const Face& f = mesh.faces[k];
-      if (f.sem != sem) continue;
-      if (f.v.size() < 3) file.fail("face " + std::to_string(k) + " has fewer than 3 vertices");
-      if (!header) out += std::string("g ") + semantic_name(sem) + "\n", header = true;
-      out += 'f';
-      for (int i : f.v) {
-        if (i < 0 || std::size_t(i) >= mesh.vertices.size())
-          file.fail("face " + std::to_string(k) + " references missing vertex " + std::to_string(i));
-        out += ' ' + std::to_string(i + 1);
-      }
-      out += '\n';
-    }
-  }
-  return out;
-}
 
 template <class T>
 void put_le(std::string& out, T v) {
@@ -587,56 +334,6 @@ void put_le(std::string& out, T v) {
 }
 
 }  // namespace
-
-AtomicFile::AtomicFile(const std::string& path) : path_(path), tmp_(path + ".tmp." + std::to_string(::getpid())) {
-  fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd_ < 0) fail(std::strerror(errno));
-}
-
-AtomicFile::~AtomicFile() { discard(); }
-
-void AtomicFile::write(const char* data, std::size_t n) {
-  while (n > 0) {
-    const ssize_t k = ::write(fd_, data, n);
-    if (k < 0 && errno == EINTR) continue;
-    if (k <= 0) fail(std::strerror(errno));
-    data += k, n -= std::size_t(k);
-  }
-}
-
-void AtomicFile::commit() {
-  if (::fsync(fd_) != 0) fail(std::strerror(errno));
-  const int fd = fd_;
-  fd_ = -1;
-  if (::close(fd) != 0) fail(std::strerror(errno));
-  if (std::rename(tmp_.c_str(), path_.c_str()) != 0) fail(std::strerror(errno));
-  committed_ = true;
-}
-
-void AtomicFile::fail(const std::string& reason) {
-  discard();
-  throw std::runtime_error("cannot write " + path_ + ": " + reason);
-}
-
-void AtomicFile::discard() {
-  if (fd_ >= 0) ::close(fd_);
-  fd_ = -1;
-  if (!committed_) ::unlink(tmp_.c_str());
-}
-
-Mesh read_obj(const std::string& path, int* skipped_faces) {
-  const FileKind kind = sniff_file(path);
-  if (kind != FileKind::Other) fail(path, "not an OBJ model: the file is " + file_kind_text(kind));
-  return ObjParser(path).parse(read_whole_file(path), skipped_faces);
-}
-
-Mesh read_obj(const std::string& path) { return read_obj(path, nullptr); }
-
-void write_obj(const std::string& path, const Mesh& mesh, const Vec3& origin) {
-  AtomicFile file(path);
-  file.write(obj_text(mesh, origin, file));
-  file.commit();
-}
 
 PointCloud read_ply(const std::string& path) {
   PlyReader reader(path);
@@ -660,7 +357,7 @@ void write_ply(const std::string& path, const PointCloud& cloud, const Vec3& ori
               " points");
   std::string out = "ply\nformat binary_little_endian 1.0\ncomment lodrefine\nelement vertex " +
                     std::to_string(cloud.points.size()) + "\nproperty double x\nproperty double y\nproperty double z\n";
-  if (scalar) out += "property float " + obj_name(scalar_name) + "\n";
+  if (scalar) out += "property float " + one_token(scalar_name) + "\n";
   out += "end_header\n";
   for (std::size_t i = 0; i < cloud.points.size(); ++i) {
     const Vec3 p = cloud.points[i] + origin;
@@ -669,37 +366,6 @@ void write_ply(const std::string& path, const PointCloud& cloud, const Vec3& ori
     if (out.size() >= (1 << 20)) file.write(out), out.clear();
   }
   file.write(out);
-  file.commit();
-}
-
-FileKind sniff_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  char head[64] = {};
-  if (in) in.read(head, sizeof head);
-  const std::string h(head, std::size_t(in.gcount()));
-  if (h.rfind("LASF", 0) == 0) return FileKind::Las;
-  if (h.rfind("ply\n", 0) == 0 || h.rfind("ply\r", 0) == 0) return FileKind::Ply;
-  std::string_view s = h;
-  if (s.compare(0, 3, "\xEF\xBB\xBF") == 0) s.remove_prefix(3);  // UTF-8 byte order mark
-  s = trim(s);
-  if (!s.empty() && s[0] == '<') return FileKind::Xml;
-  if (!s.empty() && (s[0] == '{' || s[0] == '[')) return FileKind::Json;
-  return FileKind::Other;
-}
-
-std::string file_kind_text(FileKind kind) {
-  switch (kind) {
-    case FileKind::Ply: return "a PLY point cloud";
-    case FileKind::Las: return "a LAS/LAZ point cloud";
-    case FileKind::Xml: return "XML (a CityGML model?)";
-    case FileKind::Json: return "JSON (a CityJSON model?)";
-    default: return "";
-  }
-}
-
-void write_file_atomic(const std::string& path, const std::string& content) {
-  AtomicFile file(path);
-  file.write(content);
   file.commit();
 }
 

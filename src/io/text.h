@@ -1,0 +1,48 @@
+// Internal to the io library: the small text and file helpers its readers and writers share
+// (messages, tokens, numbers). Not a public header: nothing outside src/io/ includes it.
+#pragma once
+#include <charconv>
+#include <cstdint>
+#include <fstream>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "lodrefine/core/types.h"
+
+namespace lodrefine::io_text {
+
+// Every reader's refusal: one line, "<path>: <fault>".
+[[noreturn]] inline void fail(const std::string& path, const std::string& fault) {
+  throw InputError(path + ": " + fault);
+}
+
+// Quotes file content safely: printable, short, so messages stay on one line.
+std::string quote(std::string_view s);
+
+std::string_view trim(std::string_view s);
+std::vector<std::string_view> split_ws(std::string_view s);
+
+// Whole-token number parsing (double or integer); nullopt on any trailing junk or overflow.
+// <charconv>, so a C locale change cannot break files. from_chars takes no '+', so one is
+// dropped here, but not in front of a '-': "+-5" is no number.
+template <class T>
+std::optional<T> parse_number(std::string_view t) {
+  if (t.size() > 1 && t[0] == '+' && t[1] != '-') t.remove_prefix(1);
+  T v = 0;
+  const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+  if (r.ec != std::errc() || r.ptr != t.data() + t.size()) return std::nullopt;
+  return v;
+}
+
+// Opens an input file for binary reading, and gives its size if asked; refuses directories and
+// unreadable files with the reason.
+std::ifstream open_input(const std::string& path, std::uint64_t* size = nullptr);
+std::string read_whole_file(const std::string& path);
+
+// One-token names for OBJ `o` lines and PLY property names: whitespace and control characters
+// become '_' so other tools read one token.
+std::string one_token(const std::string& name);
+
+}  // namespace lodrefine::io_text
