@@ -25,7 +25,6 @@ namespace bg = boost::geometry;
 using BPoint = bg::model::d2::point_xy<double>;
 using BPolygon = bg::model::polygon<BPoint, false, false>;  // CCW, open
 using BMulti = bg::model::multi_polygon<BPolygon>;
-using Clock = std::chrono::steady_clock;
 
 // Vertices moved by the repair's weld may snap onto their surfaces' plane meet by at most this
 // (m), so that the arrangement's planes and the kept model agree; warped input faces keep theirs.
@@ -57,7 +56,6 @@ constexpr double kSlabTolerance = 0.05, kSureIn = 0.99, kSureOut = 0.01, kCoplan
 // The assembled pieces were cut exactly; welding at 1 mm joins their rounding only.
 constexpr double kAssemblyWeld = 1e-3;
 
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // Moves each vertex onto the meet of the planes of its surfaces (least squares), so that the
 // model is exactly consistent with the planes the arrangement uses. Moves beyond `max_move`

@@ -13,7 +13,6 @@
 namespace lodrefine {
 namespace {
 
-using Clock = std::chrono::steady_clock;
 
 // m: local frames have their origin on this grid (the model's box minimum rounded down), so all
 // computation runs on coordinates of a few hundred metres and reports show a readable origin.
@@ -22,22 +21,16 @@ constexpr double kOriginGrid = 100.0;
 // steps (the same wall re-found after another moved has the same position within rounding).
 constexpr double kPositionSteps = 100.0;
 
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // The cloud near the model, in its local frame (crops may carry whole streets): the model's
 // box grown by the matching distance and the arrangement's region margins.
 PointCloud cloud_near(const Mesh& local_model, const PointCloud& cloud, const Vec3& origin, const Params& prm) {
-  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-  for (const auto& v : local_model.vertices) {
-    lo = lo.cwiseMin(v);
-    hi = hi.cwiseMax(v);
-  }
-  const Vec3 pad = Vec3::Constant(prm.match_distance + prm.bbox_margin) + prm.bbox_expand * (hi - lo);
+  const Eigen::AlignedBox3d box = bounding_box(local_model.vertices);
+  const Vec3 pad = Vec3::Constant(prm.match_distance + prm.bbox_margin) + prm.bbox_expand * box.sizes();
+  const Eigen::AlignedBox3d near(box.min() - pad, box.max() + pad);
   PointCloud local;
-  for (const auto& p : cloud.points) {
-    const Vec3 q = p - origin;
-    if ((q.array() >= (lo - pad).array()).all() && (q.array() <= (hi + pad).array()).all()) local.points.push_back(q);
-  }
+  for (const auto& p : cloud.points)
+    if (near.contains(p - origin)) local.points.push_back(p - origin);
   return local;
 }
 
@@ -164,9 +157,9 @@ const char* outcome_name(Outcome outcome) {
 }
 
 Vec3 local_origin(const Mesh& model) {
-  Vec3 lo = Vec3::Constant(1e300);
-  for (const auto& v : model.vertices) lo = lo.cwiseMin(v);
-  if (!lo.allFinite() || model.vertices.empty()) return Vec3::Zero();
+  if (model.vertices.empty()) return Vec3::Zero();
+  const Vec3 lo = bounding_box(model.vertices).min();
+  if (!lo.allFinite()) return Vec3::Zero();
   return (lo / kOriginGrid).array().floor().matrix() * kOriginGrid;
 }
 

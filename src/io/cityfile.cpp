@@ -19,13 +19,11 @@ namespace lodrefine {
 namespace {
 
 using json = nlohmann::ordered_json;
-using Clock = std::chrono::steady_clock;
 
 // A CityJSONSeq header line holds metadata and the transform, never objects: a first line
 // longer than this is a one-line CityJSON file, not parsed twice to find out.
 constexpr std::size_t kMaxSequenceHeader = 1 << 20;
 
-double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 // The outcome of one building in the three words of the report, with its reason: anything
 // refine_building does not call "refined" is kept (its original geometry stays), and a kept

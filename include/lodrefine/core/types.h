@@ -2,6 +2,7 @@
 #pragma once
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross products on Vec3 everywhere
+#include <chrono>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -35,6 +36,10 @@ struct Mesh {
 struct PointCloud {
   std::vector<Vec3> points;
 };
+
+// Stage timings for reports.
+using Clock = std::chrono::steady_clock;
+inline double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // Input that cannot be used; what() is a one-line message naming the file and the fault.
 struct InputError : std::runtime_error {
