@@ -1,11 +1,10 @@
-// Metrics of the paper's evaluation: statistics, ΔD, watertightness, scanned walls, pooling, and
-// the SVG plots (the C2M distances themselves: tests/core/test_distance.cpp).
+// Metrics of the paper's evaluation: statistics, ΔD, watertightness, scanned walls, pooling
+// (the C2M distances themselves: tests/core/test_distance.cpp; plots: test_plots.cpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "lodrefine/eval/eval.h"
-#include "lodrefine/eval/plots.h"
 #include "support/mesh_fixtures.h"
 
 using namespace lodrefine;
@@ -106,23 +105,6 @@ TEST(EvalPool, PooledOverPointsVersusMeanOfBuildings) {
   EXPECT_NEAR(p.delta_d_mean, 0.1, 1e-12);
   EXPECT_NEAR(p.watertight_rate_before, 1.0 / 3, 1e-12);
   EXPECT_NEAR(p.watertight_rate_after, 2.0 / 3, 1e-12);  // the failure counts as not watertight
-}
-
-TEST(EvalPlots, SvgDocuments) {
-  const std::vector<double> before = {-0.3, -0.1, 0.0, 0.2, 0.25, 1.5}, after = {-0.02, 0.0, 0.01, 0.03};
-  for (const std::string& svg : {svg_histogram(before, after, "C2M"), svg_boxplot(before, after, "C2M")}) {
-    EXPECT_EQ(svg.rfind("<svg", 0), 0u);
-    EXPECT_NE(svg.find("</svg>"), std::string::npos);
-    EXPECT_EQ(svg.find("nan"), std::string::npos);
-  }
-  std::vector<Vec3> pts(12000, Vec3(0.5, 0.0, 0.5));
-  const std::string fp = svg_footprint(box({0, 0, 0}, {10, 8, 6}), box({0.2, 0, 0}, {10, 8, 6}), pts, "b & <1>");
-  std::size_t circles = 0;
-  for (std::size_t at = fp.find("<circle"); at != std::string::npos; at = fp.find("<circle", at + 1)) ++circles;
-  EXPECT_LE(circles, 5000u);
-  EXPECT_GE(circles, 4000u);
-  EXPECT_NE(fp.find("b &amp; &lt;1&gt;"), std::string::npos);
-  EXPECT_NE(fp.find(" m</text>"), std::string::npos);  // the scale bar
 }
 
 // End to end on a building-sized box: the coarse model is shifted 30 cm in x and 20 cm in y,
