@@ -109,19 +109,15 @@ Region replacement_region(const Mesh& mesh, const std::vector<ModelSurface>& sur
   axes.col(0) = u;
   axes.col(1) = v;
   axes.col(2) = rep.plane.n;
-  std::vector<Vec3> pts;
+  std::vector<Vec3> pts;  // the old wall and its projection onto the new plane, in the region's axes
   for (int s : rep.surfaces)
     for (int f : surfaces[s].faces)
       for (int vi : mesh.faces[f].v) {
-        pts.push_back(mesh.vertices[vi]);
-        pts.push_back(rep.plane.project(mesh.vertices[vi]));
+        pts.push_back(axes.transpose() * mesh.vertices[vi]);
+        pts.push_back(axes.transpose() * rep.plane.project(mesh.vertices[vi]));
       }
-  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-  for (const auto& p : pts) {
-    const Vec3 q = axes.transpose() * p;
-    lo = lo.cwiseMin(q);
-    hi = hi.cwiseMax(q);
-  }
+  const Eigen::AlignedBox3d box = bounding_box(pts);
+  const Vec3 lo = box.min(), hi = box.max();
   const Vec3 ext = hi - lo;
   Vec3 margin;
   margin.x() = std::max(prm.bbox_margin, prm.bbox_expand * ext.x());

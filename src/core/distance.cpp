@@ -82,10 +82,7 @@ class SurfaceIndex {
   SurfaceIndex(const SurfaceIndex&) = delete;  // the tree points into cgal_
   SurfaceIndex& operator=(const SurfaceIndex&) = delete;
 
-  struct Nearest {
-    double distance;  // signed if asked for, else >= 0
-    int face;
-  };
+  using Nearest = MeshDistance::Nearest;
 
   Nearest nearest(const Vec3& world, bool want_sign) const {
     const Vec3 p = world - origin_;
@@ -138,23 +135,28 @@ MeshDistance::MeshDistance(const Mesh& mesh) : index_(std::make_unique<Index>(me
 MeshDistance::~MeshDistance() = default;
 
 MeshDistance::Nearest MeshDistance::nearest(const Vec3& point, bool signed_distance) const {
-  const auto n = index_->nearest(point, signed_distance);
-  return {n.distance, n.face};
+  return index_->nearest(point, signed_distance);
 }
 
-std::vector<double> cloud_to_mesh(const Mesh& mesh, const std::vector<Vec3>& points) {
-  const SurfaceIndex index(mesh);
+namespace {
+
+std::vector<double> distances(const Mesh& mesh, const std::vector<Vec3>& points, bool want_sign) {
+  const MeshDistance index(mesh);
   std::vector<double> d(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) d[i] = index.nearest(points[i], true).distance;
+  for (std::size_t i = 0; i < points.size(); ++i) d[i] = index.nearest(points[i], want_sign).distance;
   return d;
+}
+
+}  // namespace
+
+// Unlike unsigned_distances, a mesh without faces is refused even for no points.
+std::vector<double> cloud_to_mesh(const Mesh& mesh, const std::vector<Vec3>& points) {
+  return distances(mesh, points, true);
 }
 
 std::vector<double> unsigned_distances(const Mesh& mesh, const std::vector<Vec3>& pts) {
   if (pts.empty()) return {};
-  const MeshDistance index(mesh);
-  std::vector<double> d(pts.size());
-  for (std::size_t i = 0; i < pts.size(); ++i) d[i] = index.nearest(pts[i], false).distance;
-  return d;
+  return distances(mesh, pts, false);
 }
 
 double rms_distance(const Mesh& mesh, const std::vector<Vec3>& pts) {
