@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
 # Refines every building of the dev tiles (../shared/devtiles) and scores them with the
-# project's judge (score.py). Prints per tile the score table and the per-building rows.
+# project's judges: score.py for synth, real and topo (per tile the score table and the
+# per-building rows), score_city.py for the city file (correct buildings changed).
 #   scripts/devtiles.sh [OUT_DIR=devtiles-out] [extra refine args...]
+#   TILES_ONLY="topo city" scripts/devtiles.sh OUT   runs only those tiles
 set -uo pipefail
 cd "$(dirname "$0")/.."
 OUT=${1:-devtiles-out}; shift || true
 TILES=${DEVTILES:-../shared/devtiles}
 BIN=${LODREFINE:-build/lodrefine}
-for tile in synth real; do
+for tile in ${TILES_ONLY:-synth real topo city}; do
+  [ "$tile" = city ] && continue
   [ -d "$TILES/$tile" ] || { echo "no $TILES/$tile"; continue; }
   mkdir -p "$OUT/$tile"
   ls "$TILES/$tile/models" | sed 's/\.obj$//' | \
@@ -41,3 +44,16 @@ for r in s["rows"]:
 print(f"made worse: {worse}; slowest: {slow:.2f} s")
 PY
 done
+
+case " ${TILES_ONLY:-city} " in
+  *" city "*)
+    if [ -f "$TILES/city/coarse.city.json" ]; then
+      echo "== city"
+      mkdir -p "$OUT/city"
+      s=$(date +%s.%N)
+      "$BIN" refine --model "$TILES/city/coarse.city.json" --cloud "$TILES/city/tile.ply" \
+        --out "$OUT/city/refined.city.json" --report "$OUT/city/report.json" "$@" > "$OUT/city/log.txt" 2>&1
+      echo "city refine rc=$? $(echo "$(date +%s.%N) - $s" | bc) s; $(tail -n 1 "$OUT/city/log.txt")"
+      /usr/bin/python3 "$TILES/score_city.py" "$OUT/city/refined.city.json" "$OUT/city" --json "$OUT/city/score.json"
+    fi ;;
+esac
