@@ -120,7 +120,9 @@ inline TileRun tile_and_batch(const std::string& name, int buildings) {
 inline std::vector<std::string> temporaries(const fs::path& run) {
   std::vector<std::string> found;
   for (const auto& e : fs::recursive_directory_iterator(run))
-    if (e.path().filename().string().find(".tmp") != std::string::npos) found.push_back(e.path().string());
+    if (e.path().filename().string().find(".tmp") != std::string::npos ||
+        e.path().filename().string().find("lodrefine-tmp") != std::string::npos)
+      found.push_back(e.path().string());
   return found;
 }
 
