@@ -7,6 +7,7 @@
 
 #include "commands.h"
 #include "lodrefine/io/citygml.h"
+#include "lodrefine/io/files.h"
 #include "lodrefine/io/obj.h"
 
 namespace lodrefine::app {
@@ -18,6 +19,37 @@ struct ConvertArgs {
   std::string cityjson, citygml, out_dir, lod;
   std::vector<std::string> ids;
 };
+
+// Output names for the chosen buildings: safe and distinct (SafeNames), each <name>.obj new
+// in --out-dir and none the input file, all checked before anything is written.
+std::vector<fs::path> output_paths(const std::vector<const CityJsonBuilding*>& chosen, const ConvertArgs& a,
+                                   const std::string& input) {
+  SafeNames names;
+  std::vector<fs::path> out;
+  for (const CityJsonBuilding* b : chosen) {
+    out.push_back(fs::path(a.out_dir) / (names.add(b->mesh.id) + ".obj"));
+    if (same_file(out.back().string(), input))
+      throw InputError(out.back().string() + ": would overwrite the input file; give another --out-dir");
+    std::error_code ec;
+    if (fs::exists(fs::symlink_status(out.back(), ec)))
+      throw InputError(out.back().string() + ": already exists (convert never overwrites); give an empty or new --out-dir");
+  }
+  return out;
+}
+
+// Writes every model or none: on a failure (a full disk) what was written is removed again.
+void write_all(const std::vector<const CityJsonBuilding*>& chosen, const std::vector<fs::path>& paths,
+               const ConvertArgs& a) {
+  const bool made_dir = fs::create_directories(a.out_dir);
+  std::size_t written = 0;
+  try {
+    for (; written < chosen.size(); ++written) write_obj(paths[written].string(), chosen[written]->mesh);
+  } catch (...) {
+    for (std::size_t i = 0; i < written; ++i) fs::remove(paths[i]);
+    if (made_dir) fs::remove(a.out_dir);
+    throw;
+  }
+}
 
 void run(const ConvertArgs& a) {
   if (a.cityjson.empty() && a.citygml.empty()) throw InputError("convert needs --cityjson FILE or --citygml FILE");
@@ -31,21 +63,17 @@ void run(const ConvertArgs& a) {
   for (const auto& b : file.buildings)
     if (wanted.empty() || wanted.count(b.mesh.id)) chosen.push_back(&b), found.insert(b.mesh.id);
   for (const auto& id : wanted)
-    if (!found.count(id)) throw InputError(path + ": no Building/BuildingPart '" + id + "' with an LoD 2.x geometry");
+    if (!found.count(id)) throw InputError(path + ": no Building/BuildingPart " + shown_id(id) + " with an LoD 2.x geometry");
   if (chosen.empty())
     throw InputError(path + ": no Building/BuildingPart with " +
                      (a.lod.empty() ? std::string("an LoD 2.x") : "an LoD " + a.lod) + " geometry (" +
                      std::to_string(file.objects_without_lod2) + " building object(s) without one); nothing to convert");
-  fs::create_directories(a.out_dir);
-  std::set<std::string> stems;
-  for (const CityJsonBuilding* b : chosen) {
-    std::string stem = file_stem_for_id(b->mesh.id);
-    for (int k = 2; !stems.insert(stem).second; ++k) stem = file_stem_for_id(b->mesh.id) + "_" + std::to_string(k);
-    write_obj((fs::path(a.out_dir) / (stem + ".obj")).string(), b->mesh);
-    if (b->skipped_holes + b->skipped_rings + b->skipped_shells > 0)
-      std::fprintf(stderr, "lodrefine: note: %s: dropped %d inner ring(s), %d degenerate surface(s), %d interior shell(s)\n",
-                   b->mesh.id.c_str(), b->skipped_holes, b->skipped_rings, b->skipped_shells);
-  }
+  const std::vector<fs::path> paths = output_paths(chosen, a, path);
+  write_all(chosen, paths, a);
+  // Every building by name: the ones written (file <- id), then what the reader dropped or changed.
+  for (std::size_t i = 0; i < chosen.size(); ++i)
+    std::printf("%s <- %s\n", paths[i].filename().string().c_str(), shown_id(chosen[i]->mesh.id).c_str());
+  for (const auto& note : file.notes) std::fprintf(stderr, "lodrefine: note: %s: %s\n", path.c_str(), note.c_str());
   std::printf("%zu building(s) written to %s (%s %s%s, %s; %d object(s) without LoD %s skipped)\n", chosen.size(),
               a.out_dir.c_str(), file.format.c_str(), file.version.c_str(), file.sequence ? " sequence" : "",
               file.crs.empty() ? "no CRS" : file.crs.c_str(), file.objects_without_lod2,
@@ -64,7 +92,7 @@ void add_convert_command(CLI::App& app) {
       ->excludes(json_in);
   cmd->add_option("--lod", args.lod, "The LoD geometry to write, e.g. 2.2 or 1.2 (default: the highest 2.x)");
   cmd->add_option("--id", args.ids, "Only these CityObject ids (repeatable; default: every building)");
-  cmd->add_option("--out-dir", args.out_dir, "Directory for <id>.obj (created if missing)")->required();
+  cmd->add_option("--out-dir", args.out_dir, "Directory for <name>.obj (created if missing; existing files are never overwritten). <name> is the id when it is a safe file name ([A-Za-z0-9._-], at most 100 bytes), else a safe form with a hash; the id stays inside the file")->required();
   cmd->callback([] { run(args); });
 }
 

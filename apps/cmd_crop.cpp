@@ -1,11 +1,13 @@
 // `lodrefine crop`: one cloud per building from a large tile, in one streaming pass.
-#include <unistd.h>
-
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <tuple>
 
 #include "commands.h"
 #include "lodrefine/io/crop.h"
+#include "lodrefine/io/files.h"
 #include "lodrefine/io/obj.h"
 #include "options.h"
 
@@ -23,50 +25,114 @@ struct CropArgs {
   CloudOptions cloud_options;
 };
 
-// Models: DIR/*.obj (id = stem) or DIR/<id>/coarse.obj.
-std::vector<std::pair<std::string, fs::path>> find_models(const fs::path& dir) {
-  std::vector<std::pair<std::string, fs::path>> found;
+// One building: its id (the model's file stem or folder name), its model file and the run
+// folder's sub-folder it gets (a safe name).
+struct Model {
+  std::string id;
+  fs::path path;
+  std::string folder;
+  std::string own_id;  // the id the model file holds (`o`, `# id:`), empty if none; set once read
+};
+
+// Models: DIR/*.obj (id = stem) or DIR/<id>/coarse.obj, in id order, each with its own safe
+// folder name; two models with one id are refused (one would silently replace the other).
+std::vector<Model> find_models(const fs::path& dir) {
+  std::vector<Model> found;
   for (const auto& e : fs::directory_iterator(dir)) {
-    if (e.is_regular_file() && e.path().extension() == ".obj") found.emplace_back(e.path().stem().string(), e.path());
+    if (e.is_regular_file() && e.path().extension() == ".obj") found.push_back({e.path().stem().string(), e.path(), "", ""});
     if (e.is_directory() && fs::exists(e.path() / "coarse.obj"))
-      found.emplace_back(e.path().filename().string(), e.path() / "coarse.obj");
+      found.push_back({e.path().filename().string(), e.path() / "coarse.obj", "", ""});
   }
-  std::sort(found.begin(), found.end());
+  std::sort(found.begin(), found.end(), [](const Model& a, const Model& b) { return std::tie(a.id, a.path) < std::tie(b.id, b.path); });
+  for (std::size_t i = 1; i < found.size(); ++i)
+    if (found[i].id == found[i - 1].id)
+      throw InputError(dir.string() + ": two models for building " + shown_id(found[i].id) + " (" +
+                       found[i - 1].path.string() + ", " + found[i].path.string() + "); keep one");
+  SafeNames names({"plots"});  // the run folder's own sub-folder
+  for (auto& m : found) m.folder = names.add(m.id);
   return found;
 }
+
+// The outputs of the kept models, refused before anything is written when one is the tile.
+void check_outputs(const std::vector<Model>& kept, const CropArgs& a) {
+  for (const auto& m : kept)
+    for (const char* name : {"cloud.ply", "coarse.obj"})
+      if (same_file((fs::path(a.out) / m.folder / name).string(), a.tile))
+        throw InputError(a.tile + ": the tile would be overwritten by " + shown_id(m.id) + "'s " + name + "; give another --out");
+}
+
+// A building's coarse.obj in the run folder: the model's bytes, with a `# id:` line in front when
+// the model holds no id and the folder name is not its id (the OBJ reader would take the stem
+// "coarse" otherwise).
+void place_model(const Model& m, const fs::path& dir) {
+  const fs::path target = dir / "coarse.obj";
+  if (same_file(m.path.string(), target.string())) return;
+  const bool one_line = m.id.find_first_of("\r\n") == std::string::npos;
+  if (m.folder == m.id || !m.own_id.empty() || !one_line) return copy_file_atomic(m.path.string(), target.string());
+  std::ifstream in(m.path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  write_file_atomic(target.string(), "# id: " + m.id + "\n" + text.str());
+}
+
+// What a failed crop removes again: the folders and files it created (not those it replaced).
+struct Created {
+  std::vector<fs::path> paths;  // in creation order
+  void dir(const fs::path& d) {
+    if (fs::create_directories(d)) paths.push_back(d);
+  }
+  void file(const fs::path& f) {
+    if (!fs::exists(fs::symlink_status(f))) paths.push_back(f);
+  }
+  void undo() {
+    std::error_code ec;
+    for (auto it = paths.rbegin(); it != paths.rend(); ++it) fs::remove(*it, ec);
+  }
+};
 
 void run(const CropArgs& a) {
   if (!fs::is_directory(a.models)) throw InputError(a.models + ": not a directory");
   const auto models = find_models(a.models);
   if (models.empty()) throw InputError(a.models + ": no *.obj or */coarse.obj models");
   std::vector<CropTarget> targets;
-  std::vector<std::string> ids;
+  std::vector<Model> kept;  // kept[i] is targets[i]'s model
   int skipped = 0;
-  for (const auto& [id, path] : models) {
+  for (const auto& m : models) {
     try {
-      targets.push_back(crop_target(read_obj(path.string()), a.expand, a.margin));
-      ids.push_back(id);
+      const Mesh model = read_obj(m.path.string());
+      targets.push_back(crop_target(model, a.expand, a.margin));
+      kept.push_back(m);
+      if (model.id != m.path.stem().string()) kept.back().own_id = model.id;
     } catch (const InputError& e) {  // one broken model must not stop the tile
-      std::fprintf(stderr, "lodrefine: warning: skipping %s: %s\n", id.c_str(), e.what());
+      std::fprintf(stderr, "lodrefine: warning: skipping %s: %s\n", shown_id(m.id).c_str(), e.what());
       ++skipped;
     }
   }
-  std::vector<std::string> clouds;
-  for (const auto& id : ids) {
-    fs::create_directories(fs::path(a.out) / id);
-    clouds.push_back((fs::path(a.out) / id / "cloud.ply").string());
-  }
+  check_outputs(kept, a);
+  Created created;
   std::vector<std::size_t> counts;
-  const std::size_t n = crop_tile_to_files(a.tile, targets, clouds, a.buffer_points, counts, a.cloud_options);
-  for (std::size_t i = 0; i < targets.size(); ++i) {
-    const fs::path dir = fs::path(a.out) / ids[i];
-    const fs::path model = models[i].second;
-    if (fs::absolute(model) != fs::absolute(dir / "coarse.obj")) {  // copied atomically, as every output
-      const fs::path tmp = dir / ("coarse.obj.tmp." + std::to_string(::getpid()));
-      fs::copy_file(model, tmp, fs::copy_options::overwrite_existing);
-      fs::rename(tmp, dir / "coarse.obj");
+  std::size_t n = 0;
+  try {
+    created.dir(a.out);
+    std::vector<std::string> clouds;
+    for (const auto& m : kept) {
+      created.dir(fs::path(a.out) / m.folder);
+      clouds.push_back((fs::path(a.out) / m.folder / "cloud.ply").string());
+      created.file(clouds.back());
+      created.file(fs::path(a.out) / m.folder / "coarse.obj");
     }
-    std::printf("%s: %zu points\n", ids[i].c_str(), counts[i]);
+    n = crop_tile_to_files(a.tile, targets, clouds, a.buffer_points, counts, a.cloud_options);
+    for (const auto& m : kept) place_model(m, fs::path(a.out) / m.folder);
+  } catch (...) {
+    created.undo();
+    throw;
+  }
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    const std::string& id = kept[i].own_id.empty() ? kept[i].id : kept[i].own_id;
+    if (kept[i].folder == id)
+      std::printf("%s: %zu points\n", kept[i].folder.c_str(), counts[i]);
+    else
+      std::printf("%s: %zu points (building %s)\n", kept[i].folder.c_str(), counts[i], shown_id(id).c_str());
   }
   std::printf("%zu tile points, %zu buildings cropped, %d skipped\n", n, targets.size(), skipped);
   if (skipped) exit_code() = 1;
@@ -79,7 +145,7 @@ void add_crop_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("crop", "Cut one cloud per building from a large PLY or LAS tile (streaming)");
   cmd->add_option("--tile", args.tile, "Large point cloud tile (PLY or LAS)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--models", args.models, "Folder of models: *.obj or <id>/coarse.obj")->required();
-  cmd->add_option("--out", args.out, "Run folder: writes <id>/cloud.ply and <id>/coarse.obj")->required();
+  cmd->add_option("--out", args.out, "Run folder: writes <name>/cloud.ply and <name>/coarse.obj (<name>: the id when it is a safe folder name, else a safe form with a hash)")->required();
   add_ranged_option(cmd, "--expand", args.expand, "Relative box growth on each side", 0.0, 10.0);
   add_ranged_option(cmd, "--margin", args.margin, "Absolute box growth on each side (m)", 0.0, 1000.0);
   add_ranged_option(cmd, "--buffer-points", args.buffer_points, "Points held in memory before spilling to disk (memory bound)", std::size_t(1), std::size_t(1) << 40);

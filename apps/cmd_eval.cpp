@@ -102,12 +102,6 @@ Mesh read_refined(const std::string& path, std::string& error) {
   }
 }
 
-std::string file_safe(std::string s) {
-  for (char& c : s)
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';
-  return s.empty() ? "building" : s;
-}
-
 std::vector<Vec3> facade_points(const BuildingEval& e, const PointCloud& cloud) {
   std::vector<Vec3> pts;
   for (int i : e.facade_index) pts.push_back(cloud.points[std::size_t(i)]);
@@ -125,7 +119,7 @@ constexpr std::size_t kFootprintFilePoints = 5000;
 
 void write_footprint(const std::string& svg_dir, const BuildingEval& e, const Mesh& original, const Mesh& refined,
                      const PointCloud& cloud) {
-  write_file_atomic((fs::path(svg_dir) / ("footprint_" + file_safe(e.id) + ".svg")).string(),
+  write_file_atomic((fs::path(svg_dir) / ("footprint_" + safe_name(e.id) + ".svg")).string(),
                     footprint_svg(e, original, refined, cloud, kFootprintFilePoints));
 }
 

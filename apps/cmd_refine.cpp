@@ -30,12 +30,30 @@ nlohmann::json params_json(const Params& p) {
   return j;
 }
 
-// Fails before any work when an output could not be written (so nothing is left half done).
+// Fails before any work when an output could not be written (so nothing is left half done):
+// its folder must exist and take a new file (a temporary is created and removed again).
 void check_output_dir(const std::string& path) {
   if (path.empty()) return;
   const std::filesystem::path dir = std::filesystem::absolute(path).parent_path();
   if (!std::filesystem::is_directory(dir)) throw InputError(path + ": output directory " + dir.string() + " does not exist");
   if (std::filesystem::is_directory(path)) throw InputError(path + ": is a directory");
+  try {
+    AtomicFile probe(path);
+  } catch (const std::runtime_error& e) {
+    throw InputError(e.what());
+  }
+}
+
+// Refuses, before anything is read, an output that is an input or the other output (compared
+// as files: links and other spellings of one path count).
+void check_outputs_are_new(const RefineArgs& a) {
+  const std::pair<const char*, const std::string*> ins[] = {{"--model", &a.model}, {"--cloud", &a.cloud}};
+  const std::pair<const char*, const std::string*> outs[] = {{"--out", &a.out}, {"--report", &a.report}};
+  for (const auto& [out_name, out] : outs)
+    for (const auto& [in_name, in] : ins)
+      if (!out->empty() && same_file(*out, *in))
+        throw InputError(*out + ": " + out_name + " is the " + in_name + " file; it would be overwritten");
+  if (!a.report.empty() && same_file(a.out, a.report)) throw InputError(a.report + ": --report is the --out file");
 }
 
 // A city file (CityJSON, CityJSONSeq, CityGML) in: every building the cloud covers, one
@@ -74,6 +92,7 @@ bool is_city_file(const std::string& path) {
 
 void run(const RefineArgs& a) {
   a.params.validate();
+  check_outputs_are_new(a);
   check_output_dir(a.out);
   check_output_dir(a.report);
   if (is_city_file(a.model)) {
@@ -104,8 +123,8 @@ void run(const RefineArgs& a) {
   report["cloud"]["path"] = a.cloud;
   report["params"] = params_json(a.params);
   report["written"] = a.out;
+  write_obj(a.out, r.mesh);  // the model first: a report never names a model that is not there
   if (!a.report.empty()) write_file_atomic(a.report, report.dump(2) + "\n");
-  write_obj(a.out, r.mesh);
   std::printf("%s: %s (%s) -> %s (%.2f s)%s\n", model.id.c_str(), outcome_name(r.outcome), r.reason.c_str(),
               a.out.c_str(), r.trace.stage_seconds("total"), overlap.empty() ? "" : ("; warning: " + overlap).c_str());
 }

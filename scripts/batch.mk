@@ -12,53 +12,78 @@
 # RUN/.batch.lock); a second one stops with one line. At the end, and whenever any building
 # changed, `lodrefine eval --dir` pools the figures into RUN/summary.{txt,json,csv}, RUN/plots/
 # and RUN/report.html.
+#
+# Building folder names are data (ids from a city file): the run stops with one line, before
+# anything runs, when one is not a safe name ([A-Za-z0-9._-], not starting with '-' or '.';
+# `lodrefine crop` and `convert` only make such names). RUN itself may hold spaces: the batch
+# runs inside it (make -C), so no target or recipe holds the RUN path.
 
 LODREFINE ?= build/lodrefine
 RUN ?= run
 ARGS ?=
-SCRIPTS := $(dir $(lastword $(MAKEFILE_LIST)))
-export LODREFINE ARGS
-# The per-building command; `make ... todo` only lists the ids a run would (re)do, one a line
-# (how scripts/parallel_batch.sh and scripts/slurm_batch.sh pick their work).
-REFINE_ONE := $(SCRIPTS)refine_one.sh
-ifeq ($(MAKECMDGOALS),todo)
-REFINE_ONE := printf '%.0s%s\n'
-endif
+BATCH_MK := $(abspath $(lastword $(MAKEFILE_LIST)))
+SCRIPTS := $(dir $(BATCH_MK))
+# A word for the shell in single quotes.
+quote = '$(subst ','\'',$(1))'
 
-LOCK := $(shell $(SCRIPTS)batch_lock.sh '$(RUN)')
+.PHONY: all refined todo clean-results
+
+ifndef LODREFINE_BATCH_DIR
+# The calling make: checks the names and takes RUN's lock (for as long as it lives), then runs
+# the batch inside RUN.
+LOCK := $(shell $(call quote,$(SCRIPTS)batch_lock.sh) $(call quote,$(RUN)))
 ifneq ($(LOCK),ok)
 $(error $(LOCK))
 endif
+BINARY := $(if $(findstring /,$(LODREFINE)),$(abspath $(LODREFINE)),$(LODREFINE))
 
-IDS := $(sort $(patsubst $(RUN)/%/coarse.obj,%,$(wildcard $(RUN)/*/coarse.obj)))
+INNER = $(MAKE) --no-print-directory -C $(call quote,$(RUN)) -f $(call quote,$(BATCH_MK)) \
+        LODREFINE_BATCH_DIR=$(call quote,$(RUN)) LODREFINE=$(call quote,$(BINARY))
+all refined todo clean-results:
+	@$(INNER) $@
+# One building's output, e.g. RUN/<id>/refined.obj.
+.DEFAULT:
+	@$(INNER) $(call quote,$(subst $(RUN)/,,$@))
+
+else
+# Inside RUN: every name below is a checked building folder name or a fixed one.
+export LODREFINE ARGS LODREFINE_BATCH_DIR
+# The per-building command; `make ... todo` only lists the ids a run would (re)do, one a line
+# (how scripts/parallel_batch.sh and scripts/slurm_batch.sh pick their work).
+REFINE_ONE := $(call quote,$(SCRIPTS)refine_one.sh) .
+ifeq ($(MAKECMDGOALS),todo)
+REFINE_ONE := printf '%s\n'
+endif
+
+IDS := $(sort $(patsubst %/coarse.obj,%,$(wildcard */coarse.obj)))
 TOTAL := $(words $(IDS))
 # A failed building's output is FAILED, a refined one's its model and report.
-OUTPUTS := $(foreach id,$(IDS),$(if $(wildcard $(RUN)/$(id)/FAILED),$(RUN)/$(id)/FAILED,\
-             $(RUN)/$(id)/refined.obj $(RUN)/$(id)/report.json))
+OUTPUTS := $(foreach id,$(IDS),$(if $(wildcard $(id)/FAILED),$(id)/FAILED,$(id)/refined.obj $(id)/report.json))
 
 # The list of buildings, rewritten only when it changes: a removed building refreshes the summary.
-$(shell printf '%s\n' $(IDS) > '$(RUN)/.ids.tmp' && \
-        { cmp -s '$(RUN)/.ids.tmp' '$(RUN)/.ids' && rm -f '$(RUN)/.ids.tmp' || mv -f '$(RUN)/.ids.tmp' '$(RUN)/.ids'; })
+$(file >.ids.new,$(IDS))
+$(shell cmp -s .ids.new .ids && rm -f .ids.new || mv -f .ids.new .ids)
 
-.PHONY: all refined todo clean-results
-all: $(RUN)/summary.txt
+all: summary.txt
 refined: $(OUTPUTS)  # every building, without the summary
 todo: $(OUTPUTS)
 
 # One building (both targets come from one run): never fails the batch.
-$(RUN)/%/refined.obj $(RUN)/%/report.json: $(RUN)/%/coarse.obj $(RUN)/%/cloud.ply
-	@$(REFINE_ONE) '$(RUN)' '$*'
+%/refined.obj %/report.json: %/coarse.obj %/cloud.ply
+	@$(REFINE_ONE) '$*'
 
-$(RUN)/%/FAILED: $(RUN)/%/coarse.obj $(RUN)/%/cloud.ply
-	@$(REFINE_ONE) '$(RUN)' '$*'
+%/FAILED: %/coarse.obj %/cloud.ply
+	@$(REFINE_ONE) '$*'
 
-$(RUN)/summary.txt: $(OUTPUTS) $(RUN)/.ids
-	@mkdir -p $(RUN)/plots
-	@tmp='$@.tmp.'$$$$; $(LODREFINE) eval --dir $(RUN) --json $(RUN)/summary.json --csv $(RUN)/summary.csv \
-	    --svg-dir $(RUN)/plots --html $(RUN)/report.html > "$$tmp" && mv -f "$$tmp" $@ || { rm -f "$$tmp"; exit 1; }
+summary.txt: $(OUTPUTS) .ids
+	@mkdir -p plots
+	@tmp=$$(mktemp .lodrefine-tmp-XXXXXXXXXX) && chmod 644 "$$tmp" && \
+	    "$$LODREFINE" eval --dir "$$PWD" --json "$$PWD/summary.json" --csv "$$PWD/summary.csv" \
+	    --svg-dir "$$PWD/plots" --html "$$PWD/report.html" > "$$tmp" && mv -f "$$tmp" $@ || { rm -f "$$tmp"; exit 1; }
 	@cat $@
-	@echo "report: $(RUN)/report.html"
-	@echo "failed: $$(ls $(RUN)/*/FAILED 2>/dev/null | wc -l) of $(TOTAL) (see $(RUN)/<id>/FAILED)"
+	@echo "report: $$LODREFINE_BATCH_DIR/report.html"
+	@echo "failed: $$(ls */FAILED 2>/dev/null | wc -l) of $(TOTAL) (see $$LODREFINE_BATCH_DIR/<id>/FAILED)"
 
 clean-results:
-	rm -f $(RUN)/*/FAILED $(RUN)/*/refined.obj $(RUN)/*/report.json $(RUN)/*/log.txt $(RUN)/*/done $(RUN)/summary.* $(RUN)/.ids
+	rm -f */FAILED */refined.obj */report.json */log.txt */done summary.* .ids
+endif

@@ -21,6 +21,7 @@ todo=$(mktemp)
 trap 'rm -f "$todo"' EXIT
 "${batch[@]}" todo > "$todo"
 echo "$(wc -l < "$todo") buildings to refine"
-# --env: remote hosts get the binary and options; the ids come one a line from the list.
-parallel --will-cite --env LODREFINE --env ARGS "$@" "$scripts/refine_one.sh" "$run" {} :::: "$todo"
+# --env: remote hosts get the binary and options; the ids (checked safe names) come one a line
+# from the list; -q: the command's words reach the (remote) shell quoted, RUN with spaces too.
+parallel --will-cite -q --env LODREFINE --env ARGS "$@" "$scripts/refine_one.sh" "$run" {} :::: "$todo"
 "${batch[@]}"

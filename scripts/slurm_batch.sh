@@ -22,7 +22,7 @@ fi
 command -v sbatch > /dev/null || { echo "lodrefine: error: sbatch not found (Debian: slurm-client)" >&2; exit 2; }
 
 mkdir -p "$run/.slurm"
-list=$run/.slurm/todo.$$
+list=$(mktemp "$run/.slurm/todo.XXXXXXXXXX")
 "${batch[@]}" todo > "$list"
 n=$(wc -l < "$list")
 if ((n == 0)); then
@@ -30,13 +30,14 @@ if ((n == 0)); then
   exec "${batch[@]}"
 fi
 tasks=$((n < ${MAX_TASKS:-1000} ? n : ${MAX_TASKS:-1000}))
-# Each task: every tasks-th id of the list, starting at its own index.
-task="for id in \$(awk -v k=\$SLURM_ARRAY_TASK_ID -v t=$tasks '(NR - 1) % t == k' '$list'); do
-        '$scripts/refine_one.sh' '$run' \"\$id\"; done"
+# Each task: every tasks-th id of the list (checked safe names), starting at its own index. Paths
+# go into the job script %q-quoted.
+task="for id in \$(awk -v k=\$SLURM_ARRAY_TASK_ID -v t=$tasks '(NR - 1) % t == k' $(printf %q "$list")); do
+        $(printf %q "$scripts/refine_one.sh") $(printf %q "$run") \"\$id\"; done"
 array=$(sbatch --parsable --export=ALL --array=0-$((tasks - 1)) --job-name=lodrefine \
         --output="$run/.slurm/%A_%a.out" "$@" --wrap "$task")
 echo "submitted job array $array: $n buildings in $tasks tasks"
 last=$(sbatch --parsable --export=ALL --dependency=afterany:"$array" --job-name=lodrefine-summary \
        --output="$run/.slurm/summary_%j.out" "${wait[@]}" "$@" \
-       --wrap "$(printf '%q ' "${batch[@]}"); rm -f '$list'")
+       --wrap "$(printf '%q ' "${batch[@]}"); rm -f $(printf %q "$list")")
 echo "summary job $last (after $array): $run/summary.txt"

@@ -404,16 +404,6 @@ Semantic semantic_from_cityjson(const std::string& type) {
   return Semantic::Other;
 }
 
-std::string file_stem_for_id(const std::string& id) {
-  std::string out;
-  for (char c : id) {
-    const auto u = static_cast<unsigned char>(c);
-    out += (u < 0x21 || u == 0x7f || std::string_view("/\\:*?\"<>|").find(c) != std::string_view::npos) ? '_' : c;
-  }
-  if (out.empty() || out.find_first_not_of('.') == std::string::npos) out = "_" + out;
-  return out;
-}
-
 CityJsonFile parse_cityjson(const std::string& text, const std::string& name, const std::string& lod) {
   return Reader(name, lod).read(text);
 }

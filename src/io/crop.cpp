@@ -1,5 +1,6 @@
 #include "lodrefine/io/crop.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include <unordered_map>
 
 #include "lodrefine/core/geometry.h"
+#include "lodrefine/io/files.h"
 #include "lodrefine/io/ply.h"
 
 namespace lodrefine {
@@ -66,16 +68,20 @@ std::size_t for_each_hit(const std::string& tile, const std::vector<CropTarget>&
   return n;
 }
 
-// Appends points to a spill file (raw doubles), or reads them all back.
-void spill(const std::string& path, const std::vector<Vec3>& points) {
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "ab"), std::fclose);
+// Appends points to a spill file (raw doubles), created exclusively beside `out_path` on the
+// first spill (`path` empty until then) and reopened without following links after that.
+void spill(const std::string& out_path, std::string& path, const std::vector<Vec3>& points) {
+  const int fd = path.empty() ? create_temp_file(std::filesystem::path(out_path).parent_path().string(), out_path, path)
+                              : ::open(path.c_str(), O_WRONLY | O_APPEND | O_NOFOLLOW | O_CLOEXEC);
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(fd < 0 ? nullptr : ::fdopen(fd, "ab"), std::fclose);
+  if (fd >= 0 && !f) ::close(fd);
   const std::size_t bytes = points.size() * sizeof(Vec3);
   if (!f || std::fwrite(points.data(), 1, bytes, f.get()) != bytes || std::fflush(f.get()) != 0)
     throw InputError("cannot write " + path + ": " + std::strerror(errno));
 }
 
 std::vector<Vec3> unspill(const std::string& path) {
-  std::vector<Vec3> points(std::filesystem::exists(path) ? std::filesystem::file_size(path) / sizeof(Vec3) : 0);
+  std::vector<Vec3> points(!path.empty() ? std::filesystem::file_size(path) / sizeof(Vec3) : 0);
   if (points.empty()) return points;
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), std::fclose);
   if (!f || std::fread(points.data(), sizeof(Vec3), points.size(), f.get()) != points.size())
@@ -96,13 +102,12 @@ std::size_t crop_tile_to_files(const std::string& tile, const std::vector<CropTa
                                std::vector<std::size_t>& counts, const CloudOptions& options) {
   static_assert(sizeof(Vec3) == 3 * sizeof(double), "spill files hold Vec3 as three doubles");
   std::vector<std::vector<Vec3>> held(targets.size());
-  std::vector<std::string> spills;
-  for (const auto& path : out_paths) spills.push_back(path + ".spill.tmp." + std::to_string(::getpid()));
+  std::vector<std::string> spills(targets.size());  // created on a target's first spill
   counts.assign(targets.size(), 0);
   std::size_t in_memory = 0;
   auto flush_all = [&] {
     for (std::size_t i = 0; i < held.size(); ++i)
-      if (!held[i].empty()) spill(spills[i], held[i]), std::vector<Vec3>().swap(held[i]);
+      if (!held[i].empty()) spill(out_paths[i], spills[i], held[i]), std::vector<Vec3>().swap(held[i]);
     in_memory = 0;
   };
   std::size_t n = 0;
@@ -118,10 +123,11 @@ std::size_t crop_tile_to_files(const std::string& tile, const std::vector<CropTa
       cloud.points.insert(cloud.points.end(), held[i].begin(), held[i].end());
       std::vector<Vec3>().swap(held[i]);
       write_ply(out_paths[i], cloud);
-      std::filesystem::remove(spills[i]);
+      if (!spills[i].empty()) std::filesystem::remove(spills[i]);
     }
   } catch (...) {
-    for (const auto& s : spills) std::filesystem::remove(s);
+    for (const auto& s : spills)
+      if (!s.empty()) ::unlink(s.c_str());
     throw;
   }
   return n;

@@ -1,22 +1,44 @@
-// Atomic writes and telling formats apart by content.
+// Atomic writes, exclusive temporaries, safe names and telling formats apart by content.
 #include "lodrefine/io/files.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <random>
 #include <string_view>
+
+#include <nlohmann/json.hpp>
 
 #include "text.h"
 
 namespace lodrefine {
 
-AtomicFile::AtomicFile(const std::string& path) : path_(path), tmp_(path + ".tmp." + std::to_string(::getpid())) {
-  fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd_ < 0) fail(std::strerror(errno));
+namespace fs = std::filesystem;
+
+int create_temp_file(const std::string& dir, const std::string& for_path, std::string& path) {
+  static const char kChars[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789";
+  thread_local std::mt19937_64 random{std::random_device{}() ^ (std::uint64_t(::getpid()) << 32)};
+  const fs::path folder = dir.empty() ? fs::path(".") : fs::path(dir);
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    std::string name = kTempPrefix;
+    for (int i = 0; i < 10; ++i) name += kChars[random() % (sizeof kChars - 1)];
+    path = (folder / name).string();
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd >= 0) return fd;
+    if (errno != EEXIST) throw std::runtime_error("cannot write " + for_path + ": " + std::strerror(errno));
+  }
+  throw std::runtime_error("cannot write " + for_path + ": no free temporary name in " + folder.string());
+}
+
+AtomicFile::AtomicFile(const std::string& path) : path_(path) {
+  fd_ = create_temp_file(fs::path(path).parent_path().string(), path, tmp_);
 }
 
 AtomicFile::~AtomicFile() { discard(); }
@@ -47,10 +69,12 @@ void AtomicFile::fail(const std::string& reason) {
 void AtomicFile::discard() {
   if (fd_ >= 0) ::close(fd_);
   fd_ = -1;
-  if (!committed_) ::unlink(tmp_.c_str());
+  if (!committed_ && !tmp_.empty()) ::unlink(tmp_.c_str());
 }
 
 FileKind sniff_file(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return FileKind::Other;  // a FIFO would block
   std::ifstream in(path, std::ios::binary);
   char head[64] = {};
   if (in) in.read(head, sizeof head);
@@ -79,6 +103,92 @@ void write_file_atomic(const std::string& path, const std::string& content) {
   AtomicFile file(path);
   file.write(content);
   file.commit();
+}
+
+void copy_file_atomic(const std::string& from, const std::string& to) {
+  require_regular_file(from);
+  std::ifstream in(from, std::ios::binary);
+  if (!in) throw InputError(from + ": cannot open (" + std::strerror(errno) + ")");
+  AtomicFile file(to);
+  char buffer[1 << 16];
+  while (in.read(buffer, sizeof buffer) || in.gcount() > 0) file.write(buffer, std::size_t(in.gcount()));
+  if (in.bad()) file.fail("read error in " + from);
+  file.commit();
+}
+
+void require_regular_file(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+    throw InputError(path + (S_ISDIR(st.st_mode) ? ": is a directory, not a file"
+                                                 : ": not a regular file (a device, FIFO or socket); give a file"));
+}
+
+bool same_file(const std::string& a, const std::string& b) {
+  struct stat sa {}, sb {};
+  const bool has_a = ::stat(a.c_str(), &sa) == 0, has_b = ::stat(b.c_str(), &sb) == 0;
+  if (has_a && has_b) return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+  if (has_a != has_b) return false;
+  auto where = [](const std::string& p) {
+    const fs::path abs = fs::absolute(p);
+    std::error_code ec;
+    const fs::path parent = fs::weakly_canonical(abs.parent_path(), ec);
+    return (ec ? abs.parent_path() : parent) / abs.filename();
+  };
+  return where(a) == where(b);
+}
+
+namespace {
+
+bool safe_char(char c) {
+  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' || c == '_' || c == '-';
+}
+
+std::string hashed_name(const std::string& id) {
+  std::uint64_t h = 14695981039346656037ull;  // FNV-1a
+  for (unsigned char c : id) h = (h ^ c) * 1099511628211ull;
+  std::string out = id.empty() || id[0] == '-' || id[0] == '.' ? "_" : "";
+  for (char c : id.substr(0, 80 - out.size())) out += safe_char(c) ? c : '_';
+  char hex[16];
+  std::snprintf(hex, sizeof hex, "%012llx", static_cast<unsigned long long>(h & 0xffffffffffffull));
+  return out + "--" + hex;
+}
+
+std::string lower(std::string s) {
+  for (char& c : s)
+    if (c >= 'A' && c <= 'Z') c = char(c - 'A' + 'a');
+  return s;
+}
+
+}  // namespace
+
+std::string shown_id(const std::string& id) {
+  return nlohmann::json(id).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+bool is_safe_name(const std::string& name) {
+  if (name.empty() || name.size() > kMaxSafeName || name[0] == '-' || name[0] == '.') return false;
+  for (char c : name)
+    if (!safe_char(c)) return false;
+  return true;
+}
+
+std::string safe_name(const std::string& id) {
+  return is_safe_name(id) ? id : hashed_name(id);
+}
+
+SafeNames::SafeNames(const std::vector<std::string>& reserved) {
+  for (const auto& r : reserved) taken_.insert(lower(r));
+}
+
+bool SafeNames::take(const std::string& name) { return taken_.insert(lower(name)).second; }
+
+std::string SafeNames::add(const std::string& id) {
+  const std::string name = safe_name(id);
+  if (take(name)) return name;
+  const std::string hashed = hashed_name(id);
+  if (take(hashed)) return hashed;
+  for (int k = 2;; ++k)
+    if (take(hashed + "-" + std::to_string(k))) return hashed + "-" + std::to_string(k);
 }
 
 }  // namespace lodrefine

@@ -257,7 +257,17 @@ void append_fixed(std::string& out, double v) {
 
 std::string obj_text(const Mesh& mesh, const Vec3& origin, AtomicFile& file) {
   std::string out = "# lodrefine\n";
-  if (!mesh.id.empty()) out += "o " + one_token(mesh.id) + "\n";
+  // An id with blanks goes in a `# id:` comment (read back as is; `o` takes one token for other
+  // tools), unless line breaks or outer blanks would not survive that either.
+  const std::string token = one_token(mesh.id);
+  const bool one_line_id = std::none_of(mesh.id.begin(), mesh.id.end(), [](char c) {
+    const auto u = static_cast<unsigned char>(c);
+    return (u < 0x20 && c != '\t') || u == 0x7f;
+  });
+  if (token != mesh.id && one_line_id && trim(mesh.id) == mesh.id)
+    out += "# id: " + mesh.id + "\n";
+  else if (!mesh.id.empty())
+    out += "o " + token + "\n";
   for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
     const Vec3 p = mesh.vertices[i] + origin;
     if (!p.allFinite()) file.fail("vertex " + std::to_string(i) + " is not finite");

@@ -1,5 +1,7 @@
 #include "text.h"
 
+#include "lodrefine/io/files.h"
+
 #include <cctype>
 #include <cerrno>
 #include <cstring>
@@ -35,6 +37,7 @@ std::vector<std::string_view> split_ws(std::string_view s) {
 std::ifstream open_input(const std::string& path, std::uint64_t* size) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) fail(path, "is a directory, not a file");
+  require_regular_file(path);  // /dev/zero or a FIFO would be read without end
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, std::string("cannot open (") + std::strerror(errno) + ")");
   if (size) {

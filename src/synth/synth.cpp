@@ -1277,9 +1277,13 @@ void write_synth_building(const std::string& dir, const SynthBuilding& b, bool w
 std::uint64_t write_synth_tile(const std::string& dir, const std::string& tile_ply, int count, std::uint64_t first_seed,
                                double spacing, const SynthOptions& opt,
                                const std::function<void(const SynthBuilding&)>& progress) {
-  const std::string tmp = tile_ply + ".tmp." + std::to_string(::getpid());
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(tmp.c_str(), "wb"), std::fclose);
-  if (!f) throw InputError("cannot write " + tmp + ": " + std::strerror(errno));
+  std::string tmp;  // created exclusively beside the tile (a planted link is never followed)
+  const int fd = create_temp_file(std::filesystem::path(tile_ply).parent_path().string(), tile_ply, tmp);
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(::fdopen(fd, "wb"), std::fclose);
+  if (!f) {
+    ::close(fd), std::remove(tmp.c_str());
+    throw InputError("cannot write " + tile_ply + ": " + std::strerror(errno));
+  }
   // The count is only known at the end: a fixed-width field, rewritten in place.
   constexpr int kCountWidth = 15;
   const std::string head = "ply\nformat binary_little_endian 1.0\ncomment lodrefine synth tile\nelement vertex ";

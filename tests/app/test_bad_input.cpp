@@ -29,11 +29,13 @@
 #include <iostream>
 #include <limits>
 #include <random>
+#include <set>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "lodrefine/core/candidates.h"
+#include "lodrefine/io/files.h"
 #include "lodrefine/io/obj.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/refine.h"
@@ -182,12 +184,15 @@ std::vector<std::string> lines(const std::string& s) {
   return out;
 }
 
-// Files left in `dir` that look like an interrupted atomic write ("<name>.tmp.<pid>").
+// Files left in `dir` that look like an interrupted atomic write (".lodrefine-tmp-*", or an old
+// "<name>.tmp.<pid>").
 std::vector<std::string> temp_leftovers(const std::string& dir) {
   std::vector<std::string> out;
   std::error_code ec;
   for (const auto& e : fs::recursive_directory_iterator(dir, ec))
-    if (e.path().filename().string().find(".tmp") != std::string::npos) out.push_back(e.path().string());
+    if (e.path().filename().string().find(".tmp") != std::string::npos ||
+        e.path().filename().string().find("lodrefine-tmp") != std::string::npos)
+      out.push_back(e.path().string());
   return out;
 }
 
@@ -949,3 +954,241 @@ TEST(BadInputSolver, RefineFallsBackToTheOriginalWhenSelectionTimesOut) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Untrusted ids, paths and files (issue 15): outputs stay in the output folder, never replace an
+// input or a file already there, temporaries are ours, and every building is accounted for.
+
+namespace {
+
+// A CityJSON 2.0 file: each id a copy of the box (MultiSurface, LoD 2.2); ids in `flat` get a
+// geometry without any usable surface (rings of one repeated vertex).
+std::string box_city(const std::vector<std::string>& ids, const std::vector<std::string>& flat = {}) {
+  json doc = {{"type", "CityJSON"}, {"version", "2.0"},
+              {"transform", {{"scale", {0.001, 0.001, 0.001}}, {"translate", {kOrigin.x(), kOrigin.y(), kOrigin.z()}}}},
+              {"CityObjects", json::object()}, {"vertices", json::array()}};
+  for (const Vec3& v : kBox) doc["vertices"].push_back({std::llround(v.x() * 1000), std::llround(v.y() * 1000), std::llround(v.z() * 1000)});
+  json boundaries = json::array(), degenerate = json::array();
+  for (const Quad& q : kQuads) boundaries.push_back({{q.v[0], q.v[1], q.v[2], q.v[3]}}), degenerate.push_back({{0, 0, 0}});
+  for (const auto& id : ids) {
+    const bool is_flat = std::find(flat.begin(), flat.end(), id) != flat.end();
+    doc["CityObjects"][id] = {{"type", "Building"},
+                              {"geometry", {{{"type", "MultiSurface"}, {"lod", "2.2"}, {"boundaries", is_flat ? degenerate : boundaries}}}}};
+  }
+  return doc.dump();
+}
+
+std::vector<std::string> files_in(const std::string& dir) {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(dir)) out.push_back(e.path().filename().string());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+void expect_one_error_line(const CliRun& r, const std::string& says) {
+  EXPECT_EQ(r.exit, 2) << r.err;
+  EXPECT_EQ(lines(r.err).size(), 1u) << r.err;
+  EXPECT_EQ(r.err.rfind("lodrefine: error: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+}
+
+}  // namespace
+
+// A model named `...obj` (stem "..") must not make crop write into the parent of --out.
+TEST(BadInputFiles, CropKeepsAModelNamedDotDotInsideOut) {
+  const std::string dir = temp_dir("crop_dotdot");
+  fs::create_directories(dir + "/models");
+  write_text(dir + "/models/...obj", valid_model());
+  write_text(dir + "/tile.ply", valid_cloud());
+  const CliRun r = run_cli("crop --tile " + dir + "/tile.ply --models " + dir + "/models --out " + dir + "/run", dir);
+  ASSERT_EQ(r.exit, 0) << r.err;
+  EXPECT_EQ(files_in(dir), (std::vector<std::string>{"models", "run", "tile.ply"})) << "wrote beside --out";
+  const auto folders = files_in(dir + "/run");
+  ASSERT_EQ(folders.size(), 1u);
+  EXPECT_TRUE(is_safe_name(folders[0])) << folders[0];
+  EXPECT_EQ(files_in(dir + "/run/" + folders[0]), (std::vector<std::string>{"cloud.ply", "coarse.obj"}));
+  add_row("crop: model `...obj` (stem `..`)", "stays in --out, folder " + folders[0], r.exit);
+}
+
+// After an unreadable model is skipped, every building still gets its own model (the kept list
+// and the model list used to drift apart by one).
+TEST(BadInputFiles, CropPairsEachBuildingWithItsOwnModelAfterASkip) {
+  const std::string dir = temp_dir("crop_skip");
+  fs::create_directories(dir + "/models");
+  write_text(dir + "/models/a.obj", "v 0 0\n");  // unreadable: skipped with a warning
+  std::string b = valid_model(), c = valid_model();
+  b.replace(b.find("o bldg_0001"), 11, "o B");
+  c.replace(c.find("o bldg_0001"), 11, "o C");
+  write_text(dir + "/models/b.obj", b);
+  write_text(dir + "/models/c.obj", c);
+  write_text(dir + "/tile.ply", valid_cloud());
+  const CliRun r = run_cli("crop --tile " + dir + "/tile.ply --models " + dir + "/models --out " + dir + "/run", dir);
+  EXPECT_EQ(r.exit, 1) << r.err;
+  EXPECT_NE(r.err.find("skipping \"a\""), std::string::npos) << r.err;
+  EXPECT_EQ(files_in(dir + "/run"), (std::vector<std::string>{"b", "c"}));
+  EXPECT_EQ(read_text(dir + "/run/b/coarse.obj"), b);
+  EXPECT_EQ(read_text(dir + "/run/c/coarse.obj"), c);
+  add_row("crop: first model unreadable", "skipped; the others keep their own models", r.exit);
+}
+
+// A.obj and A/coarse.obj are two models for one building: refused, nothing written.
+TEST(BadInputFiles, CropRefusesTwoModelsForOneBuilding) {
+  const std::string dir = temp_dir("crop_twice");
+  fs::create_directories(dir + "/models/A");
+  write_text(dir + "/models/A.obj", valid_model());
+  write_text(dir + "/models/A/coarse.obj", box_obj({0, 1, 2, 3, 4}));
+  write_text(dir + "/tile.ply", valid_cloud());
+  const CliRun r = run_cli("crop --tile " + dir + "/tile.ply --models " + dir + "/models --out " + dir + "/run", dir);
+  expect_one_error_line(r, "two models for building \"A\"");
+  EXPECT_FALSE(fs::exists(dir + "/run"));
+  // The tile as an output of the crop (the run folder holding it) is refused too, the tile kept.
+  fs::remove_all(dir + "/models/A");
+  fs::create_directories(dir + "/run/A");
+  write_text(dir + "/run/A/cloud.ply", valid_cloud());
+  const CliRun t = run_cli("crop --tile " + dir + "/run/A/cloud.ply --models " + dir + "/models --out " + dir + "/run", dir);
+  expect_one_error_line(t, "the tile would be overwritten");
+  EXPECT_EQ(read_text(dir + "/run/A/cloud.ply"), valid_cloud());
+  add_row("crop: A.obj and A/coarse.obj; tile inside --out", "refused: two models / tile would be overwritten", r.exit);
+}
+
+// convert: each building by name on stdout (written) or stderr (dropped), distinct safe file
+// names that never replace a file already in --out-dir, the real id inside each model, ids of
+// any length.
+TEST(BadInputFiles, ConvertAccountsForEveryBuildingAndNeverOverwrites) {
+  const std::string dir = temp_dir("convert_names");
+  const std::string long_a(300, 'a'), long_b = std::string(299, 'a') + "b";
+  const std::vector<std::string> ids = {"B 1", "B_1", "$(touch PWNED)", "-rf", long_a, long_b, "Flat roof"};
+  write_text(dir + "/city.json", box_city(ids, {"Flat roof"}));
+  const CliRun r = run_cli("convert --cityjson " + dir + "/city.json --out-dir " + dir + "/objs", dir);
+  ASSERT_EQ(r.exit, 0) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/PWNED"));
+  const auto names = files_in(dir + "/objs");
+  ASSERT_EQ(names.size(), 6u) << r.out;
+  std::set<std::string> read_ids;
+  for (const auto& n : names) {
+    EXPECT_TRUE(is_safe_name(n.substr(0, n.size() - 4))) << n;
+    read_ids.insert(read_obj(dir + "/objs/" + n).id);
+  }
+  EXPECT_EQ(read_ids, std::set<std::string>(ids.begin(), ids.end() - 1)) << "the real ids, inside the models";
+  EXPECT_EQ(lines(r.out).size(), 7u) << r.out;  // one line per written building, then the total
+  EXPECT_NE(r.out.find(".obj <- \"B 1\""), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("Flat roof"), std::string::npos) << "the dropped building is named: " << r.err;
+  // Again into the same folder: refused before anything is written, the files kept.
+  const std::string before = read_text(dir + "/objs/B_1.obj");
+  write_text(dir + "/objs/B_1.obj", "mine\n");
+  const CliRun again = run_cli("convert --cityjson " + dir + "/city.json --out-dir " + dir + "/objs", dir);
+  expect_one_error_line(again, "already exists");
+  EXPECT_EQ(read_text(dir + "/objs/B_1.obj"), "mine\n");
+  EXPECT_EQ(files_in(dir + "/objs"), names);
+  add_row("convert: ids `B 1`/`B_1`, shell code, 300 bytes, no surface", "distinct safe names, ids kept, dropped named", r.exit);
+}
+
+// An output that is an input (any spelling of it) or the other output is refused before
+// anything is read; the input is untouched.
+TEST(BadInputFiles, RefineRefusesOutputsThatAreInputs) {
+  const std::string dir = temp_dir("refine_same");
+  fs::create_directories(dir + "/sub");
+  const std::string model = dir + "/model.obj", cloud = dir + "/cloud.ply";
+  write_text(model, valid_model());
+  write_text(cloud, valid_cloud());
+  fs::create_symlink(model, dir + "/link.obj");
+  const std::string in = "refine --model " + model + " --cloud " + cloud;
+  for (const std::string& outputs : {" --out " + model, " --out " + dir + "/link.obj", " --out " + dir + "/sub/../model.obj",
+                                     " --out " + dir + "/r.obj --report " + cloud,
+                                     " --out " + dir + "/r.obj --report " + dir + "/sub/../r.obj"}) {
+    const CliRun r = run_cli(in + outputs, dir);
+    expect_one_error_line(r, "--");
+    EXPECT_LT(r.seconds, 5.0) << outputs;
+    EXPECT_EQ(read_text(model), valid_model()) << outputs;
+    EXPECT_EQ(read_text(cloud), valid_cloud()) << outputs;
+    EXPECT_FALSE(fs::exists(dir + "/r.obj")) << outputs;
+  }
+  // A city file: --out the model.
+  write_text(dir + "/city.json", box_city({"B"}));
+  const CliRun c = run_cli("refine --model " + dir + "/city.json --cloud " + cloud + " --out " + dir + "/city.json", dir);
+  expect_one_error_line(c, "is the --model file");
+  EXPECT_EQ(read_text(dir + "/city.json"), box_city({"B"}));
+  add_row("refine: --out/--report = --model/--cloud (links, ../)", "refused before reading", c.exit);
+}
+
+// A report never names a model that is not there; an output folder that takes no file is
+// found before the work (single building and city file). /proc/self takes no new file, even for root.
+TEST(BadInputFiles, UnwritableOutputFailsFirstAndLeavesNoReport) {
+  const std::string dir = temp_dir("refine_unwritable");
+  const std::string model = dir + "/model.obj", cloud = dir + "/cloud.ply";
+  write_text(model, valid_model());
+  write_text(cloud, valid_cloud());
+  const CliRun r = run_cli("refine --model " + model + " --cloud " + cloud + " --out /proc/self/refined.obj --report " + dir + "/report.json", dir);
+  expect_one_error_line(r, "cannot write /proc/self/refined.obj");
+  EXPECT_FALSE(fs::exists(dir + "/report.json")) << "the report claims a model that was never written";
+  write_text(dir + "/city.json", box_city({"B"}));
+  const CliRun c = run_cli("refine --model " + dir + "/city.json --cloud " + cloud + " --out /proc/self/out.city.json", dir);
+  expect_one_error_line(c, "cannot write /proc/self/out.city.json");
+  EXPECT_EQ(c.out, "") << "refined before finding the output unwritable";
+  EXPECT_TRUE(temp_leftovers(dir).empty());
+  add_row("refine: --out in a folder that takes no file", "refused before refining; no report", r.exit);
+}
+
+// Devices and FIFOs are refused at once, not read for gigabytes (or forever).
+TEST(BadInputFiles, DevZeroIsRefusedAtOnce) {
+  const std::string dir = temp_dir("dev_zero");
+  write_text(dir + "/model.obj", valid_model());
+  write_text(dir + "/cloud.ply", valid_cloud());
+  ASSERT_EQ(::mkfifo((dir + "/fifo").c_str(), 0600), 0);
+  for (const std::string& args : {"--model /dev/zero --cloud " + dir + "/cloud.ply", "--model " + dir + "/model.obj --cloud /dev/zero",
+                                  "--model " + dir + "/fifo --cloud " + dir + "/cloud.ply"}) {
+    const CliRun r = run_cli("refine " + args + " --out " + dir + "/r.obj", dir, 60);
+    expect_one_error_line(r, "not a regular file");
+    EXPECT_LT(r.seconds, 5.0) << args;
+  }
+  add_row("refine --model /dev/zero (or a FIFO)", "refused at once: not a regular file", 2);
+}
+
+// A write that fails half-way (here a file size limit, as a full disk would) leaves no half run
+// folder: crop and convert remove what they created.
+TEST(BadInputFiles, FailedWriteLeavesNoHalfRunFolder) {
+  const std::string dir = temp_dir("full_disk");
+  fs::create_directories(dir + "/models");
+  for (const char* id : {"a", "b", "c"}) write_text(dir + "/models/" + id + ".obj", valid_model());
+  write_text(dir + "/tile.ply", valid_cloud());
+  write_text(dir + "/city.json", box_city({"a", "b", "c"}));
+  // SIGXFSZ ignored: a write beyond 64 KB fails with EFBIG, as on a full disk.
+  auto limited = [&](const std::string& args) {
+    return std::system(("cd " + shell_quote(dir) + " && sh -c \"trap '' XFSZ; ulimit -f 64; exec " + shell_quote(LODREFINE_BINARY) +
+                        " " + args + "\" > /dev/null 2> err.txt")
+                           .c_str());
+  };
+  EXPECT_NE(limited("crop --tile tile.ply --models models --out run"), 0);
+  EXPECT_NE(read_text(dir + "/err.txt").find("lodrefine: error: "), std::string::npos) << read_text(dir + "/err.txt");
+  EXPECT_FALSE(fs::exists(dir + "/run")) << "a half run folder is left";
+  // convert: a model too big for the limit (many faces) after small ones.
+  json doc = json::parse(box_city({"a", "b", "c"}));
+  const json box = doc["CityObjects"]["c"]["geometry"][0]["boundaries"];
+  json& big = doc["CityObjects"]["c"]["geometry"][0]["boundaries"];
+  for (int k = 0; k < 800; ++k) big.insert(big.end(), box.begin(), box.end());  // ~100 KB of faces
+  write_text(dir + "/city.json", doc.dump());
+  EXPECT_NE(limited("convert --cityjson city.json --out-dir objs"), 0);
+  EXPECT_FALSE(fs::exists(dir + "/objs")) << "half the models are left";
+  EXPECT_TRUE(temp_leftovers(dir).empty());
+  add_row("crop / convert hitting a full disk (file size limit)", "nothing half written left", 1);
+}
+
+// eval --svg-dir: one footprint file per building, whatever its id (the old per-character
+// mapping gave `a b`, `a_b` and `a:b` one footprint_a_b.svg, written by two threads at once).
+TEST(BadInputFiles, EvalFootprintsAreOneFilePerBuilding) {
+  const std::string dir = temp_dir("eval_svg");
+  for (const char* id : {"a b", "a_b", "a:b"}) {
+    fs::create_directories(dir + "/run/" + id);
+    write_text(dir + "/run/" + id + "/coarse.obj", valid_model());
+    write_text(dir + "/run/" + id + "/refined.obj", valid_model());
+    write_text(dir + "/run/" + id + "/cloud.ply", valid_cloud());
+  }
+  const CliRun r = run_cli("eval --dir " + dir + "/run --svg-dir " + dir + "/svg --jobs 3", dir);
+  ASSERT_EQ(r.exit, 0) << r.err;
+  std::vector<std::string> footprints;
+  for (const auto& f : files_in(dir + "/svg"))
+    if (f.rfind("footprint_", 0) == 0) footprints.push_back(f);
+  EXPECT_EQ(footprints.size(), 3u) << r.out;
+  EXPECT_TRUE(temp_leftovers(dir).empty());
+  add_row("eval --svg-dir: ids `a b`, `a_b`, `a:b`", "three footprint files", r.exit);
+}

@@ -1,11 +1,16 @@
 // scripts/batch.mk over a small generated tile: resumable (a removed or older output redoes that
 // building, and only that one), a summary that follows every change, one run per folder (lock),
-// and SIGKILL at any point followed by a rerun giving exactly the outputs of an uninterrupted run.
+// and SIGKILL at any point followed by a rerun giving exactly the outputs of an uninterrupted run;
+// ids that are shell code pass through convert, crop and the dispatchers as data (BatchIds).
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
+#include <set>
 #include <thread>
 
+#include "lodrefine/io/files.h"
+#include "lodrefine/io/obj.h"
 #include "support/batch_fixtures.h"
 
 using namespace lodrefine::batch_fixtures;
@@ -240,3 +245,140 @@ TEST_F(Batch, TileTableWorstFirstWithOutcomesAndMovedFacades) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Untrusted ids (issue 15): ids are data all the way from a city file to the dispatchers.
+
+namespace {
+
+const std::vector<std::string> kHostileIds = {"$(touch PWNED)", "a';touch PWNED;'", "x;touch PWNED", "plain"};
+
+// Every file named PWNED below `dir`, and in the test's working folder.
+std::vector<std::string> pwned(const fs::path& dir) {
+  std::vector<std::string> found;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.path().filename() == "PWNED") found.push_back(e.path().string());
+  if (fs::exists("PWNED")) found.push_back(fs::absolute("PWNED").string());
+  return found;
+}
+
+// A CityJSON 2.0 file holding the given models (polygon soups) under the given ids.
+std::string city_json(const std::vector<lodrefine::Mesh>& models, const std::vector<std::string>& ids) {
+  json doc = {{"type", "CityJSON"}, {"version", "2.0"},
+              {"transform", {{"scale", {0.001, 0.001, 0.001}}, {"translate", {0.0, 0.0, 0.0}}}},
+              {"CityObjects", json::object()}, {"vertices", json::array()}};
+  for (std::size_t b = 0; b < models.size(); ++b) {
+    const std::size_t first = doc["vertices"].size();
+    for (const auto& v : models[b].vertices)
+      doc["vertices"].push_back({std::llround(v.x() * 1000), std::llround(v.y() * 1000), std::llround(v.z() * 1000)});
+    json boundaries = json::array();
+    for (const auto& f : models[b].faces) {
+      json ring = json::array();
+      for (int i : f.v) ring.push_back(first + std::size_t(i));
+      boundaries.push_back({ring});
+    }
+    doc["CityObjects"][ids[b]] = {{"type", "Building"},
+                                  {"geometry", {{{"type", "MultiSurface"}, {"lod", "2.2"}, {"boundaries", boundaries}}}}};
+  }
+  return doc.dump();
+}
+
+}  // namespace
+
+// convert -> crop -> batch.mk (and GNU Parallel when installed) with ids that are shell code, in
+// a RUN path with a space: nothing runs, every building is refined, the real ids reach the reports.
+TEST(BatchIds, HostileIdsThroughConvertCropAndDispatchersRunNothing) {
+  const fs::path base = fresh_dir("batch ids");
+  const std::string in_base = "cd " + shell_quoted(base) + " && ";
+  ASSERT_EQ(shell(in_base + shell_quoted(kBinary) + " synth --tile tile.ply --count 4 --points 3000 --out synth > /dev/null"), 0);
+  std::vector<lodrefine::Mesh> models;
+  for (const auto& e : fs::directory_iterator(base / "synth")) models.push_back(lodrefine::read_obj((e.path() / "coarse.obj").string()));
+  ASSERT_EQ(models.size(), kHostileIds.size());
+  std::ofstream(base / "city.json") << city_json(models, kHostileIds);
+
+  const fs::path run = base / "my run";
+  const fs::path log = base / "log.txt";
+  ASSERT_EQ(shell(in_base + shell_quoted(kBinary) + " convert --cityjson city.json --out-dir objs > log.txt 2>&1"), 0) << read_text(log);
+  ASSERT_EQ(shell(in_base + shell_quoted(kBinary) + " crop --tile tile.ply --models objs --out 'my run' > log.txt 2>&1"), 0) << read_text(log);
+  ASSERT_EQ(shell(in_base + batch_command(run) + " > log.txt 2>&1"), 0) << read_text(log);
+  EXPECT_TRUE(pwned(base).empty()) << pwned(base).front();
+
+  auto expect_all_refined = [&](const fs::path& r) {
+    std::set<std::string> ids;
+    for (const auto& e : fs::directory_iterator(r)) {
+      if (!fs::exists(e.path() / "coarse.obj")) continue;
+      EXPECT_TRUE(lodrefine::is_safe_name(e.path().filename().string())) << e.path();
+      EXPECT_TRUE(fs::exists(e.path() / "refined.obj")) << e.path() << ": " << read_text(e.path() / "FAILED");
+      if (fs::exists(e.path() / "report.json")) ids.insert(json::parse(read_text(e.path() / "report.json"))["id"].get<std::string>());
+    }
+    EXPECT_EQ(ids, std::set<std::string>(kHostileIds.begin(), kHostileIds.end())) << "the reports hold the real ids";
+    EXPECT_EQ(json::parse(read_text(r / "summary.json"))["pooled"]["buildings"], 4);
+  };
+  expect_all_refined(run);
+
+  if (shell("command -v parallel > /dev/null") == 0) {
+    ASSERT_EQ(shell("make -s -f " + shell_quoted(kSource / "scripts" / "batch.mk") + " RUN=" + shell_quoted(run) + " clean-results"), 0);
+    ASSERT_EQ(shell(in_base + "LODREFINE=" + shell_quoted(kBinary) + " HOME=" + shell_quoted(base) + " " +
+                    shell_quoted(kSource / "scripts" / "parallel_batch.sh") + " " + shell_quoted(run) +
+                    " --sshlogin : -j2 > log.txt 2>&1"),
+              0)
+        << read_text(log);
+    EXPECT_TRUE(pwned(base).empty()) << pwned(base).front();
+    expect_all_refined(run);
+  }
+  if (!HasFailure()) fs::remove_all(base);
+}
+
+// A folder name that is not a safe name (made by hand, or by an older crop) is refused with one
+// line before anything runs, by make and by GNU Parallel; nothing is executed.
+TEST(BatchIds, UnsafeFolderNamesAreRefusedBeforeAnythingRuns) {
+  const fs::path base = fresh_dir("batch_unsafe");
+  const fs::path run = base / "run";
+  make_tile(run, 1);
+  const fs::path good = fs::directory_iterator(run)->path();
+  for (const std::string name : {"x;touch PWNED", "$(touch PWNED)", "-rf", "a'b"}) {
+    const fs::path bad = run / name;
+    fs::create_directories(bad);
+    fs::copy_file(good / "coarse.obj", bad / "coarse.obj");
+    fs::copy_file(good / "cloud.ply", bad / "cloud.ply");
+    const fs::path err = base / "err.txt";
+    EXPECT_EQ(shell("cd " + shell_quoted(base) + " && " + batch_command(run) + " > /dev/null 2> " + shell_quoted(err)), 2) << name;
+    const std::string message = read_text(err);
+    EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
+    EXPECT_NE(message.find("is not a safe name"), std::string::npos) << message;
+    if (shell("command -v parallel > /dev/null") == 0)
+      EXPECT_NE(shell("cd " + shell_quoted(base) + " && LODREFINE=" + shell_quoted(kBinary) + " HOME=" + shell_quoted(base) +
+                      " " + shell_quoted(kSource / "scripts" / "parallel_batch.sh") + " " + shell_quoted(run) +
+                      " --sshlogin : > /dev/null 2>&1"),
+                0)
+          << name;
+    EXPECT_EQ(shell("cd " + shell_quoted(base) + " && " + shell_quoted(kSource / "scripts" / "refine_one.sh") + " " +
+                    shell_quoted(run) + " " + shell_quoted(name) + " 2> /dev/null"),
+              2)
+        << name;
+    EXPECT_TRUE(pwned(base).empty()) << name;
+    EXPECT_FALSE(fs::exists(good / "refined.obj")) << "nothing runs when a name is refused";
+    fs::remove_all(bad);
+  }
+  fs::remove_all(base);
+}
+
+// Leftovers: the batch removes lodrefine's own temporaries of a killed run, and never a user's
+// file that merely has ".tmp." in its name.
+TEST(BatchIds, OnlyLodrefineTemporariesAreCleanedUp) {
+  const fs::path base = fresh_dir("batch_leftovers");
+  const fs::path run = base / "run";
+  make_tile(run, 1);
+  const fs::path building = fs::directory_iterator(run)->path();
+  for (const fs::path& p : {run / "notes.tmp.1", building / "mine.tmp.2", building / "refined.obj.tmp.3"})
+    std::ofstream(p) << "user data\n";
+  std::ofstream(building / ".lodrefine-tmp-AbCdEf1234") << "killed writer\n";
+  std::ofstream(run / ".lodrefine-tmp-XyZ") << "killed writer\n";
+  ASSERT_EQ(shell(batch_command(run) + " > /dev/null 2>&1"), 0);
+  EXPECT_TRUE(fs::exists(building / "refined.obj"));
+  for (const fs::path& p : {run / "notes.tmp.1", building / "mine.tmp.2", building / "refined.obj.tmp.3"})
+    EXPECT_EQ(read_text(p), "user data\n") << p;
+  EXPECT_FALSE(fs::exists(building / ".lodrefine-tmp-AbCdEf1234"));
+  EXPECT_FALSE(fs::exists(run / ".lodrefine-tmp-XyZ"));
+  fs::remove_all(base);
+}

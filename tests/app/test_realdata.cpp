@@ -18,6 +18,7 @@
 #include <random>
 
 #include "lodrefine/io/cityjson.h"
+#include "lodrefine/io/files.h"
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/io/obj.h"
 #include "lodrefine/io/ply.h"
@@ -187,7 +188,7 @@ std::string env(const char* name) {
 // building with `lodrefine refine --model model.obj --cloud scan.ply ...`.
 void dump_case(const Mesh& soup, const PointCloud& scan, const Mesh& refined) {
   if (env("LODREFINE_REALDATA_DUMP").empty()) return;
-  const fs::path d = fs::path(env("LODREFINE_REALDATA_DUMP")) / file_stem_for_id(soup.id);
+  const fs::path d = fs::path(env("LODREFINE_REALDATA_DUMP")) / safe_name(soup.id);
   fs::create_directories(d);
   write_obj((d / "model.obj").string(), soup);
   write_ply((d / "scan.ply").string(), scan);

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 
 #include "lodrefine/io/crop.h"
 #include "lodrefine/core/geometry.h"
@@ -63,8 +64,15 @@ TEST(Crop, BoundedMemoryCropWritesTheSameClouds) {
   crop_tile(path, in_memory);
   std::vector<std::string> outs;
   for (std::size_t i = 0; i < targets.size(); ++i) outs.push_back((dir / ("crop" + std::to_string(i) + ".ply")).string());
+  // Links planted at the spill files' old, predictable names are not followed (issue 15).
+  const auto victim = dir / "victim.txt";
+  { std::ofstream(victim) << "precious\n"; }
+  for (const auto& out : outs) std::filesystem::create_symlink(victim, out + ".spill.tmp." + std::to_string(::getpid()));
   std::vector<std::size_t> counts;
   EXPECT_EQ(crop_tile_to_files(path, targets, outs, 7, counts), tile.points.size());
+  EXPECT_EQ(std::filesystem::file_size(victim), 9u);
+  for (const auto& out : outs) std::filesystem::remove(out + ".spill.tmp." + std::to_string(::getpid()));
+  std::filesystem::remove(victim);
   std::size_t total = 0;
   for (std::size_t i = 0; i < targets.size(); ++i) {
     const PointCloud c = read_ply(outs[i]);
@@ -75,6 +83,6 @@ TEST(Crop, BoundedMemoryCropWritesTheSameClouds) {
   }
   EXPECT_GT(total, tile.points.size()) << "the boxes overlap: some points belong to two crops";
   for (const auto& e : std::filesystem::directory_iterator(dir))
-    EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << e.path();
+    EXPECT_EQ(e.path().filename().string().find("tmp"), std::string::npos) << e.path();
   std::filesystem::remove_all(dir);
 }

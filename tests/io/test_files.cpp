@@ -9,6 +9,9 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <set>
+
+#include <unistd.h>
 
 #include "lodrefine/io/files.h"
 #include "lodrefine/io/obj.h"
@@ -57,5 +60,113 @@ TEST(IoWrite, AtomicWriteReplacesAndLeavesNoTempOnFailure) {
   EXPECT_EQ(s, "new content");
   std::size_t entries = 0;
   for ([[maybe_unused]] const auto& e : fs::directory_iterator(fs::path(path).parent_path())) ++entries;
-  EXPECT_EQ(entries, 1u);  // no leftover .tmp.<pid>
+  EXPECT_EQ(entries, 1u);  // no leftover .lodrefine-tmp-*
+}
+
+// ---------------------------------------------------------------------------------------------
+// Untrusted names and paths (issue 15)
+
+namespace {
+
+bool only_safe_chars(const std::string& s) {
+  return std::all_of(s.begin(), s.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-'; });
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+}  // namespace
+
+TEST(SafeName, KeepsSafeIdsAndHashesTheRest) {
+  EXPECT_EQ(safe_name("NL.IMBAG.Pand.0503100000031927-0"), "NL.IMBAG.Pand.0503100000031927-0");
+  EXPECT_EQ(safe_name("bldg_0001"), "bldg_0001");
+  for (const std::string& id : std::vector<std::string>{"$(touch PWNED)", "a';touch PWNED;'", "x;touch PWNED", "{10A31B7E-8FC2}", "..", ".", "",
+                               "-rf", ".hidden", "a/b c\\d:e\n", "caf\xc3\xa9", std::string(300, 'x'),
+                               std::string("nul\0byte", 8)}) {
+    const std::string name = safe_name(id);
+    EXPECT_NE(name, id);
+    EXPECT_TRUE(is_safe_name(name)) << name;
+    EXPECT_TRUE(only_safe_chars(name)) << name;
+    EXPECT_LE(name.size(), kMaxSafeName) << name;
+    EXPECT_TRUE(name[0] != '-' && name[0] != '.') << name;
+    EXPECT_EQ(name.size() >= 14 ? name.substr(name.size() - 14, 2) : "", "--") << name << ": no hash suffix";
+    EXPECT_EQ(safe_name(id), name) << "not deterministic";
+    EXPECT_EQ(safe_name(name), name) << "not idempotent: convert's names would change in crop";
+  }
+  EXPECT_EQ(safe_name("a b").substr(0, 5), "a_b--");  // readable where it can be
+  EXPECT_NE(safe_name("a b"), safe_name("a:b"));       // the hash tells them apart
+  EXPECT_EQ(safe_name(std::string(100, 'y')), std::string(100, 'y'));
+  EXPECT_NE(safe_name(std::string(101, 'y')), std::string(101, 'y'));
+  EXPECT_FALSE(is_safe_name("a b"));
+  EXPECT_FALSE(is_safe_name("-x"));
+  EXPECT_FALSE(is_safe_name(".."));
+  EXPECT_FALSE(is_safe_name(""));
+}
+
+TEST(SafeName, SafeNamesAreDistinctAlsoIgnoringCase) {
+  // Ids that the old per-character mapping (or a case-folding file system) merged into one name.
+  const std::vector<std::string> ids = {"a b", "a_b", "a:b", "a/b", "A_B", "A", "a", "a", "plots", "PLOTS",
+                                        std::string(120, 'z') + "1", std::string(120, 'z') + "2",
+                                        safe_name("a b"), "a_b--ffffffffffff"};
+  SafeNames names({"plots"});
+  std::set<std::string> seen;
+  std::vector<std::string> given;
+  for (const auto& id : ids) {
+    given.push_back(names.add(id));
+    EXPECT_TRUE(is_safe_name(given.back())) << given.back();
+    EXPECT_TRUE(seen.insert(lower(given.back())).second) << id << " -> " << given.back();
+  }
+  EXPECT_EQ(given[1], "a_b");  // an id that is safe keeps its name when it is free
+  EXPECT_EQ(given[5], "A");
+  EXPECT_NE(lower(given[8]), "plots");  // reserved
+  SafeNames again({"plots"});
+  for (std::size_t i = 0; i < ids.size(); ++i) EXPECT_EQ(again.add(ids[i]), given[i]) << "not deterministic";
+}
+
+TEST(IoWrite, PlantedSymlinkAtATempNameIsNeverFollowed) {
+  const fs::path dir = fs::path(temp_path("symlink_dir"));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path victim = dir / "victim.txt", target = dir / "out.txt";
+  { std::ofstream(victim) << "precious\n"; }
+  // The old temporary name (<path>.tmp.<pid>) and a link at the target itself.
+  fs::create_symlink(victim, dir / ("out.txt.tmp." + std::to_string(::getpid())));
+  write_file_atomic(target.string(), "new\n");
+  fs::create_symlink(victim, dir / "link.txt");
+  write_file_atomic((dir / "link.txt").string(), "replaced the link\n");
+  std::ifstream in(victim);
+  std::string s;
+  std::getline(in, s);
+  EXPECT_EQ(s, "precious");
+  EXPECT_FALSE(fs::is_symlink(dir / "link.txt"));
+  // Temporaries are ours by name and created exclusively.
+  std::string path;
+  const int fd = create_temp_file(dir.string(), target.string(), path);
+  ASSERT_GE(fd, 0);
+  ::close(fd);
+  EXPECT_EQ(fs::path(path).filename().string().rfind(kTempPrefix, 0), 0u) << path;
+  fs::remove_all(dir);
+}
+
+TEST(IoWrite, NonRegularFilesAreRefusedAndSameFilesRecognised) {
+  EXPECT_THROW(require_regular_file("/dev/zero"), InputError);
+  EXPECT_THROW(require_regular_file("/tmp"), InputError);
+  EXPECT_EQ(sniff_file("/dev/zero"), FileKind::Other);
+  const fs::path dir = fs::path(temp_path("same_dir"));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "sub");
+  const fs::path a = dir / "a.obj";
+  { std::ofstream(a) << "x\n"; }
+  require_regular_file(a.string());
+  fs::create_symlink(a, dir / "link.obj");
+  fs::create_hard_link(a, dir / "hard.obj");
+  EXPECT_TRUE(same_file(a.string(), (dir / "link.obj").string()));
+  EXPECT_TRUE(same_file(a.string(), (dir / "hard.obj").string()));
+  EXPECT_TRUE(same_file(a.string(), (dir / "sub" / ".." / "a.obj").string()));
+  EXPECT_FALSE(same_file(a.string(), (dir / "b.obj").string()));
+  EXPECT_TRUE(same_file((dir / "new.obj").string(), (dir / "sub" / ".." / "new.obj").string()));  // neither exists yet
+  EXPECT_FALSE(same_file((dir / "new.obj").string(), (dir / "sub" / "new.obj").string()));
+  fs::remove_all(dir);
 }

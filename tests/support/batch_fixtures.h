@@ -25,7 +25,12 @@ using nlohmann::json;
 inline const fs::path kSource = LODREFINE_SOURCE_DIR;
 inline const std::string kBinary = LODREFINE_BINARY;
 
-inline std::string shell_quoted(const fs::path& p) { return "'" + p.string() + "'"; }
+// One shell word: in single quotes, a quote inside as '\''.
+inline std::string shell_quoted(const fs::path& p) {
+  std::string q = "'";
+  for (char c : p.string()) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
 
 inline std::string read_text(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -120,7 +125,9 @@ inline TileRun tile_and_batch(const std::string& name, int buildings) {
 inline std::vector<std::string> temporaries(const fs::path& run) {
   std::vector<std::string> found;
   for (const auto& e : fs::recursive_directory_iterator(run))
-    if (e.path().filename().string().find(".tmp") != std::string::npos) found.push_back(e.path().string());
+    if (e.path().filename().string().find(".tmp") != std::string::npos ||
+        e.path().filename().string().find("lodrefine-tmp") != std::string::npos)
+      found.push_back(e.path().string());
   return found;
 }
 

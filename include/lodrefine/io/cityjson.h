@@ -61,10 +61,6 @@ CityJsonFile read_cityjson_document(const nlohmann::ordered_json& doc, const std
 // more lines (the CityJSONFeatures).
 bool is_cityjson_sequence(const std::string& text);
 
-// A file name (without extension) for a CityObject id: characters that are unsafe in paths
-// (separators, whitespace, control and shell-special characters) become '_'.
-std::string file_stem_for_id(const std::string& id);
-
 // Semantic of a CityJSON semantic surface type ("WallSurface" -> Wall, ...; others -> Other).
 Semantic semantic_from_cityjson(const std::string& type);
 

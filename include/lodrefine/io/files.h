@@ -2,7 +2,9 @@
 // and atomic writes (a temporary beside the target, renamed over it), so no partial file is left.
 #pragma once
 #include <cstddef>
+#include <set>
 #include <string>
+#include <vector>
 
 #include "lodrefine/core/types.h"
 
@@ -21,9 +23,21 @@ FileKind sniff_file(const std::string& path);  // Other also for unreadable file
 // model?)"; empty for Other.
 std::string file_kind_text(FileKind kind);
 
-// A file written through a temporary beside the target and renamed over it on commit();
-// the temporary is removed if commit() is never reached (an exception, a kill leaves only a
-// "<path>.tmp.<pid>"). For outputs written in pieces (streams); write_file_atomic for one piece.
+// Prefix of every temporary file lodrefine writes (AtomicFile, crop's spill files): a kill -9
+// leaves only files named so, which the batch scripts remove (and nothing else of the user's).
+inline constexpr const char* kTempPrefix = ".lodrefine-tmp-";
+
+// Creates a new, empty file `<dir>/.lodrefine-tmp-<random>` exclusively (O_EXCL|O_NOFOLLOW, so
+// a file or symlink planted under a guessed name is never opened or followed) and returns its
+// open descriptor (close-on-exec, mode 0644 less umask); `path` gets its name. Throws
+// std::runtime_error "cannot write <for_path>: <reason>" when it cannot be created.
+int create_temp_file(const std::string& dir, const std::string& for_path, std::string& path);
+
+// A file written through a temporary beside the target (create_temp_file) and renamed over it
+// on commit(); the temporary is removed if commit() is never reached (an exception; a kill -9
+// leaves a ".lodrefine-tmp-*"). A symlink at `path` is replaced, never followed. Constructing
+// one is also the check that `path` can be written (its folder exists and is writable). For
+// outputs written in pieces (streams); write_file_atomic for one piece.
 class AtomicFile {
  public:
   explicit AtomicFile(const std::string& path);
@@ -44,5 +58,47 @@ class AtomicFile {
 
 // Writes `content` to `path` atomically (temp file in the same directory + rename).
 void write_file_atomic(const std::string& path, const std::string& content);
+// Copies the regular file `from` to `to` atomically (same guarantees as write_file_atomic).
+void copy_file_atomic(const std::string& from, const std::string& to);
+
+// Throws InputError "<path>: not a regular file ..." for devices, FIFOs, sockets and
+// directories: reading /dev/zero or a pipe would not end (or not before gigabytes), and their
+// size is unknown up front. Symlinks to regular files pass.
+void require_regular_file(const std::string& path);
+
+// True when `a` and `b` name the same file: the same device and inode when both exist (links,
+// hard links and `./x` vs `x` all count), else the same real parent folder and name. Used to
+// refuse an output that would overwrite an input, or another output, before reading anything.
+bool same_file(const std::string& a, const std::string& b);
+
+// Names for untrusted ids (CityObject ids, file stems) in file and folder names that make, the
+// shell and every file system take as they are.
+//
+// safe_name(id) is `id` itself when it is already safe: only [A-Za-z0-9._-], not starting with
+// '-' or '.', at most kMaxSafeName bytes (so safe_name(safe_name(x)) == safe_name(x)). Otherwise
+// every other byte becomes '_', a leading '-'/'.' (or an empty id) gets a '_' in front, it is
+// cut to 80 bytes and "--" plus 12 hex digits of a hash of the whole id are appended, so two ids
+// that differ give different names (up to hash collisions and an id that is literally another
+// one's hashed name: SafeNames resolves both within a set).
+inline constexpr std::size_t kMaxSafeName = 100;
+// An untrusted id for a message line: in double quotes, JSON-escaped (control characters as
+// \u00XX, invalid UTF-8 as U+FFFD), so it can neither break the line nor the terminal.
+std::string shown_id(const std::string& id);
+std::string safe_name(const std::string& id);
+bool is_safe_name(const std::string& name);
+
+// Distinct safe names for a sequence of ids, deterministic for a given order, distinct also
+// when compared case-insensitively (macOS, Windows and SMB shares fold case): a name already
+// taken goes to its hashed form, then gets "-2", "-3", ... Names passed as `reserved` (e.g.
+// "plots" in a run folder) are never given. Every name is at most kMaxSafeName bytes.
+class SafeNames {
+ public:
+  explicit SafeNames(const std::vector<std::string>& reserved = {});
+  std::string add(const std::string& id);
+
+ private:
+  bool take(const std::string& name);
+  std::set<std::string> taken_;  // lower case
+};
 
 }  // namespace lodrefine
