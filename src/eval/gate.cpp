@@ -299,7 +299,28 @@ Gates read_gates(const std::string& text, const std::string& source) {
   return gates;
 }
 
-GateVerdict check_run(const RunFigures& run, const RunFigures* baseline, const Gates* gates, double tolerance) {
+namespace {
+// Ids as a baseline stores them (JSON holds UTF-8 only): bytes that are not UTF-8 as U+FFFD, so
+// a run matches the baseline it wrote.
+RunFigures with_utf8_ids(RunFigures run) {
+  for (auto& b : run.buildings) {
+    std::string id;
+    for (std::size_t i = 0; i < b.id.size();) {
+      const auto [cp, len] = decode_utf8(b.id, i);
+      id += cp < 0 ? std::string("\xEF\xBF\xBD") : b.id.substr(i, len);
+      i += len;
+    }
+    b.id = std::move(id);
+  }
+  return run;
+}
+}  // namespace
+
+GateVerdict check_run(const RunFigures& run_as_read, const RunFigures* baseline_as_read, const Gates* gates,
+                      double tolerance) {
+  const RunFigures run = with_utf8_ids(run_as_read);
+  const std::optional<RunFigures> baseline_ids = baseline_as_read ? std::optional(with_utf8_ids(*baseline_as_read)) : std::nullopt;
+  const RunFigures* baseline = baseline_ids ? &*baseline_ids : nullptr;
   GateVerdict verdict;
   Checker c{tolerance, verdict};
   for (const auto& b : run.buildings) verdict.buildings.push_back(b.id);

@@ -79,6 +79,16 @@ TEST(Gate, BaselineRoundTripsAndAnUnchangedRunPasses) {
   EXPECT_EQ(v.pooled_checks, std::vector<std::string>{"baseline"});
 }
 
+TEST(Gate, IdsThatAreNotUtf8MatchTheBaselineTheyWrote) {
+  RunFigures run = sample_run();
+  run.buildings[1].id = "b\xFF\xC3";
+  const RunFigures base = read_baseline(baseline_json(run), "base.json");
+  EXPECT_EQ(base.buildings[1].id, "b\xEF\xBF\xBD\xEF\xBF\xBD");
+  const GateVerdict v = check_run(run, &base, nullptr, 0.005);
+  EXPECT_FALSE(v.failed()) << texts(v).front();
+  EXPECT_TRUE(v.new_buildings.empty());
+}
+
 TEST(Gate, EachRegressionNamesBuildingFigureAndValues) {
   const RunFigures base = sample_run();
   RunFigures run = sample_run();
