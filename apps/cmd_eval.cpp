@@ -691,6 +691,9 @@ struct GateInputs {
 };
 
 GateInputs read_gate_inputs(const EvalArgs& a) {
+  for (const std::string& out : {a.baseline_out, a.junit_out})
+    if (!out.empty() && !fs::is_directory(fs::absolute(out).parent_path()))
+      throw InputError(out + ": output directory " + fs::absolute(out).parent_path().string() + " does not exist");
   GateInputs in;
   if (!a.baseline_in.empty()) in.baseline = read_baseline(read_small_file(a.baseline_in), a.baseline_in);
   if (!a.gates.empty()) in.gates = read_gates(read_small_file(a.gates), a.gates);

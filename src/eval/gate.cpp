@@ -144,8 +144,11 @@ bool breaches(const std::string& gate, double value, double limit) {
   return gate.rfind("max_", 0) == 0 ? value > limit : value < limit;
 }
 
+// Counts without decimals, distances and rates with four.
+std::string value_text(double v) { return v == std::floor(v) && std::abs(v) < 1e15 ? num(v, 0) : num(v); }
+
 std::string limit_text(const std::string& gate, double value, double limit) {
-  return num(value) + (gate.rfind("max_", 0) == 0 ? " > " : " < ") + num(limit) + " (" + gate + ")";
+  return gate + " " + value_text(value) + (gate.rfind("max_", 0) == 0 ? " > " : " < ") + value_text(limit);
 }
 
 void check_gates(const RunFigures& run, const Gates& gates, Checker& c) {
@@ -154,7 +157,7 @@ void check_gates(const RunFigures& run, const Gates& gates, Checker& c) {
     if (!g.per_building) {
       c.verdict.pooled_checks.push_back(gate);
       if (!g.pooled)
-        c.fail("", gate, gate, gate + ": not measured in this run");
+        c.fail("", gate, gate, gate + " not measured in this run");
       else if (breaches(gate, *g.pooled, limit))
         c.fail("", gate, gate, limit_text(gate, *g.pooled, limit));
       continue;

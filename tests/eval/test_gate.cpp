@@ -144,14 +144,17 @@ TEST(Gate, GatesBreachedPooledAndPerBuilding) {
   const GateVerdict v = check_run(sample_run(), nullptr, &g, 0.005);
   const auto t = texts(v);
   ASSERT_EQ(t.size(), 3u) << ::testing::PrintToString(t);  // the ratio 0.105 is within 0.5
-  EXPECT_EQ(t[0], "b: 0.0300 > 0.0250 (max_building_c2m_rmse_refined)");
+  EXPECT_EQ(t[0], "b: max_building_c2m_rmse_refined 0.0300 > 0.0250");
   EXPECT_EQ(v.failures[0].building, "b");
-  EXPECT_EQ(t[1], "pooled: 0.0210 > 0.0200 (max_c2m_rmse_refined)");
-  EXPECT_EQ(t[2], "pooled: max_truth_roof_rmse_refined: not measured in this run");
+  EXPECT_EQ(t[1], "pooled: max_c2m_rmse_refined 0.0210 > 0.0200");
+  EXPECT_EQ(t[2], "pooled: max_truth_roof_rmse_refined not measured in this run");
   EXPECT_EQ(v.pooled_checks.size(), 5u);  // every gate but the per-building one
+  RunFigures failing = sample_run();
+  failing.failed = 2;
+  EXPECT_EQ(texts(check_run(failing, nullptr, &g, 0.005))[2], "pooled: max_failed_buildings 2 > 0");
   const Gates ratio = {{"max_c2m_rmse_ratio", 0.1}};
   EXPECT_EQ(texts(check_run(sample_run(), nullptr, &ratio, 0.005)),
-            std::vector<std::string>{"pooled: 0.1050 > 0.1000 (max_c2m_rmse_ratio)"});
+            std::vector<std::string>{"pooled: max_c2m_rmse_ratio 0.1050 > 0.1000"});
 }
 
 TEST(Gate, BadGateAndBaselineFilesAreOneLineErrors) {
