@@ -11,7 +11,6 @@
 #include <mutex>
 #include <map>
 #include <optional>
-#include <sstream>
 #include <thread>
 #include <tuple>
 
@@ -676,14 +675,6 @@ RunFigures run_figures(const std::vector<Row>& rows, const PooledEval& p) {
   return run;
 }
 
-std::string read_small_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open the file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 // Reads the gate's inputs before any work, so a bad file costs no evaluation.
 struct GateInputs {
   std::optional<RunFigures> baseline;
@@ -695,8 +686,8 @@ GateInputs read_gate_inputs(const EvalArgs& a) {
     if (!out.empty() && !fs::is_directory(fs::absolute(out).parent_path()))
       throw InputError(out + ": output directory " + fs::absolute(out).parent_path().string() + " does not exist");
   GateInputs in;
-  if (!a.baseline_in.empty()) in.baseline = read_baseline(read_small_file(a.baseline_in), a.baseline_in);
-  if (!a.gates.empty()) in.gates = read_gates(read_small_file(a.gates), a.gates);
+  if (!a.baseline_in.empty()) in.baseline = read_baseline(read_file(a.baseline_in), a.baseline_in);
+  if (!a.gates.empty()) in.gates = read_gates(read_file(a.gates), a.gates);
   return in;
 }
 

@@ -85,8 +85,10 @@ std::string caption(const CityReviewBuilding& b) {
 }
 
 // The check a kept building's reason names: its text before any ':' or '(' with numbers as "N"
-// (reasons carry the figures of the building, e.g. "... better (RMS 0.12 -> 0.15 m)").
-std::string check_of(const std::string& reason) {
+// (reasons carry the figures of the building, e.g. "... better (RMS 0.12 -> 0.15 m)"), without
+// a leading "building <id>: ".
+std::string check_of(const std::string& id, std::string reason) {
+  if (const std::string own = "building " + id + ": "; reason.rfind(own, 0) == 0) reason.erase(0, own.size());
   std::string key = reason.substr(0, std::min(reason.find(':'), reason.find('(')));
   std::string out;
   for (std::size_t i = 0; i < key.size(); ++i) {
@@ -102,7 +104,7 @@ std::string check_of(const std::string& reason) {
 std::string refusals_text(const CityReview& r) {
   std::map<std::string, std::size_t> count;
   for (const auto& b : r.buildings)
-    if (b.outcome == "kept" || b.outcome == "kept-invalid") ++count[b.outcome + ": " + check_of(b.reason)];
+    if (b.outcome == "kept" || b.outcome == "kept-invalid") ++count[b.outcome + ": " + check_of(b.id, b.reason)];
   std::vector<std::pair<std::string, std::size_t>> sorted(count.begin(), count.end());
   std::stable_sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
   std::string out = "\nchecks that refused (kept buildings by reason):\n";

@@ -81,4 +81,6 @@ void write_file_atomic(const std::string& path, const std::string& content) {
   file.commit();
 }
 
+std::string read_file(const std::string& path) { return io_text::read_whole_file(path); }
+
 }  // namespace lodrefine

@@ -35,22 +35,15 @@ TEST(Report, PageLoadsWithoutErrorsAndTheScreenshotShowsTheModel) {
   EXPECT_LT(failed_row, html.find("<tr class=\"refined\">"));
   EXPECT_EQ(html.find("id=\"view-" + broken + "\""), std::string::npos) << "no view of unreadable inputs";
 
-  const fs::path dom = run / "dom.html", log = run / "chromium.log", shot = run / "shot.png";
-  ASSERT_EQ(shell(chromium(run / "profile", 900) + "--enable-logging=stderr --v=0 --dump-dom " +
-                  shell_quoted(run / "report.html") + " > " + shell_quoted(dom) + " 2> " + shell_quoted(log)),
-            0)
-      << read_text(log);
-  const std::string page = read_text(dom);
+  const fs::path shot = run / "shot.png";
+  const PageDump d = dump_page(run / "report.html", run);
+  ASSERT_EQ(d.exit, 0) << d.log;
+  const std::string& page = d.page;
   std::smatch m;
-  ASSERT_TRUE(std::regex_search(page, m, std::regex("<html[^>]*>"))) << page.substr(0, 500);
-  const std::string root = m.str();
-  EXPECT_EQ(root.find("data-errors"), std::string::npos) << root;
-  EXPECT_NE(root.find("data-rendered=\"3\""), std::string::npos) << root << "\n" << read_text(log);
-  // Chromium logs page console messages as CONSOLE lines: none may be an error.
-  std::istringstream lines(read_text(log));
-  for (std::string line; std::getline(lines, line);)
-    if (line.find(":CONSOLE") != std::string::npos)
-      EXPECT_EQ(line.find("ERROR"), std::string::npos) << line;
+  ASSERT_FALSE(d.root.empty()) << page.substr(0, 500);
+  EXPECT_EQ(d.root.find("data-errors"), std::string::npos) << d.root;
+  EXPECT_NE(d.root.find("data-rendered=\"3\""), std::string::npos) << d.root << "\n" << d.log;
+  for (const std::string& line : d.console_errors) ADD_FAILURE() << line;
 
   // The first 3D canvas, where the page says it is; then its pixels in a screenshot.
   ASSERT_TRUE(std::regex_search(page, m, std::regex("data-rect=\"(\\d+),(\\d+),(\\d+),(\\d+)\""))) << "no canvas rect";
@@ -63,18 +56,11 @@ TEST(Report, PageLoadsWithoutErrorsAndTheScreenshotShowsTheModel) {
   const Image img = decode_png(read_text(shot));
   ASSERT_GE(img.width, x0 + w);
   ASSERT_GE(img.height, y0 + h);
-  std::size_t drawn = 0, orange = 0, total = 0;
-  for (int y = y0 + 3; y < y0 + h - 3; ++y)
-    for (int x = x0 + 3; x < x0 + w - 3; ++x) {
-      const auto& p = img.at(x, y);
-      ++total;
-      drawn += std::max({255 - p[0], 255 - p[1], 255 - p[2]}) > 30;  // not the white background
-      orange += p[0] > 150 && p[1] > 60 && p[1] < 170 && p[2] < 90;   // the refined model's colour
-    }
+  const CanvasShares c = canvas_shares(img, x0, y0, w, h);
   std::printf("3D canvas %dx%d at (%d, %d): %.1f %% drawn, %.1f %% refined-model orange\n", w, h, x0, y0,
-              100.0 * double(drawn) / double(total), 100.0 * double(orange) / double(total));
-  EXPECT_GT(double(drawn) / double(total), 0.05) << "the 3D view looks empty";
-  EXPECT_GT(double(orange) / double(total), 0.02) << "the refined model is not visible";
+              100.0 * c.drawn, 100.0 * c.orange);
+  EXPECT_GT(c.drawn, 0.05) << "the 3D view looks empty";
+  EXPECT_GT(c.orange, 0.02) << "the refined model is not visible";
   // Outside the canvas, left of it, the page background is white.
   EXPECT_EQ(img.at(x0 - 5 > 0 ? x0 - 5 : 0, y0 + h / 2)[0] > 200, true);
   if (!HasFailure()) fs::remove_all(run);

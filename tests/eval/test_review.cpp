@@ -49,6 +49,10 @@ TEST(Review, HostileIdsEscapedAndTableWorstFirst) {
   r.buildings = {reviewed("good", "refined", 0.01, 0), reviewed(kHostile, "refined", 0.05, 20),
                  reviewed("k1", "kept", 0.3, 40), reviewed("k2", "kept", 0.3, 60), reviewed("u", "untouched", 0, 80)};
   r.buildings[3].reason = "no wall matched a scan plane";
+  for (const std::string id : {"i1", "i2"}) {
+    r.buildings.push_back(reviewed(id, "kept-invalid", 0.3, 100));
+    r.buildings.back().reason = "building " + id + ": not closable: 2 non-manifold edges (more than two faces)";
+  }
   const std::string h = city_review_html(r);
   // Only "</" and "<!--" can end or bend a script element: escaped, in the HTML as in the JSON.
   EXPECT_EQ(h.find("</script><script>document"), std::string::npos);
@@ -75,6 +79,7 @@ TEST(Review, HostileIdsEscapedAndTableWorstFirst) {
   // The refusals by check, numbers folded.
   EXPECT_NE(h.find("1  kept: the refinement does not fit the scan better"), std::string::npos);
   EXPECT_NE(h.find("1  kept: no wall matched a scan plane"), std::string::npos);
+  EXPECT_NE(h.find("2  kept-invalid: not closable\n"), std::string::npos) << h.substr(h.find("checks that"), 300);
   // The map: every building outlined, refined ones linked to their view.
   EXPECT_NE(h.find("<a href=\"#view-good\"><path"), std::string::npos);
   EXPECT_NE(h.find("<title>u: untouched</title>"), std::string::npos);
@@ -144,22 +149,15 @@ TEST(Review, DelfshavenRefinePageRendersEveryRefinedBuilding) {
   EXPECT_NE(html.find("853 building(s): " + std::to_string(refined.size()) + " refined"), std::string::npos);
   EXPECT_NE(html.find(std::to_string(rep["untouched"].get<int>()) + " untouched"), std::string::npos);
 
-  const fs::path dom = dir / "dom.html", log = dir / "chromium.log";
-  ASSERT_EQ(shell(chromium(dir / "profile", 900) + "--enable-logging=stderr --v=0 --dump-dom " +
-                  shell_quoted(dir / "review.html") + " > " + shell_quoted(dom) + " 2> " + shell_quoted(log)),
-            0)
-      << read_text(log);
-  const std::string page = read_text(dom);
-  std::smatch m;
-  ASSERT_TRUE(std::regex_search(page, m, std::regex("<html[^>]*>"))) << page.substr(0, 500);
-  const std::string root = m.str();
-  EXPECT_EQ(root.find("data-errors"), std::string::npos) << root;
-  EXPECT_EQ(root.find("data-pwned"), std::string::npos) << "the hostile id ran";
-  EXPECT_NE(root.find("data-rendered=\"" + std::to_string(refined.size()) + "\""), std::string::npos)
-      << root << "\n" << read_text(log);
-  std::istringstream lines(read_text(log));
-  for (std::string line; std::getline(lines, line);)
-    if (line.find(":CONSOLE") != std::string::npos) EXPECT_EQ(line.find("ERROR"), std::string::npos) << line;
+  const PageDump d = dump_page(dir / "review.html", dir);
+  ASSERT_EQ(d.exit, 0) << d.log;
+  const std::string& page = d.page;
+  ASSERT_FALSE(d.root.empty()) << page.substr(0, 500);
+  EXPECT_EQ(d.root.find("data-errors"), std::string::npos) << d.root;
+  EXPECT_EQ(d.root.find("data-pwned"), std::string::npos) << "the hostile id ran";
+  EXPECT_NE(d.root.find("data-rendered=\"" + std::to_string(refined.size()) + "\""), std::string::npos)
+      << d.root << "\n" << d.log;
+  for (const std::string& line : d.console_errors) ADD_FAILURE() << line;
 
   // Every refined building's canvas, in one screenshot tall enough for all of them.
   std::vector<std::array<int, 4>> rects;
@@ -178,18 +176,11 @@ TEST(Review, DelfshavenRefinePageRendersEveryRefinedBuilding) {
     ASSERT_GT(w, 100);
     ASSERT_GE(img.width, x0 + w);
     ASSERT_GE(img.height, y0 + h);
-    std::size_t drawn = 0, orange = 0, total = 0;
-    for (int y = y0 + 3; y < y0 + h - 3; ++y)
-      for (int x = x0 + 3; x < x0 + w - 3; ++x) {
-        const auto& p = img.at(x, y);
-        ++total;
-        drawn += std::max({255 - p[0], 255 - p[1], 255 - p[2]}) > 30;
-        orange += p[0] > 150 && p[1] > 60 && p[1] < 170 && p[2] < 90;
-      }
-    std::printf("3D canvas at (%d, %d): %.1f %% drawn, %.1f %% refined-model orange\n", x0, y0,
-                100.0 * double(drawn) / double(total), 100.0 * double(orange) / double(total));
-    EXPECT_GT(double(drawn) / double(total), 0.05) << "a 3D view looks empty";
-    EXPECT_GT(double(orange) / double(total), 0.02) << "a refined model is not visible";
+    const CanvasShares c = canvas_shares(img, x0, y0, w, h);
+    std::printf("3D canvas at (%d, %d): %.1f %% drawn, %.1f %% refined-model orange\n", x0, y0, 100.0 * c.drawn,
+                100.0 * c.orange);
+    EXPECT_GT(c.drawn, 0.05) << "a 3D view looks empty";
+    EXPECT_GT(c.orange, 0.02) << "a refined model is not visible";
   }
   if (!HasFailure()) fs::remove_all(dir);
 }

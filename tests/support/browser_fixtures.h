@@ -1,12 +1,17 @@
 // Headless Chromium for the tests of the HTML pages (run report, city review): the command line
 // with software WebGL and a fixed viewport, and a decoder for its PNG screenshots.
 #pragma once
+#include <sys/wait.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -85,6 +90,54 @@ inline Image decode_png(const std::string& file) {
     prev = cur;
   }
   return img;
+}
+
+// The page after its scripts ran (--dump-dom): its text, the <html> start tag (where the pages
+// note data-rendered and data-errors), Chromium's log and its console lines that are errors.
+struct PageDump {
+  int exit = -1;
+  std::string page, root, log;
+  std::vector<std::string> console_errors;
+};
+
+inline std::string file_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+inline PageDump dump_page(const fs::path& html, const fs::path& dir) {
+  PageDump d;
+  const int st = std::system((chromium(dir / "profile", 900) + "--enable-logging=stderr --v=0 --dump-dom " + quoted(html) +
+                              " > " + quoted(dir / "dom.html") + " 2> " + quoted(dir / "chromium.log"))
+                                 .c_str());
+  d.exit = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  d.page = file_text(dir / "dom.html");
+  d.log = file_text(dir / "chromium.log");
+  std::smatch m;
+  if (std::regex_search(d.page, m, std::regex("<html[^>]*>"))) d.root = m.str();
+  std::istringstream lines(d.log);
+  for (std::string line; std::getline(lines, line);)  // page console messages are CONSOLE lines
+    if (line.find(":CONSOLE") != std::string::npos && line.find("ERROR") != std::string::npos)
+      d.console_errors.push_back(line);
+  return d;
+}
+
+// Shares of the pixels inside a canvas rectangle (3 px in from its border) that are drawn (not
+// the white background) and of the refined model's orange.
+struct CanvasShares {
+  double drawn = 0.0, orange = 0.0;
+};
+
+inline CanvasShares canvas_shares(const Image& img, int x0, int y0, int w, int h) {
+  std::size_t drawn = 0, orange = 0, total = 0;
+  for (int y = y0 + 3; y < y0 + h - 3; ++y)
+    for (int x = x0 + 3; x < x0 + w - 3; ++x) {
+      const auto& p = img.at(x, y);
+      ++total;
+      drawn += std::max({255 - p[0], 255 - p[1], 255 - p[2]}) > 30;
+      orange += p[0] > 150 && p[1] > 60 && p[1] < 170 && p[2] < 90;
+    }
+  return {double(drawn) / double(std::max<std::size_t>(1, total)), double(orange) / double(std::max<std::size_t>(1, total))};
 }
 
 }  // namespace lodrefine::browser_fixtures
