@@ -184,3 +184,20 @@ TEST(Review, DelfshavenRefinePageRendersEveryRefinedBuilding) {
   }
   if (!HasFailure()) fs::remove_all(dir);
 }
+
+TEST(Review, HtmlNeedsACityFileAndAWritableFolder) {
+  const fs::path dir = fresh_dir("review_bad");
+  const std::string sample = (kSource / "data" / "samples" / "synth_gable_0001").string();
+  const std::string refine = kBinary + " refine --model " + shell_quoted(sample + "/coarse.obj") + " --cloud " +
+                             shell_quoted(sample + "/cloud.ply") + " --out " + shell_quoted(dir / "r.obj");
+  EXPECT_EQ(shell(refine + " --html " + shell_quoted(dir / "r.html") + " > /dev/null 2> " + shell_quoted(dir / "err")), 2);
+  EXPECT_NE(read_text(dir / "err").find("lodrefine: error: " + (dir / "r.html").string() +
+                                        ": --html is the review page of a city refine"),
+            std::string::npos)
+      << read_text(dir / "err");
+  EXPECT_FALSE(fs::exists(dir / "r.obj"));
+  EXPECT_EQ(shell(refine + " --html " + shell_quoted(dir / "no" / "r.html") + " > /dev/null 2> " + shell_quoted(dir / "err")),
+            2);
+  EXPECT_NE(read_text(dir / "err").find("output directory"), std::string::npos) << read_text(dir / "err");
+  if (!HasFailure()) fs::remove_all(dir);
+}
