@@ -18,6 +18,7 @@
 
 #include "commands.h"
 #include "lodrefine/eval/eval.h"
+#include "lodrefine/eval/gate.h"
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/io/obj.h"
 #include "lodrefine/io/files.h"
@@ -35,6 +36,8 @@ using nlohmann::json;
 struct EvalArgs {
   std::string original, refined, cloud, truth, meta, dir, json_out, csv_out, svg_dir, html_out;
   int html_views = 20;
+  std::string baseline_in, baseline_out, gates, junit_out;  // the regression gate (--dir)
+  double tolerance = 0.005;
   int jobs = int(std::max(1u, std::thread::hardware_concurrency()));
   Params params;
   CloudOptions cloud_options;  // single-building mode (a run folder holds cropped PLYs)
@@ -634,8 +637,71 @@ void write_outputs(const EvalArgs& a, const std::vector<Row>& rows, const Pooled
   if (!a.html_out.empty()) write_html(a, rows, pooled, plots);
 }
 
+// --- the regression gate ------------------------------------------------------------------
+
+// A row's figures for the gate: its outcome in refine's words (kept-invalid kept apart).
+BuildingFigures building_figures(const Row& r) {
+  const BuildingEval& e = r.eval;
+  BuildingFigures b;
+  b.id = e.id;
+  b.outcome = r.outcome == "kept" && r.refine_outcome.rfind("kept-invalid", 0) == 0 ? "kept-invalid" : r.outcome;
+  b.reason = r.reason;
+  if (e.ok() && e.facade_points > 0) b.c2m_rmse = e.after.rmse, b.c2m_mae = e.after.mae;
+  if (e.ok() && e.truth_facade_after) b.truth_facade_rmse = e.truth_facade_after->rmse;
+  if (e.ok() && e.truth_roof_after) b.truth_roof_rmse = e.truth_roof_after->rmse;
+  b.watertight = e.ok() && e.watertight_after;
+  const MovedSummary m = summarize_moved(r.moved);
+  b.facades_moved = m.count;
+  if (std::isfinite(m.max)) b.moved_max = m.max;
+  return b;
+}
+
+RunFigures run_figures(const std::vector<Row>& rows, const PooledEval& p) {
+  RunFigures run;
+  for (const Row& r : rows) run.buildings.push_back(building_figures(r));
+  run.failed = p.failed;
+  run.refined = std::size_t(std::count_if(rows.begin(), rows.end(), [](const Row& r) { return r.outcome == "refined"; }));
+  run.watertight_rate = p.watertight_rate_after;
+  if (p.before.count) run.c2m_rmse_original = p.before.rmse;
+  if (p.after.count) run.c2m_rmse = p.after.rmse, run.c2m_mae = p.after.mae;
+  if (p.truth_facade_after) run.truth_facade_rmse = p.truth_facade_after->rmse;
+  if (p.truth_roof_after) run.truth_roof_rmse = p.truth_roof_after->rmse;
+  return run;
+}
+
+// Reads the gate's inputs before any work, so a bad file costs no evaluation.
+struct GateInputs {
+  std::optional<RunFigures> baseline;
+  std::optional<Gates> gates;
+};
+
+GateInputs read_gate_inputs(const EvalArgs& a) {
+  for (const std::string& out : {a.baseline_out, a.junit_out})
+    if (!out.empty() && !fs::is_directory(fs::absolute(out).parent_path()))
+      throw InputError(out + ": output directory " + fs::absolute(out).parent_path().string() + " does not exist");
+  GateInputs in;
+  if (!a.baseline_in.empty()) in.baseline = read_baseline(read_file(a.baseline_in), a.baseline_in);
+  if (!a.gates.empty()) in.gates = read_gates(read_file(a.gates), a.gates);
+  return in;
+}
+
+// Writes the baseline, compares and gates; one line per regression or breach on stdout and exit
+// code 1 when there is any.
+void apply_gate(const EvalArgs& a, const GateInputs& in, const RunFigures& run) {
+  if (!a.baseline_out.empty()) write_file_atomic(a.baseline_out, baseline_json(run));
+  if (!in.baseline && !in.gates && a.junit_out.empty()) return;
+  const GateVerdict v = check_run(run, in.baseline ? &*in.baseline : nullptr, in.gates ? &*in.gates : nullptr, a.tolerance);
+  if (!a.junit_out.empty()) write_file_atomic(a.junit_out, junit_xml(v, "lodrefine eval " + a.dir));
+  std::printf("\ngate: %zu building(s), %zu new, %zu pooled check(s): %s\n", v.buildings.size(), v.new_buildings.size(),
+              v.pooled_checks.size(), v.failed() ? "FAILED" : "passed");
+  for (const std::string& id : v.new_buildings) std::printf("new: %s (not in the baseline)\n", id.c_str());
+  for (const GateLine& l : v.failures) std::printf("%s: %s\n", l.check == "baseline" ? "regression" : "breach", l.text.c_str());
+  if (v.failed()) exit_code() = 1;
+}
+
 void run(const EvalArgs& a) {
   a.params.validate();
+  const GateInputs gate_inputs = read_gate_inputs(a);
   if (!a.dir.empty() && !a.cloud_options.classes.empty())
     throw InputError(a.dir + ": --classes applies to --cloud; a run folder holds cropped PLY clouds");
   const bool batch = !a.dir.empty();
@@ -656,6 +722,22 @@ void run(const EvalArgs& a) {
   print_table(stdout, pooled, batch);
   if (batch) print_totals(stdout, run_totals(rows));
   write_outputs(a, rows, pooled);
+  if (batch) apply_gate(a, gate_inputs, run_figures(rows, pooled));
+}
+
+void add_gate_options(CLI::App* cmd, EvalArgs& a, CLI::Option* dir) {
+  cmd->add_option("--write-baseline", a.baseline_out, "With --dir: write the run's figures per building and pooled "
+                                                       "(outcome, C2M, watertight, truth distances, facades moved) as a "
+                                                       "baseline for --baseline")->needs(dir);
+  cmd->add_option("--baseline", a.baseline_in, "With --dir: compare with this baseline; exit 1 when a building got "
+                                                "worse, changed outcome for the worse or went missing (one line each)")
+      ->check(CLI::ExistingFile)->needs(dir);
+  add_ranged_option(cmd, "--tolerance", a.tolerance, "With --baseline: a distance may grow by this much (m)", 0.0, 100.0);
+  cmd->add_option("--gates", a.gates, "With --dir: absolute limits (JSON: max_c2m_rmse_refined, min_watertight_rate, "
+                                       "max_failed_buildings, max_building_truth_facade_rmse_refined, ...); exit 1 "
+                                       "on a breach")->check(CLI::ExistingFile)->needs(dir);
+  cmd->add_option("--junit", a.junit_out, "With --dir: write the verdict as JUnit XML (one test case per building and "
+                                           "per pooled check)")->needs(dir);
 }
 
 }  // namespace
@@ -683,6 +765,7 @@ void add_eval_command(CLI::App& app) {
   cmd->add_option("--jobs", a.jobs, "With --dir: buildings evaluated at once (default: all cores)")
       ->check(CLI::Range(1, 1024));
   dir->excludes(orig);
+  add_gate_options(cmd, a, dir);
   add_cloud_options(cmd, a.cloud_options);
   add_param_options(cmd, a.params);
   cmd->callback([] { run(a); });

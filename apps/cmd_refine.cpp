@@ -1,6 +1,9 @@
 // `lodrefine refine`: one coarse building + its MLS crop -> the refined building.
 #include <cstdio>
 #include <filesystem>
+#include <functional>
+#include <mutex>
+#include <optional>
 
 #include "commands.h"
 #include "lodrefine/io/cityfile.h"
@@ -9,6 +12,7 @@
 #include "lodrefine/io/files.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/io/refine_report.h"
+#include "lodrefine/eval/review.h"
 #include "options.h"
 
 namespace lodrefine::app {
@@ -20,7 +24,58 @@ struct RefineArgs {
   Params params;
   CloudOptions cloud_options;
   std::string building, lod;  // city files only
+  std::string html;           // city files only: the review page
 };
+
+// Scan points per refined building on the review page: enough to see each facade, and what
+// bounds the collector's memory (only refined buildings keep meshes and points).
+constexpr std::size_t kReviewPoints = 3000;
+
+// Collects the review page's data while the city is refined (CityRefineOptions::on_building):
+// every building's outline; for a refined one its view (meshes + capped points), built outside
+// the lock as the hook may be called from several threads.
+struct ReviewCollector {
+  CityReview review;
+  std::optional<Vec3> origin;  // the district frame: the first building's local origin
+  std::mutex mutex;
+
+  void operator()(const Mesh& model, const CityBuildingOutcome* o, const RefineResult* r, const PointCloud* crop) {
+    CityReviewBuilding b;
+    b.id = model.id;
+    b.outcome = o ? o->outcome : "untouched";
+    if (o) b.reason = o->reason, b.points = o->points, b.facades_moved = std::size_t(o->facades_moved);
+    if (r && r->trace.facade_fit && r->trace.facade_fit->points > 0)
+      b.fit_before = r->trace.facade_fit->rms_before, b.fit_after = r->trace.facade_fit->rms_after;
+    if (r && b.outcome == "refined") {
+      add_moves(b, r->trace.facades);
+      if (crop) b.view = review_view(b.id, model, r->mesh, crop->points, kReviewPoints);
+    }
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (!origin) origin = local_origin(model);
+    b.outline = review_outline(model, *origin);
+    review.buildings.push_back(std::move(b));
+  }
+
+  static void add_moves(CityReviewBuilding& b, const std::vector<RefineTrace::FacadeMove>& moves) {
+    if (moves.empty()) return;
+    b.moved_max = b.moved_mean = 0.0;
+    for (const auto& m : moves) b.moved_max = std::max(b.moved_max, m.max_move), b.moved_mean += m.mean_move;
+    b.moved_mean /= double(moves.size());
+  }
+};
+
+void write_review(const RefineArgs& a, const CityRefineSummary& s, ReviewCollector& c) {
+  c.review.title = "lodrefine city refine: " + std::filesystem::path(a.model).filename().string() + " with " +
+                   std::filesystem::path(a.cloud).filename().string();
+  char line[512];
+  std::snprintf(line, sizeof line, "%s: %d building(s): %d refined, %d kept, %d kept-invalid, %d untouched (no cloud "
+                "points)\ncloud: %llu points, %llu in building crops\ntime: read %.1f s, crop %.1f s, refine %.1f s, "
+                "write %.1f s\n", s.input_format.c_str(), s.buildings, s.refined, s.kept, s.kept_invalid, s.untouched,
+                (unsigned long long)s.cloud_points, (unsigned long long)s.cropped_points, s.seconds_read, s.seconds_crop,
+                s.seconds_refine, s.seconds_write);
+  c.review.summary = line;
+  write_file_atomic(a.html, city_review_html(c.review));
+}
 
 nlohmann::json params_json(const Params& p) {
   nlohmann::json j;
@@ -63,7 +118,10 @@ void run_city(const RefineArgs& a) {
   o.building = a.building;
   o.lod = a.lod;
   o.cloud = a.cloud_options;
+  ReviewCollector review;
+  if (!a.html.empty()) o.on_building = std::ref(review);
   const CityRefineSummary s = refine_city(a.model, a.cloud, a.out, a.params, o);
+  if (!a.html.empty()) write_review(a, s, review);
   if (!a.report.empty()) {
     nlohmann::json j = {{"model", a.model}, {"cloud", a.cloud}, {"written", a.out}, {"input", s.input_format},
                         {"buildings", s.buildings}, {"refined", s.refined}, {"kept", s.kept},
@@ -95,12 +153,14 @@ void run(const RefineArgs& a) {
   check_outputs_are_new(a);
   check_output_dir(a.out);
   check_output_dir(a.report);
+  check_output_dir(a.html);
   if (is_city_file(a.model)) {
     const std::string ext = std::filesystem::path(a.out).extension().string();
     if (ext == ".obj" || ext == ".OBJ")
       throw InputError(a.out + ": a city file in gives a CityJSON city file out; name it e.g. refined.city.json");
     return run_city(a);
   }
+  if (!a.html.empty()) throw InputError(a.html + ": --html is the review page of a city refine (a city file as --model)");
   if (!a.building.empty() || !a.lod.empty())
     throw InputError(a.model + ": --building and --lod pick buildings of a city file (CityJSON, CityGML), not of an OBJ");
   const Mesh model = read_obj(a.model);
@@ -141,6 +201,9 @@ void add_refine_command(CLI::App& app) {
   cmd->add_option("--out", args.out, "Refined model (OBJ; CityJSON for a city file), written atomically")->required();
   cmd->add_option("--building", args.building, "City file: refine only this CityObject id");
   cmd->add_option("--lod", args.lod, "City file: the LoD geometry to refine, e.g. 2.2 (default: the highest 2.x)");
+  cmd->add_option("--html", args.html, "City file: write a review page (self-contained HTML, three.js embedded): "
+                                        "summary, the buildings the cloud reached, a district map, each refined "
+                                        "building in 3D over its scan");
   cmd->add_option("--report", args.report, "JSON report: matches, planes, candidates, MIP, timings, validation");
   cmd->add_option("--max-points", args.max_points, "Refuse clouds with more points (a tile, not a crop)")->capture_default_str();
   add_cloud_options(cmd, args.cloud_options);

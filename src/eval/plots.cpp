@@ -320,4 +320,54 @@ std::string svg_footprint(const Mesh& original, const Mesh& refined, const std::
   return svg.str();
 }
 
+std::string svg_district_map(const std::vector<MapOutline>& buildings, const std::string& title, double width) {
+  double minx = std::numeric_limits<double>::max(), miny = minx, maxx = -minx, maxy = -minx;
+  for (const auto& b : buildings)
+    for (const auto& ring : b.rings)
+      for (const Vec2& p : ring) {
+        if (!p.allFinite()) continue;
+        minx = std::min(minx, p.x()), maxx = std::max(maxx, p.x());
+        miny = std::min(miny, p.y()), maxy = std::max(maxy, p.y());
+      }
+  if (minx > maxx) minx = maxx = miny = maxy = 0;
+  const double span = std::max({maxx - minx, maxy - miny, 1.0});
+  const double margin = 30, header = 60, footer = 50;
+  const TopView v{minx, maxy, (width - 2 * margin) / span, margin, header};
+  const double plot_h = (maxy - miny) * v.scale;
+  Svg svg(width, header + plot_h + footer);
+  svg.title(title);
+  const std::pair<const char*, const char*> styles[] = {
+      {"refined", kOrange}, {"kept", "#e6c229"}, {"kept-invalid", "#d62728"}, {"untouched", "#bbbbbb"}};
+  auto colour_of = [&](const std::string& outcome) {
+    for (const auto& [name, colour] : styles)
+      if (outcome == name) return colour;
+    return styles[3].second;
+  };
+  double x = margin;
+  for (const auto& [name, colour] : styles) {
+    const auto n = std::count_if(buildings.begin(), buildings.end(),
+                                 [&, name = name](const MapOutline& b) { return colour_of(b.outcome) == colour_of(name); });
+    const std::string label = std::string(name) + " (" + std::to_string(n) + ")";
+    legend_entry(svg, x, 46, colour, label);
+    x += 40 + 7.0 * double(label.size());
+  }
+  for (const auto& b : buildings) {
+    std::ostringstream d;
+    for (const auto& ring : b.rings) {
+      for (std::size_t i = 0; i < ring.size(); ++i) {
+        const Vec3 p(ring[i].x(), ring[i].y(), 0.0);
+        d << (i == 0 ? 'M' : 'L') << num(v.px(p)) << ' ' << num(v.py(p)) << ' ';
+      }
+      if (!ring.empty()) d << "Z ";
+    }
+    const std::string colour = colour_of(b.outcome);
+    std::string path = "<path d=\"" + d.str() + "\" fill=\"" + colour + "\" fill-opacity=\"0.75\" stroke=\"#555\" "
+                       "stroke-width=\"0.6\"><title>" + escape(b.id + ": " + b.outcome) + "</title></path>";
+    if (b.linked) path = "<a href=\"#view-" + escape(b.id) + "\">" + path + "</a>";
+    svg.raw(path);
+  }
+  scale_bar(svg, v, span, margin, header + plot_h + 28);
+  return svg.str();
+}
+
 }  // namespace lodrefine

@@ -37,10 +37,13 @@ std::string html_escape(const std::string& s) {
 }
 
 // Text inside <script>: "</" could end the element early and "<!--" changes how the parser
-// reads it. Both can only occur inside JSON strings or JS string literals, where "\u003c" is "<".
+// reads it; U+2028/9 end a line in older JS parsers. All can only occur inside JSON strings or JS
+// string literals, where "\u003c" is "<" and "\u2028" the separator.
 std::string script_safe(std::string s) {
   for (const std::string from : {"</", "<!--"})
     for (std::size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + 6)) s.replace(at, 1, "\\u003c");
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"\xE2\x80\xA8", "\\u2028"}, {"\xE2\x80\xA9", "\\u2029"}})
+    for (std::size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size())) s.replace(at, from.size(), to);
   return s;
 }
 
@@ -69,6 +72,7 @@ tr.failed { background: #fdd; } tr.kept { background: #ffd; }
 .view .footprint svg { width: 560px; height: auto; }
 canvas.view3d { border: 1px solid #ccc; cursor: grab; }
 .legend { font-size: 12px; }
+.map svg { max-width: 100%; height: auto; border: 1px solid #ccc; }
 )css";
 
 // Renders every view with one WebGL renderer into its own 2D canvas (browsers allow only a few
@@ -181,10 +185,11 @@ BuildingView make_building_view(const std::string& id, const Mesh& original, con
 std::string html_report(const HtmlReport& r) {
   std::string h = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" + html_escape(r.title) +
                   "</title>\n<script>" + kErrorTrap + "</script>\n<style>" + kStyle + "</style></head>\n<body>\n";
-  h += "<h1>" + html_escape(r.title) + "</h1>\n<h2>Pooled figures (Table 1)</h2>\n<pre>" + html_escape(r.table1) +
-       "</pre>\n<div class=\"plots\">" + r.histogram_svg + r.boxplot_svg + "</div>\n";
+  h += "<h1>" + html_escape(r.title) + "</h1>\n<h2>" + html_escape(r.summary_heading) + "</h2>\n<pre>" +
+       html_escape(r.table1) + "</pre>\n<div class=\"plots\">" + r.histogram_svg + r.boxplot_svg + "</div>\n";
+  if (!r.map_svg.empty()) h += "<div class=\"map\">" + r.map_svg + "</div>\n";
 
-  h += "<h2>Buildings, worst first</h2>\n<table class=\"buildings\"><thead><tr>";
+  h += "<h2>" + html_escape(r.table_heading) + "</h2>\n<table class=\"buildings\"><thead><tr>";
   for (const auto& c : r.columns) h += "<th>" + html_escape(c[1].get<std::string>()) + "</th>";
   h += "</tr></thead><tbody>\n";
   std::vector<std::string> shown;
@@ -202,10 +207,7 @@ std::string html_report(const HtmlReport& r) {
   h += "</tbody></table>\n";
 
   if (!r.views.empty()) {
-    h += "<h2>Before / after</h2>\n<p class=\"legend\">Left: top view, original (blue, dashed) and refined (orange) "
-         "over the facade points. Right: 3D, drag to turn, wheel to zoom; original blue (transparent), refined "
-         "orange, scan points coloured by their C2M distance to the refined model (blue &minus;0.3 m, green 0, "
-         "red +0.3 m).</p>\n";
+    h += "<h2>Before / after</h2>\n<p class=\"legend\">" + html_escape(r.views_legend) + "</p>\n";
     json views = json::array();
     for (const auto& v : r.views) {
       h += "<section id=\"view-" + html_escape(v.id) + "\"><h3>" + html_escape(v.id) + " &mdash; " +
@@ -216,7 +218,7 @@ std::string html_report(const HtmlReport& r) {
       h += "</div></div></div></section>\n";
       views.push_back({{"id", v.id}, {"original", v.original}, {"refined", v.refined}, {"points", v.points}, {"c2m", v.c2m}});
     }
-    h += "<script type=\"application/json\" id=\"lodrefine-views\">" + script_safe(views.dump()) + "</script>\n";
+    h += "<script type=\"application/json\" id=\"lodrefine-views\">" + script_safe(views.dump(-1, ' ', false, json::error_handler_t::replace)) + "</script>\n";
     h += "<script type=\"text/plain\" id=\"three-module\">" + script_safe(three_module_js()) + "</script>\n";
     h += std::string("<script type=\"module\">") + kViewer + "</script>\n";
   } else {

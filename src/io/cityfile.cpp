@@ -63,13 +63,14 @@ CityJsonTransform transform_of(const json& header) {
 // buildings in order; `target_of[first + i]` is building i's crop target (npos: not asked for).
 void refine_document(json& doc, const CityJsonTransform& tf, const std::vector<CityJsonBuilding>& buildings,
                      std::vector<CropTarget>& targets, const std::vector<std::size_t>& target_of, std::size_t first,
-                     const Params& params, CityRefineSummary& sum) {
+                     const Params& params, const CityBuildingHook& hook, CityRefineSummary& sum) {
   json& objects = doc["CityObjects"];
   for (std::size_t i = 0; i < buildings.size(); ++i) {
     const CityJsonBuilding& b = buildings[i];
     const std::size_t ti = target_of[first + i];
     if (ti == std::string::npos || targets[ti].cloud.points.empty()) {
       ++sum.untouched;
+      if (hook) hook(b.mesh, nullptr, nullptr, nullptr);
       continue;
     }
     PointCloud cloud = std::move(targets[ti].cloud);
@@ -77,8 +78,10 @@ void refine_document(json& doc, const CityJsonTransform& tf, const std::vector<C
     const auto t0 = Clock::now();
     CityBuildingOutcome o;
     RefineResult r;
+    const RefineResult* result = nullptr;  // set once refine_building returned
     try {
       r = refine_building(b.mesh, cloud, params);
+      result = &r;
       o = classify(r);
     } catch (const std::exception& e) {  // never lose a building: keep it as read
       o.outcome = "kept-invalid";
@@ -101,6 +104,7 @@ void refine_document(json& doc, const CityJsonTransform& tf, const std::vector<C
     obj["attributes"]["lodrefine_outcome"] = o.outcome;
     obj["attributes"]["lodrefine_reason"] = o.reason;
     obj["attributes"]["lodrefine_facades_moved"] = o.facades_moved;
+    if (hook) hook(b.mesh, &o, result, &cloud);
     sum.outcomes.push_back(std::move(o));
   }
 }
@@ -268,7 +272,7 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
     const CityJsonFile f = read_cityjson_document(feature_document(header, feature),
                                                   model_path + ": line " + std::to_string(n), options.lod);
     if (upgrade) upgrade_objects(feature["CityObjects"]);
-    refine_document(feature, tf, f.buildings, targets, target_of, first, params, sum);
+    refine_document(feature, tf, f.buildings, targets, target_of, first, params, options.on_building, sum);
     first += f.buildings.size();
     out.write(feature.dump() + "\n");
   });
@@ -352,7 +356,7 @@ CityRefineSummary refine_city(const std::string& model_path, const std::string& 
     upgrade_objects(doc["CityObjects"]);
   }
   ensure_transform(doc);
-  refine_document(doc, transform_of(doc), file.buildings, targets, target_of, 0, params, sum);
+  refine_document(doc, transform_of(doc), file.buildings, targets, target_of, 0, params, options.on_building, sum);
   sum.seconds_refine = seconds_since(t);
 
   t = Clock::now();

@@ -191,4 +191,6 @@ std::string SafeNames::add(const std::string& id) {
     if (take(hashed + "-" + std::to_string(k))) return hashed + "-" + std::to_string(k);
 }
 
+std::string read_file(const std::string& path) { return io_text::read_whole_file(path); }
+
 }  // namespace lodrefine

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "support/cli_fixtures.h"
+#include "support/scan_fixtures.h"
 
 #include <chrono>
 #include <functional>
@@ -35,6 +36,8 @@ namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
 
 namespace {
+
+using fixtures::sample_face;
 
 using cli_fixtures::Cli;
 using cli_fixtures::run_cli;
@@ -190,24 +193,6 @@ std::vector<SynthBuilding> synth_street(const std::vector<BuildingType>& types, 
     if (k < scanned) cloud.points.insert(cloud.points.end(), bs.back().cloud.points.begin(), bs.back().cloud.points.end());
   }
   return bs;
-}
-
-// Points on a wall face moved `offset` along its normal, every `step` metres, with noise.
-void sample_face(const std::vector<Vec3>& poly, double offset, double step, std::mt19937& rng, PointCloud& out) {
-  const Plane pl = polygon_plane(poly);
-  const auto [u, v] = pl.basis();
-  std::vector<Vec2> p2;
-  double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
-  for (const auto& p : poly) {
-    p2.emplace_back(u.dot(p), v.dot(p));
-    u0 = std::min(u0, p2.back().x()), u1 = std::max(u1, p2.back().x());
-    v0 = std::min(v0, p2.back().y()), v1 = std::max(v1, p2.back().y());
-  }
-  std::normal_distribution<double> noise(0.0, 0.005);
-  const Vec3 base = pl.project(Vec3::Zero());
-  for (double a = u0 + step / 2; a < u1; a += step)
-    for (double b = v0 + step / 2; b < v1; b += step)
-      if (point_in_polygon_2d(Vec2(a, b), p2)) out.points.push_back(base + a * u + b * v + (offset + noise(rng)) * pl.n);
 }
 
 }  // namespace

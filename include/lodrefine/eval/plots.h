@@ -25,4 +25,17 @@ std::string svg_boxplot(const std::vector<double>& before, const std::vector<dou
 std::string svg_footprint(const Mesh& original, const Mesh& refined, const std::vector<Vec3>& facade_points,
                           const std::string& title, std::size_t max_points = 5000);
 
+// One building of a district map: its XY outline rings (any common frame, metres) and outcome.
+struct MapOutline {
+  std::string id;
+  std::string outcome;  // "refined", "kept", "kept-invalid", anything else drawn as untouched
+  std::vector<std::vector<Vec2>> rings;
+  bool linked = false;  // a link to "#view-<id>" (its view on the same page)
+};
+
+// Top view of a district, north up, about `width` pixels wide: each outline filled by its
+// outcome (refined orange, kept yellow, kept-invalid red, untouched grey) with its id as tooltip,
+// a legend with the counts and a scale bar. Ids are escaped.
+std::string svg_district_map(const std::vector<MapOutline>& buildings, const std::string& title, double width = 1100);
+
 }  // namespace lodrefine

@@ -32,12 +32,20 @@ struct HtmlReport {
   std::string title;
   std::string table1;                   // the pooled figures, preformatted text
   std::string histogram_svg, boxplot_svg;
+  std::string map_svg;                  // full width below the plots, when set
+  // Headings and the legend of the views (other pages, e.g. the city review, name them).
+  std::string summary_heading = "Pooled figures (Table 1)", table_heading = "Buildings, worst first";
+  std::string views_legend = "Left: top view, original (blue, dashed) and refined (orange) over the facade points. "
+                             "Right: 3D, drag to turn, wheel to zoom; original blue (transparent), refined orange, "
+                             "scan points coloured by their C2M distance to the refined model (blue -0.3 m, green "
+                             "0, red +0.3 m).";
   nlohmann::json columns;               // [[key, heading], ...] of the building table
   nlohmann::json rows;                  // one object per building, worst first
   std::vector<BuildingView> views;      // the buildings shown in 3D (a subset of rows)
 };
 
-// The page; the embedded three.js ES module (three_module_js()) renders the views. After the
+// The page (ids, captions and cells escaped, JSON inside <script> made safe: "</", "<!--",
+// U+2028/9 escaped, bytes that are not UTF-8 replaced); the embedded three.js ES module (three_module_js()) renders the views. After the
 // first render of every view the <html> element gets data-rendered="<number of views>" and each
 // canvas's page rectangle in data-rect; script errors go to data-errors (for headless tests).
 std::string html_report(const HtmlReport& report);

@@ -13,6 +13,7 @@
 // CityGML input is converted first (citygml_to_cityjson) and written as CityJSON 2.0.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -23,12 +24,22 @@
 
 namespace lodrefine {
 
+struct CityBuildingOutcome;
+struct RefineResult;
+
+// Called once per building of the file, in file order, when set (e.g. to collect a review page):
+// `outcome` and `crop` are null for a building the cloud does not reach, `result` is null unless
+// refine_building returned. All in the input frame.
+using CityBuildingHook = std::function<void(const Mesh& model, const CityBuildingOutcome* outcome,
+                                            const RefineResult* result, const PointCloud* crop)>;
+
 struct CityRefineOptions {
   std::string building;  // refine only this CityObject id ("" = every building the cloud covers)
   std::string lod;       // the LoD geometry to refine, e.g. "2.2" ("" = the highest 2.x)
   CloudOptions cloud;    // LAS class filter
   double crop_expand = 0.1;  // crop box growth, relative and absolute (as lodrefine crop)
   double crop_margin = 3.0;
+  CityBuildingHook on_building;  // optional
 };
 
 struct CityBuildingOutcome {

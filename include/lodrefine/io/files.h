@@ -56,6 +56,10 @@ class AtomicFile {
   bool committed_ = false;
 };
 
+// The whole file as bytes (small inputs: a baseline, a gates file); throws InputError, one line
+// naming `path`, for a directory or a file that cannot be read.
+std::string read_file(const std::string& path);
+
 // Writes `content` to `path` atomically (temp file in the same directory + rename).
 void write_file_atomic(const std::string& path, const std::string& content);
 // Copies the regular file `from` to `to` atomically (same guarantees as write_file_atomic).

@@ -1,0 +1,203 @@
+// The review page of a city refine: hostile ids escaped in the HTML and inside the <script> JSON,
+// the table worst first without the untouched buildings, the refusals counted; and the page of a
+// refine of Rotterdam Delfshaven (853 buildings, a scan of three with one wall 0.4 m off, one of
+// them with a hostile id) loads in headless Chromium with every refined building rendered.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <regex>
+
+#include <nlohmann/json.hpp>
+
+#include "lodrefine/core/geometry.h"
+#include "lodrefine/eval/review.h"
+#include "lodrefine/io/cityjson.h"
+#include "lodrefine/io/ply.h"
+#include "support/batch_fixtures.h"
+#include "support/browser_fixtures.h"
+#include "support/mesh_fixtures.h"
+#include "support/realdata.h"
+#include "support/scan_fixtures.h"
+
+using namespace lodrefine;
+using namespace lodrefine::batch_fixtures;
+using namespace lodrefine::browser_fixtures;
+
+namespace {
+
+const std::string kHostile = "</script><script>document.title='pwned'</script>\"'<!--\xE2\x80\xA8&";
+
+CityReviewBuilding reviewed(const std::string& id, const std::string& outcome, double fit_after, double x) {
+  CityReviewBuilding b;
+  b.id = id;
+  b.outcome = outcome;
+  b.reason = outcome == "refined" ? "" : "the refinement does not fit the scan better (RMS 0.1 -> 0.2 m)";
+  b.fit_before = 0.2;
+  b.fit_after = fit_after;
+  const Mesh m = fixtures::box({x, 0, 0}, {x + 8, 6, 5});
+  b.outline = review_outline(m, Vec3::Zero());
+  if (outcome == "refined") b.view = review_view(id, m, fixtures::box({x + 0.3, 0, 0}, {x + 8, 6, 5}), {}, 100);
+  return b;
+}
+
+}  // namespace
+
+TEST(Review, HostileIdsEscapedAndTableWorstFirst) {
+  CityReview r;
+  r.title = "city <b>";
+  r.summary = "2 refined";
+  r.buildings = {reviewed("good", "refined", 0.01, 0), reviewed(kHostile, "refined", 0.05, 20),
+                 reviewed("k1", "kept", 0.3, 40), reviewed("k2", "kept", 0.3, 60), reviewed("u", "untouched", 0, 80)};
+  r.buildings[3].reason = "no wall matched a scan plane";
+  for (const std::string id : {"i1", "i2"}) {
+    r.buildings.push_back(reviewed(id, "kept-invalid", 0.3, 100));
+    r.buildings.back().reason = "building " + id + ": not closable: 2 non-manifold edges (more than two faces)";
+  }
+  const std::string h = city_review_html(r);
+  // Only "</" and "<!--" can end or bend a script element: escaped, in the HTML as in the JSON.
+  EXPECT_EQ(h.find("</script><script>document"), std::string::npos);
+  EXPECT_EQ(h.find("<script>document"), h.find("\\u003c/script><script>document") + 14);
+  EXPECT_EQ(h.find("<b>"), std::string::npos);
+  EXPECT_NE(h.find("&lt;/script&gt;&lt;script&gt;document.title="), std::string::npos);
+  const auto json_at = h.find("id=\"lodrefine-views\">");
+  ASSERT_NE(json_at, std::string::npos);
+  const std::string views = h.substr(json_at, h.find("</script>", json_at) - json_at);
+  EXPECT_NE(views.find("\\u003c/script><script>document.title='pwned'\\u003c/script>\\\"'\\u003c!--\\u2028&"),
+            std::string::npos)
+      << views.substr(0, 400);
+  // Worst first: kept before refined, the worse fit first; untouched buildings are not listed.
+  const auto k1 = h.find("<td>k1</td>"), bad = h.find("<td><a href=\"#view-&lt;/script&gt;"),
+             good = h.find("<td><a href=\"#view-good\">good</a></td>");
+  ASSERT_NE(k1, std::string::npos);
+  ASSERT_NE(bad, std::string::npos);
+  ASSERT_NE(good, std::string::npos);
+  EXPECT_LT(k1, bad);
+  EXPECT_LT(bad, good);
+  EXPECT_EQ(h.find("<td>u</td>"), std::string::npos);
+  EXPECT_NE(h.find("id=\"view-good\""), std::string::npos);
+  EXPECT_EQ(h.find("id=\"view-k1\""), std::string::npos) << "only refined buildings get a view";
+  // The refusals by check, numbers folded.
+  EXPECT_NE(h.find("1  kept: the refinement does not fit the scan better"), std::string::npos);
+  EXPECT_NE(h.find("1  kept: no wall matched a scan plane"), std::string::npos);
+  EXPECT_NE(h.find("2  kept-invalid: not closable\n"), std::string::npos) << h.substr(h.find("checks that"), 300);
+  // The map: every building outlined, refined ones linked to their view.
+  EXPECT_NE(h.find("<a href=\"#view-good\"><path"), std::string::npos);
+  EXPECT_NE(h.find("<title>u: untouched</title>"), std::string::npos);
+}
+
+TEST(Review, ViewKeepsOnlyPointsNearTheRefinedModelAndCapsThem) {
+  const Mesh coarse = fixtures::box({100000, 400000, 0}, {100008, 400006, 5});
+  const Mesh refined = fixtures::box({100000.3, 400000, 0}, {100008, 400006, 5});
+  std::vector<Vec3> points;
+  for (int i = 0; i < 5000; ++i) points.emplace_back(100000.3, 400000 + 6.0 * i / 5000, 0.5 + 4.0 * (i % 7) / 7);
+  for (int i = 0; i < 5000; ++i) points.emplace_back(100030, 400000, 1);  // a neighbour far off
+  const BuildingView v = review_view("b", coarse, refined, points, 800);
+  ASSERT_FALSE(v.c2m.empty());
+  EXPECT_LE(v.c2m.size(), 800u);
+  EXPECT_EQ(v.points.size(), 3 * v.c2m.size());
+  for (float d : v.c2m) EXPECT_LT(std::abs(d), 0.02);
+  for (std::size_t i = 0; i < v.points.size(); i += 3) EXPECT_LT(std::abs(v.points[i]), 1.0f) << "a local frame";
+}
+
+TEST(Review, DelfshavenRefinePageRendersEveryRefinedBuilding) {
+  REQUIRE_REALDATA("val3dity/data/rotterdam/3-20-DELFSHAVEN.city.json");
+  if (!chromium_available()) GTEST_SKIP() << "chromium not installed (Debian: chromium; .ci/run installs it)";
+  const fs::path dir = fresh_dir("review");
+  // The city with one scanned building renamed to a hostile id.
+  const CityJsonFile city = read_cityjson(data_path.string());
+  std::mt19937 rng(3);
+  PointCloud cloud;
+  std::vector<std::string> scanned;
+  for (const auto& b : city.buildings) {
+    if (scanned.size() == 3) break;
+    if (b.mesh.faces.size() < 6 || b.mesh.faces.size() > 14) continue;
+    std::size_t largest = 0;
+    double area = 0;
+    for (std::size_t k = 0; k < b.mesh.faces.size(); ++k)
+      if (b.mesh.faces[k].sem == Semantic::Wall && polygon_area(face_points(b.mesh, b.mesh.faces[k])) > area)
+        area = polygon_area(face_points(b.mesh, b.mesh.faces[k])), largest = k;
+    if (area < 40) continue;
+    for (std::size_t k = 0; k < b.mesh.faces.size(); ++k)
+      if (b.mesh.faces[k].sem == Semantic::Wall)
+        fixtures::sample_face(face_points(b.mesh, b.mesh.faces[k]), k == largest ? 0.4 : 0.0, 0.1, rng, cloud);
+    scanned.push_back(b.mesh.id);
+  }
+  ASSERT_EQ(scanned.size(), 3u);
+  write_ply((dir / "scan.ply").string(), cloud);
+  nlohmann::ordered_json doc = nlohmann::ordered_json::parse(read_text(data_path));
+  // Would mark the page if it ever ran.
+  const std::string hostile = "</script><img src=x onerror=\"document.documentElement.dataset.pwned=1\">'";
+  doc["CityObjects"][hostile] = doc["CityObjects"][scanned[1]];
+  doc["CityObjects"].erase(scanned[1]);
+  std::ofstream(dir / "city.json") << doc.dump();
+
+  ASSERT_EQ(shell(kBinary + " refine --model " + shell_quoted(dir / "city.json") + " --cloud " +
+                  shell_quoted(dir / "scan.ply") + " --out " + shell_quoted(dir / "out.city.json") + " --report " +
+                  shell_quoted(dir / "report.json") + " --html " + shell_quoted(dir / "review.html") + " > " +
+                  shell_quoted(dir / "refine.log") + " 2>&1"),
+            0)
+      << read_text(dir / "refine.log");
+  const json rep = json::parse(read_text(dir / "report.json"));
+  std::vector<std::string> refined;
+  for (const auto& o : rep["outcomes"])
+    if (o["outcome"] == "refined") refined.push_back(o["id"]);
+  ASSERT_GE(refined.size(), 1u) << rep.dump(1);
+  const std::string html = read_text(dir / "review.html");
+  EXPECT_EQ(html.find("</script><img"), std::string::npos);
+  EXPECT_EQ(html.find("src=\"http"), std::string::npos);
+  EXPECT_EQ(html.find("<link"), std::string::npos);
+  EXPECT_NE(html.find("853 building(s): " + std::to_string(refined.size()) + " refined"), std::string::npos);
+  EXPECT_NE(html.find(std::to_string(rep["untouched"].get<int>()) + " untouched"), std::string::npos);
+
+  const PageDump d = dump_page(dir / "review.html", dir);
+  ASSERT_EQ(d.exit, 0) << d.log;
+  const std::string& page = d.page;
+  ASSERT_FALSE(d.root.empty()) << page.substr(0, 500);
+  EXPECT_EQ(d.root.find("data-errors"), std::string::npos) << d.root;
+  EXPECT_EQ(d.root.find("data-pwned"), std::string::npos) << "the hostile id ran";
+  EXPECT_NE(d.root.find("data-rendered=\"" + std::to_string(refined.size()) + "\""), std::string::npos)
+      << d.root << "\n" << d.log;
+  for (const std::string& line : d.console_errors) ADD_FAILURE() << line;
+
+  // Every refined building's canvas, in one screenshot tall enough for all of them.
+  std::vector<std::array<int, 4>> rects;
+  const std::regex rect("data-rect=\"(\\d+),(\\d+),(\\d+),(\\d+)\"");
+  for (auto it = std::sregex_iterator(page.begin(), page.end(), rect); it != std::sregex_iterator(); ++it)
+    rects.push_back({std::stoi((*it)[1]), std::stoi((*it)[2]), std::stoi((*it)[3]), std::stoi((*it)[4])});
+  ASSERT_EQ(rects.size(), refined.size());
+  int bottom = 0;
+  for (const auto& r : rects) bottom = std::max(bottom, r[1] + r[3]);
+  const fs::path shot = dir / "shot.png";
+  ASSERT_EQ(shell(chromium(dir / "profile", bottom + 40) + "--screenshot=" + shell_quoted(shot) + " " +
+                  shell_quoted(dir / "review.html") + " > /dev/null 2>&1"),
+            0);
+  const Image img = decode_png(read_text(shot));
+  for (const auto& [x0, y0, w, h] : rects) {
+    ASSERT_GT(w, 100);
+    ASSERT_GE(img.width, x0 + w);
+    ASSERT_GE(img.height, y0 + h);
+    const CanvasShares c = canvas_shares(img, x0, y0, w, h);
+    std::printf("3D canvas at (%d, %d): %.1f %% drawn, %.1f %% refined-model orange\n", x0, y0, 100.0 * c.drawn,
+                100.0 * c.orange);
+    EXPECT_GT(c.drawn, 0.05) << "a 3D view looks empty";
+    EXPECT_GT(c.orange, 0.02) << "a refined model is not visible";
+  }
+  if (!HasFailure()) fs::remove_all(dir);
+}
+
+TEST(Review, HtmlNeedsACityFileAndAWritableFolder) {
+  const fs::path dir = fresh_dir("review_bad");
+  const std::string sample = (kSource / "data" / "samples" / "synth_gable_0001").string();
+  const std::string refine = kBinary + " refine --model " + shell_quoted(sample + "/coarse.obj") + " --cloud " +
+                             shell_quoted(sample + "/cloud.ply") + " --out " + shell_quoted(dir / "r.obj");
+  EXPECT_EQ(shell(refine + " --html " + shell_quoted(dir / "r.html") + " > /dev/null 2> " + shell_quoted(dir / "err")), 2);
+  EXPECT_NE(read_text(dir / "err").find("lodrefine: error: " + (dir / "r.html").string() +
+                                        ": --html is the review page of a city refine"),
+            std::string::npos)
+      << read_text(dir / "err");
+  EXPECT_FALSE(fs::exists(dir / "r.obj"));
+  EXPECT_EQ(shell(refine + " --html " + shell_quoted(dir / "no" / "r.html") + " > /dev/null 2> " + shell_quoted(dir / "err")),
+            2);
+  EXPECT_NE(read_text(dir / "err").find("output directory"), std::string::npos) << read_text(dir / "err");
+  if (!HasFailure()) fs::remove_all(dir);
+}
