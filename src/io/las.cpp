@@ -28,20 +28,9 @@ constexpr int kCompressedBits = 0xC0;
 constexpr std::size_t kChunkBytes = 1 << 20;
 
 using io_text::fail;
+using io_text::get_le;
 using io_text::open_input;
-
-template <class T>
-T get_le(const unsigned char* p) {
-  std::uint64_t bits = 0;
-  for (std::size_t i = 0; i < sizeof(T); ++i) bits |= std::uint64_t(p[i]) << (8 * i);
-  if constexpr (std::is_same_v<T, double>) {
-    double d;
-    std::memcpy(&d, &bits, 8);
-    return d;
-  } else {
-    return T(bits);
-  }
-}
+using io_text::read_at;
 
 template <class T>
 void put_le(std::string& out, T v) {
@@ -55,12 +44,6 @@ Vec3 get_vec(const unsigned char* p, int stride) {
   return {get_le<double>(p), get_le<double>(p + stride), get_le<double>(p + 2 * stride)};
 }
 
-bool read_at(std::ifstream& in, std::uint64_t pos, unsigned char* dst, std::size_t n) {
-  in.clear();
-  in.seekg(std::streamoff(pos));
-  in.read(reinterpret_cast<char*>(dst), std::streamsize(n));
-  return in.gcount() == std::streamsize(n);
-}
 
 // The LASzip VLR's payload, when one of the VLRs between the header and the point data is
 // "laszip encoded" (record 22204): that marks LAZ even when a tool cleared the format bits.

@@ -17,6 +17,7 @@ namespace lodrefine::laz {
 namespace {
 
 using io_text::fail;
+using io_text::read_at;
 
 // Item types of the LASzip VLR.
 enum ItemType : std::uint16_t {
@@ -223,11 +224,9 @@ class IntegerDecoder {
   std::vector<std::unique_ptr<SymbolModel>> corrector_;
 };
 
-std::uint32_t get_u32(const unsigned char* p) {
-  return std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[3]) << 24;
-}
-std::uint16_t get_u16(const unsigned char* p) { return std::uint16_t(p[0] | p[1] << 8); }
-std::uint64_t get_u64(const unsigned char* p) { return get_u32(p) | std::uint64_t(get_u32(p + 4)) << 32; }
+std::uint16_t get_u16(const unsigned char* p) { return io_text::get_le<std::uint16_t>(p); }
+std::uint32_t get_u32(const unsigned char* p) { return io_text::get_le<std::uint32_t>(p); }
+std::uint64_t get_u64(const unsigned char* p) { return io_text::get_le<std::uint64_t>(p); }
 void put_u32(unsigned char* p, std::uint32_t v) {
   for (int i = 0; i < 4; ++i) p[i] = (unsigned char)(v >> (8 * i));
 }
@@ -856,12 +855,6 @@ class LayeredChunk {
   std::size_t rgb_size_ = 0;
 };
 
-bool read_at(std::ifstream& in, std::uint64_t pos, unsigned char* dst, std::size_t n) {
-  in.clear();
-  in.seekg(std::streamoff(pos));
-  in.read(reinterpret_cast<char*>(dst), std::streamsize(n));
-  return in.gcount() == std::streamsize(n);
-}
 
 // The items a point format needs, in record order (extra bytes come last, as one BYTE item):
 // version 2 items for formats 0–5 (compressor 2), version 3 for 6–10 (compressor 3).
@@ -1012,6 +1005,7 @@ void stream_records(const std::string& path, std::ifstream& in, std::uint64_t fi
   std::vector<unsigned char> chunk, record(h.record_length);
   std::uint64_t pos = h.point_offset + 8, done = 0;
   for (std::uint32_t i = 0; done < h.point_count; ++i) {
+    if (i >= L.chunk_count) fail(path, "LAZ chunk table changed while reading (file modified?)");
     std::pair<std::uint32_t, std::uint32_t> entry;
     try {
       entry = table.next();
