@@ -325,3 +325,20 @@ TEST(Laz, SampleFolderEqualsLazPerf) {
   }
   EXPECT_GT(same, 0u);
 }
+
+// A LAZ count is bounded by its chunk table, not by the file size: a 4-billion-point header over
+// 6 chunks declared as huge is refused when the data runs out, having reserved little.
+TEST(Laz, HugeDeclaredCountsAllocateLittle) {
+  std::string b = cli_fixtures::slurp(corpus_dir() + "/v12_f0.laz");
+  ASSERT_EQ(b.substr(227 + 2, 14), "laszip encoded");
+  poke<std::uint32_t>(b, 227 + 54 + 12, 0xfffffff0u);  // the VLR's chunk size
+  poke<std::uint32_t>(b, 107, 0xffffff00u);
+  const std::string path = write_bytes(temp_path("huge.laz"), b);
+  EXPECT_EQ(read_las_header(path).point_count, 0xffffff00u);
+  try {
+    read_cloud(path);
+    ADD_FAILURE() << "4 billion points from 500 bytes";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("truncated or corrupt"), std::string::npos) << e.what();
+  }
+}
