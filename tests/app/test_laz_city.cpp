@@ -1,5 +1,5 @@
 // A real LAZ tile end to end: 3dfier's AHN3 crop (LAZ 1.2, point format 1, 640,510 points)
-// goes through `crop` and city refine with the city model of the same area and CRS
+// goes through `crop`, `eval` and city refine with the city model of the same area and CRS
 // (3dfier's testarea.json: CityJSON 1.0, 160 LoD1 buildings) and gets exactly the points of
 // its LAS equivalent: the same header and records, uncompressed. Skips without ../shared.
 #include <gtest/gtest.h>
@@ -65,6 +65,19 @@ TEST(LazCity, Ahn3LazCropsAndRefinesLikeItsLas) {
   }
   EXPECT_EQ(clouds, 160u);
   EXPECT_GT(nonempty, 130u);
+
+  // eval reads the tile too (class 9, 267 points, keeps it short): the same figures.
+  const std::string model = fs::directory_iterator(dir + "/models")->path().string();
+  for (const char* kind : {"laz", "las"}) {
+    r = cli_fixtures::run_cli("eval --original '" + model + "' --refined '" + model + "' --cloud '" +
+                                  std::string(std::strcmp(kind, "laz") == 0 ? laz : las) +
+                                  "' --classes 9 --json '" + dir + "/eval_" + kind + ".json'",
+                              dir);
+    ASSERT_EQ(r.exit, 0) << r.err;
+  }
+  const std::string eval = cli_fixtures::slurp(dir + "/eval_laz.json");
+  EXPECT_NE(eval.find("\"mls\""), std::string::npos) << eval.substr(0, 400);
+  EXPECT_EQ(eval, cli_fixtures::slurp(dir + "/eval_las.json"));
 
   // City refine (CityJSON 1.0 read, LoD1 refined): the same city file from either tile.
   for (const char* kind : {"laz", "las"}) {
