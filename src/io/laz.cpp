@@ -703,30 +703,44 @@ class Point14Decoder {
   int channel_ = 0;
 };
 
-// RGB14 / RGBNIR14 and BYTE14 keep their last values per scanner channel too; a channel's
-// first point continues from the channel before it (LASzip's rule).
+// RGB14 / RGBNIR14 and BYTE14 keep their models and last values per scanner channel too. As
+// LASzip's v3 readers do (and laz-perf): a channel's first point continues from the channel
+// before it; after a switch back to a channel already seen in the chunk, the prediction still
+// comes from (and updates) the previous channel's last value, with the new channel's models.
 template <class Last, class Models>
-struct ChannelState {
+class ChannelState {
+ public:
+  void first(int channel, const Last& value, std::unique_ptr<Models> models) {
+    current_ = channel;
+    ctx_[channel].used = true;
+    ctx_[channel].last = value;
+    ctx_[channel].models = std::move(models);
+  }
+  // The last value to predict from for a point of `channel`; makes its context when new.
+  Last& select(int channel, const std::function<std::unique_ptr<Models>()>& make) {
+    Last* last = &ctx_[current_].last;
+    if (channel != current_) {
+      current_ = channel;
+      if (!ctx_[channel].used) {
+        ctx_[channel].used = true;
+        ctx_[channel].last = *last;
+        ctx_[channel].models = make();
+        last = &ctx_[channel].last;
+      }
+    }
+    return *last;
+  }
+  Models& models() { return *ctx_[current_].models; }
+  Last& current_last() { return ctx_[current_].last; }
+
+ private:
   struct Context {
     bool used = false;
     Last last{};
     std::unique_ptr<Models> models;
   };
-  std::array<Context, 4> ctx;
-  int channel = 0;
-
-  void first(int ch, const Last& value) {
-    channel = ch;
-    ctx[ch].used = true;
-    ctx[ch].last = value;
-  }
-  // The context of `ch`, made from the current one when new.
-  Context& switch_to(int ch, const std::function<std::unique_ptr<Models>()>& make) {
-    if (!ctx[ch].used) ctx[ch].used = true, ctx[ch].last = ctx[channel].last;
-    channel = ch;
-    if (!ctx[ch].models) ctx[ch].models = make();
-    return ctx[ch];
-  }
+  std::array<Context, 4> ctx_;
+  int current_ = 0;
 };
 
 struct NirModels {
@@ -734,42 +748,50 @@ struct NirModels {
   std::array<SymbolModel, 2> diff{SymbolModel(256), SymbolModel(256)};
 };
 
+// RGB14 (6 bytes) or RGBNIR14 (8 bytes: the colour and the near infrared, two layers).
 class Rgb14Decoder {
  public:
   explicit Rgb14Decoder(bool nir) : nir_(nir) {}
   void first(ByteReader& in, unsigned char* out, int channel) {
     in.bytes(out, nir_ ? 8 : 6);
-    rgb_.first(channel, get_rgb(out));
-    if (nir_) nir_state_.first(channel, get_u16(out + 6));
+    state_.first(channel, {get_rgb(out), nir_ ? get_u16(out + 6) : 0u}, make());
   }
   std::array<Layer, 2>& layers() { return layers_; }
   void next(unsigned char* out, int channel) {
-    auto& c = rgb_.switch_to(channel, [] { return std::make_unique<RgbModels>(); });
-    if (layers_[0].present()) c.last = decode_rgb(*layers_[0], *c.models, c.last);
-    put_rgb(out, c.last);
+    Last& last = state_.select(channel, make);
+    if (layers_[0].present()) last.rgb = decode_rgb(*layers_[0], state_.models().rgb, last.rgb);
+    put_rgb(out, last.rgb);
     if (!nir_) return;
-    auto& n = nir_state_.switch_to(channel, [] { return std::make_unique<NirModels>(); });
+    // LASzip predicts the infrared from the same last value, but keeps it in the current channel.
+    std::uint32_t& kept = state_.current_last().nir;
     if (layers_[1].present()) {
       ArithmeticDecoder& dec = *layers_[1];
-      const std::uint32_t sym = dec.symbol(n.models->byte_used);
-      std::uint32_t v = sym & 1 ? (dec.symbol(n.models->diff[0]) + n.last) & 0xff : n.last & 0xff;
-      v |= sym & 2 ? ((dec.symbol(n.models->diff[1]) + (n.last >> 8)) & 0xff) << 8 : n.last & 0xff00;
-      n.last = v;
+      NirModels& m = state_.models().nir;
+      const std::uint32_t sym = dec.symbol(m.byte_used);
+      std::uint32_t v = sym & 1 ? (dec.symbol(m.diff[0]) + last.nir) & 0xff : last.nir & 0xff;
+      v |= sym & 2 ? ((dec.symbol(m.diff[1]) + (last.nir >> 8)) & 0xff) << 8 : last.nir & 0xff00;
+      kept = v;
     }
-    put_u16(out + 6, std::uint16_t(n.last));
+    put_u16(out + 6, std::uint16_t(kept));
   }
 
  private:
+  struct Last {
+    std::array<std::uint32_t, 3> rgb{};
+    std::uint32_t nir = 0;
+  };
+  struct Models {
+    RgbModels rgb;
+    NirModels nir;
+  };
+  static std::unique_ptr<Models> make() { return std::make_unique<Models>(); }
+
   bool nir_;
-  ChannelState<std::array<std::uint32_t, 3>, RgbModels> rgb_;
-  ChannelState<std::uint32_t, NirModels> nir_state_;
+  ChannelState<Last, Models> state_;
   std::array<Layer, 2> layers_;
 };
 
-struct Byte14Models {
-  std::vector<SymbolModel> byte;
-};
-
+// BYTE14: each extra byte its own layer, a difference to its last value.
 class Byte14Decoder {
  public:
   explicit Byte14Decoder(std::size_t n) : layers_(n) {}
@@ -777,25 +799,24 @@ class Byte14Decoder {
     std::vector<unsigned char> v(layers_.size());
     in.bytes(v.data(), v.size());
     std::copy(v.begin(), v.end(), out);
-    state_.first(channel, v);
+    state_.first(channel, v, make(v.size()));
   }
   std::vector<Layer>& layers() { return layers_; }
   void next(unsigned char* out, int channel) {
     const std::size_t n = layers_.size();
-    auto& c = state_.switch_to(channel, [n] {
-      auto m = std::make_unique<Byte14Models>();
-      m->byte.assign(n, SymbolModel(256));
-      return m;
-    });
+    std::vector<unsigned char>& last = state_.select(channel, [n] { return make(n); });
     for (std::size_t i = 0; i < n; ++i) {
-      if (layers_[i].present()) c.last[i] = (unsigned char)(c.last[i] + layers_[i]->symbol(c.models->byte[i]));
-      out[i] = c.last[i];
+      if (layers_[i].present()) last[i] = (unsigned char)(last[i] + layers_[i]->symbol(state_.models()[i]));
+      out[i] = last[i];
     }
   }
 
  private:
+  using Models = std::vector<SymbolModel>;
+  static std::unique_ptr<Models> make(std::size_t n) { return std::make_unique<Models>(n, SymbolModel(256)); }
+
   std::vector<Layer> layers_;
-  ChannelState<std::vector<unsigned char>, Byte14Models> state_;
+  ChannelState<std::vector<unsigned char>, Models> state_;
 };
 
 // One chunk of a layered (compressor 3) file.
