@@ -1,5 +1,6 @@
-// LAS reader and writer (ASPRS LAS 1.4 R15; 1.0–1.3 are prefixes of the same header).
-// All fields are little-endian and read byte-wise, so the code does not depend on the host.
+// LAS reader and writer (ASPRS LAS 1.4 R15; 1.0–1.3 are prefixes of the same header); LAZ
+// point data goes through our decoder (laz.h). All fields are little-endian and read
+// byte-wise, so the code does not depend on the host.
 #include "lodrefine/io/las.h"
 
 #include <algorithm>

@@ -44,7 +44,7 @@ std::uint64_t stream_las_records(const std::string& path,
                                  const std::function<void(const LasHeader&, const unsigned char*)>& on_record);
 
 // Streams the points (x = X·scale + offset, in double) in file order, reading the file in
-// chunks. `classes` (empty: every point) keeps only points whose classification is listed:
+// chunks (LAZ: one compressed chunk at a time). `classes` (empty: every point) keeps only points whose classification is listed:
 // formats 0–5 carry a 5-bit class (bits 0–4 of byte 15), formats 6–10 a full byte (byte 16).
 // Returns the number of points passed on. Rejects coordinates beyond 1e9 m (kMaxCoordinate).
 std::uint64_t stream_las(const std::string& path, const std::vector<int>& classes,
