@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (clang, ASan + UBSan) into build-fuzz/ and runs them.
-#   scripts/fuzz.sh [TARGET|all] [SECONDS]   fuzz TARGET (fuzz_obj, fuzz_ply, fuzz_las, fuzz_citygml,
+#   scripts/fuzz.sh [TARGET|all] [SECONDS]   fuzz TARGET (fuzz_obj, fuzz_ply, fuzz_las, fuzz_laz, fuzz_citygml,
 #                                           fuzz_refine; default all, one after the other) for SECONDS
 #                                           each (default 600)
 #   scripts/fuzz.sh regress                 run every saved input of tests/fuzz/regressions/<target>/
@@ -11,7 +11,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
-TARGETS=(fuzz_obj fuzz_ply fuzz_las fuzz_citygml fuzz_refine)
+TARGETS=(fuzz_obj fuzz_ply fuzz_las fuzz_laz fuzz_citygml fuzz_refine)
 what=${1:-all}
 seconds=${2:-600}
 

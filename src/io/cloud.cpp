@@ -1,6 +1,7 @@
 // Format dispatch for point clouds: PLY (io) or LAS (las), by content.
 #include "lodrefine/io/cloud.h"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "lodrefine/io/ply.h"
@@ -34,9 +35,18 @@ void stream_cloud(const std::string& path, const CloudOptions& options,
 
 PointCloud read_cloud(const std::string& path, const CloudOptions& options) {
   PointCloud cloud;
-  // The declared count is bounded by the file size (checked in the header); with a class
-  // filter most points may be dropped, so the vector grows instead.
-  if (options.classes.empty()) cloud.points.reserve(cloud_point_count(path));
+  // A LAS count is bounded by the file size (checked in the header), a LAZ count only by what
+  // its chunks decode to, so beyond a few million points the vector grows as points arrive.
+  // With a class filter most points may be dropped, so the vector grows too.
+  constexpr std::uint64_t kReserveLimit = std::uint64_t(1) << 22;
+  if (options.classes.empty()) {
+    if (cloud_format(path) == CloudFormat::Las) {
+      const LasHeader h = read_las_header(path);
+      cloud.points.reserve(h.compressed ? std::min(h.point_count, kReserveLimit) : h.point_count);
+    } else {
+      cloud.points.reserve(ply_vertex_count(path));
+    }
+  }
   stream_cloud(path, options, [&](const Vec3& p) { cloud.points.push_back(p); });
   return cloud;
 }

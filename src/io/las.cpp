@@ -1,5 +1,6 @@
-// LAS reader and writer (ASPRS LAS 1.4 R15; 1.0–1.3 are prefixes of the same header).
-// All fields are little-endian and read byte-wise, so the code does not depend on the host.
+// LAS reader and writer (ASPRS LAS 1.4 R15; 1.0–1.3 are prefixes of the same header); LAZ
+// point data goes through our decoder (laz.h). All fields are little-endian and read
+// byte-wise, so the code does not depend on the host.
 #include "lodrefine/io/las.h"
 
 #include <algorithm>
@@ -8,9 +9,11 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <optional>
 
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/io/files.h"
+#include "laz.h"
 #include "text.h"
 
 namespace lodrefine {
@@ -26,26 +29,9 @@ constexpr int kCompressedBits = 0xC0;
 constexpr std::size_t kChunkBytes = 1 << 20;
 
 using io_text::fail;
+using io_text::get_le;
 using io_text::open_input;
-
-[[noreturn]] void fail_laz(const std::string& path) {
-  fail(path,
-       "compressed LAZ point cloud; lodrefine reads uncompressed LAS only: decompress it first "
-       "(e.g. `laszip -i in.laz -o out.las` or `pdal translate in.laz out.las`)");
-}
-
-template <class T>
-T get_le(const unsigned char* p) {
-  std::uint64_t bits = 0;
-  for (std::size_t i = 0; i < sizeof(T); ++i) bits |= std::uint64_t(p[i]) << (8 * i);
-  if constexpr (std::is_same_v<T, double>) {
-    double d;
-    std::memcpy(&d, &bits, 8);
-    return d;
-  } else {
-    return T(bits);
-  }
-}
+using io_text::read_at;
 
 template <class T>
 void put_le(std::string& out, T v) {
@@ -59,29 +45,36 @@ Vec3 get_vec(const unsigned char* p, int stride) {
   return {get_le<double>(p), get_le<double>(p + stride), get_le<double>(p + 2 * stride)};
 }
 
-bool read_at(std::ifstream& in, std::uint64_t pos, unsigned char* dst, std::size_t n) {
-  in.clear();
-  in.seekg(std::streamoff(pos));
-  in.read(reinterpret_cast<char*>(dst), std::streamsize(n));
-  return in.gcount() == std::streamsize(n);
-}
 
-// The VLRs between the header and the point data: a "laszip encoded" one marks LAZ even when
-// a tool cleared the format bits. Walks only as far as the VLRs fit before the point data.
-bool has_laszip_vlr(std::ifstream& in, const LasHeader& h, std::uint32_t vlr_count) {
+// The LASzip VLR's payload, when one of the VLRs between the header and the point data is
+// "laszip encoded" (record 22204): that marks LAZ even when a tool cleared the format bits.
+// Walks only as far as the VLRs fit before the point data; a VLR holds at most 64 kB.
+std::optional<std::string> laszip_vlr(std::ifstream& in, const LasHeader& h, std::uint32_t vlr_count) {
   std::uint64_t pos = h.header_size;
   for (std::uint32_t i = 0; i < vlr_count && pos + kVlrHeaderSize <= h.point_offset; ++i) {
     unsigned char v[kVlrHeaderSize];
-    if (!read_at(in, pos, v, sizeof v)) return false;
+    if (!read_at(in, pos, v, sizeof v)) return std::nullopt;
+    const std::uint16_t length = get_le<std::uint16_t>(v + 20);
     if (std::string(reinterpret_cast<const char*>(v + 2), strnlen(reinterpret_cast<const char*>(v + 2), 16)) ==
-        "laszip encoded")
-      return true;
-    pos += kVlrHeaderSize + get_le<std::uint16_t>(v + 20);
+            "laszip encoded" &&
+        get_le<std::uint16_t>(v + 18) == 22204) {
+      std::string payload(std::min<std::uint64_t>(length, h.point_offset - pos - kVlrHeaderSize), '\0');
+      if (!read_at(in, pos + kVlrHeaderSize, reinterpret_cast<unsigned char*>(payload.data()), payload.size()))
+        return std::nullopt;
+      return payload;
+    }
+    pos += kVlrHeaderSize + length;
   }
-  return false;
+  return std::nullopt;
 }
 
-LasHeader parse_header(const std::string& path, std::ifstream& in, std::uint64_t file_size) {
+// A header and, for LAZ, the layout of its compressed data.
+struct Parsed {
+  LasHeader header;
+  std::optional<laz::Layout> laz;
+};
+
+Parsed parse_header(const std::string& path, std::ifstream& in, std::uint64_t file_size) {
   if (file_size == 0) fail(path, "empty file");
   unsigned char b[kHeaderSize14] = {};
   const std::size_t got = std::size_t(std::min<std::uint64_t>(file_size, sizeof b));
@@ -92,8 +85,7 @@ LasHeader parse_header(const std::string& path, std::ifstream& in, std::uint64_t
                    " bytes)");
   LasHeader h;
   h.version_major = b[24], h.version_minor = b[25];
-  const int format_id = b[104];
-  if (format_id & kCompressedBits) fail_laz(path);
+  const int format_id = b[104] & ~kCompressedBits;
   if (h.version_major != 1 || h.version_minor > 4)
     fail(path, "unsupported LAS version " + std::to_string(h.version_major) + "." + std::to_string(h.version_minor) +
                    " (1.0–1.4 are read)");
@@ -115,7 +107,9 @@ LasHeader parse_header(const std::string& path, std::ifstream& in, std::uint64_t
   if (h.point_offset > file_size)
     fail(path, "point data offset " + std::to_string(h.point_offset) + " is beyond the end of the file (" +
                    std::to_string(file_size) + " bytes; truncated?)");
-  if (has_laszip_vlr(in, h, vlr_count)) fail_laz(path);
+  std::optional<std::string> vlr = laszip_vlr(in, h, vlr_count);
+  h.compressed = (b[104] & kCompressedBits) != 0 || vlr.has_value();
+  if (h.compressed && !vlr) fail(path, "compressed point format bits set but no LASzip VLR (\"laszip encoded\", 22204)");
   if (format_id > 10) fail(path, "unknown point data format " + std::to_string(format_id) + " (0–10 are defined)");
   h.point_format = format_id;
   const std::uint32_t min_record = las_min_record_length(format_id);
@@ -133,7 +127,7 @@ LasHeader parse_header(const std::string& path, std::ifstream& in, std::uint64_t
     if (count64 != 0) h.point_count = count64;
   }
   const std::uint64_t data_bytes = file_size - h.point_offset;
-  if (h.point_count > data_bytes / h.record_length)
+  if (!h.compressed && h.point_count > data_bytes / h.record_length)
     fail(path, "header declares " + std::to_string(h.point_count) + " points of " + std::to_string(h.record_length) +
                    " bytes but the file holds only " + std::to_string(data_bytes) + " bytes of point data (truncated?)");
 
@@ -147,7 +141,9 @@ LasHeader parse_header(const std::string& path, std::ifstream& in, std::uint64_t
     if (!std::isfinite(h.offset[a]) || std::abs(h.offset[a]) > kMaxCoordinate)
       fail(path, std::string("offset of ") + char('x' + a) + " is not finite or beyond 1e9 m");
   }
-  return h;
+  Parsed parsed{h, std::nullopt};
+  if (h.compressed) parsed.laz = laz::read_layout(path, in, file_size, h, *vlr);
+  return parsed;
 }
 
 }  // namespace
@@ -161,45 +157,57 @@ std::uint32_t las_min_record_length(int point_format) {
 LasHeader read_las_header(const std::string& path) {
   std::uint64_t size = 0;
   std::ifstream in = open_input(path, &size);
-  return parse_header(path, in, size);
+  return parse_header(path, in, size).header;
 }
 
-std::uint64_t stream_las(const std::string& path, const std::vector<int>& classes,
-                         const std::function<void(const Vec3&)>& on_point) {
+std::uint64_t stream_las_records(const std::string& path,
+                                 const std::function<void(const LasHeader&, const unsigned char*)>& on_record) {
   std::uint64_t size = 0;
   std::ifstream in = open_input(path, &size);
-  const LasHeader h = parse_header(path, in, size);
-  std::bitset<256> keep;
-  for (int c : classes) {
-    if (c < 0 || c > 255) throw std::invalid_argument("LAS classification out of range 0..255");
-    keep.set(std::size_t(c));
+  const Parsed parsed = parse_header(path, in, size);
+  const LasHeader& h = parsed.header;
+  if (parsed.laz) {
+    laz::stream_records(path, in, size, h, *parsed.laz, [&](const unsigned char* r) { on_record(h, r); });
+    return h.point_count;
   }
-  const bool filter = !classes.empty();
-  // Formats 6–10 hold the class in a byte of its own; 0–5 in the low 5 bits of byte 15.
-  const bool extended = h.point_format >= 6;
   const std::size_t per_chunk = std::max<std::size_t>(1, kChunkBytes / h.record_length);
   std::vector<unsigned char> buf(per_chunk * h.record_length);
   in.clear();
   in.seekg(std::streamoff(h.point_offset));
-  std::uint64_t done = 0, passed = 0;
+  std::uint64_t done = 0;
   while (done < h.point_count) {
     const std::size_t n = std::size_t(std::min<std::uint64_t>(per_chunk, h.point_count - done));
     in.read(reinterpret_cast<char*>(buf.data()), std::streamsize(n * h.record_length));
     if (in.gcount() != std::streamsize(n * h.record_length))
       fail(path, "data ends after " + std::to_string(done + std::uint64_t(in.gcount()) / h.record_length) + " of " +
                      std::to_string(h.point_count) + " points (truncated)");
-    for (std::size_t i = 0; i < n; ++i, ++done) {
-      const unsigned char* r = buf.data() + i * h.record_length;
-      if (filter && !keep[extended ? r[16] : (r[15] & 0x1f)]) continue;
-      const Vec3 p(double(get_le<std::int32_t>(r)) * h.scale.x() + h.offset.x(),
-                   double(get_le<std::int32_t>(r + 4)) * h.scale.y() + h.offset.y(),
-                   double(get_le<std::int32_t>(r + 8)) * h.scale.z() + h.offset.z());
-      if (p.cwiseAbs().maxCoeff() > kMaxCoordinate)
-        fail(path, "point " + std::to_string(done) + " has a coordinate beyond 1e9 m");
-      on_point(p);
-      ++passed;
-    }
+    for (std::size_t i = 0; i < n; ++i, ++done) on_record(h, buf.data() + i * h.record_length);
   }
+  return h.point_count;
+}
+
+std::uint64_t stream_las(const std::string& path, const std::vector<int>& classes,
+                         const std::function<void(const Vec3&)>& on_point) {
+  std::bitset<256> keep;
+  for (int c : classes) {
+    if (c < 0 || c > 255) throw std::invalid_argument("LAS classification out of range 0..255");
+    keep.set(std::size_t(c));
+  }
+  const bool filter = !classes.empty();
+  std::uint64_t done = 0, passed = 0;
+  stream_las_records(path, [&](const LasHeader& h, const unsigned char* r) {
+    // Formats 6–10 hold the class in a byte of its own; 0–5 in the low 5 bits of byte 15.
+    const bool extended = h.point_format >= 6;
+    const std::uint64_t index = done++;
+    if (filter && !keep[extended ? r[16] : (r[15] & 0x1f)]) return;
+    const Vec3 p(double(get_le<std::int32_t>(r)) * h.scale.x() + h.offset.x(),
+                 double(get_le<std::int32_t>(r + 4)) * h.scale.y() + h.offset.y(),
+                 double(get_le<std::int32_t>(r + 8)) * h.scale.z() + h.offset.z());
+    if (p.cwiseAbs().maxCoeff() > kMaxCoordinate)
+      fail(path, "point " + std::to_string(index) + " has a coordinate beyond 1e9 m");
+    on_point(p);
+    ++passed;
+  });
   return passed;
 }
 

@@ -2,6 +2,8 @@
 // (messages, tokens, numbers). Not a public header: nothing outside src/io/ includes it.
 #pragma once
 #include <charconv>
+#include <cstring>
+#include <type_traits>
 #include <cstdint>
 #include <fstream>
 #include <optional>
@@ -40,6 +42,28 @@ std::optional<T> parse_number(std::string_view t) {
 // unreadable files with the reason.
 std::ifstream open_input(const std::string& path, std::uint64_t* size = nullptr);
 std::string read_whole_file(const std::string& path);
+
+// Little-endian binary fields (LAS, LAZ), read byte-wise so nothing depends on the host.
+template <class T>
+T get_le(const unsigned char* p) {
+  std::uint64_t bits = 0;
+  for (std::size_t i = 0; i < sizeof(T); ++i) bits |= std::uint64_t(p[i]) << (8 * i);
+  if constexpr (std::is_same_v<T, double>) {
+    double d;
+    std::memcpy(&d, &bits, 8);
+    return d;
+  } else {
+    return T(bits);
+  }
+}
+
+// Reads n bytes at byte offset pos; false when the file is shorter.
+inline bool read_at(std::ifstream& in, std::uint64_t pos, unsigned char* dst, std::size_t n) {
+  in.clear();
+  in.seekg(std::streamoff(pos));
+  in.read(reinterpret_cast<char*>(dst), std::streamsize(n));
+  return in.gcount() == std::streamsize(n);
+}
 
 // One-token names for OBJ `o` lines and PLY property names: whitespace and control characters
 // become '_' so other tools read one token.

@@ -360,6 +360,20 @@ std::vector<Case> cases() {
 
   // --- malformed clouds
   c.push_back({"cloud: empty file (0 bytes)", [](Paths& p) { cloud_is(p, ""); }, Expect::Error, "empty"});
+  {
+    // A LAZ (the fuzz seed: 6 points, one per chunk) cut inside its chunk table, and with a
+    // header count beyond what its chunks hold.
+    const std::string laz = read_text(std::string(LODREFINE_SOURCE_DIR) + "/tests/fuzz/corpus/fuzz_laz/v12_f0.laz");
+    c.push_back({"cloud: LAZ cut inside its chunk table",
+                 [laz](Paths& p) { cloud_is(p, laz.substr(0, laz.size() - 6)); }, Expect::Error, "LAZ chunk"});
+    c.push_back({"cloud: LAZ header count beyond its chunks",
+                 [laz](Paths& p) {
+                   std::string b = laz;
+                   b[107] = 7;  // 7 points declared, 6 chunks of 1
+                   cloud_is(p, b);
+                 },
+                 Expect::Error, "header declares 7 points but the LAZ chunks hold only 6"});
+  }
   c.push_back({"cloud: header cut before end_header",
                [](Paths& p) { cloud_is(p, "ply\nformat binary_little_endian 1.0\nelement vertex 10\nproperty dou"); },
                Expect::Error});

@@ -1,7 +1,7 @@
 // Reading ASPRS LAS point clouds: versions 1.0–1.4, point data record formats 0–10,
-// uncompressed. Debian ships no LAS library (no PDAL, LASlib, liblas) and no LAZ decoder, so
-// this is a small reader of the public header block and the x/y/z/classification fields.
-// Compressed LAZ is recognised and refused with a message saying how to decompress it.
+// uncompressed, and LASzip-compressed LAZ of point formats 0–3 (our own decoder, src/io/laz.cpp:
+// Debian ships no LAS library, no PDAL, LASlib, liblas, LASzip or laz-perf). A small reader of
+// the public header block and the point records; other LAZ is refused with one line.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -22,6 +22,7 @@ struct LasHeader {
   std::uint64_t point_count = 0;   // LAS 1.4: the 64-bit count; before: the 32-bit legacy count
   Vec3 scale = Vec3::Ones(), offset = Vec3::Zero();
   Vec3 min = Vec3::Zero(), max = Vec3::Zero();  // bounding box as declared by the writer
+  bool compressed = false;         // LAZ: point format bit 7 or 6, or a "laszip encoded" VLR
 };
 
 // Smallest record length of point data format 0..10 (ASPRS LAS 1.4 R15, Tables 7–17).
@@ -30,13 +31,20 @@ std::uint32_t las_min_record_length(int point_format);
 // Reads and checks the header: 'LASF' signature, version 1.0–1.4, header size, point data
 // offset and record length within the file, point format 0–10, record length at least the
 // format's minimum, the point count times the record length within the file, finite non-zero
-// scales and finite offsets. A compressed LAZ file (point format bit 7 or 6, or a
-// "laszip encoded" VLR) is refused with a message to decompress it first. Throws InputError
-// "<path>: <fault>" (one line); never allocates more than the header.
+// scales and finite offsets. For LAZ (point format bit 7 or 6, or a "laszip encoded" VLR;
+// point_format is then the format without those bits) instead of the count check: a LASzip VLR
+// the decoder supports, a chunk table inside the file whose chunks hold at least the declared
+// points. Throws InputError "<path>: <fault>" (one line); allocates no more than the header, a
+// VLR (64 kB) and a bounded slice of the chunk table.
 LasHeader read_las_header(const std::string& path);
 
+// Streams the raw point records in file order: header.record_length bytes each, in the LAS
+// layout (LAZ decompressed chunk by chunk, so memory stays bounded). Returns the count.
+std::uint64_t stream_las_records(const std::string& path,
+                                 const std::function<void(const LasHeader&, const unsigned char*)>& on_record);
+
 // Streams the points (x = X·scale + offset, in double) in file order, reading the file in
-// chunks. `classes` (empty: every point) keeps only points whose classification is listed:
+// chunks (LAZ: one compressed chunk at a time). `classes` (empty: every point) keeps only points whose classification is listed:
 // formats 0–5 carry a 5-bit class (bits 0–4 of byte 15), formats 6–10 a full byte (byte 16).
 // Returns the number of points passed on. Rejects coordinates beyond 1e9 m (kMaxCoordinate).
 std::uint64_t stream_las(const std::string& path, const std::vector<int>& classes,
