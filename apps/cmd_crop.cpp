@@ -3,10 +3,12 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 
 #include "commands.h"
 #include "lodrefine/io/crop.h"
 #include "lodrefine/io/obj.h"
+#include "lodrefine/io/progress.h"
 #include "options.h"
 
 namespace lodrefine::app {
@@ -21,6 +23,7 @@ struct CropArgs {
   // whatever the tile's size.
   std::size_t buffer_points = 4000000;
   CloudOptions cloud_options;
+  bool quiet = false;
 };
 
 // Models: DIR/*.obj (id = stem) or DIR/<id>/coarse.obj.
@@ -57,7 +60,16 @@ void run(const CropArgs& a) {
     clouds.push_back((fs::path(a.out) / id / "cloud.ply").string());
   }
   std::vector<std::size_t> counts;
-  const std::size_t n = crop_tile_to_files(a.tile, targets, clouds, a.buffer_points, counts, a.cloud_options);
+  std::unique_ptr<Progress> progress;  // made once the tile reads (its header count is the total)
+  const std::size_t n = crop_tile_to_files(a.tile, targets, clouds, a.buffer_points, counts, a.cloud_options,
+                                           [&](std::uint64_t read) {
+                                             if (!progress)
+                                               progress = std::make_unique<Progress>(
+                                                   "crop", "points", cloud_point_count(a.tile),
+                                                   Progress::mode_for_stderr(a.quiet));
+                                             progress->update(read);
+                                           });
+  if (progress) progress->update(n), progress->finish();
   for (std::size_t i = 0; i < targets.size(); ++i) {
     const fs::path dir = fs::path(a.out) / ids[i];
     const fs::path model = models[i].second;
@@ -84,6 +96,7 @@ void add_crop_command(CLI::App& app) {
   add_ranged_option(cmd, "--margin", args.margin, "Absolute box growth on each side (m)", 0.0, 1000.0);
   add_ranged_option(cmd, "--buffer-points", args.buffer_points, "Points held in memory before spilling to disk (memory bound)", std::size_t(1), std::size_t(1) << 40);
   add_cloud_options(cmd, args.cloud_options);
+  cmd->add_flag("--quiet", args.quiet, "No progress line on stderr");
   cmd->callback([] { run(args); });
 }
 

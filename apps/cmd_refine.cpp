@@ -1,6 +1,7 @@
 // `lodrefine refine`: one coarse building + its MLS crop -> the refined building.
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 
 #include "commands.h"
 #include "lodrefine/io/cityfile.h"
@@ -8,6 +9,7 @@
 #include "lodrefine/io/obj.h"
 #include "lodrefine/io/files.h"
 #include "lodrefine/core/refine.h"
+#include "lodrefine/io/progress.h"
 #include "lodrefine/io/refine_report.h"
 #include "options.h"
 
@@ -20,6 +22,8 @@ struct RefineArgs {
   Params params;
   CloudOptions cloud_options;
   std::string building, lod;  // city files only
+  int jobs = default_jobs();  // city files only
+  bool quiet = false;
 };
 
 nlohmann::json params_json(const Params& p) {
@@ -38,6 +42,12 @@ void check_output_dir(const std::string& path) {
   if (std::filesystem::is_directory(path)) throw InputError(path + ": is a directory");
 }
 
+// "12 refined, 3 kept, 1 kept-invalid": the progress line's tally.
+std::string tally_text(const CityRefineSummary& s) {
+  return std::to_string(s.refined) + " refined, " + std::to_string(s.kept) + " kept, " +
+         std::to_string(s.kept_invalid) + " kept-invalid";
+}
+
 // A city file (CityJSON, CityJSONSeq, CityGML) in: every building the cloud covers, one
 // CityJSON 2.0 file out.
 void run_city(const RefineArgs& a) {
@@ -45,7 +55,21 @@ void run_city(const RefineArgs& a) {
   o.building = a.building;
   o.lod = a.lod;
   o.cloud = a.cloud_options;
+  o.jobs = a.jobs;
+  const Progress::Mode mode = Progress::mode_for_stderr(a.quiet);
+  std::unique_ptr<Progress> crop, refine;
+  o.crop_progress = [&](std::uint64_t read) {
+    if (!crop) crop = std::make_unique<Progress>("crop", "points", cloud_point_count(a.cloud), mode);
+    crop->update(read);
+  };
+  o.progress = [&](const CityRefineSummary& s) {
+    if (crop) crop->finish();
+    if (!refine) refine = std::make_unique<Progress>("refine", "buildings", std::uint64_t(s.buildings), mode);
+    refine->update(std::uint64_t(s.refined + s.kept + s.kept_invalid + s.untouched), tally_text(s));
+  };
   const CityRefineSummary s = refine_city(a.model, a.cloud, a.out, a.params, o);
+  if (crop) crop->finish();
+  if (refine) refine->finish();
   if (!a.report.empty()) {
     nlohmann::json j = {{"model", a.model}, {"cloud", a.cloud}, {"written", a.out}, {"input", s.input_format},
                         {"buildings", s.buildings}, {"refined", s.refined}, {"kept", s.kept},
@@ -122,6 +146,9 @@ void add_refine_command(CLI::App& app) {
   cmd->add_option("--out", args.out, "Refined model (OBJ; CityJSON for a city file), written atomically")->required();
   cmd->add_option("--building", args.building, "City file: refine only this CityObject id");
   cmd->add_option("--lod", args.lod, "City file: the LoD geometry to refine, e.g. 2.2 (default: the highest 2.x)");
+  add_ranged_option(cmd, "--jobs", args.jobs, "City file: buildings refined at once, one thread each (default: "
+                    "all cores; the output is the same whatever the number)", 1, 1024);
+  cmd->add_flag("--quiet", args.quiet, "City file: no progress line on stderr");
   cmd->add_option("--report", args.report, "JSON report: matches, planes, candidates, MIP, timings, validation");
   cmd->add_option("--max-points", args.max_points, "Refuse clouds with more points (a tile, not a crop)")->capture_default_str();
   add_cloud_options(cmd, args.cloud_options);

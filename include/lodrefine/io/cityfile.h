@@ -3,8 +3,8 @@
 // is written with everything else kept exactly.
 //
 // The cloud is read once: one streaming pass cuts a crop per building (lodrefine crop's box),
-// then each building is refined on its crop, one after another (memory: the crops, not the
-// cloud). A refined building's chosen LoD geometry is replaced by a Solid with semantics
+// then each building is refined on its crop, `jobs` buildings at once (memory: the crops, not
+// the cloud); results are written in file order. A refined building's chosen LoD geometry is replaced by a Solid with semantics
 // (WallSurface / RoofSurface / GroundSurface from the refined mesh's faces); its other LoDs,
 // attributes and id stay. Every other building, attribute, LoD, the metadata and the transform
 // are kept as read (new vertices are appended, so existing indices hold). Each building the
@@ -13,6 +13,7 @@
 // CityGML input is converted first (citygml_to_cityjson) and written as CityJSON 2.0.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -23,12 +24,21 @@
 
 namespace lodrefine {
 
+struct CityRefineSummary;
+
 struct CityRefineOptions {
   std::string building;  // refine only this CityObject id ("" = every building the cloud covers)
   std::string lod;       // the LoD geometry to refine, e.g. "2.2" ("" = the highest 2.x)
   CloudOptions cloud;    // LAS class filter
   double crop_expand = 0.1;  // crop box growth, relative and absolute (as lodrefine crop)
   double crop_margin = 3.0;
+  // Buildings refined at once, each on its own thread (1: one after another on the caller's).
+  // The output is the same bytes whatever the number.
+  int jobs = 1;
+  // Called after each building (CityJSONSeq: each feature) is written into the output, in
+  // file order on the caller's thread, with the counts so far (may be empty).
+  std::function<void(const CityRefineSummary&)> progress;
+  std::function<void(std::uint64_t)> crop_progress;  // points read so far in the cloud pass (may be empty)
 };
 
 struct CityBuildingOutcome {
