@@ -28,6 +28,8 @@ using json = nlohmann::ordered_json;
 // A CityJSONSeq header line holds metadata and the transform, never objects: a first line
 // longer than this is a one-line CityJSON file, not parsed twice to find out.
 constexpr std::size_t kMaxSequenceHeader = 1 << 20;
+// Buildings in flight per thread of the pool (see in_order_pool).
+constexpr int kItemsPerJob = 16;
 
 
 // The outcome of one building in the three words of the report, with its reason: anything
@@ -131,7 +133,9 @@ void apply_job(json& doc, const CityJsonTransform& tf, const CityJsonBuilding& b
 
 // Calls take() for items in order until it returns null, work() on up to `jobs` items at once on
 // a pool of `jobs` threads, and give() on the calling order's thread one at a time, in the order
-// take() made them. At most 2 x jobs items are alive at once (memory: a few crops, not all).
+// take() made them. At most kItemsPerJob x jobs items are alive at once: enough that one slow
+// building does not idle the other threads while its successors wait to be given in order
+// (the crops are in memory anyway; what waits is their refined meshes).
 template <class Item>
 void in_order_pool(int jobs, const std::function<std::shared_ptr<Item>()>& take,
                    const std::function<void(Item&)>& work, const std::function<void(Item&)>& give) {
@@ -148,7 +152,7 @@ void in_order_pool(int jobs, const std::function<std::shared_ptr<Item>()>& take,
   tbb::task_arena arena(jobs);
   arena.execute([&] {
     tbb::parallel_pipeline(
-        std::size_t(2 * jobs),
+        std::size_t(kItemsPerJob * jobs),
         tbb::make_filter<void, Ptr>(tbb::filter_mode::serial_in_order,
                                     [&](tbb::flow_control& fc) {
                                       Ptr item = take();

@@ -83,7 +83,10 @@ void Progress::update(std::uint64_t done, const std::string& tally) {
   const double now = clock_();
   // A terminal shows the line at once; a log gets its first line after an interval.
   const bool first = mode_ == Mode::Terminal && !printed_;
-  if (!first && now - last_print_ < (mode_ == Mode::Terminal ? redraw_ : interval_)) return;
+  if (!first && now - last_print_ < (mode_ == Mode::Terminal ? redraw_ : interval_)) {
+    pending_ = true;
+    return;
+  }
   last_print_ = now;
   print(false);
 }
@@ -91,7 +94,11 @@ void Progress::update(std::uint64_t done, const std::string& tally) {
 void Progress::finish() {
   if (finished_) return;
   finished_ = true;
-  if (mode_ != Mode::Off && printed_) print(true);
+  if (mode_ == Mode::Off || !printed_) return;
+  if (pending_)
+    print(true);
+  else if (mode_ == Mode::Terminal)
+    sink_("\n");  // the line on screen is already the last one
 }
 
 void Progress::print(bool last) {
@@ -101,6 +108,7 @@ void Progress::print(bool last) {
   else
     sink_(line + "\n");
   printed_ = true;
+  pending_ = false;
 }
 
 }  // namespace lodrefine

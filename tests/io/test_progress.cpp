@@ -67,6 +67,20 @@ TEST(Progress, LinesModePrintsEveryIntervalAndALastLineOnlyAfterOne) {
   EXPECT_EQ(rig.out[2].back(), '\n');
 }
 
+TEST(Progress, FinishDoesNotRepeatTheLastLine) {
+  Rig rig;
+  Progress lines = rig.make(Progress::Mode::Lines, 5);
+  rig.now += 11;
+  lines.update(5);
+  lines.finish();
+  EXPECT_EQ(rig.out.size(), 1u) << "the figures printed last are not printed again";
+  Progress tty = rig.make(Progress::Mode::Terminal, 5);
+  tty.update(5);
+  tty.finish();
+  ASSERT_EQ(rig.out.size(), 3u);
+  EXPECT_EQ(rig.out[2], "\n") << "the terminal line is only ended";
+}
+
 TEST(Progress, ShortRunPrintsNothing) {
   Rig rig;
   Progress p = rig.make(Progress::Mode::Lines, 3);

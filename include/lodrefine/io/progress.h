@@ -28,7 +28,8 @@ class Progress {
 
   // `done` so far, and a tally to append ("12 refined, 3 kept"). Prints only when due.
   void update(std::uint64_t done, const std::string& tally = "");
-  // Prints the last figures when anything was printed before (Terminal: ends the line). Once.
+  // Prints the last figures when anything was printed before and they are newer (Terminal:
+  // ends the line). Once.
   void finish();
 
   // "what: done/total unit (p %), rate/s, ETA t, tally" for `seconds` since the start (rate and
@@ -53,6 +54,7 @@ class Progress {
   std::uint64_t done_ = 0;
   std::string tally_;
   bool printed_ = false, finished_ = false;
+  bool pending_ = false;  // figures newer than the last line printed
 };
 
 }  // namespace lodrefine
