@@ -4,11 +4,13 @@
 #include <fstream>
 #include <sstream>
 #include <tuple>
+#include <memory>
 
 #include "commands.h"
 #include "lodrefine/io/crop.h"
 #include "lodrefine/io/files.h"
 #include "lodrefine/io/obj.h"
+#include "lodrefine/io/progress.h"
 #include "options.h"
 
 namespace lodrefine::app {
@@ -23,6 +25,7 @@ struct CropArgs {
   // whatever the tile's size.
   std::size_t buffer_points = 4000000;
   CloudOptions cloud_options;
+  bool quiet = false;
 };
 
 // One building: its id (the model's file stem or folder name), its model file and the run
@@ -121,7 +124,13 @@ void run(const CropArgs& a) {
       created.file(clouds.back());
       created.file(fs::path(a.out) / m.folder / "coarse.obj");
     }
-    n = crop_tile_to_files(a.tile, targets, clouds, a.buffer_points, counts, a.cloud_options);
+    std::unique_ptr<Progress> progress;  // made once the tile reads (its header count is the total)
+    n = crop_tile_to_files(a.tile, targets, clouds, a.buffer_points, counts, a.cloud_options, [&](std::uint64_t read) {
+      if (!progress)
+        progress = std::make_unique<Progress>("crop", "points", cloud_point_count(a.tile), Progress::mode_for_stderr(a.quiet));
+      progress->update(read);
+    });
+    if (progress) progress->update(n), progress->finish();
     for (const auto& m : kept) place_model(m, fs::path(a.out) / m.folder);
   } catch (...) {
     created.undo();
@@ -150,6 +159,7 @@ void add_crop_command(CLI::App& app) {
   add_ranged_option(cmd, "--margin", args.margin, "Absolute box growth on each side (m)", 0.0, 1000.0);
   add_ranged_option(cmd, "--buffer-points", args.buffer_points, "Points held in memory before spilling to disk (memory bound)", std::size_t(1), std::size_t(1) << 40);
   add_cloud_options(cmd, args.cloud_options);
+  cmd->add_flag("--quiet", args.quiet, "No progress line on stderr");
   cmd->callback([] { run(args); });
 }
 

@@ -22,6 +22,7 @@
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/io/obj.h"
 #include "lodrefine/io/files.h"
+#include "lodrefine/io/progress.h"
 #include "lodrefine/eval/plots.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/eval/report.h"
@@ -38,7 +39,8 @@ struct EvalArgs {
   int html_views = 20;
   std::string baseline_in, baseline_out, gates, junit_out;  // the regression gate (--dir)
   double tolerance = 0.005;
-  int jobs = int(std::max(1u, std::thread::hardware_concurrency()));
+  int jobs = default_jobs();
+  bool quiet = false;
   Params params;
   CloudOptions cloud_options;  // single-building mode (a run folder holds cropped PLYs)
 };
@@ -272,34 +274,21 @@ std::string fmt(double v, int decimals = 3) {
   return buf;
 }
 
-void progress(std::size_t k, std::size_t n, const Row& r, double seconds) {
-  const BuildingEval& e = r.eval;
-  if (!e.ok()) {
-    std::fprintf(stderr, "[%zu/%zu] %s: FAILED: %s\n", k, n, e.id.c_str(), e.error.c_str());
-    return;
-  }
-  if (e.facade_points == 0) {
-    std::fprintf(stderr, "[%zu/%zu] %s: no facade points selected, watertight %s -> %s (%.1f s)\n", k, n, e.id.c_str(),
-                 e.watertight_before ? "yes" : "no", e.watertight_after ? "yes" : "no", seconds);
-    return;
-  }
-  std::fprintf(stderr, "[%zu/%zu] %s: %zu facade points, C2M RMSE %s -> %s m, dD %s m, watertight %s -> %s (%.1f s)\n",
-               k, n, e.id.c_str(), e.facade_points, fmt(e.before.rmse).c_str(), fmt(e.after.rmse).c_str(),
-               fmt(e.delta_d).c_str(), e.watertight_before ? "yes" : "no", e.watertight_after ? "yes" : "no", seconds);
-}
-
 // Buildings are independent: `jobs` threads take the next one; rows stay in id order and the
-// first unexpected error (not a building's bad input) is rethrown here.
-std::vector<Row> evaluate_run(const std::string& dir, const Params& params, const std::string& svg_dir, int jobs) {
+// first unexpected error (not a building's bad input) is rethrown here. Each building's
+// per-point series go into `series` as it finishes and are dropped (memory: the bins, not the
+// run's points); a progress line counts the buildings (`progress_mode`).
+std::vector<Row> evaluate_run(const std::string& dir, const Params& params, const std::string& svg_dir, int jobs,
+                              PooledSeries& series, Progress::Mode progress_mode) {
   const auto buildings = discover(dir);
   std::vector<Row> rows(buildings.size());
   std::atomic<std::size_t> next{0};
-  std::size_t finished = 0;
+  std::size_t finished = 0, failed = 0;
   std::mutex mutex;
   std::exception_ptr error;
+  Progress progress("eval", "buildings", buildings.size(), progress_mode);
   auto work = [&] {
     for (std::size_t k; (k = next++) < buildings.size();) {
-      const auto t0 = std::chrono::steady_clock::now();
       Row& row = rows[k];
       try {
         try {
@@ -316,13 +305,17 @@ std::vector<Row> evaluate_run(const std::string& dir, const Params& params, cons
         return;
       }
       const std::lock_guard<std::mutex> lock(mutex);
-      progress(++finished, buildings.size(), row, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      series.add(row.eval);
+      drop_series(row.eval);
+      failed += !row.eval.ok();
+      progress.update(++finished, std::to_string(failed) + " failed");
     }
   };
   std::vector<std::thread> threads;
   for (int t = 1; t < std::max(1, jobs); ++t) threads.emplace_back(work);
   work();
   for (auto& t : threads) t.join();
+  progress.finish();
   if (error) std::rethrow_exception(error);
   return rows;
 }
@@ -525,16 +518,11 @@ void print_totals(std::FILE* out, const RunTotals& t) {
               fmt(t.moved.max).c_str(), fmt(t.moved.mean).c_str(), t.refine_seconds);
 }
 
-// C2M histogram and boxplot over every evaluated building's facade points.
-std::pair<std::string, std::string> c2m_plots(const std::vector<Row>& rows) {
-  std::vector<double> before, after;
-  for (const Row& r : rows)
-    if (r.eval.ok()) {
-      before.insert(before.end(), r.eval.c2m_before.begin(), r.eval.c2m_before.end());
-      after.insert(after.end(), r.eval.c2m_after.begin(), r.eval.c2m_after.end());
-    }
+// C2M histogram and boxplot over every evaluated building's facade points (their pooled bins).
+std::pair<std::string, std::string> c2m_plots(const PooledSeries& series) {
   const char* title = "C2M signed distance of the facade points";
-  return {svg_histogram(before, after, title), svg_boxplot(before, after, title)};
+  return {svg_histogram(series.c2m_before, series.c2m_after, title),
+          svg_boxplot(series.c2m_before, series.c2m_after, title)};
 }
 
 void write_plots(const std::string& svg_dir, const std::string& histogram, const std::string& boxplot) {
@@ -571,10 +559,14 @@ json html_row(const Row& r) {
 }
 
 // The 3D + footprint view of one building, read again from its files (only the shown ones).
-BuildingView html_view(const Row& r) {
+BuildingView html_view(const Row& r, const Params& params) {
   std::string refined_error;
   const LocalBuilding b = read_local(r.files, r.origin, refined_error);
-  const BuildingEval& e = r.eval;
+  // A run drops each building's per-point series once pooled: the few shown are measured again
+  // (the same points and distances: the evaluation is deterministic).
+  const BuildingEval e = r.eval.facade_points > 0 && r.eval.facade_index.empty()
+                             ? evaluate_building(b.original, b.refined, b.cloud, nullptr, params)
+                             : r.eval;
   const std::vector<double>& c2m = e.ok() ? e.c2m_after : e.c2m_before;
   constexpr std::size_t kViewPoints = 4000;       // per building: enough to see the facades, keeps the page small
   constexpr std::size_t kFootprintPoints = 1500;  // idem for the top view
@@ -614,14 +606,15 @@ void write_html(const EvalArgs& a, const std::vector<Row>& rows, const PooledEva
     h.rows.push_back(html_row(*r));
     if (int(h.views.size()) >= a.html_views) continue;
     try {
-      h.views.push_back(html_view(*r));
+      h.views.push_back(html_view(*r, a.params));
     } catch (const InputError&) {  // unreadable inputs: the table row says so, no view
     }
   }
   write_file_atomic(a.html_out, html_report(h));
 }
 
-void write_outputs(const EvalArgs& a, const std::vector<Row>& rows, const PooledEval& pooled) {
+void write_outputs(const EvalArgs& a, const std::vector<Row>& rows, const PooledEval& pooled,
+                   const PooledSeries& series) {
   const auto order = worst_first(rows);
   if (!a.json_out.empty()) {
     json j = {{"pooled", pooled_json(pooled)}, {"buildings", json::array()}, {"params", params_json(a.params)}};
@@ -632,7 +625,7 @@ void write_outputs(const EvalArgs& a, const std::vector<Row>& rows, const Pooled
   }
   if (!a.csv_out.empty()) write_file_atomic(a.csv_out, csv_text(order));
   if (a.svg_dir.empty() && a.html_out.empty()) return;
-  const auto plots = c2m_plots(rows);
+  const auto plots = c2m_plots(series);
   if (!a.svg_dir.empty()) write_plots(a.svg_dir, plots.first, plots.second);
   if (!a.html_out.empty()) write_html(a, rows, pooled, plots);
 }
@@ -709,19 +702,21 @@ void run(const EvalArgs& a) {
     throw InputError("eval: give --dir RUN_DIR, or --original, --refined and --cloud");
   if (!a.svg_dir.empty()) fs::create_directories(a.svg_dir);
   std::vector<Row> rows;
+  PooledSeries series;
   if (batch) {
-    rows = evaluate_run(a.dir, a.params, a.svg_dir, a.jobs);
+    rows = evaluate_run(a.dir, a.params, a.svg_dir, a.jobs, series, Progress::mode_for_stderr(a.quiet));
   } else {
     rows.push_back(evaluate_files({"", a.original, a.refined, a.cloud, a.truth, a.meta, "", ""}, a.params, a.svg_dir,
                                   a.cloud_options));
     if (!rows.back().eval.ok()) std::fprintf(stderr, "lodrefine: warning: %s\n", rows.back().eval.error.c_str());
+    series.add(rows.back().eval);
   }
   std::vector<BuildingEval> evals;
   for (const Row& r : rows) evals.push_back(r.eval);
-  const PooledEval pooled = pool_evaluations(evals);
+  const PooledEval pooled = pool_evaluations(evals, series);
   print_table(stdout, pooled, batch);
   if (batch) print_totals(stdout, run_totals(rows));
-  write_outputs(a, rows, pooled);
+  write_outputs(a, rows, pooled, series);
   if (batch) apply_gate(a, gate_inputs, run_figures(rows, pooled));
 }
 
@@ -764,6 +759,7 @@ void add_eval_command(CLI::App& app) {
   html->needs(dir);
   cmd->add_option("--jobs", a.jobs, "With --dir: buildings evaluated at once (default: all cores)")
       ->check(CLI::Range(1, 1024));
+  cmd->add_flag("--quiet", a.quiet, "With --dir: no progress line on stderr");
   dir->excludes(orig);
   add_gate_options(cmd, a, dir);
   add_cloud_options(cmd, a.cloud_options);

@@ -4,6 +4,7 @@
 #include <functional>
 #include <mutex>
 #include <optional>
+#include <memory>
 
 #include "commands.h"
 #include "lodrefine/io/cityfile.h"
@@ -11,6 +12,7 @@
 #include "lodrefine/io/obj.h"
 #include "lodrefine/io/files.h"
 #include "lodrefine/core/refine.h"
+#include "lodrefine/io/progress.h"
 #include "lodrefine/io/refine_report.h"
 #include "lodrefine/eval/review.h"
 #include "options.h"
@@ -25,6 +27,8 @@ struct RefineArgs {
   CloudOptions cloud_options;
   std::string building, lod;  // city files only
   std::string html;           // city files only: the review page
+  int jobs = default_jobs();  // city files only
+  bool quiet = false;
 };
 
 // Scan points per refined building on the review page: enough to see each facade, and what
@@ -111,6 +115,12 @@ void check_outputs_are_new(const RefineArgs& a) {
   if (!a.report.empty() && same_file(a.out, a.report)) throw InputError(a.report + ": --report is the --out file");
 }
 
+// "12 refined, 3 kept, 1 kept-invalid": the progress line's tally.
+std::string tally_text(const CityRefineSummary& s) {
+  return std::to_string(s.refined) + " refined, " + std::to_string(s.kept) + " kept, " +
+         std::to_string(s.kept_invalid) + " kept-invalid";
+}
+
 // A city file (CityJSON, CityJSONSeq, CityGML) in: every building the cloud covers, one
 // CityJSON 2.0 file out.
 void run_city(const RefineArgs& a) {
@@ -118,9 +128,23 @@ void run_city(const RefineArgs& a) {
   o.building = a.building;
   o.lod = a.lod;
   o.cloud = a.cloud_options;
+  o.jobs = a.jobs;
   ReviewCollector review;
   if (!a.html.empty()) o.on_building = std::ref(review);
+  const Progress::Mode mode = Progress::mode_for_stderr(a.quiet);
+  std::unique_ptr<Progress> crop, refine;
+  o.crop_progress = [&](std::uint64_t read) {
+    if (!crop) crop = std::make_unique<Progress>("crop", "points", cloud_point_count(a.cloud), mode);
+    crop->update(read);
+  };
+  o.progress = [&](const CityRefineSummary& s) {
+    if (crop) crop->finish();
+    if (!refine) refine = std::make_unique<Progress>("refine", "buildings", std::uint64_t(s.buildings), mode);
+    refine->update(std::uint64_t(s.refined + s.kept + s.kept_invalid + s.untouched), tally_text(s));
+  };
   const CityRefineSummary s = refine_city(a.model, a.cloud, a.out, a.params, o);
+  if (crop) crop->finish();
+  if (refine) refine->finish();
   if (!a.html.empty()) write_review(a, s, review);
   if (!a.report.empty()) {
     nlohmann::json j = {{"model", a.model}, {"cloud", a.cloud}, {"written", a.out}, {"input", s.input_format},
@@ -204,6 +228,9 @@ void add_refine_command(CLI::App& app) {
   cmd->add_option("--html", args.html, "City file: write a review page (self-contained HTML, three.js embedded): "
                                         "summary, the buildings the cloud reached, a district map, each refined "
                                         "building in 3D over its scan");
+  add_ranged_option(cmd, "--jobs", args.jobs, "City file: buildings refined at once, one thread each (default: "
+                    "all cores; the output is the same whatever the number)", 1, 1024);
+  cmd->add_flag("--quiet", args.quiet, "City file: no progress line on stderr");
   cmd->add_option("--report", args.report, "JSON report: matches, planes, candidates, MIP, timings, validation");
   cmd->add_option("--max-points", args.max_points, "Refuse clouds with more points (a tile, not a crop)")->capture_default_str();
   add_cloud_options(cmd, args.cloud_options);

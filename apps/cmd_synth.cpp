@@ -3,6 +3,7 @@
 #include <string>
 
 #include "commands.h"
+#include "lodrefine/io/progress.h"
 #include "lodrefine/synth/synth.h"
 #include "options.h"
 
@@ -16,7 +17,7 @@ struct SynthArgs {
   int count = 1;
   std::string out, tile;
   double grid = 80.0;
-  bool no_defects = false, no_nuisances = false;
+  bool no_defects = false, no_nuisances = false, quiet = false;
   SynthOptions opt;
 };
 
@@ -41,10 +42,11 @@ void run(SynthArgs& a) {
   a.opt.defects = !a.no_defects;
   a.opt.nuisances = !a.no_nuisances;
   if (!a.tile.empty()) {
-    std::size_t done = 0;
-    const std::uint64_t points = write_synth_tile(a.out, a.tile, a.count, a.seed, a.grid, a.opt, [&](const SynthBuilding&) {
-      if (++done % 100 == 0) std::fprintf(stderr, "[%zu/%d] buildings\n", done, a.count);
-    });
+    std::uint64_t done = 0;
+    Progress progress("synth", "buildings", std::uint64_t(a.count), Progress::mode_for_stderr(a.quiet));
+    const std::uint64_t points = write_synth_tile(a.out, a.tile, a.count, a.seed, a.grid, a.opt,
+                                                  [&](const SynthBuilding&) { progress.update(++done); });
+    progress.finish();
     std::printf("%d buildings -> %s/<id>/{coarse,truth}.obj, %llu points -> %s\n", a.count, a.out.c_str(),
                 static_cast<unsigned long long>(points), a.tile.c_str());
     return;
@@ -87,6 +89,7 @@ void add_synth_command(CLI::App& app) {
   cmd->add_option("--origin-y", o.origin.y(), "georeferenced origin y")->capture_default_str();
   cmd->add_flag("--no-defects", a.no_defects, "coarse model without export defects");
   cmd->add_flag("--no-nuisances", a.no_nuisances, "cloud without windows, clutter, ground and neighbours");
+  cmd->add_flag("--quiet", a.quiet, "with --tile: no progress line on stderr");
   cmd->callback([] { run(a); });
 }
 

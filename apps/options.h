@@ -2,6 +2,7 @@
 #pragma once
 #include <algorithm>
 #include <string>
+#include <thread>
 
 #include <CLI/CLI.hpp>
 
@@ -33,6 +34,9 @@ inline void add_param_options(CLI::App* cmd, Params& params) {
   LODREFINE_PARAMS(LODREFINE_PARAM_OPTION)
 #undef LODREFINE_PARAM_OPTION
 }
+
+// The default of --jobs: every core the machine has (1 when it cannot tell).
+inline int default_jobs() { return int(std::max(1u, std::thread::hardware_concurrency())); }
 
 // `--classes 2,6`: the LAS classification filter of a command that reads a cloud.
 inline void add_cloud_options(CLI::App* cmd, CloudOptions& options) {

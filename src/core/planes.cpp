@@ -13,6 +13,12 @@
 #include <cmath>
 #include <tuple>
 
+// City files refine buildings on several threads: CGAL's default random generator must then be
+// thread-local, which it is only with CGAL_HAS_THREADS.
+#ifndef CGAL_HAS_THREADS
+#error "lodrefine refines buildings on several threads: CGAL must be configured with CGAL_HAS_THREADS"
+#endif
+
 namespace lodrefine {
 namespace {
 
@@ -153,7 +159,8 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm)
   CGAL::pca_estimate_normals<CGAL::Sequential_tag>(
       pts, prm.normal_neighbors, CGAL::parameters::point_map(PointMap()).normal_map(NormalMap()));
 
-  // Efficient RANSAC draws from CGAL's default generator: seed it for reproducible runs.
+  // Efficient RANSAC draws from CGAL's default generator: seed it for reproducible runs. The
+  // generator is thread-local (CGAL_HAS_THREADS), so buildings refined at once do not share it.
   CGAL::get_default_random() = CGAL::Random(static_cast<unsigned>(prm.seed));
   Ransac ransac;
   ransac.set_input(pts);

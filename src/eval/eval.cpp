@@ -145,8 +145,6 @@ DistanceStats average_stats(const std::vector<const DistanceStats*>& all) {
   return m;
 }
 
-void append(std::vector<double>& to, const std::vector<double>& from) { to.insert(to.end(), from.begin(), from.end()); }
-
 }  // namespace
 
 double percentile_sorted(const std::vector<double>& s, double q) {
@@ -274,7 +272,27 @@ BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const 
   return e;
 }
 
-PooledEval pool_evaluations(const std::vector<BuildingEval>& buildings) {
+void PooledSeries::add(const BuildingEval& b) {
+  if (!b.ok()) return;
+  if (b.facade_points > 0) c2m_before.add(b.c2m_before), c2m_after.add(b.c2m_after);
+  truth_facade_before.add(b.truth_facade_d_before), truth_facade_after.add(b.truth_facade_d_after);
+  truth_roof_before.add(b.truth_roof_d_before), truth_roof_after.add(b.truth_roof_d_after);
+}
+
+void PooledSeries::merge(const PooledSeries& o) {
+  c2m_before.merge(o.c2m_before), c2m_after.merge(o.c2m_after);
+  truth_facade_before.merge(o.truth_facade_before), truth_facade_after.merge(o.truth_facade_after);
+  truth_roof_before.merge(o.truth_roof_before), truth_roof_after.merge(o.truth_roof_after);
+}
+
+void drop_series(BuildingEval& b) {
+  for (auto* v : {&b.c2m_before, &b.c2m_after, &b.truth_facade_d_before, &b.truth_facade_d_after,
+                  &b.truth_roof_d_before, &b.truth_roof_d_after})
+    std::vector<double>().swap(*v);
+  std::vector<int>().swap(b.facade_index);
+}
+
+PooledEval pool_evaluations(const std::vector<BuildingEval>& buildings, const PooledSeries& series) {
   PooledEval p;
   p.buildings = buildings.size();
   std::vector<double> delta;
@@ -293,15 +311,8 @@ PooledEval pool_evaluations(const std::vector<BuildingEval>& buildings) {
     per_before.push_back(&b.before), per_after.push_back(&b.after);
     if (std::isfinite(b.delta_d)) delta.push_back(b.delta_d);
   }
-  // One pooled series at a time: a city's distances are held once more, not six times.
-  auto pooled = [&](std::vector<double> BuildingEval::*series, bool with_facade_points) {
-    std::vector<double> all;
-    for (const auto& b : buildings)
-      if (b.ok() && (!with_facade_points || b.facade_points > 0)) append(all, b.*series);
-    return all;
-  };
-  p.before = summarize_distances(pooled(&BuildingEval::c2m_before, true));
-  p.after = summarize_distances(pooled(&BuildingEval::c2m_after, true));
+  p.before = pooled_stats(per_before, series.c2m_before);
+  p.after = pooled_stats(per_after, series.c2m_after);
   p.mean_before = average_stats(per_before), p.mean_after = average_stats(per_after);
   if (!delta.empty()) {
     const DistanceStats s = summarize_distances(delta);
@@ -311,11 +322,24 @@ PooledEval pool_evaluations(const std::vector<BuildingEval>& buildings) {
     p.watertight_rate_before = double(wt_before) / double(p.buildings);
     p.watertight_rate_after = double(wt_after) / double(p.buildings);
   }
-  p.truth_facade_before = stats_if_any(pooled(&BuildingEval::truth_facade_d_before, false));
-  p.truth_facade_after = stats_if_any(pooled(&BuildingEval::truth_facade_d_after, false));
-  p.truth_roof_before = stats_if_any(pooled(&BuildingEval::truth_roof_d_before, false));
-  p.truth_roof_after = stats_if_any(pooled(&BuildingEval::truth_roof_d_after, false));
+  // Truth samples of every building measured with both models.
+  auto truth = [&](std::optional<DistanceStats> BuildingEval::*part, const DistanceHistogram& h) {
+    std::vector<const DistanceStats*> parts;
+    for (const auto& b : buildings)
+      if (b.ok() && b.*part) parts.push_back(&*(b.*part));
+    return h.count() ? std::optional(pooled_stats(parts, h)) : std::nullopt;
+  };
+  p.truth_facade_before = truth(&BuildingEval::truth_facade_before, series.truth_facade_before);
+  p.truth_facade_after = truth(&BuildingEval::truth_facade_after, series.truth_facade_after);
+  p.truth_roof_before = truth(&BuildingEval::truth_roof_before, series.truth_roof_before);
+  p.truth_roof_after = truth(&BuildingEval::truth_roof_after, series.truth_roof_after);
   return p;
+}
+
+PooledEval pool_evaluations(const std::vector<BuildingEval>& buildings) {
+  PooledSeries series;
+  for (const auto& b : buildings) series.add(b);
+  return pool_evaluations(buildings, series);
 }
 
 }  // namespace lodrefine

@@ -108,42 +108,66 @@ void legend_entry(Svg& svg, double x, double y, const std::string& color, const 
   svg.text(x + 20, y, label);
 }
 
-// Histogram half-width: the 99th percentile of |d| rounded up to a nice value, >= 0.1 m.
-double auto_range(const std::vector<double>& a, const std::vector<double>& b) {
-  std::vector<double> all;
-  for (double x : a) all.push_back(std::abs(x));
-  for (double x : b) all.push_back(std::abs(x));
-  const double q = percentile(all, 0.99);
+// Histogram half-width: the 99th percentile of |d| (`q`) rounded up to a nice value, >= 0.1 m.
+double nice_range(double q) {
   if (!(q > 0)) return 0.1;
   const double step = nice_step(q, 4);
   return std::max(0.1, std::ceil(q / step) * step);
 }
 
-// Percent of points per bin over [-range, range], and the percent outside.
-std::vector<double> bin_shares(const std::vector<double>& d, double range, int bins, double& outside) {
-  std::vector<double> h(std::size_t(bins), 0.0);
+double auto_range(const std::vector<double>& a, const std::vector<double>& b) {
+  std::vector<double> all;
+  for (double x : a) all.push_back(std::abs(x));
+  for (double x : b) all.push_back(std::abs(x));
+  return nice_range(percentile(all, 0.99));
+}
+
+// One series of the histogram plot: percent of points per bin over [-range, range], the percent
+// outside, the count and the RMSE.
+struct HistogramSeries {
+  std::vector<double> shares;
+  double outside = 0, rmse = 0;
+  std::uint64_t n = 0;
+};
+
+HistogramSeries histogram_series(const std::vector<double>& d, double range, int bins) {
+  HistogramSeries s;
+  s.shares.assign(std::size_t(bins), 0.0);
   std::size_t out = 0;
   for (double x : d) {
     const int b = int(std::floor((x + range) / (2 * range) * bins));
     if (b < 0 || b >= bins) ++out;
-    else h[std::size_t(b)] += 1;
+    else s.shares[std::size_t(b)] += 1;
   }
-  const double n = std::max<std::size_t>(1, d.size());
-  for (double& v : h) v *= 100.0 / n;
-  outside = 100.0 * double(out) / n;
-  return h;
+  s.n = d.size();
+  const double n = double(std::max<std::size_t>(1, d.size()));
+  for (double& v : s.shares) v *= 100.0 / n;
+  s.outside = 100.0 * double(out) / n;
+  s.rmse = summarize_distances(d).rmse;
+  return s;
 }
 
-}  // namespace
+// The same from a pooled histogram (each fine bin counted in the plot bin of its centre).
+HistogramSeries histogram_series(const DistanceHistogram& d, double range, int bins) {
+  HistogramSeries s;
+  s.shares.assign(std::size_t(bins), 0.0);
+  const double bw = 2 * range / bins, n = double(std::max<std::uint64_t>(1, d.count()));
+  std::uint64_t inside = 0;
+  for (int i = 0; i < bins; ++i) {
+    const std::uint64_t c = d.count_between(-range + i * bw, i + 1 == bins ? range : -range + (i + 1) * bw);
+    inside += c;
+    s.shares[std::size_t(i)] = 100.0 * double(c) / n;
+  }
+  s.n = d.count();
+  s.outside = 100.0 * double(d.count() - inside) / n;
+  s.rmse = d.stats().rmse;
+  return s;
+}
 
-std::string svg_histogram(const std::vector<double>& before, const std::vector<double>& after,
-                          const std::string& title, double range, int bins) {
-  if (!(range > 0)) range = auto_range(before, after);
-  bins = std::max(1, bins);
-  double out_before = 0, out_after = 0;
-  const auto hb = bin_shares(before, range, bins, out_before);
-  const auto ha = bin_shares(after, range, bins, out_after);
-  const double top = std::max(*std::max_element(hb.begin(), hb.end()), *std::max_element(ha.begin(), ha.end()));
+std::string draw_histogram(const HistogramSeries& hb, const HistogramSeries& ha, const std::string& title,
+                           double range, int bins) {
+  const double top = std::max(*std::max_element(hb.shares.begin(), hb.shares.end()),
+                              *std::max_element(ha.shares.begin(), ha.shares.end()));
   Svg svg(760, 440);
   svg.title(title);
   const Frame f{80, 40, 650, 330, -range, range, 0.0, std::max(1.0, top * 1.08)};
@@ -156,27 +180,50 @@ std::string svg_histogram(const std::vector<double>& before, const std::vector<d
                std::string("fill=\"") + color + "\" fill-opacity=\"0.5\" stroke=\"" + color + "\" stroke-width=\"0.5\"");
     }
   };
-  bars(hb, kBlue);
-  bars(ha, kOrange);
+  bars(hb.shares, kBlue);
+  bars(ha.shares, kOrange);
   svg.line(f.px(0), f.top, f.px(0), f.top + f.height, "stroke=\"#555\" stroke-dasharray=\"4 3\"");
-  auto label = [&](const char* name, const std::vector<double>& d, double out) {
-    return std::string(name) + ": n=" + std::to_string(d.size()) + ", RMSE " + num(summarize_distances(d).rmse, 3) + " m, " + num(out, 1) +
+  auto label = [&](const char* name, const HistogramSeries& h) {
+    return std::string(name) + ": n=" + std::to_string(h.n) + ", RMSE " + num(h.rmse, 3) + " m, " + num(h.outside, 1) +
            "% beyond ±" + num(range, 2) + " m";
   };
-  legend_entry(svg, f.left + 10, f.top + 18, kBlue, label("original", before, out_before));
-  legend_entry(svg, f.left + 10, f.top + 36, kOrange, label("refined", after, out_after));
+  legend_entry(svg, f.left + 10, f.top + 18, kBlue, label("original", hb));
+  legend_entry(svg, f.left + 10, f.top + 36, kOrange, label("refined", ha));
   return svg.str();
+}
+
+}  // namespace
+
+std::string svg_histogram(const std::vector<double>& before, const std::vector<double>& after,
+                          const std::string& title, double range, int bins) {
+  if (!(range > 0)) range = auto_range(before, after);
+  bins = std::max(1, bins);
+  return draw_histogram(histogram_series(before, range, bins), histogram_series(after, range, bins), title, range,
+                        bins);
+}
+
+std::string svg_histogram(const DistanceHistogram& before, const DistanceHistogram& after, const std::string& title,
+                          double range, int bins) {
+  if (!(range > 0)) {
+    DistanceHistogram both = before;
+    both.merge(after);
+    range = nice_range(both.abs_quantile(0.99));
+  }
+  bins = std::max(1, bins);
+  return draw_histogram(histogram_series(before, range, bins), histogram_series(after, range, bins), title, range,
+                        bins);
 }
 
 namespace {
 
 struct BoxStats {
   double q1 = 0, median = 0, q3 = 0, lo = 0, hi = 0, mean = 0;
-  std::size_t outliers = 0;
+  std::uint64_t outliers = 0, n = 0;
 };
 
 BoxStats box_stats(std::vector<double> d) {
   BoxStats b;
+  b.n = d.size();
   if (d.empty()) return b;
   b.q1 = percentile(d, 0.25), b.median = percentile(d, 0.5), b.q3 = percentile(d, 0.75);
   const double iqr = b.q3 - b.q1, fence_lo = b.q1 - 1.5 * iqr, fence_hi = b.q3 + 1.5 * iqr;
@@ -188,6 +235,21 @@ BoxStats box_stats(std::vector<double> d) {
     else b.lo = std::min(b.lo, x), b.hi = std::max(b.hi, x);
   }
   b.mean = sum / double(d.size());
+  return b;
+}
+
+// The same from a pooled histogram: quartiles, whiskers and outliers to one bin, the mean exact.
+BoxStats box_stats(const DistanceHistogram& d) {
+  BoxStats b;
+  b.n = d.count();
+  if (d.count() == 0) return b;
+  b.q1 = d.quantile(0.25), b.median = d.quantile(0.5), b.q3 = d.quantile(0.75);
+  const double iqr = b.q3 - b.q1, fence_lo = b.q1 - 1.5 * iqr, fence_hi = b.q3 + 1.5 * iqr;
+  const double lo = d.lowest_in(fence_lo, fence_hi), hi = d.highest_in(fence_lo, fence_hi);
+  b.lo = std::isfinite(lo) ? std::min(lo, b.q1) : b.q1;
+  b.hi = std::isfinite(hi) ? std::max(hi, b.q3) : b.q3;
+  b.outliers = d.count() - d.count_between(fence_lo, std::nextafter(fence_hi, HUGE_VAL));
+  b.mean = d.mean();
   return b;
 }
 
@@ -206,10 +268,8 @@ void draw_box(Svg& svg, const Frame& f, double cx, const BoxStats& b, const char
   svg.line(cx - 5, my + 5, cx + 5, my - 5, "stroke=\"black\"");
 }
 
-}  // namespace
 
-std::string svg_boxplot(const std::vector<double>& before, const std::vector<double>& after, const std::string& title) {
-  const BoxStats bb = box_stats(before), ba = box_stats(after);
+std::string draw_boxplot(const BoxStats& bb, const BoxStats& ba, const std::string& title) {
   double lo = std::min({bb.lo, ba.lo, 0.0}), hi = std::max({bb.hi, ba.hi, 0.0});
   const double pad = std::max(0.02, 0.08 * (hi - lo));
   Svg svg(520, 460);
@@ -220,15 +280,25 @@ std::string svg_boxplot(const std::vector<double>& before, const std::vector<dou
   const double c1 = f.left + f.width * 0.28, c2 = f.left + f.width * 0.72;
   draw_box(svg, f, c1, bb, kBlue);
   draw_box(svg, f, c2, ba, kOrange);
-  auto caption = [&](double cx, const char* name, const BoxStats& b, std::size_t n) {
+  auto caption = [&](double cx, const char* name, const BoxStats& b) {
     svg.text(cx, f.top + f.height + 20, name, "text-anchor=\"middle\"");
     const std::string small = "text-anchor=\"middle\" font-size=\"10\"";
     svg.text(cx, f.top + f.height + 34, "median " + num(b.median, 3) + " m, IQR " + num(b.q3 - b.q1, 3) + " m", small);
-    svg.text(cx, f.top + f.height + 47, std::to_string(b.outliers) + " of " + std::to_string(n) + " beyond whiskers", small);
+    svg.text(cx, f.top + f.height + 47, std::to_string(b.outliers) + " of " + std::to_string(b.n) + " beyond whiskers", small);
   };
-  caption(c1, "original", bb, before.size());
-  caption(c2, "refined", ba, after.size());
+  caption(c1, "original", bb);
+  caption(c2, "refined", ba);
   return svg.str();
+}
+
+}  // namespace
+
+std::string svg_boxplot(const std::vector<double>& before, const std::vector<double>& after, const std::string& title) {
+  return draw_boxplot(box_stats(before), box_stats(after), title);
+}
+
+std::string svg_boxplot(const DistanceHistogram& before, const DistanceHistogram& after, const std::string& title) {
+  return draw_boxplot(box_stats(before), box_stats(after), title);
 }
 
 namespace {

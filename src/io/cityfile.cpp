@@ -6,7 +6,12 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <memory>
 #include <sstream>
+
+#include <tbb/global_control.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
 
 #include "lodrefine/io/cityjson.h"
 #include "lodrefine/io/citygml.h"
@@ -23,6 +28,8 @@ using json = nlohmann::ordered_json;
 // A CityJSONSeq header line holds metadata and the transform, never objects: a first line
 // longer than this is a one-line CityJSON file, not parsed twice to find out.
 constexpr std::size_t kMaxSequenceHeader = 1 << 20;
+// Buildings in flight per thread of the pool (see in_order_pool).
+constexpr int kItemsPerJob = 16;
 
 
 // The outcome of one building in the three words of the report, with its reason: anything
@@ -58,55 +65,145 @@ CityJsonTransform transform_of(const json& header) {
   return t;
 }
 
+// One building's refinement: the part that runs on the pool. Touches nothing shared (the
+// crop is its own, refine_building keeps its state per call: CGAL's default random generator
+// and GLPK's environment are thread-local, see ARCHITECTURE.md).
+struct BuildingJob {
+  std::size_t index = 0;  // in the document's buildings
+  bool has_points = false;
+  PointCloud cloud;
+  RefineResult result;
+  bool returned = false;  // refine_building returned (result is set)
+  CityBuildingOutcome outcome;
+};
+
+void run_job(BuildingJob& job, const CityJsonBuilding& b, const Params& params) {
+  if (!job.has_points) return;
+  const auto t0 = Clock::now();
+  try {
+    job.result = refine_building(b.mesh, job.cloud, params);
+    job.returned = true;
+    job.outcome = classify(job.result);
+  } catch (const std::exception& e) {  // never lose a building: keep it as read
+    job.outcome.outcome = "kept-invalid";
+    job.outcome.reason = e.what();
+  }
+  job.outcome.id = b.mesh.id;
+  job.outcome.points = job.cloud.points.size();
+  job.outcome.seconds = seconds_since(t0);
+}
+
+// Takes building i's crop out of the targets (npos target or no points: nothing to refine).
+BuildingJob take_job(std::size_t i, std::vector<CropTarget>& targets, const std::vector<std::size_t>& target_of,
+                     std::size_t first) {
+  BuildingJob job;
+  job.index = i;
+  const std::size_t ti = target_of[first + i];
+  if (ti == std::string::npos || targets[ti].cloud.points.empty()) return job;
+  job.has_points = true;
+  job.cloud = std::move(targets[ti].cloud);
+  targets[ti].cloud = PointCloud();
+  return job;
+}
+
+// Writes a finished job into the document (in input order: new vertices are appended).
+// `hook` (may be empty) sees the building, its outcome, result and crop; the crop is freed after.
+void apply_job(json& doc, const CityJsonTransform& tf, const CityJsonBuilding& b, BuildingJob&& job,
+               const CityBuildingHook& hook, CityRefineSummary& sum) {
+  if (!job.has_points) {
+    ++sum.untouched;
+    if (hook) hook(b.mesh, nullptr, nullptr, nullptr);
+    return;
+  }
+  CityBuildingOutcome& o = job.outcome;
+  json& obj = doc["CityObjects"][b.mesh.id];
+  if (o.outcome == "refined") {
+    const std::string lod = obj["geometry"][std::size_t(b.geometry_index)]["lod"].is_string()
+                                ? obj["geometry"][std::size_t(b.geometry_index)]["lod"].get<std::string>()
+                                : b.lod;
+    obj["geometry"][std::size_t(b.geometry_index)] =
+        cityjson_solid(job.result.mesh, lod, tf.scale, tf.translate, doc["vertices"]);
+    ++sum.refined;
+  } else {
+    ++(o.outcome == "kept" ? sum.kept : sum.kept_invalid);
+  }
+  if (!obj.contains("attributes") || !obj["attributes"].is_object()) obj["attributes"] = json::object();
+  obj["attributes"]["lodrefine_outcome"] = o.outcome;
+  obj["attributes"]["lodrefine_reason"] = o.reason;
+  obj["attributes"]["lodrefine_facades_moved"] = o.facades_moved;
+  if (hook) hook(b.mesh, &o, job.returned ? &job.result : nullptr, &job.cloud);
+  job.cloud = PointCloud();  // the crop is no longer needed: free it now
+  sum.outcomes.push_back(std::move(o));
+}
+
+// Calls take() for items in order until it returns null, work() on up to `jobs` items at once on
+// a pool of `jobs` threads, and give() on the calling order's thread one at a time, in the order
+// take() made them. At most kItemsPerJob x jobs items are alive at once: enough that one slow
+// building does not idle the other threads while its successors wait to be given in order
+// (the crops are in memory anyway; what waits is their refined meshes).
+template <class Item>
+void in_order_pool(int jobs, const std::function<std::shared_ptr<Item>()>& take,
+                   const std::function<void(Item&)>& work, const std::function<void(Item&)>& give) {
+  if (jobs <= 1) {
+    while (auto item = take()) {
+      work(*item);
+      give(*item);
+    }
+    return;
+  }
+  using Ptr = std::shared_ptr<Item>;
+  // TBB caps its threads at the cores (and says so on stderr): --jobs asks for exactly `jobs`.
+  const tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(jobs));
+  tbb::task_arena arena(jobs);
+  arena.execute([&] {
+    tbb::parallel_pipeline(
+        std::size_t(kItemsPerJob * jobs),
+        tbb::make_filter<void, Ptr>(tbb::filter_mode::serial_in_order,
+                                    [&](tbb::flow_control& fc) {
+                                      Ptr item = take();
+                                      if (!item) fc.stop();
+                                      return item;
+                                    }) &
+            tbb::make_filter<Ptr, Ptr>(tbb::filter_mode::parallel,
+                                       [&](Ptr item) {
+                                         work(*item);
+                                         return item;
+                                       }) &
+            tbb::make_filter<Ptr, void>(tbb::filter_mode::serial_in_order, [&](Ptr item) { give(*item); }));
+  });
+}
+
+// Adds a feature's counts and outcomes to the file's.
+void merge_into(CityRefineSummary& sum, CityRefineSummary&& part) {
+  sum.refined += part.refined;
+  sum.kept += part.kept;
+  sum.kept_invalid += part.kept_invalid;
+  sum.untouched += part.untouched;
+  for (auto& o : part.outcomes) sum.outcomes.push_back(std::move(o));
+}
+
 // Refines the buildings of `doc` (a CityJSON file or one CityJSONFeature: "CityObjects" and
-// "vertices") that have points, and writes the results into `doc`. `buildings` are the doc's
-// buildings in order; `target_of[first + i]` is building i's crop target (npos: not asked for).
+// "vertices") that have points on `jobs` threads, and writes the results into `doc` in input
+// order (the same bytes whatever `jobs`). `buildings` are the doc's buildings in order;
+// `target_of[first + i]` is building i's crop target (npos: not asked for). `progress` (may be
+// empty) is called after each building with the summary so far.
 void refine_document(json& doc, const CityJsonTransform& tf, const std::vector<CityJsonBuilding>& buildings,
                      std::vector<CropTarget>& targets, const std::vector<std::size_t>& target_of, std::size_t first,
-                     const Params& params, const CityBuildingHook& hook, CityRefineSummary& sum) {
-  json& objects = doc["CityObjects"];
-  for (std::size_t i = 0; i < buildings.size(); ++i) {
-    const CityJsonBuilding& b = buildings[i];
-    const std::size_t ti = target_of[first + i];
-    if (ti == std::string::npos || targets[ti].cloud.points.empty()) {
-      ++sum.untouched;
-      if (hook) hook(b.mesh, nullptr, nullptr, nullptr);
-      continue;
-    }
-    PointCloud cloud = std::move(targets[ti].cloud);
-    targets[ti].cloud = PointCloud();  // the crop is no longer needed: free it now
-    const auto t0 = Clock::now();
-    CityBuildingOutcome o;
-    RefineResult r;
-    const RefineResult* result = nullptr;  // set once refine_building returned
-    try {
-      r = refine_building(b.mesh, cloud, params);
-      result = &r;
-      o = classify(r);
-    } catch (const std::exception& e) {  // never lose a building: keep it as read
-      o.outcome = "kept-invalid";
-      o.reason = e.what();
-    }
-    o.id = b.mesh.id;
-    o.points = cloud.points.size();
-    o.seconds = seconds_since(t0);
-    json& obj = objects[b.mesh.id];
-    if (o.outcome == "refined") {
-      const std::string lod = obj["geometry"][std::size_t(b.geometry_index)]["lod"].is_string()
-                                  ? obj["geometry"][std::size_t(b.geometry_index)]["lod"].get<std::string>()
-                                  : b.lod;
-      obj["geometry"][std::size_t(b.geometry_index)] = cityjson_solid(r.mesh, lod, tf.scale, tf.translate, doc["vertices"]);
-      ++sum.refined;
-    } else {
-      ++(o.outcome == "kept" ? sum.kept : sum.kept_invalid);
-    }
-    if (!obj.contains("attributes") || !obj["attributes"].is_object()) obj["attributes"] = json::object();
-    obj["attributes"]["lodrefine_outcome"] = o.outcome;
-    obj["attributes"]["lodrefine_reason"] = o.reason;
-    obj["attributes"]["lodrefine_facades_moved"] = o.facades_moved;
-    if (hook) hook(b.mesh, &o, result, &cloud);
-    sum.outcomes.push_back(std::move(o));
-  }
+                     const Params& params, int jobs, const CityBuildingHook& hook, CityRefineSummary& sum,
+                     const std::function<void(const CityRefineSummary&)>& progress) {
+  std::size_t next = 0;
+  in_order_pool<BuildingJob>(
+      jobs,
+      [&]() -> std::shared_ptr<BuildingJob> {
+        if (next == buildings.size()) return nullptr;
+        const std::size_t i = next++;
+        return std::make_shared<BuildingJob>(take_job(i, targets, target_of, first));
+      },
+      [&](BuildingJob& job) { run_job(job, buildings[job.index], params); },
+      [&](BuildingJob& job) {
+        apply_job(doc, tf, buildings[job.index], std::move(job), hook, sum);
+        if (progress) progress(sum);
+      });
 }
 
 // CityJSON 1.0 / 1.1 objects as 2.0 wants them: "lod" a string (1.0 wrote numbers), the
@@ -217,9 +314,17 @@ json sequence_header(const std::string& path) {
   return nullptr;
 }
 
+// One line of a CityJSONSeq after the header; `where` names it in the error.
+json parse_feature(const std::string& line, const std::string& where) {
+  json feature = json::parse(line, nullptr, false);
+  if (!feature.is_object() || feature.value("type", "") != "CityJSONFeature")
+    throw InputError(where + ": expected a CityJSONFeature object");
+  return feature;
+}
+
 // CityJSONSeq in, CityJSONSeq out, streamed: pass 1 reads each feature's buildings for the
 // crop boxes (keeping only the boxes), the cloud pass fills them, pass 2 reads each feature
-// again, refines its buildings and writes the line out.
+// again, refines its buildings (features on the pool) and writes the lines out in order.
 CityRefineSummary refine_sequence(const json& header, const std::string& model_path, const std::string& cloud_path,
                                   const std::string& out_path, const Params& params, const CityRefineOptions& options) {
   CityRefineSummary sum;
@@ -229,6 +334,8 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
   auto t = Clock::now();
   std::vector<CropTarget> targets;
   std::vector<std::size_t> target_of;
+  std::vector<std::size_t> feature_buildings;  // per feature line, for pass 2's building indices
+  std::size_t features = 0;
   Eigen::AlignedBox3d city_box;
   const auto for_each_feature = [&](const std::function<void(int, json&&)>& f) {
     std::ifstream in(model_path, std::ios::binary);
@@ -236,16 +343,14 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
     std::getline(in, line);
     for (int n = 2; std::getline(in, line); ++n) {
       if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-      json feature = json::parse(line, nullptr, false);
-      if (!feature.is_object() || feature.value("type", "") != "CityJSONFeature")
-        throw InputError(model_path + ": line " + std::to_string(n) + ": expected a CityJSONFeature object");
-      f(n, std::move(feature));
+      f(n, parse_feature(line, model_path + ": line " + std::to_string(n)));
     }
   };
   for_each_feature([&](int n, json&& feature) {
     const CityJsonFile f = read_cityjson_document(feature_document(header, std::move(feature)),
                                                   model_path + ": line " + std::to_string(n), options.lod);
     sum.buildings += int(f.buildings.size());
+    feature_buildings.push_back(f.buildings.size());
     sum.objects_without_lod += f.objects_without_lod2;
     city_box.extend(model_box(f.buildings));
     add_targets(f.buildings, options, targets, target_of);
@@ -256,7 +361,7 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
 
   t = Clock::now();
   Eigen::AlignedBox3d cloud_box;
-  sum.cloud_points = crop_tile(cloud_path, targets, options.cloud, &cloud_box);
+  sum.cloud_points = crop_tile(cloud_path, targets, options.cloud, &cloud_box, options.crop_progress);
   sum.cropped_points = check_cloud_reaches(targets, cloud_box, city_box, cloud_path);
   sum.seconds_crop = seconds_since(t);
 
@@ -267,15 +372,48 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
   if (upgrade) upgrade_header(h);
   h["version"] = "2.0";
   out.write(h.dump() + "\n");
+  // Pass 2 on the pool, one feature an item: its line is parsed, refined and dumped on a
+  // worker, and written here in file order.
+  struct FeatureJob {
+    int line = 0;
+    std::string text;
+    std::size_t first = 0;  // its first building's index over the file
+    CityRefineSummary part;
+  };
+  std::ifstream in(model_path, std::ios::binary);
+  std::string line;
+  std::getline(in, line);
+  int n = 1;
   std::size_t first = 0;
-  for_each_feature([&](int n, json&& feature) {
-    const CityJsonFile f = read_cityjson_document(feature_document(header, feature),
-                                                  model_path + ": line " + std::to_string(n), options.lod);
-    if (upgrade) upgrade_objects(feature["CityObjects"]);
-    refine_document(feature, tf, f.buildings, targets, target_of, first, params, options.on_building, sum);
-    first += f.buildings.size();
-    out.write(feature.dump() + "\n");
-  });
+  in_order_pool<FeatureJob>(
+      options.jobs,
+      [&]() -> std::shared_ptr<FeatureJob> {
+        while (std::getline(in, line)) {
+          ++n;
+          if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+          auto job = std::make_shared<FeatureJob>();
+          job->line = n;
+          job->text = std::move(line);
+          job->first = first;
+          if (feature_buildings.size() <= features) throw InputError(model_path + ": changed while being read");
+          first += feature_buildings[features++];
+          return job;
+        }
+        return nullptr;
+      },
+      [&](FeatureJob& job) {
+        const std::string where = model_path + ": line " + std::to_string(job.line);
+        json feature = parse_feature(job.text, where);
+        const CityJsonFile f = read_cityjson_document(feature_document(header, feature), where, options.lod);
+        if (upgrade) upgrade_objects(feature["CityObjects"]);
+        refine_document(feature, tf, f.buildings, targets, target_of, job.first, params, 1, options.on_building, job.part, {});
+        job.text = feature.dump() + "\n";
+      },
+      [&](FeatureJob& job) {
+        out.write(job.text);
+        merge_into(sum, std::move(job.part));
+        if (options.progress) options.progress(sum);
+      });
   out.commit();
   sum.seconds_refine = seconds_since(t);
   return sum;
@@ -346,7 +484,7 @@ CityRefineSummary refine_city(const std::string& model_path, const std::string& 
 
   t = Clock::now();
   Eigen::AlignedBox3d cloud_box;
-  sum.cloud_points = crop_tile(cloud_path, targets, options.cloud, &cloud_box);
+  sum.cloud_points = crop_tile(cloud_path, targets, options.cloud, &cloud_box, options.crop_progress);
   sum.cropped_points = check_cloud_reaches(targets, cloud_box, model_box(file.buildings), cloud_path);
   sum.seconds_crop = seconds_since(t);
 
@@ -356,7 +494,8 @@ CityRefineSummary refine_city(const std::string& model_path, const std::string& 
     upgrade_objects(doc["CityObjects"]);
   }
   ensure_transform(doc);
-  refine_document(doc, transform_of(doc), file.buildings, targets, target_of, 0, params, options.on_building, sum);
+  refine_document(doc, transform_of(doc), file.buildings, targets, target_of, 0, params, options.jobs, options.on_building, sum,
+                  options.progress);
   sum.seconds_refine = seconds_since(t);
 
   t = Clock::now();

@@ -34,11 +34,15 @@ CropTarget crop_target(const Mesh& model, double relative, double absolute) {
 
 namespace {
 
+// Points read between two calls of the progress callback.
+constexpr std::size_t kProgressPoints = 1 << 16;
+
 // Streams the tile (PLY or LAS, `options` filtering LAS classes) once and calls on_hit(i, p)
 // for every target i whose box holds p; a 2D grid over the targets keeps this O(points).
 // Returns the number of points read; `bounds` (optional) gets their bounding box.
 std::size_t for_each_hit(const std::string& tile, const std::vector<CropTarget>& targets, const CloudOptions& options,
-                         Eigen::AlignedBox3d* bounds, const std::function<void(std::size_t, const Vec3&)>& on_hit) {
+                         Eigen::AlignedBox3d* bounds, const std::function<void(std::size_t, const Vec3&)>& on_hit,
+                         const std::function<void(std::uint64_t)>& on_read) {
   if (targets.empty()) return 0;
   // Grid cell size: about the median box size, so each box touches few cells.
   std::vector<double> sizes;
@@ -56,7 +60,7 @@ std::size_t for_each_hit(const std::string& tile, const std::vector<CropTarget>&
   }
   std::size_t n = 0;
   stream_cloud(tile, options, [&](const Vec3& p) {
-    ++n;
+    if (++n % kProgressPoints == 0 && on_read) on_read(n);
     if (bounds) bounds->extend(p);
     const auto it = grid.find(key(p.x(), p.y()));
     if (it == grid.end()) return;
@@ -92,14 +96,16 @@ std::vector<Vec3> unspill(const std::string& path) {
 }  // namespace
 
 std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets, const CloudOptions& options,
-                      Eigen::AlignedBox3d* bounds) {
-  return for_each_hit(tile, targets, options, bounds,
-                      [&](std::size_t i, const Vec3& p) { targets[i].cloud.points.push_back(p); });
+                      Eigen::AlignedBox3d* bounds, const std::function<void(std::uint64_t)>& on_read) {
+  return for_each_hit(
+      tile, targets, options, bounds, [&](std::size_t i, const Vec3& p) { targets[i].cloud.points.push_back(p); },
+      on_read);
 }
 
 std::size_t crop_tile_to_files(const std::string& tile, const std::vector<CropTarget>& targets,
                                const std::vector<std::string>& out_paths, std::size_t buffer_points,
-                               std::vector<std::size_t>& counts, const CloudOptions& options) {
+                               std::vector<std::size_t>& counts, const CloudOptions& options,
+                               const std::function<void(std::uint64_t)>& on_read) {
   static_assert(sizeof(Vec3) == 3 * sizeof(double), "spill files hold Vec3 as three doubles");
   std::vector<std::vector<Vec3>> held(targets.size());
   std::vector<std::string> spills(targets.size());  // created on a target's first spill
@@ -116,7 +122,7 @@ std::size_t crop_tile_to_files(const std::string& tile, const std::vector<CropTa
       held[i].push_back(p);
       ++counts[i];
       if (++in_memory > buffer_points) flush_all();
-    });
+    }, on_read);
     for (std::size_t i = 0; i < targets.size(); ++i) {
       PointCloud cloud;
       cloud.points = unspill(spills[i]);

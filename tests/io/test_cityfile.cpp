@@ -502,3 +502,82 @@ TEST(CityFile, LasTileWithClassesThroughTheCli) {
   }
   EXPECT_GE(b["refined"].get<int>(), 1);
 }
+
+// --jobs: buildings refined on a pool, written in file order: the same bytes as one at a time,
+// for a CityJSON file and for a CityJSONSeq, with the progress callback called once a building
+// (once a feature) in order and counting up to the file's buildings.
+TEST(CityFile, JobsWriteTheSameBytesAsOneAtATime) {
+  const std::string dir = test_dir();
+  PointCloud cloud;
+  const std::vector<SynthBuilding> bs = synth_street(
+      {BuildingType::Gable, BuildingType::LShape, BuildingType::Flat, BuildingType::Hip, BuildingType::Shed,
+       BuildingType::Stepped, BuildingType::TShape},
+      41, 5000, 6, cloud);
+  const json in = synth_city(bs, Vec3(93000, 436000, 0));
+  write_file_atomic(dir + "/city.json", in.dump());
+  std::string seq = synth_city({}, Vec3(93000, 436000, 0)).dump() + "\n";
+  for (const auto& b : bs) {
+    json one = synth_city({b}, Vec3(93000, 436000, 0));
+    seq += json({{"type", "CityJSONFeature"}, {"id", b.id}, {"CityObjects", one["CityObjects"]}, {"vertices", one["vertices"]}})
+               .dump() + "\n";
+  }
+  write_file_atomic(dir + "/city.city.jsonl", seq);
+  write_ply(dir + "/cloud.ply", cloud);
+  for (const std::string name : {"city.json", "city.city.jsonl"}) {
+    std::map<int, std::string> written;
+    std::map<int, std::vector<std::string>> order;
+    for (int jobs : {1, 3}) {
+      CityRefineOptions o;
+      o.jobs = jobs;
+      std::vector<int> done;
+      o.progress = [&](const CityRefineSummary& s) {
+        done.push_back(s.refined + s.kept + s.kept_invalid + s.untouched);
+        EXPECT_EQ(s.buildings, int(bs.size()));
+      };
+      const std::string out = dir + "/out" + std::to_string(jobs) + "." + name;
+      const CityRefineSummary s = refine_city(dir + "/" + name, dir + "/cloud.ply", out, Params{}, o);
+      EXPECT_EQ(s.refined + s.kept + s.kept_invalid, 6);
+      EXPECT_GE(s.refined, 4) << name;
+      ASSERT_EQ(done.size(), bs.size()) << name;
+      for (std::size_t i = 0; i < done.size(); ++i) EXPECT_EQ(done[i], int(i) + 1);
+      std::ifstream f(out, std::ios::binary);
+      written[jobs].assign(std::istreambuf_iterator<char>(f), {});
+      for (const auto& b : s.outcomes) order[jobs].push_back(b.id);
+    }
+    EXPECT_EQ(written[1], written[3]) << name << ": --jobs 3 wrote other bytes than --jobs 1";
+    EXPECT_EQ(order[1], order[3]) << name << ": outcomes not in file order";
+    EXPECT_GT(written[1].size(), 1000u);
+  }
+}
+
+// The progress line: redrawn in place on a terminal (a pty from script(1)), absent from a
+// short run into a file and with --quiet; stdout and the exit code the same either way.
+TEST(CityFile, ProgressLineOnATerminalOnly) {
+  if (std::system("script -V >/dev/null 2>&1") != 0) GTEST_SKIP() << "script(1) absent";
+  const std::string dir = test_dir();
+  PointCloud cloud;
+  const std::vector<SynthBuilding> bs =
+      synth_street({BuildingType::Gable, BuildingType::LShape, BuildingType::Hip}, 61, 6000, 3, cloud);
+  write_file_atomic(dir + "/city.json", synth_city(bs, Vec3(93000, 436000, 0)).dump());
+  write_ply(dir + "/cloud.ply", cloud);
+  const std::string args = "refine --jobs 2 --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir + "/o.city.json";
+  const Cli plain = run_cli(args, dir);
+  ASSERT_EQ(plain.exit, 0) << plain.err;
+  EXPECT_EQ(plain.err, "") << "a short run into a file prints no progress";
+  EXPECT_NE(plain.out.find("3 building(s)"), std::string::npos) << plain.out;
+  auto on_terminal = [&](const std::string& extra) {
+    const std::string log = dir + "/tty.log";
+    const int st = std::system(("script -qec '" + std::string(LODREFINE_BINARY) + " " + args + extra + "' /dev/null > " +
+                                log + " 2>&1").c_str());
+    EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0);
+    std::ifstream in(log, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string tty = on_terminal("");
+  EXPECT_NE(tty.find("\rrefine: "), std::string::npos) << tty;
+  EXPECT_NE(tty.find("\x1b[K"), std::string::npos) << "the redrawn line clears its tail";
+  EXPECT_NE(tty.find("refine: 3/3 buildings (100 %)"), std::string::npos) << "the last figures stay: " << tty;
+  EXPECT_NE(tty.find(plain.out.substr(0, plain.out.find(" -> "))), std::string::npos) << "stdout unchanged";
+  const std::string quiet = on_terminal(" --quiet");
+  EXPECT_EQ(quiet.find("refine: "), std::string::npos) << quiet;
+}

@@ -8,6 +8,7 @@
 #include "lodrefine/core/distance.h"  // cloud_to_mesh, sample_faces: the measures used here
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/types.h"
+#include "lodrefine/eval/histogram.h"
 
 namespace lodrefine {
 
@@ -90,8 +91,23 @@ struct PooledEval {
   std::optional<DistanceStats> truth_facade_before, truth_facade_after;  // over all samples
   std::optional<DistanceStats> truth_roof_before, truth_roof_after;
 };
+// The per-point series of a run pooled in bins, one building at a time (memory does not grow
+// with the run): add() each building's evaluation, then drop_series() it.
+struct PooledSeries {
+  DistanceHistogram c2m_before, c2m_after;  // buildings measured with both models
+  DistanceHistogram truth_facade_before, truth_facade_after, truth_roof_before, truth_roof_after;
+  void add(const BuildingEval& b);
+  void merge(const PooledSeries& other);
+};
+// Frees a building's per-point series (c2m_*, truth_*_d_*, facade_index); its figures stay.
+void drop_series(BuildingEval& b);
+
 // Failed buildings count in the watertight rates only (as not watertight after refinement):
 // C2M and ΔD pool the buildings measured with both models, so the columns stay comparable.
+// Count, RMSE, MAE, mean, std and max |d| come from the buildings' own figures (exact, in
+// their order); median and p95 from `series` (to one bin, see histogram.h).
+PooledEval pool_evaluations(const std::vector<BuildingEval>& buildings, const PooledSeries& series);
+// The same, pooling the buildings' own series (they must not have been dropped).
 PooledEval pool_evaluations(const std::vector<BuildingEval>& buildings);
 
 }  // namespace lodrefine

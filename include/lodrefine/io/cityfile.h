@@ -3,8 +3,8 @@
 // is written with everything else kept exactly.
 //
 // The cloud is read once: one streaming pass cuts a crop per building (lodrefine crop's box),
-// then each building is refined on its crop, one after another (memory: the crops, not the
-// cloud). A refined building's chosen LoD geometry is replaced by a Solid with semantics
+// then each building is refined on its crop, `jobs` buildings at once (memory: the crops, not
+// the cloud); results are written in file order. A refined building's chosen LoD geometry is replaced by a Solid with semantics
 // (WallSurface / RoofSurface / GroundSurface from the refined mesh's faces); its other LoDs,
 // attributes and id stay. Every other building, attribute, LoD, the metadata and the transform
 // are kept as read (new vertices are appended, so existing indices hold). Each building the
@@ -27,11 +27,14 @@ namespace lodrefine {
 struct CityBuildingOutcome;
 struct RefineResult;
 
-// Called once per building of the file, in file order, when set (e.g. to collect a review page):
+// Called once per building of the file when set (e.g. to collect a review page): in file order on
+// the caller's thread for a CityJSON file; for a CityJSONSeq by the thread that refines the
+// feature, so concurrently when jobs > 1 (the hook must then be thread-safe).
 // `outcome` and `crop` are null for a building the cloud does not reach, `result` is null unless
 // refine_building returned. All in the input frame.
 using CityBuildingHook = std::function<void(const Mesh& model, const CityBuildingOutcome* outcome,
                                             const RefineResult* result, const PointCloud* crop)>;
+struct CityRefineSummary;
 
 struct CityRefineOptions {
   std::string building;  // refine only this CityObject id ("" = every building the cloud covers)
@@ -40,6 +43,13 @@ struct CityRefineOptions {
   double crop_expand = 0.1;  // crop box growth, relative and absolute (as lodrefine crop)
   double crop_margin = 3.0;
   CityBuildingHook on_building;  // optional
+  // Buildings refined at once, each on its own thread (1: one after another on the caller's).
+  // The output is the same bytes whatever the number.
+  int jobs = 1;
+  // Called after each building (CityJSONSeq: each feature) is written into the output, in
+  // file order on the caller's thread, with the counts so far (may be empty).
+  std::function<void(const CityRefineSummary&)> progress;
+  std::function<void(std::uint64_t)> crop_progress;  // points read so far in the cloud pass (may be empty)
 };
 
 struct CityBuildingOutcome {

@@ -21,9 +21,10 @@ CropTarget crop_target(const Mesh& model, double relative, double absolute);
 // Streams the tile (PLY or LAS, `options` filtering LAS classes) once and appends each point
 // to every target whose box holds it (a 2D grid over the targets keeps this O(points)).
 // Returns the number of points read (after the class filter); `bounds` (optional) gets the
-// bounding box of every point read.
+// bounding box of every point read. `on_read` (optional) is called with the points read so far
+// every 65,536 points (for a progress line).
 std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets, const CloudOptions& options = {},
-                      Eigen::AlignedBox3d* bounds = nullptr);
+                      Eigen::AlignedBox3d* bounds = nullptr, const std::function<void(std::uint64_t)>& on_read = {});
 
 // The same pass for a whole city tile, with memory bounded by `buffer_points`, not by the tile:
 // each target's points go to `out_paths[i]` (a PLY, written atomically), and points held beyond
@@ -32,6 +33,7 @@ std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets,
 // `counts[i]` to each crop's size.
 std::size_t crop_tile_to_files(const std::string& tile, const std::vector<CropTarget>& targets,
                                const std::vector<std::string>& out_paths, std::size_t buffer_points,
-                               std::vector<std::size_t>& counts, const CloudOptions& options = {});
+                               std::vector<std::size_t>& counts, const CloudOptions& options = {},
+                               const std::function<void(std::uint64_t)>& on_read = {});
 
 }  // namespace lodrefine
