@@ -53,7 +53,7 @@ std::string cell_text(const json& v) {
     std::snprintf(buf, sizeof buf, "%.3f", v.get<double>());
     return buf;
   }
-  return v.dump();
+  return v.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
 const char* kStyle = R"css(
@@ -216,7 +216,7 @@ std::string html_report(const HtmlReport& r) {
       h += "</div></div></div></section>\n";
       views.push_back({{"id", v.id}, {"original", v.original}, {"refined", v.refined}, {"points", v.points}, {"c2m", v.c2m}});
     }
-    h += "<script type=\"application/json\" id=\"lodrefine-views\">" + script_safe(views.dump()) + "</script>\n";
+    h += "<script type=\"application/json\" id=\"lodrefine-views\">" + script_safe(views.dump(-1, ' ', false, json::error_handler_t::replace)) + "</script>\n";
     h += "<script type=\"text/plain\" id=\"three-module\">" + script_safe(three_module_js()) + "</script>\n";
     h += std::string("<script type=\"module\">") + kViewer + "</script>\n";
   } else {

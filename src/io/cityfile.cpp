@@ -68,7 +68,7 @@ void refine_document(json& doc, const CityJsonTransform& tf, const std::vector<C
   for (std::size_t i = 0; i < buildings.size(); ++i) {
     const CityJsonBuilding& b = buildings[i];
     const std::size_t ti = target_of[first + i];
-    if (ti == std::string::npos || targets[ti].cloud.points.empty()) {
+    if (ti == std::string::npos || (targets[ti].cloud.points.empty() && targets[ti].refused.empty())) {
       ++sum.untouched;
       continue;
     }
@@ -78,6 +78,7 @@ void refine_document(json& doc, const CityJsonTransform& tf, const std::vector<C
     CityBuildingOutcome o;
     RefineResult r;
     try {
+      if (!targets[ti].refused.empty()) throw InputError(targets[ti].refused);
       r = refine_building(b.mesh, cloud, params);
       o = classify(r);
     } catch (const std::exception& e) {  // never lose a building: keep it as read
@@ -164,7 +165,16 @@ void add_targets(const std::vector<CityJsonBuilding>& buildings, const CityRefin
       continue;
     }
     target_of.push_back(targets.size());
-    targets.push_back(crop_target(b.mesh, o.crop_expand, o.crop_margin));
+    try {
+      targets.push_back(crop_target(b.mesh, o.crop_expand, o.crop_margin));
+    } catch (const InputError& e) {  // a building too wide to crop: kept-invalid, the run goes on
+      CropTarget t;
+      t.id = b.mesh.id;
+      t.lo = Vec3::Constant(1.0);
+      t.hi = Vec3::Zero();  // an empty box: no point reaches it
+      t.refused = e.what();
+      targets.push_back(std::move(t));
+    }
   }
 }
 
@@ -200,11 +210,16 @@ json feature_document(const json& header, json feature) {
 
 // The first line of a file when it is a CityJSONSeq header (a "CityJSON" object on one line);
 // null otherwise.
-json sequence_header(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+json sequence_header(const std::string& model_path) {
+  std::ifstream in(model_path, std::ios::binary);
   std::string line;
   if (!in || !std::getline(in, line) || line.size() > kMaxSequenceHeader) return nullptr;
-  json first = json::parse(line, nullptr, false);
+  json first;
+  try {
+    first = parse_city_json(line, model_path);
+  } catch (const InputError&) {
+    return nullptr;  // not a sequence header: the whole file is parsed, and refused with the reason
+  }
   if (!first.is_object() || first.value("type", "") != "CityJSON" ||
       (first.contains("CityObjects") && !first["CityObjects"].empty()))
     return nullptr;
@@ -232,7 +247,7 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
     std::getline(in, line);
     for (int n = 2; std::getline(in, line); ++n) {
       if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-      json feature = json::parse(line, nullptr, false);
+      json feature = parse_city_json(line, model_path + ": line " + std::to_string(n));
       if (!feature.is_object() || feature.value("type", "") != "CityJSONFeature")
         throw InputError(model_path + ": line " + std::to_string(n) + ": expected a CityJSONFeature object");
       f(n, std::move(feature));
@@ -262,7 +277,7 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
   const bool upgrade = header.value("version", "") != "2.0";
   if (upgrade) upgrade_header(h);
   h["version"] = "2.0";
-  out.write(h.dump() + "\n");
+  out.write(h.dump(-1, ' ', false, json::error_handler_t::replace) + "\n");
   std::size_t first = 0;
   for_each_feature([&](int n, json&& feature) {
     const CityJsonFile f = read_cityjson_document(feature_document(header, feature),
@@ -270,7 +285,7 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
     if (upgrade) upgrade_objects(feature["CityObjects"]);
     refine_document(feature, tf, f.buildings, targets, target_of, first, params, sum);
     first += f.buildings.size();
-    out.write(feature.dump() + "\n");
+    out.write(feature.dump(-1, ' ', false, json::error_handler_t::replace) + "\n");
   });
   out.commit();
   sum.seconds_refine = seconds_since(t);
@@ -325,8 +340,7 @@ CityRefineSummary refine_city(const std::string& model_path, const std::string& 
     format = "CityGML " + version;
   } else {
     const std::string text = read_text(model_path);
-    doc = json::parse(text, nullptr, false);
-    if (doc.is_discarded()) parse_cityjson(text, model_path);  // throws the reader's own message
+    doc = parse_city_json(text, model_path);
     format = "CityJSON " + (doc.contains("version") && doc["version"].is_string() ? doc["version"].get<std::string>() : "?");
   }
   const CityJsonFile file = read_cityjson_document(doc, model_path, options.lod);
@@ -357,7 +371,7 @@ CityRefineSummary refine_city(const std::string& model_path, const std::string& 
 
   t = Clock::now();
   doc["version"] = "2.0";
-  write_file_atomic(out_path, doc.dump() + "\n");
+  write_file_atomic(out_path, doc.dump(-1, ' ', false, json::error_handler_t::replace) + "\n");
   sum.seconds_write = seconds_since(t);
   return sum;
 }
