@@ -236,6 +236,9 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
   CityRefineSummary sum;
   sum.input_format = "CityJSONSeq " + header.value("version", std::string("?"));
   if (!header.contains("transform")) throw InputError(model_path + ": line 1: a CityJSONSeq header needs a \"transform\"");
+  // The header checked by the reader (transform shape, scale) before transform_of trusts it.
+  read_cityjson_document(feature_document(header, {{"CityObjects", json::object()}, {"vertices", json::array()}}),
+                         model_path + ": line 1");
   const CityJsonTransform tf = transform_of(header);
   auto t = Clock::now();
   std::vector<CropTarget> targets;

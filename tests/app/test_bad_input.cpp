@@ -982,6 +982,8 @@ TEST(BadInputSecurity, CityFilesRefusedInOneLineNamingTheFile) {
       {"overflow.city.json", R"({"type":"CityJSON","version":"2.0","CityObjects":{},"vertices":[[1e400,0,0]]})"},
       {"scale0.city.json",
        R"({"type":"CityJSON","version":"2.0","transform":{"scale":[1,1,0],"translate":[0,0,0]},"CityObjects":{},"vertices":[]})"},
+      {"header.city.jsonl", R"({"type":"CityJSON","version":"2.0","transform":{"scale":"x"},"CityObjects":{},"vertices":[]})"
+                            "\n{\"type\":\"CityJSONFeature\",\"CityObjects\":{},\"vertices\":[]}\n"},
       {"deep.city.json", R"({"type":"CityJSON","version":"2.0","CityObjects":{},"vertices":[],"x":)" + std::string(100000, '[') +
                              std::string(100000, ']') + "}"},
   };
