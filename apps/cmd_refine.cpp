@@ -104,7 +104,8 @@ void run(const RefineArgs& a) {
   report["cloud"]["path"] = a.cloud;
   report["params"] = params_json(a.params);
   report["written"] = a.out;
-  if (!a.report.empty()) write_file_atomic(a.report, report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  if (!a.report.empty())
+    write_file_atomic(a.report, report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   write_obj(a.out, r.mesh);
   std::printf("%s: %s (%s) -> %s (%.2f s)%s\n", model.id.c_str(), outcome_name(r.outcome), r.reason.c_str(),
               a.out.c_str(), r.trace.stage_seconds("total"), overlap.empty() ? "" : ("; warning: " + overlap).c_str());

@@ -47,7 +47,8 @@ std::string format_number(double x) {
 
 bool degenerate(const std::vector<Vec3>& pts) {
   double longest = 0.0;
-  for (std::size_t i = 0; i < pts.size(); ++i) longest = std::max(longest, (pts[(i + 1) % pts.size()] - pts[i]).squaredNorm());
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    longest = std::max(longest, (pts[(i + 1) % pts.size()] - pts[i]).squaredNorm());
   return newell_normal(pts).norm() <= kDegenerateFaceRatio * longest;
 }
 
@@ -64,7 +65,9 @@ std::string malformed(const Mesh& m) {
     if (std::set<int>(v.begin(), v.end()).size() != v.size()) return face + " repeats a vertex";
   }
   for (std::size_t k = 0; k < m.faces.size(); ++k)
-    if (degenerate(face_points(m, m.faces[k]))) return "face " + std::to_string(k) + " is degenerate (no area: its vertices are on one line or it folds onto itself)";
+    if (degenerate(face_points(m, m.faces[k])))
+      return "face " + std::to_string(k) +
+             " is degenerate (no area: its vertices are on one line or it folds onto itself)";
   return {};
 }
 
@@ -186,7 +189,8 @@ std::string first_problem(const Validation& v, double planarity_tolerance, bool 
   if (v.nonmanifold_vertices) return n(v.nonmanifold_vertices) + " non-manifold vertices (faces meet only at a point)";
   if (v.inconsistent_edges) return n(v.inconsistent_edges) + " inconsistently oriented edges";
   if (single_component && v.components != 1) return n(v.components) + " connected components (expected one)";
-  if (std::abs(v.volume) < kFlatShellVolume) return "the shell encloses no volume (signed volume " + format_number(v.volume) + " m^3)";
+  if (std::abs(v.volume) < kFlatShellVolume)
+    return "the shell encloses no volume (signed volume " + format_number(v.volume) + " m^3)";
   if (!v.outward) return "faces point inward (signed volume " + format_number(v.volume) + " m^3)";
   if (v.max_planarity_error > planarity_tolerance)
     return "face planarity error " + format_number(v.max_planarity_error) + " m exceeds " +

@@ -216,7 +216,8 @@ std::string html_report(const HtmlReport& r) {
       h += "</div></div></div></section>\n";
       views.push_back({{"id", v.id}, {"original", v.original}, {"refined", v.refined}, {"points", v.points}, {"c2m", v.c2m}});
     }
-    h += "<script type=\"application/json\" id=\"lodrefine-views\">" + script_safe(views.dump(-1, ' ', false, json::error_handler_t::replace)) + "</script>\n";
+    h += "<script type=\"application/json\" id=\"lodrefine-views\">" +
+         script_safe(views.dump(-1, ' ', false, json::error_handler_t::replace)) + "</script>\n";
     h += "<script type=\"text/plain\" id=\"three-module\">" + script_safe(three_module_js()) + "</script>\n";
     h += std::string("<script type=\"module\">") + kViewer + "</script>\n";
   } else {

@@ -302,6 +302,7 @@ nlohmann::ordered_json citygml_to_cityjson(const std::string& path, std::string*
   } catch (...) {  // xerces throws its own exception types (malformed XML)
     why = "malformed XML";
   }
+  std::string().swap(text);  // the model holds what is needed now
   if (!model) {
     if (!logger->first().empty()) why = logger->first();
     for (char& c : why)

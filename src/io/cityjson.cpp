@@ -106,7 +106,8 @@ class Reader {
       if (!t.is_object()) fail("\"transform\" is not an object");
       out.scale = vec3(member(t, "scale"), "transform.scale");
       out.translate = vec3(member(t, "translate"), "transform.translate");
-      if ((out.scale.array() <= 0.0).any()) fail("transform.scale has a zero or negative factor (every vertex would collapse)");
+      if ((out.scale.array() <= 0.0).any())
+        fail("transform.scale has a zero or negative factor (every vertex would collapse)");
     }
     const json& rs = member(member(root, "metadata"), "referenceSystem");
     if (rs.is_string()) out.crs = rs.get<std::string>();

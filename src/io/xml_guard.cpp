@@ -13,7 +13,9 @@ namespace {
 
 constexpr auto npos = std::string_view::npos;
 
-bool starts_with(std::string_view s, std::size_t at, std::string_view prefix) { return s.compare(at, prefix.size(), prefix) == 0; }
+bool starts_with(std::string_view s, std::size_t at, std::string_view prefix) {
+  return s.compare(at, prefix.size(), prefix) == 0;
+}
 
 // UTF-16 and UTF-32, with or without a byte order mark: a BOM other than UTF-8's, or a NUL
 // among the first four bytes (an XML document starts with '<' or whitespace).
@@ -104,7 +106,8 @@ std::optional<unsigned long> character_reference(std::string_view name) {  // "#
   const std::string_view digits = name.substr(hex ? 2 : 1);
   unsigned long c = 0;
   const auto r = std::from_chars(digits.data(), digits.data() + digits.size(), c, hex ? 16 : 10);
-  if (digits.empty() || r.ec != std::errc() || r.ptr != digits.data() + digits.size() || !allowed_char(c)) return std::nullopt;
+  if (digits.empty() || r.ec != std::errc() || r.ptr != digits.data() + digits.size() || !allowed_char(c))
+    return std::nullopt;
   return c;
 }
 
@@ -126,8 +129,10 @@ std::optional<std::string> decode_references(std::string_view run) {
     else if (name == "gt") out += '>';
     else if (name == "quot") out += '"';
     else if (name == "apos") out += '\'';
-    else if (const auto c = name.empty() || name[0] != '#' ? std::nullopt : character_reference(name)) append_utf8(out, *c);
-    else return std::nullopt;
+    else if (const auto c = name.empty() || name[0] != '#' ? std::nullopt : character_reference(name))
+      append_utf8(out, *c);
+    else
+      return std::nullopt;
   }
   return out;
 }
@@ -172,7 +177,8 @@ std::optional<std::string> split_character_data(std::string_view t, std::size_t&
     }
   }
   const bool has_text = text.find_first_not_of(" \t\r\n") != std::string::npos;
-  if (!decodable || !has_text || (!references && pieces < 2) || text.find("]]>") != std::string::npos) return std::nullopt;
+  if (!decodable || !has_text || (!references && pieces < 2) || text.find("]]>") != std::string::npos)
+    return std::nullopt;
   return text;
 }
 
