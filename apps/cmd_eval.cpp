@@ -621,7 +621,7 @@ void write_outputs(const EvalArgs& a, const std::vector<Row>& rows, const Pooled
     j["pooled"].update(totals_json(run_totals(rows)));
     for (const Row* r : order) j["buildings"].push_back(row_json(*r));
     if (!a.dir.empty()) j["run_dir"] = a.dir;
-    write_file_atomic(a.json_out, j.dump(2) + "\n");
+    write_file_atomic(a.json_out, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   }
   if (!a.csv_out.empty()) write_file_atomic(a.csv_out, csv_text(order));
   if (a.svg_dir.empty() && a.html_out.empty()) return;

@@ -158,7 +158,7 @@ void run_city(const RefineArgs& a) {
     for (const auto& b : s.outcomes)
       j["outcomes"].push_back({{"id", b.id}, {"outcome", b.outcome}, {"reason", b.reason},
                                {"facades_moved", b.facades_moved}, {"points", b.points}, {"seconds", b.seconds}});
-    write_file_atomic(a.report, j.dump(2) + "\n");
+    write_file_atomic(a.report, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   }
   std::printf("%s: %d building(s), %llu cloud points (%llu in building crops): %d refined, %d kept, %d kept-invalid, "
               "%d untouched (no cloud points) -> %s (read %.1f s, crop %.1f s, refine %.1f s, write %.1f s)\n",
@@ -208,7 +208,8 @@ void run(const RefineArgs& a) {
   report["params"] = params_json(a.params);
   report["written"] = a.out;
   write_obj(a.out, r.mesh);  // the model first: a report never names a model that is not there
-  if (!a.report.empty()) write_file_atomic(a.report, report.dump(2) + "\n");
+  if (!a.report.empty())
+    write_file_atomic(a.report, report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   std::printf("%s: %s (%s) -> %s (%.2f s)%s\n", model.id.c_str(), outcome_name(r.outcome), r.reason.c_str(),
               a.out.c_str(), r.trace.stage_seconds("total"), overlap.empty() ? "" : ("; warning: " + overlap).c_str());
 }

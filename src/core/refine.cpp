@@ -227,7 +227,7 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
   std::vector<Vec3> facade_points;  // the matched walls' own points: the fit is judged on them
   std::vector<WallMove> moves;
   std::vector<ScannedWall> scanned;
-  RefineTrace::Matching& matching = trace.matching.emplace();
+  RefineTrace::Matching& matching = trace.matching.emplace(RefineTrace::Matching{});
   for (const auto& m : mr.matches) {
     Plane pl = planes[m.scan_plane].plane;
     if (pl.n.dot(surfaces[m.surface].plane.n) < 0) pl = pl.flipped();
@@ -249,12 +249,14 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
   std::vector<WallMove> all = moves;
   for (const auto& c : corners) all.push_back(c.move);
   std::optional<Mesh> refined;
-  if (!prm.arrangement_only) refined = substitute_valid(current, surfaces, all, prm, trace.substitution.emplace());
+  if (!prm.arrangement_only)
+    refined = substitute_valid(current, surfaces, all, prm, trace.substitution.emplace(RefineTrace::Substitution{}));
   if (refined) {
     for (const auto& mv : moves) trace.facades.push_back(describe_move(current, surfaces, mv, "scan"));
     for (const auto& c : corners) trace.facades.push_back(describe_move(current, surfaces, c.move, "corner"));
   } else if (!corners.empty() && !moves.empty()) {
-    refined = substitute_valid(current, surfaces, moves, prm, trace.substitution_without_corners.emplace());
+    refined = substitute_valid(current, surfaces, moves, prm,
+                               trace.substitution_without_corners.emplace(RefineTrace::Substitution{}));
     if (refined)
       for (const auto& mv : moves) trace.facades.push_back(describe_move(current, surfaces, mv, "scan"));
   }

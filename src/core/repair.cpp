@@ -155,15 +155,28 @@ std::vector<Face> clean_faces(const Mesh& soup, const std::vector<int>& cluster,
 int split_t_junctions(const std::vector<Vec3>& V, std::vector<Face>& faces, double tol) {
   std::set<int> used_set;
   for (const Face& f : faces) used_set.insert(f.v.begin(), f.v.end());
-  const std::vector<int> used(used_set.begin(), used_set.end());
+  // The used vertices sorted by x: an edge tests only those in its box grown by `tol` (testing
+  // every vertex made a ring pinched thousands of times take seconds).
+  std::vector<int> by_x(used_set.begin(), used_set.end());
+  std::sort(by_x.begin(), by_x.end(), [&V](int a, int b) { return V[a].x() < V[b].x(); });
+  std::vector<double> xs;
+  for (int v : by_x) xs.push_back(V[v].x());
   // Strictly within `tol` of the edge, farther than `tol` from its ends, not in the face yet.
   const SegmentRule on_edge{tol, true, 0.0, tol};
+  std::vector<int> near;
   int inserted = 0;
   for (Face& f : faces) {
     std::vector<int> out;
     for (std::size_t i = 0; i < f.v.size(); ++i) {
-      out.push_back(f.v[i]);
-      for (int w : vertices_on_segment(V, f.v[i], f.v[(i + 1) % f.v.size()], on_edge, &used, &f.v)) {
+      const int a = f.v[i], b = f.v[(i + 1) % f.v.size()];
+      const Vec3 lo = V[a].cwiseMin(V[b]).array() - tol, hi = V[a].cwiseMax(V[b]).array() + tol;
+      near.clear();
+      for (auto k = std::size_t(std::lower_bound(xs.begin(), xs.end(), lo.x()) - xs.begin()); k < xs.size() && xs[k] <= hi.x(); ++k) {
+        const Vec3& p = V[std::size_t(by_x[k])];
+        if (p.y() >= lo.y() && p.y() <= hi.y() && p.z() >= lo.z() && p.z() <= hi.z()) near.push_back(by_x[k]);
+      }
+      out.push_back(a);
+      for (int w : vertices_on_segment(V, a, b, on_edge, &near, &f.v)) {
         if (std::find(out.begin(), out.end(), w) != out.end()) continue;  // already on another edge
         out.push_back(w);
         ++inserted;
@@ -230,8 +243,10 @@ void orient_outward(const std::vector<Vec3>& V, std::vector<Face>& faces, const 
   const int ncomp = comp.empty() ? 0 : *std::max_element(comp.begin(), comp.end()) + 1;
   std::vector<std::vector<Face>> parts(ncomp);
   for (std::size_t f = 0; f < faces.size(); ++f) parts[comp[f]].push_back(faces[f]);
+  std::vector<char> negative(std::size_t(ncomp), 0);  // once per component, not per face (quadratic)
+  for (int c = 0; c < ncomp; ++c) negative[std::size_t(c)] = signed_volume(V, parts[std::size_t(c)]) < 0;
   for (std::size_t f = 0; f < faces.size(); ++f)
-    if (signed_volume(V, parts[comp[f]]) < 0) std::reverse(faces[f].v.begin(), faces[f].v.end()), flipped[f] ^= 1;
+    if (negative[std::size_t(comp[f])]) std::reverse(faces[f].v.begin(), faces[f].v.end()), flipped[f] ^= 1;
 }
 
 int pop(std::vector<int>& v) {

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <iterator>
 #include <map>
 #include <set>
@@ -28,11 +29,27 @@ using SurfaceMesh = CGAL::Surface_mesh<Kernel::Point_3>;
 using SmVertex = SurfaceMesh::Vertex_index;
 using SmFace = SurfaceMesh::Face_index;
 
+// A face whose area is below this fraction of its longest edge squared is a line or a point:
+// it has no plane (CGAL's face triangulation crashes on its null normal), so the mesh is
+// reported invalid before any triangulation. Far below any real sliver (a 10 m edge with a
+// 1 nm wide face is 1e-10), far above rounding noise of local-frame coordinates.
+constexpr double kDegenerateFaceRatio = 1e-12;
+
+// A shell enclosing less than this (m^3) is flat: a building lowered to the ground.
+constexpr double kFlatShellVolume = 1e-9;
+
 std::string format_number(double x) {
   std::ostringstream s;
   s.precision(3);
   s << x;
   return s.str();
+}
+
+bool degenerate(const std::vector<Vec3>& pts) {
+  double longest = 0.0;
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    longest = std::max(longest, (pts[(i + 1) % pts.size()] - pts[i]).squaredNorm());
+  return newell_normal(pts).norm() <= kDegenerateFaceRatio * longest;
 }
 
 // Index errors and degenerate polygons make every other check meaningless.
@@ -47,6 +64,10 @@ std::string malformed(const Mesh& m) {
       if (i < 0 || std::size_t(i) >= m.vertices.size()) return face + " references missing vertex " + std::to_string(i);
     if (std::set<int>(v.begin(), v.end()).size() != v.size()) return face + " repeats a vertex";
   }
+  for (std::size_t k = 0; k < m.faces.size(); ++k)
+    if (degenerate(face_points(m, m.faces[k])))
+      return "face " + std::to_string(k) +
+             " is degenerate (no area: its vertices are on one line or it folds onto itself)";
   return {};
 }
 
@@ -168,6 +189,8 @@ std::string first_problem(const Validation& v, double planarity_tolerance, bool 
   if (v.nonmanifold_vertices) return n(v.nonmanifold_vertices) + " non-manifold vertices (faces meet only at a point)";
   if (v.inconsistent_edges) return n(v.inconsistent_edges) + " inconsistently oriented edges";
   if (single_component && v.components != 1) return n(v.components) + " connected components (expected one)";
+  if (std::abs(v.volume) < kFlatShellVolume)
+    return "the shell encloses no volume (signed volume " + format_number(v.volume) + " m^3)";
   if (!v.outward) return "faces point inward (signed volume " + format_number(v.volume) + " m^3)";
   if (v.max_planarity_error > planarity_tolerance)
     return "face planarity error " + format_number(v.max_planarity_error) + " m exceeds " +

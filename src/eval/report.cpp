@@ -56,7 +56,7 @@ std::string cell_text(const json& v) {
     std::snprintf(buf, sizeof buf, "%.3f", v.get<double>());
     return buf;
   }
-  return v.dump();
+  return v.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
 const char* kStyle = R"css(

@@ -70,7 +70,8 @@ CityJsonTransform transform_of(const json& header) {
 // and GLPK's environment are thread-local, see ARCHITECTURE.md).
 struct BuildingJob {
   std::size_t index = 0;  // in the document's buildings
-  bool has_points = false;
+  bool has_points = false;  // or refused: either way the building gets an outcome
+  std::string refused;      // why its crop target was refused (e.g. an absurd extent)
   PointCloud cloud;
   RefineResult result;
   bool returned = false;  // refine_building returned (result is set)
@@ -81,6 +82,7 @@ void run_job(BuildingJob& job, const CityJsonBuilding& b, const Params& params) 
   if (!job.has_points) return;
   const auto t0 = Clock::now();
   try {
+    if (!job.refused.empty()) throw InputError(job.refused);
     job.result = refine_building(b.mesh, job.cloud, params);
     job.returned = true;
     job.outcome = classify(job.result);
@@ -99,8 +101,9 @@ BuildingJob take_job(std::size_t i, std::vector<CropTarget>& targets, const std:
   BuildingJob job;
   job.index = i;
   const std::size_t ti = target_of[first + i];
-  if (ti == std::string::npos || targets[ti].cloud.points.empty()) return job;
+  if (ti == std::string::npos || (targets[ti].cloud.points.empty() && targets[ti].refused.empty())) return job;
   job.has_points = true;
+  job.refused = targets[ti].refused;
   job.cloud = std::move(targets[ti].cloud);
   targets[ti].cloud = PointCloud();
   return job;
@@ -265,7 +268,16 @@ void add_targets(const std::vector<CityJsonBuilding>& buildings, const CityRefin
       continue;
     }
     target_of.push_back(targets.size());
-    targets.push_back(crop_target(b.mesh, o.crop_expand, o.crop_margin));
+    try {
+      targets.push_back(crop_target(b.mesh, o.crop_expand, o.crop_margin));
+    } catch (const InputError& e) {  // a building too wide to crop: kept-invalid, the run goes on
+      CropTarget t;
+      t.id = b.mesh.id;
+      t.lo = Vec3::Constant(1.0);
+      t.hi = Vec3::Zero();  // an empty box: no point reaches it
+      t.refused = e.what();
+      targets.push_back(std::move(t));
+    }
   }
 }
 
@@ -301,11 +313,16 @@ json feature_document(const json& header, json feature) {
 
 // The first line of a file when it is a CityJSONSeq header (a "CityJSON" object on one line);
 // null otherwise.
-json sequence_header(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+json sequence_header(const std::string& model_path) {
+  std::ifstream in(model_path, std::ios::binary);
   std::string line;
   if (!in || !std::getline(in, line) || line.size() > kMaxSequenceHeader) return nullptr;
-  json first = json::parse(line, nullptr, false);
+  json first;
+  try {
+    first = parse_city_json(line, model_path);
+  } catch (const InputError&) {
+    return nullptr;  // not a sequence header: the whole file is parsed, and refused with the reason
+  }
   if (!first.is_object() || first.value("type", "") != "CityJSON" ||
       (first.contains("CityObjects") && !first["CityObjects"].empty()))
     return nullptr;
@@ -316,7 +333,7 @@ json sequence_header(const std::string& path) {
 
 // One line of a CityJSONSeq after the header; `where` names it in the error.
 json parse_feature(const std::string& line, const std::string& where) {
-  json feature = json::parse(line, nullptr, false);
+  json feature = parse_city_json(line, where);
   if (!feature.is_object() || feature.value("type", "") != "CityJSONFeature")
     throw InputError(where + ": expected a CityJSONFeature object");
   return feature;
@@ -330,6 +347,9 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
   CityRefineSummary sum;
   sum.input_format = "CityJSONSeq " + header.value("version", std::string("?"));
   if (!header.contains("transform")) throw InputError(model_path + ": line 1: a CityJSONSeq header needs a \"transform\"");
+  // The header checked by the reader (transform shape, scale) before transform_of trusts it.
+  read_cityjson_document(feature_document(header, {{"CityObjects", json::object()}, {"vertices", json::array()}}),
+                         model_path + ": line 1");
   const CityJsonTransform tf = transform_of(header);
   auto t = Clock::now();
   std::vector<CropTarget> targets;
@@ -371,7 +391,7 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
   const bool upgrade = header.value("version", "") != "2.0";
   if (upgrade) upgrade_header(h);
   h["version"] = "2.0";
-  out.write(h.dump() + "\n");
+  out.write(h.dump(-1, ' ', false, json::error_handler_t::replace) + "\n");
   // Pass 2 on the pool, one feature an item: its line is parsed, refined and dumped on a
   // worker, and written here in file order.
   struct FeatureJob {
@@ -407,7 +427,7 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
         const CityJsonFile f = read_cityjson_document(feature_document(header, feature), where, options.lod);
         if (upgrade) upgrade_objects(feature["CityObjects"]);
         refine_document(feature, tf, f.buildings, targets, target_of, job.first, params, 1, options.on_building, job.part, {});
-        job.text = feature.dump() + "\n";
+        job.text = feature.dump(-1, ' ', false, json::error_handler_t::replace) + "\n";
       },
       [&](FeatureJob& job) {
         out.write(job.text);
@@ -467,8 +487,7 @@ CityRefineSummary refine_city(const std::string& model_path, const std::string& 
     format = "CityGML " + version;
   } else {
     const std::string text = read_text(model_path);
-    doc = json::parse(text, nullptr, false);
-    if (doc.is_discarded()) parse_cityjson(text, model_path);  // throws the reader's own message
+    doc = parse_city_json(text, model_path);
     format = "CityJSON " + (doc.contains("version") && doc["version"].is_string() ? doc["version"].get<std::string>() : "?");
   }
   const CityJsonFile file = read_cityjson_document(doc, model_path, options.lod);
@@ -500,7 +519,7 @@ CityRefineSummary refine_city(const std::string& model_path, const std::string& 
 
   t = Clock::now();
   doc["version"] = "2.0";
-  write_file_atomic(out_path, doc.dump() + "\n");
+  write_file_atomic(out_path, doc.dump(-1, ' ', false, json::error_handler_t::replace) + "\n");
   sum.seconds_write = seconds_since(t);
   return sum;
 }

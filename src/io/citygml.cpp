@@ -16,11 +16,15 @@
 #include <mutex>
 #include <regex>
 #include <set>
+#include <streambuf>
+#include <string_view>
 #include <unordered_map>
 
 #include "lodrefine/core/topology.h"
 #include "lodrefine/io/cityjson_write.h"
 #include "lodrefine/io/files.h"
+#include "text.h"
+#include "xml_guard.h"
 
 namespace lodrefine {
 namespace {
@@ -51,21 +55,31 @@ class Logger : public citygml::CityGMLLogger {
   mutable std::string first_;
 };
 
-// The CityGML version (from the namespace) and the first srsName, from the file's text; read
-// in chunks so a large file is not held twice.
-void scan_text(const std::string& path, std::string& version, std::string& srs) {
-  std::ifstream in(path, std::ios::binary);
+// The CityGML version (from the namespace) and the first srsName, from the file's text; searched
+// in windows so the regexes never run over a whole large file.
+void scan_text(std::string_view text, std::string& version, std::string& srs) {
   static const std::regex ns("http://www\\.opengis\\.net/citygml/([0-9]\\.[0-9])");
   static const std::regex srs_attr("srsName=\"([^\"]{1,200})\"");
-  std::string buf(1 << 20, '\0'), window;
-  while (in && (version.empty() || srs.empty())) {
-    in.read(&buf[0], std::streamsize(buf.size()));
-    window = window.substr(window.size() > 300 ? window.size() - 300 : 0) + buf.substr(0, std::size_t(in.gcount()));
+  constexpr std::size_t kWindow = 1 << 20, kOverlap = 300;
+  for (std::size_t at = 0; at < text.size() && (version.empty() || srs.empty()); at += kWindow - kOverlap) {
+    const std::string window(text.substr(at, kWindow));
     std::smatch m;
     if (version.empty() && std::regex_search(window, m, ns)) version = m[1];
     if (srs.empty() && std::regex_search(window, m, srs_attr)) srs = m[1];
   }
 }
+
+// libcitygml reads a std::istream: this one reads the checked text in place (no copy).
+class TextBuffer : public std::streambuf {
+ public:
+  explicit TextBuffer(std::string& text) { setg(text.data(), text.data(), text.data() + text.size()); }
+
+ protected:
+  pos_type seekoff(off_type off, std::ios_base::seekdir dir, std::ios_base::openmode) override {
+    if (off != 0 || dir != std::ios_base::cur) return pos_type(off_type(-1));
+    return pos_type(gptr() - eback());  // tellg(), which Xerces asks for its position
+  }
+};
 
 const char* semantic_type(Type t) {
   switch (t) {
@@ -123,6 +137,15 @@ class Converter {
     for (const CityObject* c : parts) building(*c, id, objects);
   }
 
+  // The gml:ids of a building and its parts, so that no name made up later takes one.
+  void reserve_ids(const CityObject& o) {
+    if (!generated_id(o.getId())) file_ids_.insert(o.getId());
+    for (unsigned i = 0; i < o.getChildCityObjectsCount(); ++i)
+      if (o.getChildCityObject(i).getType() == Type::COT_BuildingPart) reserve_ids(o.getChildCityObject(i));
+  }
+
+  const std::vector<std::string>& notes() const { return notes_; }
+
   json vertices() const {
     json v = json::array();
     for (const auto& q : vertices_) v.push_back(json::array({q[0], q[1], q[2]}));
@@ -130,11 +153,20 @@ class Converter {
   }
 
  private:
+  // Every building keeps a name of its own: a gml:id met again becomes "<id>~2" (with a note),
+  // an object without one "building-<n>", neither taking an id the file gives another object.
   std::string object_id(const CityObject& o) {
     auto it = ids_.find(&o);
     if (it != ids_.end()) return it->second;
-    std::string id = o.getId();
-    if (generated_id(id)) id = "building-" + std::to_string(ids_.size() + 1);  // no gml:id in the file
+    const std::string given = o.getId();
+    const bool generated = generated_id(given);
+    std::string id = generated ? "building-" + std::to_string(ids_.size() + 1) : given;
+    for (std::size_t k = generated ? ids_.size() + 2 : 2; taken_.count(id) || (id != given && file_ids_.count(id)); ++k)
+      id = generated ? "building-" + std::to_string(k) : given + "~" + std::to_string(k);
+    if (!generated && id != given)
+      notes_.push_back("gml:id " + io_text::quote(given) + " is given to more than one building: one is written as " +
+                       io_text::quote(id));
+    taken_.insert(id);
     return ids_[&o] = id;
   }
 
@@ -198,6 +230,8 @@ class Converter {
   std::string path_;
   CityJsonTransform transform_;
   std::unordered_map<const CityObject*, std::string> ids_;
+  std::set<std::string> file_ids_, taken_;
+  std::vector<std::string> notes_;
   std::unordered_map<GridKey, int, GridKeyHash> index_;  // quantised coordinates reach 1e13 units
   std::vector<std::array<long long, 3>> vertices_;
 };
@@ -235,7 +269,8 @@ std::string crs_url(const std::string& srs_name) {
   return "https://www.opengis.net/def/crs/EPSG/0/" + std::string(m[1].matched ? m[1] : m[2]);
 }
 
-nlohmann::ordered_json citygml_to_cityjson(const std::string& path, std::string* citygml_version) {
+nlohmann::ordered_json citygml_to_cityjson(const std::string& path, std::string* citygml_version,
+                                           std::vector<std::string>* notes) {
   const FileKind kind = sniff_file(path);
   if (kind != FileKind::Xml) {
     std::ifstream probe(path);
@@ -243,8 +278,10 @@ nlohmann::ordered_json citygml_to_cityjson(const std::string& path, std::string*
     throw InputError(path + ": not a CityGML file" +
                      (kind == FileKind::Other ? std::string(" (no XML)") : ": the file is " + file_kind_text(kind)));
   }
+  // Checked before libcitygml sees a byte: no DTD, no entities, an encoding the check can read.
+  std::string text = io_xml::safe_citygml_text(io_text::read_whole_file(path), path);
   std::string version, srs;
-  scan_text(path, version, srs);
+  scan_text(text, version, srs);
   if (version.empty()) throw InputError(path + ": XML but not CityGML (no CityGML 1.0/2.0 namespace)");
   if (version != "1.0" && version != "2.0")
     throw InputError(path + ": CityGML " + version + " is not supported (libcitygml reads CityGML 1.0 and 2.0)");
@@ -257,12 +294,15 @@ nlohmann::ordered_json citygml_to_cityjson(const std::string& path, std::string*
   std::shared_ptr<const citygml::CityModel> model;
   std::string why;
   try {
-    model = citygml::load(path, params, logger);
+    TextBuffer buffer(text);
+    std::istream in(&buffer);
+    model = citygml::load(in, params, logger);
   } catch (const std::exception& e) {
     why = e.what();
   } catch (...) {  // xerces throws its own exception types (malformed XML)
     why = "malformed XML";
   }
+  std::string().swap(text);  // the model holds what is needed now
   if (!model) {
     if (!logger->first().empty()) why = logger->first();
     for (char& c : why)
@@ -280,7 +320,9 @@ nlohmann::ordered_json citygml_to_cityjson(const std::string& path, std::string*
   transform.translate = box.isEmpty() ? Vec3::Zero() : Vec3(box.min().array().floor());
   Converter conv(path, transform);
   json objects = json::object();
+  for (const CityObject* b : buildings) conv.reserve_ids(*b);
   for (const CityObject* b : buildings) conv.building(*b, "", objects);
+  if (notes) *notes = conv.notes();
 
   json doc = json::object();
   doc["type"] = "CityJSON";
@@ -295,8 +337,10 @@ nlohmann::ordered_json citygml_to_cityjson(const std::string& path, std::string*
 
 CityJsonFile read_citygml(const std::string& path) {
   std::string version;
-  const auto doc = citygml_to_cityjson(path, &version);
+  std::vector<std::string> notes;
+  const auto doc = citygml_to_cityjson(path, &version, &notes);
   CityJsonFile f = read_cityjson_document(doc, path);
+  f.notes.insert(f.notes.begin(), notes.begin(), notes.end());
   f.format = "CityGML";
   f.version = version;
   // Attributes travel with each building (CityJSON input keeps them in its own document).

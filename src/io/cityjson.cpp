@@ -6,6 +6,8 @@
 #include <fstream>
 #include <sstream>
 #include <string_view>
+#include <unordered_map>
+#include <unordered_set>
 
 #include <nlohmann/json.hpp>
 
@@ -41,24 +43,12 @@ class Reader {
     throw InputError(name_ + ": " + (where_.empty() ? "" : where_ + ": ") + fault);
   }
 
-  json parse(const std::string& text, const std::string& what) {
-    try {
-      return json::parse(text);
-    } catch (const json::parse_error& e) {
-      // e.what() is "[json.exception.parse_error.101] parse error at ...": keep the message.
-      std::string msg = e.what();
-      const auto p = msg.find("] ");
-      if (p != std::string::npos) msg = msg.substr(p + 2);
-      fail(what + " is not valid JSON: " + one_line(msg));
-    }
-  }
-
   CityJsonFile read(const std::string& text) {
     if (is_cityjson_sequence(text)) {
       const auto eol = text.find('\n');
-      return read_sequence(json::parse(text.substr(0, eol)), text, eol + 1);
+      return read_sequence(parse_city_json(std::string_view(text).substr(0, eol), name_ + ": line 1"), text, eol + 1);
     }
-    return read_document(parse(text, "the file"));
+    return read_document(parse_city_json(text, name_));
   }
 
   CityJsonFile read_document(const json& root) {
@@ -96,7 +86,7 @@ class Reader {
       ++line_no;
       if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
       where_ = "line " + std::to_string(line_no);
-      const json feature = parse(line, "the line");
+      const json feature = parse_city_json(line, name_ + ": " + where_);
       if (!feature.is_object() || member(feature, "type") != "CityJSONFeature")
         fail("expected a CityJSONFeature object");
       const std::vector<Vec3> vertices = read_vertices(feature, out);
@@ -116,6 +106,8 @@ class Reader {
       if (!t.is_object()) fail("\"transform\" is not an object");
       out.scale = vec3(member(t, "scale"), "transform.scale");
       out.translate = vec3(member(t, "translate"), "transform.translate");
+      if ((out.scale.array() <= 0.0).any())
+        fail("transform.scale has a zero or negative factor (every vertex would collapse)");
     }
     const json& rs = member(member(root, "metadata"), "referenceSystem");
     if (rs.is_string()) out.crs = rs.get<std::string>();
@@ -135,7 +127,11 @@ class Reader {
     std::vector<Vec3> vertices;
     vertices.reserve(it->size());
     for (const json& v : *it) {
-      vertices.push_back(vec3(v, "vertex " + std::to_string(vertices.size())).cwiseProduct(out.scale) + out.translate);
+      const std::string what = "vertex " + std::to_string(vertices.size());
+      vertices.push_back(vec3(v, what).cwiseProduct(out.scale) + out.translate);
+      // Beyond this, quantising for the CityJSON written back overflows 64-bit integers.
+      if (!vertices.back().allFinite() || vertices.back().cwiseAbs().maxCoeff() > kMaxCoordinate)
+        fail(what + " is beyond 1e9 m from the origin");
     }
     return vertices;
   }
@@ -310,7 +306,7 @@ class Reader {
     }
     b.skipped_holes += int(surface.size()) - 1;
     std::vector<std::vector<int>> loops;
-    split_ring(std::move(ring), loops);
+    split_ring(ring, loops);
     if (loops.empty()) {
       ++b.skipped_rings;
       return;
@@ -352,39 +348,57 @@ class Reader {
     return pts;
   }
 
-  // Splits a ring into simple loops of >= 3 distinct vertices (none when it is degenerate).
-  // Repeated consecutive vertices and the closing repeat are dropped; an edge u->v walked back
-  // later as v->u (a keyhole bridge, or a spike u,v,u) is cut out, leaving the loops on either
-  // side; a vertex visited twice without such a bridge (a pinch) splits the ring there.
-  static void split_ring(std::vector<int> ring, std::vector<std::vector<int>>& loops) {
+  // Splits a ring into simple loops of >= 3 distinct vertices (none when it is degenerate), in
+  // one walk (linear: a ring pinched at one vertex thousands of times is common in broken
+  // exports). Repeated consecutive vertices and the closing repeat are dropped; a vertex met
+  // again closes the loop walked since its first visit: a pinch's petal, a keyhole's hole (its
+  // bridge u->v ... v->u leaves a loop of two vertices, dropped, as is a spike u,v,u).
+  static void split_ring(const std::vector<int>& ring, std::vector<std::vector<int>>& loops) {
     std::vector<int> r;
     for (int i : ring)
       if (r.empty() || r.back() != i) r.push_back(i);
     while (r.size() > 1 && r.front() == r.back()) r.pop_back();
-    const std::size_t n = r.size();
-    if (n < 3) return;
-    // positions a..b (cyclic, inclusive) as a new ring
-    auto sub = [&r, n](std::size_t a, std::size_t b) {
-      std::vector<int> out;
-      for (std::size_t k = a; k <= b; ++k) out.push_back(r[k % n]);
-      return out;
-    };
-    for (std::size_t k = 0; k < n; ++k)
-      for (std::size_t m = k + 1; m < n; ++m)
-        if (r[m] == r[(k + 1) % n] && r[(m + 1) % n] == r[k]) {  // bridge k->k+1 walked back at m->m+1
-          if (m > k + 1) split_ring(sub(k + 1, m - 1), loops);
-          if (k + n > m + 1) split_ring(sub(m + 1, k + n - 1), loops);
-          return;
-        }
-    for (std::size_t k = 0; k < n; ++k)
-      for (std::size_t m = k + 1; m < n; ++m)
-        if (r[m] == r[k]) {  // pinch
-          split_ring(sub(k, m - 1), loops);
-          split_ring(sub(m, k + n - 1), loops);
-          return;
-        }
-    loops.push_back(std::move(r));
+    std::vector<int> walk;                      // the open part of the walk: distinct vertices
+    std::unordered_map<int, std::size_t> at;   // vertex -> its position in walk
+    for (int v : r) {
+      const auto it = at.find(v);
+      if (it == at.end()) {
+        at.emplace(v, walk.size());
+        walk.push_back(v);
+        continue;
+      }
+      const std::size_t from = it->second;  // walk[from..] is a closed loop; v stays open
+      if (walk.size() - from >= 3) loops.emplace_back(walk.begin() + std::ptrdiff_t(from), walk.end());
+      for (std::size_t k = from + 1; k < walk.size(); ++k) at.erase(walk[k]);
+      walk.resize(from + 1);
+    }
+    if (walk.size() >= 3) loops.push_back(std::move(walk));  // closed by the ring's last edge
   }
+};
+
+// Refuses what the DOM parser would take silently or with a raw message: nesting deeper than
+// kMaxJsonDepth, and a CityObjects id given twice (the parser keeps one of the two objects).
+class ParseGuard {
+ public:
+  explicit ParseGuard(const std::string& name) : name_(name) {}
+  bool operator()(int depth, nlohmann::detail::parse_event_t event, json& parsed) {
+    using E = nlohmann::detail::parse_event_t;
+    if ((event == E::object_start || event == E::array_start) && depth >= kMaxJsonDepth)
+      throw InputError(name_ + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+    if (event != E::key) return true;
+    if (depth == 1) {
+      in_objects_ = parsed == "CityObjects";  // the root's member whose object opens next
+    } else if (depth == 2 && in_objects_ && !ids_.insert(parsed.get<std::string>()).second) {
+      throw InputError(name_ + ": CityObjects id " + one_line(parsed.get<std::string>(), 60) +
+                       " appears twice (two objects under one id; one would be lost)");
+    }
+    return true;
+  }
+
+ private:
+  const std::string& name_;
+  bool in_objects_ = false;
+  std::unordered_set<std::string> ids_;
 };
 
 }  // namespace
@@ -393,8 +407,25 @@ bool is_cityjson_sequence(const std::string& text) {
   // CityJSONSeq: the first line is a complete "CityJSON" object and more lines follow.
   const auto eol = text.find('\n');
   if (eol == std::string::npos || text.find_first_not_of(" \t\r\n", eol) == std::string::npos) return false;
-  const json first = json::parse(text.substr(0, eol), nullptr, false);
-  return first.is_object() && member(first, "type") == "CityJSON";
+  try {
+    const json first = parse_city_json(std::string_view(text).substr(0, eol), "");
+    return first.is_object() && member(first, "type") == "CityJSON";
+  } catch (const InputError&) {
+    return false;  // the whole text is then parsed, and refused with the reason
+  }
+}
+
+nlohmann::ordered_json parse_city_json(std::string_view text, const std::string& name) {
+  ParseGuard guard(name);
+  try {
+    return json::parse(text, std::ref(guard));
+  } catch (const json::exception& e) {
+    // "[json.exception.parse_error.101] parse error at ...": the message without its tag.
+    std::string msg = e.what();
+    const auto p = msg.find("] ");
+    if (p != std::string::npos) msg = msg.substr(p + 2);
+    throw InputError(name + ": not valid JSON: " + one_line(msg));
+  }
 }
 
 Semantic semantic_from_cityjson(const std::string& type) {

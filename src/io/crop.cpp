@@ -11,10 +11,12 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <string>
 #include <unordered_map>
 
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/io/files.h"
+#include "lodrefine/core/topology.h"
 #include "lodrefine/io/ply.h"
 
 namespace lodrefine {
@@ -26,6 +28,10 @@ CropTarget crop_target(const Mesh& model, double relative, double absolute) {
   t.lo = box.min();
   t.hi = box.max();
   const Vec3 size = t.hi - t.lo;
+  if (!box.isEmpty() && size.head<2>().maxCoeff() > kMaxBuildingExtent)
+    throw InputError(model.id + ": spans " + std::to_string(long(size.head<2>().maxCoeff() / 1000.0)) +
+                     " km, more than a building can (" + std::to_string(int(kMaxBuildingExtent / 1000.0)) +
+                     " km): a stray vertex? not cropped");
   const Vec3 grow(relative * size.x() + absolute, relative * size.y() + absolute, absolute);
   t.lo -= grow;
   t.hi += grow;
@@ -36,38 +42,72 @@ namespace {
 
 // Points read between two calls of the progress callback.
 constexpr std::size_t kProgressPoints = 1 << 16;
+// The targets filed in 2D hash grids, one per level: level L has cells of `cell * 2^L`, and a
+// box goes to the lowest level where it spans at most kSpan cells a side. Memory is
+// O(targets) whatever the boxes' sizes (one box 1000 km wide among 20 m ones filled billions of
+// cells), and a point looks up one cell per level in use.
+class TargetGrid {
+ public:
+  explicit TargetGrid(const std::vector<CropTarget>& targets) {
+    std::vector<double> sizes;
+    for (const auto& t : targets) sizes.push_back(std::max(t.hi.x() - t.lo.x(), t.hi.y() - t.lo.y()));
+    // Cell size: about the median box size, so most boxes touch few cells at level 0.
+    std::nth_element(sizes.begin(), sizes.begin() + std::ptrdiff_t(sizes.size() / 2), sizes.end());
+    cell_ = sizes.empty() ? 1.0 : std::max(1.0, sizes[sizes.size() / 2]);
+    for (std::size_t i = 0; i < targets.size(); ++i) add(targets[i], i);
+  }
+
+  template <class Fn>
+  void visit(const Vec3& p, Fn&& fn) const {
+    for (long long level : levels_) {
+      const auto it = cells_.find(key(p.x(), p.y(), level));
+      if (it != cells_.end())
+        for (std::size_t i : it->second) fn(i);
+    }
+  }
+
+ private:
+  static constexpr long long kSpan = 4;
+  double cell_ = 1.0;
+  std::vector<long long> levels_;
+  std::unordered_map<GridKey, std::vector<std::size_t>, GridKeyHash> cells_;
+
+  GridKey key(double x, double y, long long level) const {
+    const double c = std::ldexp(cell_, int(level));
+    return {(long long)std::floor(x / c), (long long)std::floor(y / c), level};
+  }
+
+  void add(const CropTarget& t, std::size_t i) {
+    if (!(t.lo.head<2>().array() <= t.hi.head<2>().array()).all()) return;  // an empty box holds nothing
+    long long level = 0;
+    GridKey lo = key(t.lo.x(), t.lo.y(), 0), hi = key(t.hi.x(), t.hi.y(), 0);
+    while (hi[0] - lo[0] >= kSpan || hi[1] - lo[1] >= kSpan) {
+      ++level;
+      lo = key(t.lo.x(), t.lo.y(), level);
+      hi = key(t.hi.x(), t.hi.y(), level);
+    }
+    if (std::find(levels_.begin(), levels_.end(), level) == levels_.end()) levels_.push_back(level);
+    for (long long x = lo[0]; x <= hi[0]; ++x)
+      for (long long y = lo[1]; y <= hi[1]; ++y) cells_[{x, y, level}].push_back(i);
+  }
+};
 
 // Streams the tile (PLY or LAS, `options` filtering LAS classes) once and calls on_hit(i, p)
-// for every target i whose box holds p; a 2D grid over the targets keeps this O(points).
+// for every target i whose box holds p; the grid keeps this O(points).
 // Returns the number of points read; `bounds` (optional) gets their bounding box.
 std::size_t for_each_hit(const std::string& tile, const std::vector<CropTarget>& targets, const CloudOptions& options,
                          Eigen::AlignedBox3d* bounds, const std::function<void(std::size_t, const Vec3&)>& on_hit,
                          const std::function<void(std::uint64_t)>& on_read) {
   if (targets.empty()) return 0;
-  // Grid cell size: about the median box size, so each box touches few cells.
-  std::vector<double> sizes;
-  for (const auto& t : targets) sizes.push_back(std::max(t.hi.x() - t.lo.x(), t.hi.y() - t.lo.y()));
-  std::nth_element(sizes.begin(), sizes.begin() + sizes.size() / 2, sizes.end());
-  const double cell = std::max(1.0, sizes[sizes.size() / 2]);
-  auto key = [cell](double x, double y) {
-    return (std::int64_t(std::floor(x / cell)) << 32) ^ (std::int64_t(std::floor(y / cell)) & 0xffffffff);
-  };
-  std::unordered_map<std::int64_t, std::vector<std::size_t>> grid;
-  for (std::size_t i = 0; i < targets.size(); ++i) {
-    const auto& t = targets[i];
-    for (double x = std::floor(t.lo.x() / cell) * cell; x <= t.hi.x(); x += cell)
-      for (double y = std::floor(t.lo.y() / cell) * cell; y <= t.hi.y(); y += cell) grid[key(x + 0.5 * cell, y + 0.5 * cell)].push_back(i);
-  }
+  const TargetGrid grid(targets);
   std::size_t n = 0;
   stream_cloud(tile, options, [&](const Vec3& p) {
     if (++n % kProgressPoints == 0 && on_read) on_read(n);
     if (bounds) bounds->extend(p);
-    const auto it = grid.find(key(p.x(), p.y()));
-    if (it == grid.end()) return;
-    for (std::size_t i : it->second) {
+    grid.visit(p, [&](std::size_t i) {
       const auto& t = targets[i];
       if ((p.array() >= t.lo.array()).all() && (p.array() <= t.hi.array()).all()) on_hit(i, p);
-    }
+    });
   });
   return n;
 }

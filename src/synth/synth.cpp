@@ -1267,7 +1267,8 @@ void write_synth_building(const std::string& dir, const SynthBuilding& b, bool w
     const std::vector<float> labels(b.point_label.begin(), b.point_label.end());
     write_ply((out / "cloud.ply").string(), b.cloud, Vec3::Zero(), &labels, "label");
   }
-  write_file_atomic((out / "meta.json").string(), meta_json(b).dump(2) + "\n");
+  write_file_atomic((out / "meta.json").string(),
+                    meta_json(b).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 #if !defined(__BYTE_ORDER__) || __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__

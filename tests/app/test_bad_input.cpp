@@ -967,6 +967,61 @@ TEST(BadInputSolver, RefineFallsBackToTheOriginalWhenSelectionTimesOut) {
   add_row("valid input, --mip-time-limit 0.001", first_line(cli.out), cli.exit);
 }
 
+// Issue 15, items 2, 13, 14 through the command line: untrusted city files and names.
+TEST(BadInputSecurity, NonUtf8NamesAreWrittenWithReplacementCharacters) {
+  const std::string dir = temp_dir("non_utf8");
+  // refine --report with an OBJ object name holding bytes that are no UTF-8.
+  write_text(dir + "/m.obj", "o bldg_\xff\xfe\n" + valid_model());
+  write_text(dir + "/c.ply", valid_cloud());
+  const CliRun r = run_cli("refine --model " + shell_quote(dir + "/m.obj") + " --cloud " + shell_quote(dir + "/c.ply") +
+                               " --out " + shell_quote(dir + "/r.obj") + " --report " + shell_quote(dir + "/r.json"),
+                           dir);
+  EXPECT_EQ(r.exit, 0) << r.err;
+  const json rep = json::parse(read_text(dir + "/r.json"));
+  EXPECT_NE(rep.dump().find("bldg_\xEF\xBF\xBD\xEF\xBF\xBD"), std::string::npos) << rep.dump();
+  // eval --dir over a run folder whose building folder name is no UTF-8.
+  const std::string run = dir + "/run/b\xff";
+  fs::create_directories(run);
+  write_text(run + "/coarse.obj", valid_model());
+  write_text(run + "/refined.obj", read_text(dir + "/r.obj"));
+  write_text(run + "/cloud.ply", valid_cloud());
+  const CliRun e = run_cli("eval --dir " + shell_quote(dir + "/run") + " --json " + shell_quote(dir + "/e.json") + " --jobs 1", dir);
+  EXPECT_EQ(e.exit, 0) << e.err;
+  EXPECT_EQ(e.err.find("json.exception"), std::string::npos) << e.err;
+  EXPECT_NE(read_text(dir + "/e.json").find("b\xEF\xBF\xBD"), std::string::npos);
+}
+
+TEST(BadInputSecurity, CityFilesRefusedInOneLineNamingTheFile) {
+  const std::string dir = temp_dir("city_refusals");
+  write_text(dir + "/c.ply", valid_cloud());
+  const std::string xxe = "<?xml version=\"1.0\"?>\n<!DOCTYPE CityModel [<!ENTITY e SYSTEM \"file:///etc/passwd\">]>\n"
+                          "<CityModel xmlns=\"http://www.opengis.net/citygml/2.0\"><gml:name>&e;</gml:name></CityModel>\n";
+  const std::vector<std::pair<std::string, std::string>> files = {
+      {"xxe.gml", xxe},
+      {"overflow.city.json", R"({"type":"CityJSON","version":"2.0","CityObjects":{},"vertices":[[1e400,0,0]]})"},
+      {"scale0.city.json",
+       R"({"type":"CityJSON","version":"2.0","transform":{"scale":[1,1,0],"translate":[0,0,0]},"CityObjects":{},"vertices":[]})"},
+      {"header.city.jsonl", R"({"type":"CityJSON","version":"2.0","transform":{"scale":"x"},"CityObjects":{},"vertices":[]})"
+                            "\n{\"type\":\"CityJSONFeature\",\"CityObjects\":{},\"vertices\":[]}\n"},
+      {"deep.city.json", R"({"type":"CityJSON","version":"2.0","CityObjects":{},"vertices":[],"x":)" + std::string(100000, '[') +
+                             std::string(100000, ']') + "}"},
+  };
+  for (const auto& [name, text] : files) {
+    const std::string model = dir + "/" + name;
+    write_text(model, text);
+    const CliRun r = run_cli("refine --model " + shell_quote(model) + " --cloud " + shell_quote(dir + "/c.ply") + " --out " +
+                                 shell_quote(dir + "/out.city.json"),
+                             dir);
+    EXPECT_EQ(r.exit, 2) << name << ": " << r.err;
+    EXPECT_EQ(lines(r.err).size(), 1u) << r.err;
+    EXPECT_EQ(r.err.rfind("lodrefine: error: " + model + ": ", 0), 0u) << r.err;
+    EXPECT_EQ(r.err.find("root:"), std::string::npos) << r.err;  // nothing of /etc/passwd
+    EXPECT_EQ(r.err.find("json.exception"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir + "/out.city.json")) << name;
+    EXPECT_TRUE(temp_leftovers(dir).empty()) << name;
+  }
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <random>
 
 #include "lodrefine/core/geometry.h"
@@ -183,6 +185,31 @@ TEST(Repair, UnclosableInputThrowsOneLineInputError) {
   Mesh bad = soup(box({0, 0, 0}, {1, 1, 1}));
   bad.faces[0].v[0] = 99;
   expect_rejected(bad, "references missing vertex 99");
+}
+
+// Issue 15, item 12: a face pinched at one vertex 6000 times took minutes: the T-junction
+// split searched every candidate vertex in the whole ring, cubic in the ring's length.
+TEST(Repair, FacePinchedThousandsOfTimesIsRepairedQuickly) {
+  Mesh m;
+  m.vertices.push_back(Vec3(85000, 447000, 0));
+  Face f;
+  f.sem = Semantic::Roof;
+  const int petals = 6000;
+  for (int k = 0; k < petals; ++k) {
+    for (const double s : {0.0, 0.5}) {
+      const double a = 2 * kPi * (k + s) / petals;
+      m.vertices.push_back(Vec3(85000 + 100 * std::cos(a), 447000 + 100 * std::sin(a), 0));
+    }
+    f.v.insert(f.v.end(), {0, 2 * k + 1, 2 * k + 2});
+  }
+  m.faces.push_back(f);
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    RepairReport r;
+    repair_model(m, 0.01, &r);  // one flat face closes nothing: refused, but at once
+  } catch (const InputError&) {
+  }
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2.0);
 }
 
 TEST(Repair, MergeJoinsCoplanarTilesButKeepsARingAroundAHoleApart) {

@@ -164,6 +164,31 @@ TEST(Validate, MalformedFacesAreReportedNotCrashed) {
   EXPECT_EQ(validate_mesh(Mesh{}, kPlanarity).problem, "no faces");
 }
 
+// Issue 15, item 9: a building lowered to the ground crashed CGAL's face triangulation (a
+// face of no area has no normal). Degenerate faces and flat shells are reported, not crashed.
+TEST(Validate, FlatBuildingsAreReportedNotCrashed) {
+  const std::vector<Vec2> l_shape = {{0, 0}, {10, 0}, {10, 4}, {4, 4}, {4, 8}, {0, 8}};
+  Mesh flat = prism(l_shape, 2.5, 2.5);  // roof on the ground: every wall a line
+  const Validation v = validate_mesh(flat, kPlanarity);
+  EXPECT_FALSE(v.valid());
+  EXPECT_EQ(v.problem, "face 0 is degenerate (no area: its vertices are on one line or it folds onto itself)");
+  // A gable lowered to its eaves: walls of zero height around a real roof.
+  Mesh gable = prism({{0, 0}, {10, 0}, {10, 8}, {0, 8}}, 0, 0);
+  gable.vertices.push_back({0, 4, 3});
+  gable.vertices.push_back({10, 4, 3});
+  gable.faces[4] = {{4, 5, 9, 8}, Semantic::Roof, 4};
+  gable.faces.push_back({{6, 7, 8, 9}, Semantic::Roof, 6});
+  gable.faces[1].v = {1, 2, 6, 9, 5};
+  gable.faces[3].v = {3, 0, 4, 8, 7};
+  EXPECT_NE(validate_mesh(gable, kPlanarity).problem.find("is degenerate"), std::string::npos);
+  // Closed, non-degenerate faces, but no volume: two coincident triangles back to back.
+  Mesh sheet;
+  sheet.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  sheet.faces = {{{0, 1, 2}, Semantic::Roof, 0}, {{0, 2, 1}, Semantic::Ground, 1}};
+  EXPECT_EQ(validate_mesh(sheet, kPlanarity).problem.rfind("the shell encloses no volume", 0), 0u)
+      << validate_mesh(sheet, kPlanarity).problem;
+}
+
 TEST(Validate, EdgeUsesRecordDirection) {
   const EdgeUses uses = edge_uses(unit_cube().faces);
   EXPECT_EQ(uses.size(), 12u);

@@ -580,4 +580,27 @@ TEST(CityFile, ProgressLineOnATerminalOnly) {
   EXPECT_NE(tty.find(plain.out.substr(0, plain.out.find(" -> "))), std::string::npos) << "stdout unchanged";
   const std::string quiet = on_terminal(" --quiet");
   EXPECT_EQ(quiet.find("refine: "), std::string::npos) << quiet;
+// Issue 15, items 9 and 11: a building lowered to the ground crashed validation (CGAL's face
+// triangulation on a face of no area) and took the whole run down; a building with one vertex
+// 1000 km away made the crop grid allocate gigabytes. Both are kept-invalid with their reason,
+// the others refined or kept, everything written.
+TEST(CityFileSecurity, FlatAndStrayBuildingsAreKeptInvalidTheRunGoesOn) {
+  const std::string dir = test_dir();
+  PointCloud cloud;
+  std::vector<SynthBuilding> bs = synth_street({BuildingType::Gable, BuildingType::Hip, BuildingType::Gable}, 1, 6000, 3, cloud);
+  double ground = 1e9;
+  for (const auto& p : bs[1].coarse.vertices) ground = std::min(ground, p.z());
+  for (auto& p : bs[1].coarse.vertices) p.z() = ground;  // the roof lowered onto the ground
+  bs[2].coarse.vertices[0] += Vec3(1e6, 0, 0);          // one stray vertex 1000 km away
+  const json in = synth_city(bs, Vec3(93000, 436000, 0));
+  write_file_atomic(dir + "/city.json", in.dump());
+  write_ply(dir + "/cloud.ply", cloud);
+  const CityRefineSummary s = refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/out.city.json", Params{}, {});
+  ASSERT_EQ(s.outcomes.size(), 3u);
+  EXPECT_NE(s.outcomes[0].outcome, "kept-invalid") << s.outcomes[0].reason;
+  EXPECT_EQ(s.outcomes[1].outcome, "kept-invalid");
+  EXPECT_EQ(s.outcomes[2].outcome, "kept-invalid");
+  EXPECT_NE(s.outcomes[2].reason.find("spans 1000 km, more than a building can"), std::string::npos) << s.outcomes[2].reason;
+  EXPECT_EQ(s.outcomes[2].points, 0u);
+  check_city_output(in, dir + "/out.city.json", s);
 }

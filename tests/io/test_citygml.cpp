@@ -2,8 +2,12 @@
 // from gml:id (never the generated ones), semantics from the boundary surfaces, the CRS.
 #include <gtest/gtest.h>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -179,4 +183,164 @@ TEST(CityGml, CoordinatesFarApart) {
   ASSERT_EQ(f.buildings.size(), 1u);
   ASSERT_EQ(f.buildings[0].mesh.faces.size(), 1u);
   EXPECT_EQ(f.buildings[0].mesh.vertices[1], Vec3(9e8, 0, 0));
+}
+
+namespace {
+
+// One building "b" with a generic string attribute `name` whose XML text is `value`, after a
+// prolog `prolog` (between the XML declaration and the root element).
+std::string building_with_attribute(const std::string& value, const std::string& prolog = "",
+                                    const std::string& root_attributes = "") {
+  std::string s = kHeader;
+  s.replace(s.find("\n") + 1, 0, prolog);
+  s.replace(s.find("xmlns:gml"), 0, root_attributes + " ");
+  s += "<cityObjectMember><bldg:Building gml:id=\"b\"><gen:stringAttribute name=\"name\"><gen:value>" + value +
+       "</gen:value></gen:stringAttribute><bldg:lod2MultiSurface><gml:MultiSurface>";
+  for (const auto& f : box_faces(Vec3(10, 20, 0), 4, 5, 3)) s += "<gml:surfaceMember>" + polygon(f, "") + "</gml:surfaceMember>";
+  return s + "</gml:MultiSurface></bldg:lod2MultiSurface></bldg:Building></cityObjectMember></CityModel>\n";
+}
+
+std::string refusal(const std::string& path) {
+  try {
+    read_citygml(path);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+// A TCP socket listening on 127.0.0.1 (port chosen by the system): was anything fetched?
+class Listener {
+ public:
+  Listener() {
+    fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t len = sizeof a;
+    if (fd_ < 0 || ::bind(fd_, reinterpret_cast<sockaddr*>(&a), len) != 0 || ::listen(fd_, 8) != 0 ||
+        ::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &len) != 0)
+      ADD_FAILURE() << "cannot listen on 127.0.0.1";
+    port_ = ntohs(a.sin_port);
+  }
+  ~Listener() { ::close(fd_); }
+  std::string url(const std::string& file) const { return "http://127.0.0.1:" + std::to_string(port_) + "/" + file; }
+  bool connected() const {
+    const int c = ::accept(fd_, nullptr, nullptr);
+    if (c >= 0) ::close(c);
+    return c >= 0;
+  }
+
+ private:
+  int fd_ = -1;
+  int port_ = 0;
+};
+
+}  // namespace
+
+// Issue 15, item 2: an external entity put /etc/passwd into the building's attributes. Every
+// document type declaration is refused before libcitygml sees the file, in every spelling
+// Xerces would read; a BOM, a comment or an encoding trick does not hide it.
+TEST(CityGmlSecurity, EntitiesAndDtdsAreRefusedBeforeParsing) {
+  const std::string xxe = "<!DOCTYPE CityModel [<!ENTITY e SYSTEM \"file:///etc/passwd\">]>\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"xxe.gml", building_with_attribute("&e;", xxe)},
+      {"bom.gml", "\xEF\xBB\xBF" + building_with_attribute("&e;", xxe)},
+      {"comment.gml", building_with_attribute("&e;", "<!-- a note -->\n<?pi x?>\n" + xxe)},
+      {"lower.gml", building_with_attribute("x", "<!doctype CityModel>\n")},
+      {"space.gml", building_with_attribute("x", "<! DOCTYPE CityModel>\n")},
+      {"entity.gml", building_with_attribute("x", "<!ENTITY e \"x\">\n")},
+      {"dtd.gml", building_with_attribute("x", "<!DOCTYPE CityModel SYSTEM \"file:///etc/passwd\">\n")},
+  };
+  for (const auto& [name, text] : cases) {
+    const std::string path = write_temp(name, text);
+    const std::string msg = refusal(path);
+    EXPECT_EQ(msg.rfind(path + ": the XML has a document type or entity declaration", 0), 0u) << name << ": " << msg;
+    EXPECT_EQ(msg.find("root:"), std::string::npos) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  }
+  // Encodings in which those bytes would read differently are refused as such.
+  std::string utf16;
+  for (char c : building_with_attribute("x")) utf16 += c, utf16 += '\0';
+  EXPECT_NE(refusal(write_temp("utf16.gml", utf16)).find("UTF-16 or UTF-32 is not read"), std::string::npos);
+  EXPECT_NE(refusal(write_temp("utf16bom.gml", "\xFF\xFE" + utf16)).find("not a CityGML file (no XML)"), std::string::npos);
+  std::string ebcdic = building_with_attribute("x");
+  ebcdic.replace(ebcdic.find("UTF-8"), 5, "IBM037");
+  EXPECT_NE(refusal(write_temp("ebcdic.gml", ebcdic)).find("encoding 'ibm037' is not read"), std::string::npos);
+}
+
+// Issue 15, item 2: a billion-laughs file ran for minutes; it is refused at once.
+TEST(CityGmlSecurity, BillionLaughsIsRefusedAtOnce) {
+  std::string dtd = "<!DOCTYPE CityModel [<!ENTITY l0 \"ha\">";
+  for (int k = 1; k < 12; ++k)
+    dtd += "<!ENTITY l" + std::to_string(k) + " \"" + [&] {
+      std::string r;
+      for (int i = 0; i < 10; ++i) r += "&l" + std::to_string(k - 1) + ";";
+      return r;
+    }() + "\">";
+  const std::string path = write_temp("laughs.gml", building_with_attribute("&l11;", dtd + "]>\n"));
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_NE(refusal(path).find("document type or entity declaration"), std::string::npos);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
+}
+
+// Issue 15, item 2: nothing is fetched: not an external DTD (refused), not the schemas of
+// xsi:schemaLocation, not an XInclude. A socket on 127.0.0.1 sees no connection.
+TEST(CityGmlSecurity, NothingIsFetched) {
+  const Listener server;
+  const std::string dtd = write_temp("dtd.gml", building_with_attribute("x", "<!DOCTYPE CityModel SYSTEM \"" + server.url("a.dtd") + "\">\n"));
+  EXPECT_NE(refusal(dtd).find("document type"), std::string::npos);
+  const std::string schema = write_temp(
+      "schema.gml", building_with_attribute("x<xi:include href=\"" + server.url("inc.xml") + "\"/>", "",
+                                            "xmlns:xsi=\"http://www.w3.org/2001/XMLSchema-instance\" "
+                                            "xmlns:xi=\"http://www.w3.org/2001/XInclude\" xsi:schemaLocation=\""
+                                            "http://www.opengis.net/citygml/2.0 " + server.url("CityGML.xsd") + "\""));
+  const CityJsonFile f = read_citygml(schema);
+  ASSERT_EQ(f.buildings.size(), 1u);
+  EXPECT_EQ(f.buildings[0].mesh.faces.size(), 6u);
+  EXPECT_FALSE(server.connected());
+}
+
+// Issue 15, item 8: libcitygml kept only the text after the last reference ("& Sons").
+TEST(CityGmlSecurity, ReferencesInTextComeThroughWhole) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"Bakery &amp; Sons", "Bakery & Sons"},     {"caf&#233; 1", "caf\xC3\xA9 1"},
+      {"caf\xC3\xA9 2", "caf\xC3\xA9 2"},          {"&lt;a&gt; &quot;b&quot; &apos;c&apos;", "<a> \"b\" 'c'"},
+      {"x&#x26;y&#38;z &#x1F600;", "x&y&z \xF0\x9F\x98\x80"}, {"a <![CDATA[&amp;]]> b", "a &amp; b"},
+      {"a <!-- c --> b", "a  b"}, {"\n  <![CDATA[x]]>\n", "\n  x\n"},
+      {"plain", "plain"}};
+  for (const auto& [xml, expected] : cases) {
+    const CityJsonFile f = read_citygml(write_temp("text.gml", building_with_attribute(xml)));
+    ASSERT_EQ(f.buildings.size(), 1u);
+    EXPECT_EQ(f.buildings[0].attributes.value("name", std::string("(none)")), expected) << xml;
+  }
+  // ISO-8859-1 is transcoded: the same attribute in Latin-1 bytes.
+  std::string latin1 = building_with_attribute("caf\xE9 &amp; bar");
+  latin1.replace(latin1.find("UTF-8"), 5, "ISO-8859-1");
+  const CityJsonFile f = read_citygml(write_temp("latin1.gml", latin1));
+  ASSERT_EQ(f.buildings.size(), 1u);
+  EXPECT_EQ(f.buildings[0].attributes.value("name", std::string()), "caf\xC3\xA9 & bar");
+  // An unknown entity is still an error (no DTD declares it).
+  EXPECT_NE(refusal(write_temp("unknown.gml", building_with_attribute("a &nope; b"))).find("CityGML parse error"),
+            std::string::npos);
+}
+
+// Issue 15, item 5: two buildings with one gml:id, and one without a gml:id beside a real
+// "building-1", were one building. Every building keeps a name, the duplicate is noted.
+TEST(CityGmlSecurity, EveryBuildingKeepsItsOwnId) {
+  std::string s = kHeader;
+  int n = 0;
+  for (const std::string id : {"dup", "dup", "building-1", "", "dup~2"}) {
+    s += "<cityObjectMember><bldg:Building" + (id.empty() ? std::string() : " gml:id=\"" + id + "\"") +
+         "><bldg:lod2MultiSurface><gml:MultiSurface>";
+    for (const auto& f : box_faces(Vec3(20.0 * n++, 0, 0), 4, 5, 3)) s += "<gml:surfaceMember>" + polygon(f, "") + "</gml:surfaceMember>";
+    s += "</gml:MultiSurface></bldg:lod2MultiSurface></bldg:Building></cityObjectMember>";
+  }
+  const CityJsonFile f = read_citygml(write_temp("dup.gml", s + "</CityModel>\n"));
+  std::vector<std::string> ids;
+  for (const auto& b : f.buildings) ids.push_back(b.mesh.id);
+  EXPECT_EQ(ids, (std::vector<std::string>{"dup", "dup~3", "building-1", "building-4", "dup~2"}));
+  EXPECT_NEAR(f.buildings[1].mesh.vertices[0].x(), 20.0, 1e-9);  // the second "dup" is the second building
+  ASSERT_FALSE(f.notes.empty());
+  EXPECT_EQ(f.notes[0], "gml:id 'dup' is given to more than one building: one is written as 'dup~3'");
 }

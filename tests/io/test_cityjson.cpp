@@ -7,6 +7,8 @@
 #include <unistd.h>
 
 #include <array>
+#include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
@@ -245,4 +247,70 @@ TEST(CityJsonWrite, QuantiseRoundsToTheNearestStep) {
     const auto q = t.quantise(p);
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(double(q[k]) * t.scale[k] + t.translate[k], p[k], 0.5 * kCityGmlResolution + 1e-9);
   }
+}
+
+namespace {
+
+std::string refusal_of(const std::string& text, const std::string& name = "bad.json") {
+  try {
+    parse_cityjson(text, name);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+}  // namespace
+
+// Issue 15, items 10, 13, 14: what the JSON parser took silently or with a raw message.
+TEST(CityJsonSecurity, DeepNestingOverflowsAndDuplicatesAreOneLine) {
+  const std::string ok = R"("A":{"type":"Building","geometry":[)" + cube_solid("\"2\"") + "]";
+  const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      // 100k-deep attribute: the writer's recursion overflowed the stack.
+      {cube_document("2.0", ok + R"(,"attributes":{"x":)" + deep + "}}"), "bad.json: JSON nested deeper than 256 levels"},
+      {cube_document("2.0", ok + "}").replace(1, 0, R"("deep":)" + deep + ","), "bad.json: JSON nested deeper than 256"},
+      // 1e400: out_of_range.406, raw and without the file name.
+      {cube_document("2.0", ok + R"(,"attributes":{"x":1e400}})"), "bad.json: not valid JSON: number overflow parsing '1e400'"},
+      // A zero scale collapses every vertex.
+      {R"({"type":"CityJSON","transform":{"scale":[0.001,0.001,0],"translate":[0,0,0]},"CityObjects":{},"vertices":[]})",
+       "bad.json: transform.scale has a zero or negative factor"},
+      // 2e15 m without a transform was written back as -9223372036854775808.
+      {R"({"type":"CityJSON","version":"1.1","CityObjects":{},"vertices":[[2e15,0,0]]})",
+       "bad.json: vertex 0 is beyond 1e9 m from the origin"},
+      // A duplicate CityObjects key kept one of the two buildings.
+      {cube_document("2.0", ok + "}," + ok + "}"), "bad.json: CityObjects id A appears twice"},
+  };
+  for (const auto& [text, expect] : bad) {
+    const std::string msg = refusal_of(text);
+    EXPECT_EQ(msg.rfind(expect, 0), 0u) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  }
+  // A CityJSONSeq line names its line; keys repeated elsewhere (attributes) are JSON's business.
+  const std::string seq = R"({"type":"CityJSON","version":"2.0","transform":{"scale":[1,1,1],"translate":[0,0,0]},"CityObjects":{},"vertices":[]})"
+                          "\n{\"type\":\"CityJSONFeature\",\"CityObjects\":{\"A\":{\"type\":\"Building\",\"attributes\":{\"x\":" +
+                          deep + "}}},\"vertices\":[]}\n";
+  EXPECT_EQ(refusal_of(seq).rfind("bad.json: line 2: JSON nested deeper than 256 levels", 0), 0u) << refusal_of(seq);
+  EXPECT_EQ(parse_cityjson(cube_document("2.0", ok + R"(,"attributes":{"k":1,"k":2}})")).buildings.size(), 1u);
+}
+
+// Issue 15, item 12: a ring pinched at one vertex 6000 times took minutes (cubic split).
+TEST(CityJsonSecurity, RingPinchedThousandsOfTimesSplitsInLinearTime) {
+  const int petals = 6000;
+  std::string vertices = "[[0,0,0]", ring = "[";
+  for (int k = 0; k < petals; ++k) {
+    const double a = 2 * 3.14159265358979 * k / petals, b = 2 * 3.14159265358979 * (k + 0.5) / petals;
+    vertices += ",[" + std::to_string(100 * std::cos(a)) + "," + std::to_string(100 * std::sin(a)) + ",0],[" +
+                std::to_string(100 * std::cos(b)) + "," + std::to_string(100 * std::sin(b)) + ",0]";
+    ring += (k ? ",0," : "0,") + std::to_string(2 * k + 1) + "," + std::to_string(2 * k + 2);
+  }
+  const std::string doc = R"({"type":"CityJSON","version":"2.0","CityObjects":{"P":{"type":"Building","geometry":[)"
+                          R"({"type":"MultiSurface","lod":"2","boundaries":[[)" + ring + R"(]]]}]}},"vertices":)" + vertices + "]}";
+  const auto t0 = std::chrono::steady_clock::now();
+  const CityJsonFile f = parse_cityjson(doc);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2.0);
+  ASSERT_EQ(f.buildings.size(), 1u);
+  ASSERT_EQ(f.buildings[0].mesh.faces.size(), std::size_t(petals));  // one triangle per petal
+  EXPECT_EQ(f.buildings[0].mesh.faces[1].v.size(), 3u);
+  EXPECT_EQ(f.buildings[0].mesh.vertices[std::size_t(f.buildings[0].mesh.faces[1].v[0])], Vec3::Zero());
 }

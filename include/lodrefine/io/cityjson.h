@@ -10,6 +10,7 @@
 // (WallSurface / RoofSurface / GroundSurface, anything else -> Other).
 #pragma once
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -56,6 +57,16 @@ CityJsonFile parse_cityjson(const std::string& text, const std::string& name = "
 
 // Same, from a parsed CityJSON object (not a sequence).
 CityJsonFile read_cityjson_document(const nlohmann::ordered_json& doc, const std::string& name, const std::string& lod = "");
+
+// JSON nesting accepted in a city file: CityJSON needs about ten levels (a MultiSolid's
+// boundaries are five deep); deeper nesting would overflow the stack when copied or written.
+constexpr int kMaxJsonDepth = 256;
+
+// Parses the JSON text of a CityJSON file or of one CityJSONSeq line. Throws InputError with
+// one line "<name>: <fault>" for malformed JSON, numbers beyond the double range (1e400),
+// nesting deeper than kMaxJsonDepth, and a CityObjects id that appears twice in one object
+// (JSON parsers silently keep one of the two).
+nlohmann::ordered_json parse_city_json(std::string_view text, const std::string& name);
 
 // True when `text` is a CityJSONSeq: a first line holding a complete "CityJSON" object, then
 // more lines (the CityJSONFeatures).

@@ -10,16 +10,22 @@ namespace lodrefine {
 
 struct CropTarget {
   std::string id;
-  Vec3 lo, hi;        // expanded bounding box (georeferenced)
+  Vec3 lo, hi;        // expanded bounding box (georeferenced); lo > hi: an empty box, no point
+  std::string refused;  // why this building is not cropped (empty: it is)
   PointCloud cloud;   // filled by crop_tile
 };
 
+// A model wider than this (m, in x or y) is no building: a stray vertex, or a wrong unit. Its
+// crop would hold a whole tile.
+constexpr double kMaxBuildingExtent = 5000.0;
+
 // The model's bounding box grown by `relative` of its size and `absolute` metres on each side
-// (vertically by `absolute` only).
+// (vertically by `absolute` only). Throws InputError "<model id>: spans N km ..." for a model
+// wider than kMaxBuildingExtent.
 CropTarget crop_target(const Mesh& model, double relative, double absolute);
 
 // Streams the tile (PLY or LAS, `options` filtering LAS classes) once and appends each point
-// to every target whose box holds it (a 2D grid over the targets keeps this O(points)).
+// to every target whose box holds it (2D grids over the targets keep this O(points), their memory O(targets)).
 // Returns the number of points read (after the class filter); `bounds` (optional) gets the
 // bounding box of every point read. `on_read` (optional) is called with the points read so far
 // every 65,536 points (for a progress line).
