@@ -37,6 +37,10 @@ CityBuildingOutcome classify(const RefineResult& r) {
   }
   o.outcome = (!r.valid || r.outcome == Outcome::KeptInvalid) ? "kept-invalid" : "kept";
   o.reason = r.reason.empty() ? std::string(outcome_name(r.outcome)) : r.reason;
+  if (r.trace.judgement && !r.trace.judgement->ok) o.refused_by = r.trace.judgement->check;
+  // A crop that only grazes the building (its box's edge): no wall of it faces a scan plane.
+  const bool no_facade = (r.trace.planes && r.trace.planes->empty()) || (r.trace.matching && r.trace.matching->walls.empty());
+  if (o.outcome == "kept" && no_facade) o.reason = "scan covers no facade of this building";
   if (!r.valid && r.outcome != Outcome::KeptInvalid)
     o.reason += " (not valid: " + r.trace.output_validation.problem + ")";
   return o;
@@ -97,6 +101,7 @@ void refine_document(json& doc, const CityJsonTransform& tf, const std::vector<C
     } else {
       ++(o.outcome == "kept" ? sum.kept : sum.kept_invalid);
     }
+    if (!o.refused_by.empty()) ++sum.refused[o.refused_by];
     if (!obj.contains("attributes") || !obj["attributes"].is_object()) obj["attributes"] = json::object();
     obj["attributes"]["lodrefine_outcome"] = o.outcome;
     obj["attributes"]["lodrefine_reason"] = o.reason;
