@@ -156,11 +156,12 @@ Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vec
       return j;
     }
   }
-  if (j.building.better < std::size_t(kMinGain)) {
+  const auto wall_gained = [](const Judgement::Fit& f) { return f.rms_before - f.rms_after >= kMinRmsGain; };
+  if (j.building.better < std::size_t(kMinGain) && std::none_of(j.walls.begin(), j.walls.end(), wall_gained)) {
     j.ok = false;
     j.check = "gain";
     j.detail = std::to_string(j.building.better) + " scan points closer than before (" + std::to_string(kMinGain) +
-               " needed): the scan shows no change";
+               " needed) and no moved wall's RMS down by 1 mm: the scan shows no change";
   }
   return j;
 }

@@ -50,14 +50,16 @@ struct Judgement {
 //   holds points of whatever stands near the wall, so it is judged on the RMS only); a region
 //   with fewer than Params::ransac_min_points points is unscanned and passes only when the
 //   wall moved on corner evidence.
-// - gain: fewer than kMinGain points got closer (a move within the scan's noise, e.g. a
-//   correct wall refitted a few cm off by its windows, is no refinement).
+// - gain: fewer than kMinGain points got closer and no moved wall's region RMS dropped by
+//   kMinRmsGain (a move within the scan's noise, e.g. a correct wall refitted a few cm off by
+//   its windows, is no refinement).
 // The building is judged first, then each wall, then the gain. Refuses (never throws) when a
 // mesh has no face.
 constexpr double kRmsSlack = 0.001;      // m
 constexpr double kWallRmsSlack = 0.01;   // m
 constexpr double kWorseShare = 0.25;
 constexpr int kMinGain = 50;
+constexpr double kMinRmsGain = 0.001;  // m
 Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vector<JudgedWall>& walls,
                            const PointCloud& cloud, const Params& params);
 
