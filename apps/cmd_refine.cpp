@@ -48,8 +48,8 @@ struct ReviewCollector {
     b.id = model.id;
     b.outcome = o ? o->outcome : "untouched";
     if (o) b.reason = o->reason, b.points = o->points, b.facades_moved = std::size_t(o->facades_moved);
-    if (r && r->trace.facade_fit && r->trace.facade_fit->points > 0)
-      b.fit_before = r->trace.facade_fit->rms_before, b.fit_after = r->trace.facade_fit->rms_after;
+    if (r && r->trace.judgement && r->trace.judgement->building.points > 0)  // the judge's fit on the scan near it
+      b.fit_before = r->trace.judgement->building.rms_before, b.fit_after = r->trace.judgement->building.rms_after;
     if (r && b.outcome == "refined") {
       add_moves(b, r->trace.facades);
       if (crop) b.view = review_view(b.id, model, r->mesh, crop->points, kReviewPoints);
@@ -151,19 +151,28 @@ void run_city(const RefineArgs& a) {
                         {"buildings", s.buildings}, {"refined", s.refined}, {"kept", s.kept},
                         {"kept_invalid", s.kept_invalid}, {"untouched", s.untouched},
                         {"objects_without_lod", s.objects_without_lod}, {"cloud_points", s.cloud_points},
-                        {"cropped_points", s.cropped_points},
+                        {"cropped_points", s.cropped_points}, {"refused", s.refused},
                         {"seconds", {{"read", s.seconds_read}, {"crop", s.seconds_crop}, {"refine", s.seconds_refine},
                                      {"write", s.seconds_write}}},
                         {"params", params_json(a.params)}, {"outcomes", nlohmann::json::array()}};
     for (const auto& b : s.outcomes)
       j["outcomes"].push_back({{"id", b.id}, {"outcome", b.outcome}, {"reason", b.reason},
-                               {"facades_moved", b.facades_moved}, {"points", b.points}, {"seconds", b.seconds}});
+                               {"facades_moved", b.facades_moved}, {"refused_by", b.refused_by}, {"points", b.points},
+                               {"seconds", b.seconds}});
     write_file_atomic(a.report, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   }
-  std::printf("%s: %d building(s), %llu cloud points (%llu in building crops): %d refined, %d kept, %d kept-invalid, "
-              "%d untouched (no cloud points) -> %s (read %.1f s, crop %.1f s, refine %.1f s, write %.1f s)\n",
+  std::string refused;  // "; never worse refused N (building a, wall b)"
+  int n_refused = 0;
+  for (const auto& [check, n] : s.refused) {
+    refused += (refused.empty() ? "" : ", ") + check + " " + std::to_string(n);
+    n_refused += n;
+  }
+  std::printf("%s: %d building(s), %llu cloud points (%llu in building crops): %d refined, %d kept (never worse "
+              "refused %d%s), %d kept-invalid, %d untouched (no cloud points) -> %s (read %.1f s, crop %.1f s, "
+              "refine %.1f s, write %.1f s)\n",
               s.input_format.c_str(), s.buildings, (unsigned long long)s.cloud_points,
-              (unsigned long long)s.cropped_points, s.refined, s.kept, s.kept_invalid, s.untouched, a.out.c_str(),
+              (unsigned long long)s.cropped_points, s.refined, s.kept, n_refused,
+              refused.empty() ? "" : (": " + refused).c_str(), s.kept_invalid, s.untouched, a.out.c_str(),
               s.seconds_read, s.seconds_crop, s.seconds_refine, s.seconds_write);
 }
 

@@ -18,12 +18,18 @@ constexpr double kCornerTolerance = 0.05;
 // an occluder's outline.
 constexpr double kEndSpread = 0.15;
 constexpr int kBands = 4;
-// At a facade's end the scanner must have seen something off its plane within this (m), above
-// the low part of the wall (ground and clutter below kLowBand of its height do not count).
+// At a facade's end the scanner must have seen the return onto the side wall within this depth
+// off the facade (m), above the low part of the wall (ground and clutter below kLowBand of its
+// height do not count), in all but kBands - 2 of the height bands.
 constexpr double kLookPast = 1.0;
 constexpr double kLowBand = 0.25;
 // Stray inliers tolerated past a facade's end (noise, a drainpipe).
 constexpr int kStrayPoints = 10;
+// A return: at least this many points, the nearest within kReturnStart (m) of the facade's
+// noise band, running at least kMinReturnDepth (m) back from it.
+constexpr int kMinReturnPoints = 50;
+constexpr double kReturnStart = 0.1;
+constexpr double kMinReturnDepth = 0.3;
 // Adjacent walls turned less than this from the scanned one are no corner (cos 45 deg).
 constexpr double kMaxCornerCos = 0.707;
 // Off the facade's plane means farther than this many RANSAC epsilons (its inliers lie within
@@ -42,6 +48,42 @@ double run_end(std::vector<double> t) {
     started = true;
   }
   return started ? e : -1.0;
+}
+
+// Which side of the scanned facade's plane the adjacent wall lies on: -1 behind it (a convex
+// corner, the side wall runs back into the block), +1 in front (a concave corner).
+double side_of(const Mesh& mesh, const ModelSurface& wall, const Plane& facade) {
+  double sum = 0.0;
+  for (int f : wall.faces)
+    for (int v : mesh.faces[f].v) sum += facade.distance(mesh.vertices[v]);
+  return sum >= 0 ? 1.0 : -1.0;
+}
+
+// Whether points lie on the side wall's new plane `moved`, off the facade plane on the wall's
+// `side`, over the upper part of the facade's height [z0, z1] (ground and clutter below do not
+// count): the return the scanner saw where the facade turns the corner.
+bool shows_return(const PointCloud& cloud, const Plane& facade, const Plane& moved, double side, double z0,
+                  double z1, const Params& prm) {
+  const double on_plane = std::max(kCornerTolerance, kOffPlaneEpsilons * prm.ransac_epsilon);
+  const double za = z0 + kLowBand * (z1 - z0);
+  const double off = kOffPlaneEpsilons * prm.ransac_epsilon;
+  int count = 0;
+  double near = kLookPast, far = 0.0;
+  std::set<int> bands;
+  for (const auto& p : cloud.points) {
+    if (p.z() < za || p.z() > z1) continue;
+    const double depth = side * facade.distance(p);
+    if (depth <= off || depth > kLookPast) continue;
+    if (std::abs(moved.distance(p)) > on_plane) continue;
+    ++count;
+    near = std::min(near, depth);
+    far = std::max(far, depth);
+    bands.insert(std::min(kBands - 1, int(kBands * (p.z() - z0) / (z1 - z0))));
+  }
+  // A return starts at the facade and runs back from it (a strip of points at one depth is a
+  // recess's or a neighbour's edge, not the building's side).
+  return count >= kMinReturnPoints && int(bands.size()) >= kBands - 2 && near <= off + kReturnStart &&
+         far - near >= kMinReturnDepth;
 }
 
 }  // namespace
@@ -119,20 +161,11 @@ std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSu
       int beyond = 0;
       for (double x : t) beyond += x > end + kRunGap && x <= s * uc + prm.match_distance;
       if (beyond > kStrayPoints) continue;
-      // A facade ending short of the corner must end at something the scanner saw there off
-      // its plane (the side wall turning away, a neighbour's facade): where it saw nothing, the
-      // scan ended, not the building.
-      if (gap < 0) {
-        int seen = 0;
-        for (const auto& p : cloud.points) {
-          if (p.z() < z0 + kLowBand * (z1 - z0) || p.z() > z1) continue;
-          const double depth = std::abs(w.plane.distance(p));
-          if (depth <= kOffPlaneEpsilons * prm.ransac_epsilon || depth > prm.match_distance + kLookPast) continue;
-          const double x = s * ((p - o).dot(u) - u_mid);
-          seen += x >= end - kCornerTolerance && x <= end + kLookPast;
-        }
-        if (seen <= kStrayPoints) continue;
-      }
+      // The scan must show the corner itself: a return onto the side wall where the facade's
+      // points end. A scan that just stops (tile edge, occlusion shadow, the vehicle turning)
+      // or a neighbour's facade that runs on shows no return, and moves nothing.
+      const Plane moved(as.plane.n, as.plane.d - as.plane.n.dot(s * gap * u));
+      if (!shows_return(cloud, w.plane, moved, side_of(mesh, as, w.plane), z0, z1, prm)) continue;
       // The same end in every height band that has points.
       double lo = 1e300, hi = -1e300;
       int bands = 0;
@@ -148,10 +181,9 @@ std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSu
         hi = std::max(hi, eb);
       }
       if (bands < kBands - 1 || hi - lo > kEndSpread) continue;
-      const Vec3 delta = s * gap * u;
       CornerMove cm;
       cm.move.surface = a;
-      cm.move.plane = Plane(as.plane.n, as.plane.d - as.plane.n.dot(delta));
+      cm.move.plane = moved;
       cm.scanned_surface = w.surface;
       cm.shift = gap;
       evidence[a].push_back(cm);

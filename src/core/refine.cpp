@@ -7,7 +7,6 @@
 #include <set>
 
 #include "lodrefine/core/corners.h"
-#include "lodrefine/core/distance.h"
 #include "lodrefine/core/substitute.h"
 
 namespace lodrefine {
@@ -46,6 +45,10 @@ RefineTrace::FacadeMove describe_move(const Mesh& mesh, const std::vector<ModelS
   d.evidence = evidence;
   d.max_move = surface_deviation(mesh, s, move.plane);
   d.mean_move = n > 0 ? mean / n : 0.0;
+  for (int f : s.faces) d.wall.polygons.push_back(face_points(mesh, mesh.faces[f]));
+  d.wall.from = s.plane;
+  d.wall.to = move.plane;
+  d.wall.corner = d.evidence == "corner";
   return d;
 }
 
@@ -224,7 +227,6 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
   // scan shows the corner.
   const auto surfaces = model_surfaces(current);
   const MatchResult mr = match_surfaces(current, surfaces, local, planes, prm);
-  std::vector<Vec3> facade_points;  // the matched walls' own points: the fit is judged on them
   std::vector<WallMove> moves;
   std::vector<ScannedWall> scanned;
   RefineTrace::Matching& matching = trace.matching.emplace(RefineTrace::Matching{});
@@ -234,7 +236,6 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
     scanned.push_back({m.surface, m.scan_plane, pl});
     const double dev = surface_deviation(current, surfaces[m.surface], pl);
     if (dev > prm.change_tolerance) moves.push_back({m.surface, pl, eave_follows_roof(current, surfaces, m, pl, local)});
-    for (int i : m.owned) facade_points.push_back(local.points[i]);
     matching.walls.push_back({m, dev, surfaces[m.surface].faces});
   }
   matching.rejected = mr.rejected;
@@ -278,12 +279,12 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
   const Validation vf = validate_mesh(*refined, prm.planarity_tolerance);
   if (!vf.valid()) return finish(Outcome::Kept, "refined shell failed validation: " + vf.problem, kept);
 
-  // Never worse: the refined model must fit the matched walls' points better than the input.
-  const double fit_before = rms_distance(kept, facade_points), fit_after = rms_distance(*refined, facade_points);
-  trace.facade_fit = RefineTrace::FacadeFit{facade_points.size(), fit_before, fit_after};
-  if (!(fit_after < fit_before))
-    return finish(Outcome::Kept, "the refinement does not fit the scan better (RMS " + std::to_string(fit_before) +
-                                     " -> " + std::to_string(fit_after) + " m)", kept);
+  // Never worse: on every scan point near the building, and on each moved wall's own points.
+  std::vector<JudgedWall> moved;
+  for (const auto& f : trace.facades) moved.push_back(f.wall);
+  const Judgement& verdict = trace.judgement.emplace(judge_refinement(kept, *refined, moved, local, prm));
+  if (!verdict.ok)
+    return finish(Outcome::Kept, "not written: never worse, " + verdict.check + " check: " + verdict.detail, kept);
   return finish(Outcome::Refined, std::to_string(trace.facades.size()) + " wall(s) moved", *refined);
 }
 

@@ -44,6 +44,10 @@ CityBuildingOutcome classify(const RefineResult& r) {
   }
   o.outcome = (!r.valid || r.outcome == Outcome::KeptInvalid) ? "kept-invalid" : "kept";
   o.reason = r.reason.empty() ? std::string(outcome_name(r.outcome)) : r.reason;
+  if (r.trace.judgement && !r.trace.judgement->ok) o.refused_by = r.trace.judgement->check;
+  // A crop that only grazes the building (its box's edge): no wall of it faces a scan plane.
+  const bool no_facade = (r.trace.planes && r.trace.planes->empty()) || (r.trace.matching && r.trace.matching->walls.empty());
+  if (o.outcome == "kept" && no_facade) o.reason = "scan covers no facade of this building";
   if (!r.valid && r.outcome != Outcome::KeptInvalid)
     o.reason += " (not valid: " + r.trace.output_validation.problem + ")";
   return o;
@@ -130,6 +134,7 @@ void apply_job(json& doc, const CityJsonTransform& tf, const CityJsonBuilding& b
   } else {
     ++(o.outcome == "kept" ? sum.kept : sum.kept_invalid);
   }
+  if (!o.refused_by.empty()) ++sum.refused[o.refused_by];
   if (!obj.contains("attributes") || !obj["attributes"].is_object()) obj["attributes"] = json::object();
   obj["attributes"]["lodrefine_outcome"] = o.outcome;
   obj["attributes"]["lodrefine_reason"] = o.reason;
@@ -182,6 +187,7 @@ void merge_into(CityRefineSummary& sum, CityRefineSummary&& part) {
   sum.kept += part.kept;
   sum.kept_invalid += part.kept_invalid;
   sum.untouched += part.untouched;
+  for (const auto& [check, n] : part.refused) sum.refused[check] += n;
   for (auto& o : part.outcomes) sum.outcomes.push_back(std::move(o));
 }
 

@@ -108,9 +108,16 @@ json refine_report(const RefineResult& r) {
                          {"mean_move", f.mean_move}});
     rep["facades"] = facades;
   }
-  if (t.facade_fit)
-    rep["facade_fit"] = {{"points", t.facade_fit->points}, {"rms_before", t.facade_fit->rms_before},
-                         {"rms_after", t.facade_fit->rms_after}};
+  if (t.judgement) {
+    auto fit = [](const Judgement::Fit& f) {
+      return json{{"points", f.points}, {"better", f.better}, {"worse", f.worse}, {"rms_before", f.rms_before},
+                  {"rms_after", f.rms_after}};
+    };
+    json walls = json::array();
+    for (const auto& w : t.judgement->walls) walls.push_back(fit(w));
+    rep["judgement"] = {{"ok", t.judgement->ok}, {"check", t.judgement->check}, {"detail", t.judgement->detail},
+                        {"building", fit(t.judgement->building)}, {"walls", walls}};
+  }
   return rep;
 }
 

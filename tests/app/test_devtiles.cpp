@@ -79,5 +79,7 @@ void run_tile(const std::string& tile, double max_pooled_rmse) {
 // real 0.067 m; every truth wall with cloud points on it counts, neighbours' included, so the
 // figures differ from score.py's 0.019 / 0.029 m): a regression in matching, corners or
 // substitution shows here before it reaches a user.
-TEST(DevTiles, Synth) { run_tile("synth", 0.01); }
+// 0.03 m: the synth tile's unscanned side walls are misplaced too, and its scans show no return
+// at the corners (the facade's points just end), which is no evidence to move them (issue 17).
+TEST(DevTiles, Synth) { run_tile("synth", 0.03); }
 TEST(DevTiles, Real) { run_tile("real", 0.08); }

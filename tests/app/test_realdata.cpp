@@ -23,6 +23,7 @@
 #include "lodrefine/io/obj.h"
 #include "lodrefine/io/ply.h"
 #include "lodrefine/io/files.h"
+#include "lodrefine/core/distance.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/core/repair.h"
 #include "lodrefine/core/validate.h"
@@ -396,6 +397,108 @@ TEST(RealData, RotterdamEveryBuildingKeptOrKeptInvalid) {
   EXPECT_EQ(outcomes["kept"] + outcomes["kept-invalid"], int(f.buildings.size()));
   EXPECT_GT(outcomes["kept"], int(0.8 * f.buildings.size()));
   EXPECT_LE(worst, prm.weld_tolerance);
+}
+
+// Real terraced houses: two Delfshaven buildings whose longest walls are flush and meet. The
+// scan shows A's facade where it is, running on 0.6 m past A's far end (a neighbour's facade,
+// cut there by the tile's edge), and B's facade 0.3 m out of its model. A comes out as it went
+// in; B's wall moves onto its scan.
+namespace {
+
+struct Merged {
+  Mesh soup, before;  // georeferenced input; its repaired, merged model in the local frame
+  Vec3 origin;
+  int wall = -1;      // the longest wall of `before`
+};
+
+// Points on `poly` (outward plane `pl`) moved `offset` along its normal, over the lower
+// kCover of its height, from `pre` m before its start to `post` m past its end along u.
+void scan_wall(const std::vector<Vec3>& poly, const Plane& pl, double offset, double pre, double post,
+               std::uint64_t seed, PointCloud& out) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, kNoise);
+  const Vec3 u = along_wall(pl.n);
+  double s0 = 1e300, s1 = -1e300, z0 = 1e300, z1 = -1e300;
+  for (const auto& p : poly)
+    s0 = std::min(s0, u.dot(p)), s1 = std::max(s1, u.dot(p)), z0 = std::min(z0, p.z()), z1 = std::max(z1, p.z());
+  const Vec3 o = pl.project(poly.front());
+  const Vec3 o0 = o - u.dot(o) * u - o.z() * Vec3::UnitZ();
+  const Plane moved(pl.n, pl.d - offset);
+  for (double t = s0 - pre + kSpacing / 2; t < s1 + post; t += kSpacing)
+    for (double z = z0 + 0.3; z < z0 + kCover * (z1 - z0); z += kSpacing)
+      out.points.push_back(moved.project(o0 + t * u + z * Vec3::UnitZ()) + noise(rng) * pl.n);
+}
+
+}  // namespace
+
+TEST(RealData, RotterdamCorrectTerracedHouseBesideAMisplacedOne) {
+  REQUIRE_REALDATA("val3dity/data/rotterdam/3-20-DELFSHAVEN.city.json");
+  const CityJsonFile f = read_cityjson(data_path.string());
+  const Params prm;
+  std::vector<Merged> ms;
+  for (const auto& b : f.buildings) {
+    const RefineResult base = refine_building(b.mesh, PointCloud{}, prm);
+    if (!base.valid || base.outcome != Outcome::Kept) continue;
+    Merged m{b.mesh, {}, local_origin(b.mesh), -1};
+    m.before = merge_coplanar_faces(translated(base.mesh, -m.origin));
+    m.wall = longest_wall(m.before);
+    if (m.wall >= 0) ms.push_back(std::move(m));
+  }
+  // The first pair (file order) of flush longest walls, each >= 5 m, sharing a vertical edge.
+  const auto wall_of = [](const Merged& m) {
+    std::vector<Vec3> poly = polygon_of(m.before, m.before.faces[std::size_t(m.wall)]);
+    for (auto& p : poly) p += m.origin;
+    return poly;
+  };
+  int ia = -1, ib = -1;
+  Vec3 shared;
+  for (int i = 0; i < int(ms.size()) && ia < 0; ++i) {
+    const auto pa = wall_of(ms[i]);
+    const Plane pla = polygon_plane(pa);
+    if (horizontal_length(pa, along_wall(pla.n)) < 5.0) continue;
+    for (int j = i + 1; j < int(ms.size()) && ia < 0; ++j) {
+      const auto pb = wall_of(ms[j]);
+      const Plane plb = polygon_plane(pb);
+      if (pla.n.dot(plb.n) < 0.9995 || horizontal_length(pb, along_wall(plb.n)) < 5.0) continue;
+      bool flush = true;
+      for (const auto& q : pb) flush = flush && std::abs(pla.distance(q)) < 0.02;
+      if (!flush) continue;
+      for (const auto& p : pa)
+        for (const auto& q : pb)
+          if ((p - q).norm() < 0.02 && ia < 0) ia = i, ib = j, shared = p;
+    }
+  }
+  ASSERT_GE(ia, 0) << "no flush terraced pair in Delfshaven";
+  const Merged &a = ms[std::size_t(ia)], &b = ms[std::size_t(ib)];
+  const auto pa = wall_of(a), pb = wall_of(b);
+  const Plane pla = polygon_plane(pa);
+  // A's facade runs on 0.6 m past its far end (away from B).
+  const Vec3 ua = along_wall(pla.n);
+  double lo = 1e300, hi = -1e300;
+  for (const auto& p : pa) lo = std::min(lo, ua.dot(p)), hi = std::max(hi, ua.dot(p));
+  const bool b_after = std::abs(ua.dot(shared) - hi) < std::abs(ua.dot(shared) - lo);
+  PointCloud scan;
+  // In A's local frame for precision, then back to the file's frame.
+  std::vector<Vec3> la = pa, lb = pb;
+  for (auto& p : la) p -= a.origin;
+  for (auto& p : lb) p -= a.origin;
+  scan_wall(la, polygon_plane(la), 0.0, b_after ? 0.6 : 0.0, b_after ? 0.0 : 0.6, fnv1a(a.soup.id), scan);
+  const std::size_t a_points = scan.points.size();
+  scan_wall(lb, polygon_plane(lb), kMove, 0.0, 0.0, fnv1a(b.soup.id), scan);
+  for (auto& p : scan.points) p += a.origin;
+  std::printf("terraced pair %s | %s, %zu + %zu facade points\n", a.soup.id.c_str(), b.soup.id.c_str(), a_points,
+              scan.points.size() - a_points);
+
+  const RefineResult ra = refine_building(a.soup, scan, prm);
+  EXPECT_NE(ra.outcome, Outcome::Refined) << ra.reason;
+  double worst = 0.0;
+  for (const auto& v : ra.mesh.vertices) worst = std::max(worst, nearest_vertex_distance(v, a.soup));
+  EXPECT_LE(worst, prm.weld_tolerance) << ra.reason;
+
+  const RefineResult rb = refine_building(b.soup, scan, prm);
+  EXPECT_TRUE(rb.refined()) << rb.reason;
+  std::vector<Vec3> b_scan(scan.points.begin() + long(a_points), scan.points.end());
+  EXPECT_LT(rms_distance(rb.mesh, b_scan), kMaxRms) << rb.reason;
 }
 
 TEST(RealData, ThreeDBagSeqMovedWall) {

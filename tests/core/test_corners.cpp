@@ -79,11 +79,40 @@ TEST(Corners, AScanThatJustStopsIsNoEvidence) {
   EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
 }
 
-TEST(Corners, AFacadeRunningPastTheCornerMovesItOut) {
-  Scene s = scene(12.5, 0.0);
+TEST(Corners, AFacadeRunningPastTheCornerIntoAReturnMovesItOut) {
+  Scene s = scene(12.5, 1.0);  // the building really ends at x = 12.5, its side wall seen
   const auto moves = corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{});
   ASSERT_EQ(moves.size(), 1u);
   EXPECT_NEAR(moves[0].shift, 0.5, 0.06);
+  EXPECT_NEAR(moves[0].move.plane.distance(Vec3(12.5, 0, 0)), 0.0, 0.06);
+}
+
+// The tile's edge cuts a facade that runs on (a flush neighbour) 0.5 m past the corner: the
+// scan ends there, the building does not.
+TEST(Corners, AFacadeCutAtTheTileEdgePastTheCornerIsNoEvidence) {
+  Scene s = scene(12.5, 0.0);
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
+}
+
+// A van parked across the corner hides the last 0.7 m of the facade over its whole height;
+// the scanner sees the van's side, 1 m in front of the facade, where the facade's points end.
+TEST(Corners, AnOccluderAtTheCornerIsNoEvidence) {
+  Scene s = scene(11.3, 0.0);
+  for (double x = 11.3; x < 13.5; x += 0.05)
+    for (double z = 0.1; z < 5.9; z += 0.05) s.cloud.points.emplace_back(x, -1.0, z);
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
+}
+
+// Terraced houses: the neighbour's facade starts at the true corner x = 12, 0.4 m behind this
+// one's (the party wall's exposed end is the return there); a lamp post's shadow ends this
+// facade's points at x = 11.3. The neighbour's facade beyond is no return at 11.3.
+TEST(Corners, ASetBackNeighbourBeyondAShadowIsNoEvidence) {
+  Scene s = scene(11.3, 0.0);
+  for (double z = 0.1; z < 5.9; z += 0.05) {
+    for (double x = 12.0; x < 20.0; x += 0.05) s.cloud.points.emplace_back(x, 0.4, z);
+    for (double y = 0.05; y < 0.4; y += 0.05) s.cloud.points.emplace_back(12.0, y, z);
+  }
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
 }
 
 TEST(Corners, AFacadeRunningOnIntoANeighbourIsNoEvidence) {

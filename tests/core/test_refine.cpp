@@ -2,11 +2,15 @@
 // test_end_to_end.cpp).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "lodrefine/core/refine.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/validate.h"
+#include "support/mesh_fixtures.h"
+#include "support/scan_fixtures.h"
 
 using namespace lodrefine;
 
@@ -104,4 +108,29 @@ TEST(Refine, NoScanFallsBackToTheRepairedOriginal) {
   EXPECT_EQ(r.outcome, Outcome::Kept);
   EXPECT_EQ(r.reason, "no planes found in the cloud near the model");
   EXPECT_EQ(r.mesh.faces.size(), 6u);
+}
+
+
+// Three terraced houses A [0,12], B [12,24], C [24,36]: the tile holds the street from x = -0.6
+// (a neighbour's facade left of A) to x = 24.6 (0.6 m of C). A is correct; B's front is 0.5 m
+// too far out. B's front is fixed; no side wall moves to where the tile cuts the facade (A's
+// left, B's right), so A comes out exactly as it went in.
+TEST(Refine, ACorrectTerracedHouseBesideAMisplacedOneIsLeftAsItIs) {
+  PointCloud cloud = fixtures::terraced_street_scan(-0.6, 24.6, 5);
+  for (auto& p : cloud.points) p += kOrigin;
+  const Params prm;
+  const Mesh a = box_soup(0, 12, 0, 8, 7), b = box_soup(12, 24, -0.5, 8, 7);
+  const RefineResult ra = refine_building(a, cloud, prm);
+  ASSERT_TRUE(ra.valid) << ra.reason;
+  EXPECT_FALSE(ra.refined()) << ra.reason;
+  EXPECT_LE(fixtures::largest_vertex_move(ra.mesh, a), prm.weld_tolerance) << ra.reason;
+
+  const RefineResult rb = refine_building(b, cloud, prm);
+  ASSERT_TRUE(rb.valid) << rb.reason;
+  EXPECT_TRUE(rb.refined()) << rb.reason;
+  EXPECT_LT(max_abs_y_of_front(rb.mesh, 0.0), 0.02);
+  for (const auto& p : rb.mesh.vertices) {  // the side walls stay at x = 12 and x = 24
+    const double x = p.x() - kOrigin.x();
+    EXPECT_TRUE(std::abs(x - 12) <= prm.weld_tolerance || std::abs(x - 24) <= prm.weld_tolerance) << x;
+  }
 }

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "support/cli_fixtures.h"
+#include "support/mesh_fixtures.h"
 #include "support/scan_fixtures.h"
 
 #include <chrono>
@@ -232,6 +233,46 @@ TEST(CityFile, GeneratedCityRefinedIntoCityJson2) {
   EXPECT_EQ(s1.outcomes[0].id, bs[1].id);
   EXPECT_EQ(s1.untouched, 3);
   check_city_output(in, dir + "/one.city.json", s1);
+}
+
+// The terraced street of Refine.ACorrectTerracedHouseBesideAMisplacedOneIsLeftAsItIs as a city:
+// A [0,12] correct, B [12,24] with its front 0.5 m out, G [27,39] whose crop box the tile's
+// edge (x = 24.6) only grazes. B is refined; A is kept exactly as read; G is kept because the
+// scan covers none of its facades.
+TEST(CityFile, OnlyTheMisplacedTerracedHouseChanges) {
+  const std::string dir = test_dir();
+  const Vec3 origin(93000.0, 436000.0, 0.0);
+  const auto house = [&](const char* id, double x0, double x1, double y0) {
+    SynthBuilding b;
+    b.id = id;
+    b.coarse = translated(fixtures::as_soup(fixtures::box({x0, y0, 0}, {x1, 8, 7})), origin);
+    return b;
+  };
+  const json in = synth_city({house("A", 0, 12, 0), house("B", 12, 24, -0.5), house("G", 27, 39, 0)}, origin);
+  write_file_atomic(dir + "/terraced.city.json", in.dump());
+  PointCloud cloud = fixtures::terraced_street_scan(-0.6, 24.6, 5);
+  for (auto& p : cloud.points) p += origin;
+  write_ply(dir + "/terraced.ply", cloud);
+  const CityRefineSummary s =
+      refine_city(dir + "/terraced.city.json", dir + "/terraced.ply", dir + "/terraced.out.city.json", Params{}, {});
+  ASSERT_EQ(s.outcomes.size(), 3u);
+  std::map<std::string, CityBuildingOutcome> by_id;
+  for (const auto& o : s.outcomes) by_id[o.id] = o;
+  EXPECT_EQ(by_id["A"].outcome, "kept") << by_id["A"].reason;
+  EXPECT_EQ(by_id["B"].outcome, "refined") << by_id["B"].reason;
+  EXPECT_EQ(by_id["G"].outcome, "kept");
+  EXPECT_EQ(by_id["G"].reason, "scan covers no facade of this building");
+  EXPECT_EQ(s.refused.size(), 0u);
+  check_city_output(in, dir + "/terraced.out.city.json", s);  // A and G exactly as read
+  // B's front is on the scan (y = 0), its side walls where they were.
+  for (const auto& b : read_cityjson(dir + "/terraced.out.city.json").buildings) {
+    if (b.mesh.id != "B") continue;
+    for (const auto& v : b.mesh.vertices) {
+      const Vec3 p = v - origin;
+      EXPECT_TRUE(std::abs(p.x() - 12) <= 0.01 || std::abs(p.x() - 24) <= 0.01) << p.transpose();
+      EXPECT_GE(p.y(), -0.01) << p.transpose();
+    }
+  }
 }
 
 TEST(CityFile, ErrorsAndBuildingsThatCannotBeRefined) {

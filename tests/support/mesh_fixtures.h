@@ -1,6 +1,8 @@
 // Small closed test buildings shared by the core and evaluation tests (outward, counter-clockwise
 // faces, shared vertices unless made a soup).
 #pragma once
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "lodrefine/core/types.h"
@@ -65,6 +67,18 @@ inline Mesh as_soup(const Mesh& m) {
     s.faces.push_back(g);
   }
   return s;
+}
+
+// Largest distance of a vertex of `out` from the nearest vertex of `in` (a kept building is its
+// input when this is within the weld tolerance).
+inline double largest_vertex_move(const Mesh& out, const Mesh& in) {
+  double worst = 0.0;
+  for (const auto& p : out.vertices) {
+    double best = 1e300;
+    for (const auto& q : in.vertices) best = std::min(best, (p - q).squaredNorm());
+    worst = std::max(worst, best);
+  }
+  return std::sqrt(worst);
 }
 
 }  // namespace lodrefine::fixtures

@@ -69,6 +69,18 @@ inline void sample_face(const std::vector<Vec3>& poly, double offset, double ste
   for (double a = u0 + step / 2; a < u1; a += step)
     for (double b = v0 + step / 2; b < v1; b += step)
       if (point_in_polygon_2d(Vec2(a, b), p2)) out.points.push_back(base + a * u + b * v + (offset + noise(rng)) * pl.n);
+// A terraced street: one facade plane y = 0 running from x = x0 to x1 (the houses' fronts are
+// flush, so the scan shows no corner between them), cut at both ends by the tile's edge; the
+// houses scanned from 0.2 m to 6.5 m high (1 cm range noise), with the street's ground in front.
+inline PointCloud terraced_street_scan(double x0, double x1, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  PointCloud pc;
+  for (double x = x0; x <= x1; x += 0.05)
+    for (double z = 0.2; z <= 6.5; z += 0.05) pc.points.emplace_back(x, noise(rng), z);
+  for (double x = x0; x <= x1; x += 0.1)
+    for (double y = -6.0; y < -0.3; y += 0.1) pc.points.emplace_back(x, y, noise(rng));
+  return pc;
 }
 
 }  // namespace lodrefine::fixtures

@@ -1,7 +1,10 @@
 // Stage 2b: corners from the scan's extent. A scanned facade ends where the building's corner
 // is; when it ends short of the model's corner (or runs on a little past it, then stops), the
 // adjacent wall that was not scanned is misplaced, and moves so that the corner is where the
-// scan says. Evidence must hold over the facade's height (an occluding car or tree does not).
+// scan says. Evidence must hold over the facade's height (an occluding car or tree does not),
+// and the scan must show the corner: points on the side wall's new plane where the facade's
+// points end (the return). A scan that just stops (tile or crop edge, occlusion shadow, the
+// vehicle turning) or a neighbour's facade running on past the outline moves no wall.
 #pragma once
 #include <vector>
 

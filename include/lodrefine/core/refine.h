@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "lodrefine/core/arrangement.h"
+#include "lodrefine/core/judge.h"
 #include "lodrefine/core/matching.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/planes.h"
@@ -18,8 +19,9 @@
 
 namespace lodrefine {
 
-// "refined": walls moved, validated, and the matched walls' points fit better than before;
-// "kept": the repaired input (nothing to change, or no refinement fitted better);
+// "refined": walls moved, validated, and never worse: the scan points near the building and
+// each moved wall's own points fit better than before (judge.h);
+// "kept": the repaired input (nothing to change, or the judge refused the refinement);
 // "kept-invalid": the input cannot be made a valid solid and the output is it as read.
 enum class Outcome { Refined, Kept, KeptInvalid };
 const char* outcome_name(Outcome outcome);
@@ -57,10 +59,7 @@ struct RefineTrace {
     std::set<int> input_faces;  // Face::source of its faces
     std::string evidence;       // "scan" or "corner"
     double max_move = 0.0, mean_move = 0.0;
-  };
-  struct FacadeFit {  // the never-worse check on the matched walls' own points
-    std::size_t points = 0;
-    double rms_before = 0.0, rms_after = 0.0;
+    JudgedWall wall;  // the wall before the move and its new plane, for the judge
   };
 
   std::string id;
@@ -76,7 +75,7 @@ struct RefineTrace {
   std::optional<Substitution> substitution, substitution_without_corners;
   std::optional<std::vector<Step>> replacements;  // set together with `facades`
   std::vector<FacadeMove> facades;
-  std::optional<FacadeFit> facade_fit;
+  std::optional<Judgement> judgement;  // never worse (judge.h), when a refinement was made
 
   double stage_seconds(const std::string& stage) const {  // 0 for a stage not reached
     for (const auto& [name, s] : seconds)

@@ -14,6 +14,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -57,6 +58,7 @@ struct CityBuildingOutcome {
   std::string outcome;  // "refined", "kept", "kept-invalid"
   std::string reason;   // why kept / kept-invalid (empty when refined)
   int facades_moved = 0;
+  std::string refused_by;  // the never-worse check that refused its refinement (judge.h), or empty
   std::size_t points = 0;  // cloud points in the building's crop box
   double seconds = 0.0;
 };
@@ -66,6 +68,7 @@ struct CityRefineSummary {
   int buildings = 0;          // LoD 2 buildings / building parts in the file
   int refined = 0, kept = 0, kept_invalid = 0;
   int untouched = 0;          // no cloud point in their box: written exactly as read
+  std::map<std::string, int> refused;  // kept because this never-worse check refused the refinement
   int objects_without_lod = 0;  // Building/BuildingPart objects without the LoD asked for
   std::uint64_t cloud_points = 0;  // points read (after the class filter)
   std::uint64_t cropped_points = 0;  // points held in the crops after the cloud pass (the memory that grows)

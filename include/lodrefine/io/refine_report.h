@@ -10,7 +10,8 @@ namespace lodrefine {
 
 // Keys: id, origin, outcome, reason, refined, faces, seconds, output_validation, and as far as
 // the building got: repair, input_validation, cloud, planes, matches, rejected_matches,
-// q_model, substitution, replacements, facades, facade_fit. The command adds model, cloud.path,
+// q_model, substitution, replacements, facades, judgement (never worse: ok, the refusing check
+// and why, the building's and each moved wall's fit). The command adds model, cloud.path,
 // params, written and warnings.
 nlohmann::json refine_report(const RefineResult& result);
 

@@ -1,0 +1,66 @@
+// Stage 5: never worse, for the whole building. The refined model is written only when the scan
+// shows it better than the input, judged on every scan point near the building (facade points
+// matched to a wall or not, roof points; street ground excepted), and on each moved wall's own
+// region: a wall with points in front of it must fit them better; a wall without points
+// may move only on the scan's corner evidence (corners.h).
+//
+// Inputs are in one (local) frame; distances in metres. A point is judged when it lies within
+// Params::match_distance of either model (the cap: farther points are another object's) and
+// above the lowest model vertex + kGroundBand (street ground in front of a wall moved inwards
+// would count against a right move). Its distance to each model is capped at match_distance.
+#pragma once
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "lodrefine/core/geometry.h"
+#include "lodrefine/core/params.h"
+#include "lodrefine/core/types.h"
+
+namespace lodrefine {
+
+constexpr double kGroundBand = 0.3;  // m above the model's lowest vertex
+
+// A wall the refinement moved, described before the move.
+struct JudgedWall {
+  std::vector<std::vector<Vec3>> polygons;  // its faces before the move
+  Plane from, to;                           // its plane before and after (oriented outwards)
+  bool corner = false;  // moved on corner evidence (the scan shows its corner, not its face)
+};
+
+struct Judgement {
+  struct Fit {
+    std::size_t points = 0;              // judged points
+    std::size_t better = 0, worse = 0;   // closer / farther by more than Params::ransac_epsilon
+    double rms_before = 0.0, rms_after = 0.0;  // of the capped distances
+  };
+  bool ok = true;
+  std::string check;   // the check that refused: "building", "wall" or "gain"; empty when ok
+  std::string detail;  // one line with the figures of the refusal; empty when ok
+  Fit building;            // every judged point
+  std::vector<Fit> walls;  // per JudgedWall, its region
+};
+
+// Whether `after` may replace `before` (both closed meshes, same frame as `cloud`).
+// - building: refused when the capped RMS of every judged point grows by more than kRmsSlack,
+//   or when more than kWorseShare of the points that changed (by more than
+//   Params::ransac_epsilon) got farther;
+// - wall: each moved wall's region (the judged points whose nearest face is the wall, before
+//   the move or after it) must not grow in RMS by more than kWallRmsSlack (its region also
+//   holds points of whatever stands near the wall, so it is judged on the RMS only); a region
+//   with fewer than Params::ransac_min_points points is unscanned and passes only when the
+//   wall moved on corner evidence.
+// - gain: fewer than kMinGain points got closer and no moved wall's region RMS dropped by
+//   kMinRmsGain (a move within the scan's noise, e.g. a correct wall refitted a few cm off by
+//   its windows, is no refinement).
+// The building is judged first, then each wall, then the gain. Refuses (never throws) when a
+// mesh has no face.
+constexpr double kRmsSlack = 0.001;      // m
+constexpr double kWallRmsSlack = 0.01;   // m
+constexpr double kWorseShare = 0.25;
+constexpr int kMinGain = 50;
+constexpr double kMinRmsGain = 0.001;  // m
+Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vector<JudgedWall>& walls,
+                           const PointCloud& cloud, const Params& params);
+
+}  // namespace lodrefine

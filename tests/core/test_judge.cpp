@@ -1,0 +1,149 @@
+// Never worse, for the whole building: the judge compares the input and the refined model on
+// every scan point near the building and on each moved wall's region.
+#include <gtest/gtest.h>
+
+#include "lodrefine/core/judge.h"
+#include "lodrefine/core/matching.h"
+#include "support/mesh_fixtures.h"
+#include "support/scan_fixtures.h"
+
+using namespace lodrefine;
+using fixtures::add_grid;
+using fixtures::box;
+using fixtures::wall_patch;
+
+namespace {
+
+const Vec3 kX = Vec3::UnitX(), kY = Vec3::UnitY();
+
+// The front wall (y = y0, facing -y) of the box [0,12] x [y0,8] x [0,6] as a moved wall.
+JudgedWall front_wall(double from_y, double to_y, bool corner = false) {
+  JudgedWall w;
+  w.polygons = {{{0, from_y, 0}, {12, from_y, 0}, {12, from_y, 6}, {0, from_y, 6}}};
+  w.from = Plane(-kY, from_y);
+  w.to = Plane(-kY, to_y);
+  w.corner = corner;
+  return w;
+}
+
+// A facade scan of the front wall at y = `y` over x in [x0, x1], z in [0.5, 5.5].
+void scan_front(PointCloud& cloud, double y, double x0, double x1, unsigned seed = 1) {
+  add_grid(cloud, wall_patch({x0, y, 0}, kX, x1 - x0, 0.5, 5.5), 0.05, 0.005, seed);
+}
+
+// Street ground in front of the front wall, 3 m deep.
+void scan_ground(PointCloud& cloud, double y) {
+  add_grid(cloud, {{0, y - 3.0, 0.02}, kX, kY, 0.0, 12.0, 0.0, 2.9}, 0.05);
+}
+
+}  // namespace
+
+TEST(Judge, AWallMovedOntoItsScanIsBetter) {
+  const Mesh coarse = box({0, -0.5, 0}, {12, 8, 6}), refined = box({0, 0, 0}, {12, 8, 6});
+  PointCloud cloud;
+  scan_front(cloud, 0.0, 0.5, 11.5);
+  const Judgement j = judge_refinement(coarse, refined, {front_wall(-0.5, 0.0)}, cloud, Params{});
+  EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
+  EXPECT_EQ(j.building.points, cloud.points.size());
+  EXPECT_NEAR(j.building.rms_before, 0.5, 0.01);
+  EXPECT_LT(j.building.rms_after, 0.01);
+  EXPECT_EQ(j.building.worse, 0u);
+  ASSERT_EQ(j.walls.size(), 1u);
+  EXPECT_EQ(j.walls[0].points, cloud.points.size());
+}
+
+// A wall moved inwards onto its scan brings it farther from the street's ground in front: the
+// ground does not count against the move.
+TEST(Judge, StreetGroundDoesNotCountAgainstAWallMovedInwards) {
+  const Mesh coarse = box({0, -0.6, 0}, {12, 8, 6}), refined = box({0, 0, 0}, {12, 8, 6});
+  PointCloud cloud;
+  scan_front(cloud, 0.0, 0.5, 11.5);
+  const std::size_t facade = cloud.points.size();
+  scan_ground(cloud, -0.6);
+  const Judgement j = judge_refinement(coarse, refined, {front_wall(-0.6, 0.0)}, cloud, Params{});
+  EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
+  EXPECT_EQ(j.building.points, facade);
+}
+
+// The scan shows a bay 2 m wide, 0.5 m out, in a facade the model has plain (0.2 m out): moving
+// the wall onto the bay's plane takes it away from the 10 m of facade either side.
+TEST(Judge, AWallMovedOntoABaysPlaneIsRefused) {
+  const Mesh coarse = box({0, -0.2, 0}, {12, 8, 6}), refined = box({0, -0.5, 0}, {12, 8, 6});
+  PointCloud cloud;
+  scan_front(cloud, 0.0, 0.0, 5.0, 1);
+  scan_front(cloud, -0.5, 5.0, 7.0, 2);
+  scan_front(cloud, 0.0, 7.0, 12.0, 3);
+  const Judgement j = judge_refinement(coarse, refined, {front_wall(-0.2, -0.5)}, cloud, Params{});
+  EXPECT_FALSE(j.ok);
+  EXPECT_EQ(j.check, "building");
+  EXPECT_NE(j.detail.find("RMS"), std::string::npos) << j.detail;
+  EXPECT_GT(j.building.rms_after, j.building.rms_before);
+  // Onto the facade's own plane it is better.
+  const Judgement k = judge_refinement(coarse, box({0, 0, 0}, {12, 8, 6}), {front_wall(-0.2, 0.0)}, cloud, Params{});
+  EXPECT_TRUE(k.ok) << k.check << ": " << k.detail;
+  // A bay twice as wide: no plane of the model's wall fits better than where it is.
+  PointCloud wide;
+  scan_front(wide, 0.0, 0.0, 4.0, 1);
+  scan_front(wide, -0.5, 4.0, 8.0, 2);
+  scan_front(wide, 0.0, 8.0, 12.0, 3);
+  EXPECT_FALSE(judge_refinement(coarse, box({0, 0, 0}, {12, 8, 6}), {front_wall(-0.2, 0.0)}, wide, Params{}).ok);
+}
+
+// The right side wall (x = 12) moves in by 0.7 m while only the front is scanned: the points do
+// not see it (the building fit is unchanged), so only corner evidence may move it.
+TEST(Judge, AnUnscannedWallMovesOnlyOnCornerEvidence) {
+  const Mesh coarse = box({0, 0, 0}, {12, 8, 6}), refined = box({0, 0, 0}, {11.3, 8, 6});
+  PointCloud cloud;
+  scan_front(cloud, 0.0, 0.5, 11.0);
+  JudgedWall side;
+  side.polygons = {{{12, 0, 0}, {12, 8, 0}, {12, 8, 6}, {12, 0, 6}}};
+  side.from = Plane(kX, -12.0);
+  side.to = Plane(kX, -11.3);
+  const Judgement j = judge_refinement(coarse, refined, {side}, cloud, Params{});
+  EXPECT_FALSE(j.ok);
+  EXPECT_EQ(j.check, "wall");
+  EXPECT_NE(j.detail.find("no corner evidence"), std::string::npos) << j.detail;
+  side.corner = true;
+  EXPECT_EQ(judge_refinement(coarse, refined, {side}, cloud, Params{}).check, "gain");  // nothing shows it
+  // The return onto the side wall where the facade ends (corners.h): now the scan shows it.
+  add_grid(cloud, wall_patch({11.3, 0.05, 0}, kY, 0.6, 1.0, 5.5), 0.05);
+  const Judgement k = judge_refinement(coarse, refined, {side}, cloud, Params{});
+  EXPECT_TRUE(k.ok) << k.check << ": " << k.detail;
+}
+
+// The left wall, scanned where it is, moved 1 m inwards (onto nothing): refused.
+TEST(Judge, AWallMovedAwayFromItsPointsIsRefused) {
+  const Mesh coarse = box({0, 0, 0}, {12, 8, 6}), refined = box({1.0, 0, 0}, {12, 8, 6});
+  PointCloud cloud;
+  add_grid(cloud, wall_patch({0, 7.5, 0}, -kY, 7.0, 0.5, 5.5), 0.05);
+  JudgedWall left;
+  left.polygons = {{{0, 8, 0}, {0, 0, 0}, {0, 0, 6}, {0, 8, 6}}};
+  left.from = Plane(-kX, 0.0);
+  left.to = Plane(-kX, 1.0);
+  const Judgement j = judge_refinement(coarse, refined, {left}, cloud, Params{});
+  EXPECT_FALSE(j.ok);
+  EXPECT_EQ(j.check, "building");
+  EXPECT_EQ(j.building.worse, cloud.points.size());
+  EXPECT_NEAR(j.building.rms_after, 1.0, 0.01);
+}
+
+TEST(Judge, NoPointsNearTheBuildingChangesNothingButAMovedWallNeedsEvidence) {
+  const Mesh coarse = box({0, -0.5, 0}, {12, 8, 6}), refined = box({0, 0, 0}, {12, 8, 6});
+  PointCloud cloud;
+  cloud.points.push_back({100, 100, 3});
+  const Judgement j = judge_refinement(coarse, refined, {front_wall(-0.5, 0.0)}, cloud, Params{});
+  EXPECT_EQ(j.building.points, 0u);
+  EXPECT_FALSE(j.ok);
+  EXPECT_EQ(j.check, "wall");
+}
+
+// A correct wall refitted 2.5 cm off (its windows pull the plane): no point is clearly closer.
+TEST(Judge, AMoveWithinTheScansNoiseIsNoGain) {
+  const Mesh coarse = box({0, 0, 0}, {12, 8, 6}), refined = box({0, -0.025, 0}, {12, 8, 6});
+  PointCloud cloud;
+  scan_front(cloud, -0.0125, 0.5, 11.5);  // halfway: as far from either
+  const Judgement j = judge_refinement(coarse, refined, {front_wall(0.0, -0.025)}, cloud, Params{});
+  EXPECT_FALSE(j.ok);
+  EXPECT_EQ(j.check, "gain");
+  EXPECT_EQ(j.building.better, 0u);
+}
