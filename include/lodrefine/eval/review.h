@@ -21,7 +21,7 @@ struct CityReviewBuilding {
   std::size_t points = 0;  // cloud points in its crop
   std::size_t facades_moved = 0;
   double moved_max = std::nan(""), moved_mean = std::nan("");  // facade displacement (m), NaN if none moved
-  std::optional<double> fit_before, fit_after;  // RMS distance of the matched walls' points (m)
+  std::optional<double> fit_before, fit_after;  // RMS distance of the scan points near the building, as the judge measured them (m)
   std::vector<std::vector<Vec2>> outline;       // XY rings in the district frame (review_outline())
   std::optional<BuildingView> view;             // refined buildings (review_view())
 };
