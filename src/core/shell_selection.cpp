@@ -358,6 +358,7 @@ Mesh assemble(const CandidateSet& cs, const std::vector<char>& selected, const C
 // such edge (kMendRings edge-rings, more while it has no solution), the others fixed, each
 // change costing its area. Empty when it cannot be mended.
 constexpr int kMendRings = 2, kMendTries = 3;
+constexpr int kRetries = 2;
 std::vector<char> mended_start(const CandidateSet& cs, const std::vector<char>& in_start, const Params& prm) {
   if (every_edge_used_0_or_2(cs, in_start)) return in_start;
   std::vector<char> near(cs.faces.size(), 0);
@@ -424,20 +425,29 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
     pg.warm = warm;
     for (int f = 0; f < int(cs.faces.size()); ++f) pg.fixed.push_back(d.in_zone[f] ? -1 : int(warm[f]));
   }
-  st.selection = select_faces(cs, pg, prm);
-  const auto& sel = st.selection;
   auto finish = [&](const std::string& reason) {
     out.reason = reason;
     st.seconds = seconds_since(t0);
     return out;
   };
-  if (!sel.ok) return finish("face selection " + sel.status_text());
+  // A selection whose shell does not validate (two shells touching, faces meeting at a point)
+  // is excluded: its changes from the starting shell are fixed back, and the program solved
+  // again (at most kRetries times).
   const std::vector<char>& base = warm.empty() ? d.in_start : warm;
-  for (int f = 0; f < int(cs.faces.size()); ++f) st.candidates_changed += sel.selected[f] != base[f];
-
-  out.mesh = assemble(cs, sel.selected, d, start, s);
-  st.faces_from_selection = int(out.mesh.faces.size());
-  const Validation v = validate_mesh(out.mesh, prm.planarity_tolerance);
+  Validation v;
+  for (int attempt = 0;; ++attempt) {
+    st.selection = select_faces(cs, pg, prm);
+    const auto& sel = st.selection;
+    if (!sel.ok) return finish("face selection " + sel.status_text());
+    st.candidates_changed = 0;
+    for (int f = 0; f < int(cs.faces.size()); ++f) st.candidates_changed += sel.selected[f] != base[f];
+    out.mesh = assemble(cs, sel.selected, d, start, s);
+    st.faces_from_selection = int(out.mesh.faces.size());
+    v = validate_mesh(out.mesh, prm.planarity_tolerance);
+    if (v.valid() || st.candidates_changed == 0 || warm.empty() || attempt == kRetries) break;
+    for (int f = 0; f < int(cs.faces.size()); ++f)
+      if (sel.selected[f] != base[f]) pg.fixed[f] = int(base[f]);
+  }
   if (!v.valid() && st.candidates_changed == 0) {
     // The program chose its starting shell, but the arrangement's pieces of it do not validate
     // (planes meeting almost at a point): the chosen shell is written with the start's own faces.
