@@ -325,9 +325,9 @@ CandidateData describe_candidates(const CandidateSet& cs, const Mesh& start, con
 }
 
 // Arrangement vertices closer than this (m) are one in the output: planes meeting almost at a
-// point leave edges of hundredths of a millimetre, which a reader's weld (0.1 mm is common)
-// collapses; the output is validated after this weld.
-constexpr double kOutputWeld = 1e-4;
+// point leave edges of fractions of a millimetre, which CityJSON's millimetre grid or a
+// reader's weld collapses; the output is validated after this weld.
+constexpr double kOutputWeld = 1e-3;
 
 // The selected candidates as one mesh on the arrangement's own vertices (those within
 // kOutputWeld joined), oriented outward, coplanar neighbours merged.
@@ -393,6 +393,19 @@ std::vector<char> mended_start(const CandidateSet& cs, const std::vector<char>& 
   return {};
 }
 
+// Why the assembled shell cannot be written, or empty: validate_mesh's problem, or a face that
+// passes through one vertex twice (two pieces pinched together by the output weld or merge).
+std::string shell_problem(const Mesh& m, const Params& prm) {
+  const Validation v = validate_mesh(m, prm.planarity_tolerance);
+  if (!v.valid()) return v.problem.empty() ? "invalid" : v.problem;
+  for (const auto& f : m.faces) {
+    std::vector<int> ids = f.v;
+    std::sort(ids.begin(), ids.end());
+    if (std::adjacent_find(ids.begin(), ids.end()) != ids.end()) return "a face repeats a vertex";
+  }
+  return "";
+}
+
 }  // namespace
 
 ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
@@ -434,7 +447,7 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   // is excluded: its changes from the starting shell are fixed back, and the program solved
   // again (at most kRetries times).
   const std::vector<char>& base = warm.empty() ? d.in_start : warm;
-  Validation v;
+  std::string problem;
   for (int attempt = 0;; ++attempt) {
     st.selection = select_faces(cs, pg, prm);
     const auto& sel = st.selection;
@@ -443,20 +456,20 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
     for (int f = 0; f < int(cs.faces.size()); ++f) st.candidates_changed += sel.selected[f] != base[f];
     out.mesh = assemble(cs, sel.selected, d, start, s);
     st.faces_from_selection = int(out.mesh.faces.size());
-    v = validate_mesh(out.mesh, prm.planarity_tolerance);
-    if (v.valid() || st.candidates_changed == 0 || warm.empty() || attempt == kRetries) break;
+    problem = shell_problem(out.mesh, prm);
+    if (problem.empty() || st.candidates_changed == 0 || warm.empty() || attempt == kRetries) break;
     for (int f = 0; f < int(cs.faces.size()); ++f)
       if (sel.selected[f] != base[f]) pg.fixed[f] = int(base[f]);
   }
-  if (!v.valid() && st.candidates_changed == 0) {
+  if (!problem.empty() && st.candidates_changed == 0) {
     // The program chose its starting shell, but the arrangement's pieces of it do not validate
     // (planes meeting almost at a point): the chosen shell is written with the start's own faces.
     out.mesh = start;
     st.faces_from_selection = int(start.faces.size());
     out.ok = true;
-    return finish("the starting shell was chosen; written with its own faces (its pieces: " + v.problem + ")");
+    return finish("the starting shell was chosen; written with its own faces (its pieces: " + problem + ")");
   }
-  if (!v.valid()) return finish("selected shell invalid: " + v.problem);
+  if (!problem.empty()) return finish("selected shell invalid: " + problem);
   out.ok = true;
   return finish("");
 }

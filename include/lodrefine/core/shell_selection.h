@@ -49,8 +49,11 @@ struct ShellSelection {
 
 // Selects the building's faces. `start`: a valid closed shell (local frame); `cloud`: the local
 // cloud `planes` were detected in. Faces on the start's planes keep its semantic and source;
-// faces on added scan planes are WallSurface (source -1). Never throws for geometry; !ok with
-// the reason when the program has no solution or the assembled shell fails validation.
+// faces on added scan planes are WallSurface (source -1). A selection whose shell does not
+// validate is excluded and the program solved again (its changes fixed back, twice at most);
+// when the program chose the starting shell unchanged but its pieces do not validate, the result
+// is `start` itself (ok, with that said in `reason`). Never throws for geometry; !ok with the
+// reason when the program has no solution or no valid shell.
 ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
                             const Params& params);
 
