@@ -461,13 +461,14 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
     for (int f = 0; f < int(cs.faces.size()); ++f)
       if (sel.selected[f] != base[f]) pg.fixed[f] = int(base[f]);
   }
-  if (!problem.empty() && st.candidates_changed == 0) {
-    // The program chose its starting shell, but the arrangement's pieces of it do not validate
-    // (planes meeting almost at a point): the chosen shell is written with the start's own faces.
+  if (st.candidates_changed == 0) {
+    // The program chose its starting shell: it is written with the start's own faces, whose
+    // vertices the arrangement's pieces only approximate (plane meets of a model that is planar
+    // within tolerance; away from the scan a roof must not move by that).
     out.mesh = start;
     st.faces_from_selection = int(start.faces.size());
     out.ok = true;
-    return finish("the starting shell was chosen; written with its own faces (its pieces: " + problem + ")");
+    return finish(problem.empty() ? "" : "the starting shell was chosen (its pieces: " + problem + ")");
   }
   if (!problem.empty()) return finish("selected shell invalid: " + problem);
   out.ok = true;
