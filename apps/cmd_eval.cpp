@@ -63,6 +63,7 @@ struct Row {
   Vec3 origin = Vec3::Zero();      // local frame origin (added back to centroids in the JSON)
   std::string truth_faces_source;  // "meta.json", "detected" or empty
   std::string refine_outcome;      // the refine report's "outcome" as written, if any
+  std::string selection;           // the report's selection.status (empty: older report, or none ran)
   // What the refine step recorded (report.json or FAILED).
   std::string outcome;             // "refined", "kept" (anything else written) or "failed"
   std::string reason;              // why kept / why failed
@@ -215,6 +216,10 @@ void add_refine_record(Row& row, const BuildingFiles& f) {
   const json rep = read_json_or_null(f.report);
   const json outcome_value = rep.is_object() ? rep.value("outcome", json()) : json();
   if (outcome_value.is_string()) row.refine_outcome = outcome_value.get<std::string>();
+  if (rep.is_object() && rep.contains("selection") && rep["selection"].is_object()) {
+    const json status = rep["selection"].value("status", json());
+    if (status.is_string()) row.selection = status.get<std::string>();
+  }
   if (!f.failed.empty()) row.eval.error = first_line(f.failed);
   if (!row.eval.ok()) {
     row.outcome = "failed";
@@ -378,6 +383,7 @@ json row_json(const Row& r) {
                   {"facade", {{"original", stats_json(e.truth_facade_before)}, {"refined", stats_json(e.truth_facade_after)}}},
                   {"roof", {{"original", stats_json(e.truth_roof_before)}, {"refined", stats_json(e.truth_roof_after)}}}};
   if (!r.refine_outcome.empty()) j["refine_outcome"] = r.refine_outcome;
+  if (!r.selection.empty()) j["selection"] = r.selection;
   return j;
 }
 
@@ -450,7 +456,7 @@ std::string csv_text(const std::vector<const Row*>& rows) {
       "c2m_rmse_original,c2m_mae_original,c2m_mean_original,c2m_std_original,c2m_median_original,c2m_p95_original,"
       "c2m_rmse_refined,c2m_mae_refined,c2m_mean_refined,c2m_std_refined,c2m_median_refined,c2m_p95_refined,"
       "delta_d,truth_facade_rmse_original,truth_facade_rmse_refined,truth_roof_rmse_original,truth_roof_rmse_refined,"
-      "refine_outcome\n";
+      "refine_outcome,selection\n";
   auto opt = [](double v) { return std::isfinite(v) ? fmt(v, 4) : std::string(); };
   for (const Row* r : rows) {
     const BuildingEval& e = r->eval;
@@ -463,7 +469,7 @@ std::string csv_text(const std::vector<const Row*>& rows) {
            csv_stats(measured && e.ok() ? std::optional(e.after) : std::nullopt) + ',' + opt(e.delta_d) + ',' +
            csv_rmse(e.truth_facade_before) + ',' + csv_rmse(e.truth_facade_after) + ',' + csv_rmse(e.truth_roof_before) +
            ',' + csv_rmse(e.truth_roof_after) + ',' +
-           csv_field(r->refine_outcome) + '\n';
+           csv_field(r->refine_outcome) + ',' + csv_field(r->selection) + '\n';
   }
   return out;
 }
@@ -534,6 +540,7 @@ void write_plots(const std::string& svg_dir, const std::string& histogram, const
 const json kHtmlColumns = json::array({{"id", "building"},
                                        {"outcome", "outcome"},
                                        {"reason", "reason"},
+                                       {"selection", "selection"},
                                        {"moved", "facades moved"},
                                        {"moved_max", "max move (m)"},
                                        {"moved_mean", "mean move (m)"},
@@ -549,6 +556,7 @@ json html_row(const Row& r) {
   return {{"id", e.id},
           {"outcome", r.outcome},
           {"reason", r.reason},
+          {"selection", r.selection},
           {"moved", m.count},
           {"moved_max", number_or_null(m.max)},
           {"moved_mean", number_or_null(m.mean)},

@@ -7,6 +7,8 @@
 #include <set>
 
 #include "lodrefine/core/corners.h"
+#include "lodrefine/core/distance.h"
+#include "lodrefine/core/shell_selection.h"
 #include "lodrefine/core/substitute.h"
 
 namespace lodrefine {
@@ -77,9 +79,9 @@ std::optional<Mesh> substitute_valid(const Mesh& mesh, const std::vector<ModelSu
   return m;
 }
 
-// The fallback: one wall at a time, the best-matching outdated one first, each by substitution
-// or by the local candidate arrangement, re-matching on the new model after each. Returns the
-// model once any wall moved.
+// The starting shell's fallback: one wall at a time, the best-matching outdated one first, each
+// by substitution, re-matching on the new model after each. Returns the model once any wall
+// moved.
 std::optional<Mesh> one_wall_at_a_time(const Mesh& start, const PointCloud& local, const std::vector<ScanPlane>& planes,
                                        const Params& prm, RefineTrace& trace) {
   // Each (scan plane, wall position) is tried once: a wall that would not move is not retried,
@@ -90,7 +92,6 @@ std::optional<Mesh> one_wall_at_a_time(const Mesh& start, const PointCloud& loca
   bool any = false;
   std::set<std::pair<int, long long>> tried;  // (scan plane, rounded wall position)
   auto position = [](const ModelSurface& s) { return (long long)std::llround(s.centroid.squaredNorm() * kPositionSteps); };
-  double mip_seconds = 0.0;
   for (int iter = 0; iter < max_steps; ++iter) {
     const auto ss = model_surfaces(step_mesh);
     const MatchResult mi = match_surfaces(step_mesh, ss, local, planes, prm);
@@ -104,41 +105,20 @@ std::optional<Mesh> one_wall_at_a_time(const Mesh& start, const PointCloud& loca
     if (next == nullptr) break;
     const auto& surf = ss[next->surface];
     tried.insert({next->scan_plane, position(surf)});
-    WallReplacement r;
-    r.surfaces = {next->surface};
-    r.plane = planes[next->scan_plane].plane;
-    if (r.plane.n.dot(surf.plane.n) < 0) r.plane = r.plane.flipped();
-    for (int i : planes[next->scan_plane].inliers) r.points.push_back(local.points[i]);
+    Plane plane = planes[next->scan_plane].plane;
+    if (plane.n.dot(surf.plane.n) < 0) plane = plane.flipped();
     RefineTrace::Step step;
     step.scan_plane = next->scan_plane;
     step.wall_faces = surf.faces;
-    step.moved_by = surface_deviation(step_mesh, surf, r.plane);
-    std::optional<Mesh> m;
-    if (!prm.arrangement_only) {
-      RefineTrace::Substitution unused;
-      m = substitute_valid(step_mesh, ss, {{next->surface, r.plane}}, prm, unused);
-    }
-    if (m) {
-      step.method = "substitution";
-    } else {
-      Params step_prm = prm;
-      step_prm.mip_time_limit = prm.mip_time_limit - mip_seconds;
-      if (step_prm.mip_time_limit <= 0.0) {
-        step.reason = "MIP time limit used up";
-        steps.push_back(step);
-        break;
-      }
-      ArrangementResult ar = arrange_wall(step_mesh, ss, r, step_prm);
-      if (ar.stats.selection) mip_seconds += ar.stats.selection->seconds;
-      step.arrangement = ar.stats;
-      step.method = "arrangement";
-      if (ar.ok) m = std::move(ar.mesh);
-      else step.reason = ar.reason;
-    }
+    step.moved_by = surface_deviation(step_mesh, surf, plane);
+    step.method = "substitution";
+    RefineTrace::Substitution attempt;
+    std::optional<Mesh> m = substitute_valid(step_mesh, ss, {{next->surface, plane}}, prm, attempt);
     step.ok = bool(m);
+    if (!m) step.reason = attempt.reason;
     steps.push_back(step);
     if (m) {
-      trace.facades.push_back(describe_move(step_mesh, ss, {next->surface, r.plane}, "scan"));
+      trace.facades.push_back(describe_move(step_mesh, ss, {next->surface, plane}, "scan"));
       step_mesh = std::move(*m);
       step_mesh.id = start.id;
       any = true;
@@ -240,17 +220,16 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
   }
   matching.rejected = mr.rejected;
   matching.q_model = mr.q_model;
-  const auto corners = prm.arrangement_only ? std::vector<CornerMove>{} : corner_moves(current, surfaces, scanned, local, planes, prm);
+  const auto corners = corner_moves(current, surfaces, scanned, local, planes, prm);
   lap("matching");
-  if (moves.empty() && corners.empty())
-    return finish(Outcome::Kept, mr.matches.empty() ? "no wall matched a scan plane" : "every matched wall agrees with the scan", kept);
 
-  // First choice: every outdated wall takes its scan plane at once, the model's topology kept
-  // (without the corner moves if those spoil it).
+  // The starting shell: every outdated wall takes its scan plane at once, the model's topology
+  // kept (without the corner moves if those spoil it; else one wall at a time); the input when
+  // no wall is outdated or none could be moved.
   std::vector<WallMove> all = moves;
   for (const auto& c : corners) all.push_back(c.move);
   std::optional<Mesh> refined;
-  if (!prm.arrangement_only)
+  if (!all.empty())
     refined = substitute_valid(current, surfaces, all, prm, trace.substitution.emplace(RefineTrace::Substitution{}));
   if (refined) {
     for (const auto& mv : moves) trace.facades.push_back(describe_move(current, surfaces, mv, "scan"));
@@ -261,31 +240,31 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
     if (refined)
       for (const auto& mv : moves) trace.facades.push_back(describe_move(current, surfaces, mv, "scan"));
   }
+  trace.replacements.emplace();
+  if (!refined && !all.empty()) refined = one_wall_at_a_time(current, local, planes, prm, trace);
   lap("substitution");
 
-  // Fallback: one wall at a time.
-  trace.replacements.emplace();
-  if (!refined) refined = one_wall_at_a_time(current, local, planes, prm, trace);
-  lap("replacement");
-  if (!refined) {
-    std::string why = "no wall could be replaced";
-    if (!trace.replacements->empty()) {
-      if (!trace.replacements->back().ok) why = trace.replacements->back().reason;
-    } else if (trace.substitution && !trace.substitution->ok) {
-      why = trace.substitution->reason;
-    }
-    return finish(Outcome::Kept, why, kept);
+  // The selection decides every face: the candidate arrangement over the starting shell's planes
+  // and the scan's facades, the starting shell as GLPK's first incumbent.
+  const ShellSelection chosen = select_shell(refined ? *refined : current, local, planes, prm);
+  trace.selection = chosen.stats;
+  trace.selection_reason = chosen.reason;
+  lap("selection");
+  if (!chosen.ok) return finish(Outcome::Kept, "the selection found no valid shell: " + chosen.reason, kept);
+  if (!refined && chosen.stats.candidates_changed == 0) {
+    trace.facades.clear();
+    return finish(Outcome::Kept, mr.matches.empty() ? "the selection kept the model (no wall matched a scan plane)"
+                                                    : "the selection kept the model (the scan agrees with it)", kept);
   }
-  const Validation vf = validate_mesh(*refined, prm.planarity_tolerance);
-  if (!vf.valid()) return finish(Outcome::Kept, "refined shell failed validation: " + vf.problem, kept);
 
   // Never worse: on every scan point near the building, and on each moved wall's own points.
   std::vector<JudgedWall> moved;
   for (const auto& f : trace.facades) moved.push_back(f.wall);
-  const Judgement& verdict = trace.judgement.emplace(judge_refinement(kept, *refined, moved, local, prm));
+  const Judgement& verdict = trace.judgement.emplace(judge_refinement(kept, chosen.mesh, moved, local, prm));
   if (!verdict.ok)
     return finish(Outcome::Kept, "not written: never worse, " + verdict.check + " check: " + verdict.detail, kept);
-  return finish(Outcome::Refined, std::to_string(trace.facades.size()) + " wall(s) moved", *refined);
+  return finish(Outcome::Refined, std::to_string(chosen.stats.faces_from_selection) + " face(s) selected, " +
+                                      std::to_string(trace.facades.size()) + " wall(s) moved", chosen.mesh);
 }
 
 }  // namespace lodrefine

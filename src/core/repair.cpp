@@ -460,6 +460,12 @@ void drop_straight_vertices(const std::vector<Vec3>& V, std::vector<Face>& faces
 
 }  // namespace
 
+int orient_outward(Mesh& mesh) {
+  std::vector<char> flipped(mesh.faces.size(), 0);
+  orient_outward(mesh.vertices, mesh.faces, orient_consistently(mesh.faces, flipped), flipped);
+  return int(std::count(flipped.begin(), flipped.end(), 1));
+}
+
 Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report, double gap_tolerance) {
   RepairReport r;
   r.input_vertices = int(soup.vertices.size());

@@ -39,6 +39,28 @@ json step_json(const RefineTrace::Step& s) {
   return j;
 }
 
+json selection_json(const ShellSelectionStats& st, const std::string& reason) {
+  const SelectionResult& m = st.selection;
+  json j = {{"status", m.status_text()},
+            {"candidates", st.candidates},
+            {"edges", st.edges},
+            {"supporting_planes", st.supporting_planes},
+            {"scan_planes_added", st.scan_planes_added},
+            {"step_walls", st.step_walls},
+            {"variables", m.variables},
+            {"constraints", m.constraints},
+            {"fixed_candidates", m.fixed},
+            {"gap", m.gap},
+            {"objective", m.objective},
+            {"seconds", st.seconds},
+            {"solver_seconds", m.seconds},
+            {"faces_from_selection", st.faces_from_selection},
+            {"candidates_changed", st.candidates_changed},
+            {"warm_start", m.warm_text()}};
+  if (!reason.empty()) j["reason"] = reason;
+  return j;
+}
+
 }  // namespace
 
 json validation_json(const Validation& v) {
@@ -118,6 +140,7 @@ json refine_report(const RefineResult& r) {
     rep["judgement"] = {{"ok", t.judgement->ok}, {"check", t.judgement->check}, {"detail", t.judgement->detail},
                         {"building", fit(t.judgement->building)}, {"walls", walls}};
   }
+  if (t.selection) rep["selection"] = selection_json(*t.selection, t.selection_reason);
   return rep;
 }
 

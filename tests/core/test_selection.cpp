@@ -55,3 +55,68 @@ TEST(Selection, InfeasibleBoundaryIsReportedNotCrashed) {
   EXPECT_FALSE(sel.ok);
   EXPECT_EQ(sel.status_text(), "infeasible");
 }
+
+TEST(Selection, StartsFromAClosedWarmStartAndRefusesAnOpenOne) {
+  const double a = 10, b = 8, c = 6;
+  const CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
+  Params prm;
+  const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, prm);
+  SelectionProgram pg;
+  std::vector<char> box(cs.faces.size(), 0);
+  for (std::size_t f = 0; f < cs.faces.size(); ++f) {
+    pg.cost.push_back(coverage_cost(cs.faces[f].area, conf[f].value, prm.tau_cov));
+    box[f] = inside_box(cs.faces[f].centroid, a, b, c);
+  }
+  EXPECT_TRUE(every_edge_used_0_or_2(cs, box));
+  pg.warm = box;
+  const SelectionResult sel = select_faces(cs, pg, prm);
+  ASSERT_TRUE(sel.ok) << sel.status_text();
+  EXPECT_TRUE(sel.warm_given);
+  EXPECT_TRUE(sel.warm_feasible);
+  EXPECT_TRUE(sel.warm_text() == "accepted" || sel.warm_text() == "not needed") << sel.warm_text();
+  EXPECT_EQ(sel.selected, box);
+  EXPECT_EQ(sel.gap, 0.0);
+
+  // One face short of the box: an open start is not handed to GLPK.
+  std::vector<char> open = box;
+  for (std::size_t f = 0; f < open.size(); ++f)
+    if (open[f]) {
+      open[f] = 0;
+      break;
+    }
+  EXPECT_FALSE(every_edge_used_0_or_2(cs, open));
+  pg.warm = open;
+  const SelectionResult r = select_faces(cs, pg, prm);
+  EXPECT_FALSE(r.warm_feasible);
+  EXPECT_EQ(r.warm_text(), "infeasible");
+  EXPECT_EQ(r.selected, box);  // the program still finds the box
+}
+
+TEST(Selection, FixedFacesAreConstantsOfTheProgram) {
+  const double a = 10, b = 8, c = 6;
+  const CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
+  Params prm;
+  SelectionProgram pg;
+  std::vector<char> box(cs.faces.size(), 0);
+  int inside = 0;
+  for (std::size_t f = 0; f < cs.faces.size(); ++f) {
+    box[f] = inside_box(cs.faces[f].centroid, a, b, c);
+    inside += box[f];
+    pg.cost.push_back(box[f] ? -1.0 : 1.0);
+    pg.fixed.push_back(box[f] ? 1 : -1);  // the box fixed in, the rest free
+  }
+  const SelectionResult sel = select_faces(cs, pg, prm);
+  ASSERT_TRUE(sel.ok) << sel.status_text();
+  EXPECT_EQ(sel.fixed, inside);
+  EXPECT_EQ(sel.selected, box);
+  // Everything fixed, the box one face short: the constants alone break an edge constraint.
+  for (std::size_t f = 0; f < cs.faces.size(); ++f) pg.fixed[f] = box[f];
+  for (std::size_t f = 0; f < cs.faces.size(); ++f)
+    if (box[f]) {
+      pg.fixed[f] = 0;
+      break;
+    }
+  const SelectionResult bad = select_faces(cs, pg, prm);
+  EXPECT_FALSE(bad.ok);
+  EXPECT_EQ(bad.status_text(), "infeasible");
+}

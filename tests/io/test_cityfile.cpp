@@ -621,6 +621,8 @@ TEST(CityFile, ProgressLineOnATerminalOnly) {
   EXPECT_NE(tty.find(plain.out.substr(0, plain.out.find(" -> "))), std::string::npos) << "stdout unchanged";
   const std::string quiet = on_terminal(" --quiet");
   EXPECT_EQ(quiet.find("refine: "), std::string::npos) << quiet;
+}
+
 // Issue 15, items 9 and 11: a building lowered to the ground crashed validation (CGAL's face
 // triangulation on a face of no area) and took the whole run down; a building with one vertex
 // 1000 km away made the crop grid allocate gigabytes. Both are kept-invalid with their reason,

@@ -37,7 +37,7 @@ TEST(RefineReport, RefinedBuildingHasEveryStage) {
   EXPECT_EQ(j["refined"], true);
   EXPECT_EQ(j["origin"], nlohmann::json({85000.0, 447000.0, 0.0}));
   for (const char* key : {"repair", "input_validation", "output_validation", "cloud", "planes", "matches",
-                          "rejected_matches", "q_model", "substitution", "replacements", "facades", "judgement"})
+                          "rejected_matches", "q_model", "substitution", "replacements", "facades", "judgement", "selection"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["cloud"]["points"], s.scan.points.size());
   ASSERT_EQ(j["matches"].size(), 1u);
@@ -56,8 +56,20 @@ TEST(RefineReport, RefinedBuildingHasEveryStage) {
   ASSERT_EQ(j["judgement"]["walls"].size(), 1u);
   EXPECT_EQ(j["output_validation"]["valid"], true);
   EXPECT_EQ(j["faces"], r.trace.faces);
-  for (const char* stage : {"repair", "planes", "matching", "substitution", "replacement", "total"})
+  for (const char* stage : {"repair", "planes", "matching", "substitution", "selection", "total"})
     EXPECT_TRUE(j["seconds"].contains(stage)) << stage;
+  // The selection chose every output face, starting from the substituted shell.
+  const auto& sel = j["selection"];
+  EXPECT_EQ(sel["status"], "optimal");
+  EXPECT_EQ(sel["faces_from_selection"], j["faces"]);
+  EXPECT_GT(sel["candidates"].get<int>(), 6);
+  EXPECT_GT(sel["variables"].get<int>(), 0);
+  EXPECT_GT(sel["constraints"].get<int>(), 0);
+  EXPECT_EQ(sel["gap"], 0.0);
+  const std::string warm = sel["warm_start"];
+  EXPECT_TRUE(warm == "accepted" || warm == "not needed") << warm;
+  for (const char* key : {"seconds", "scan_planes_added", "step_walls", "fixed_candidates", "candidates_changed"})
+    EXPECT_TRUE(sel.contains(key)) << key;
 }
 
 TEST(RefineReport, ABuildingStoppedAtRepairHasOnlyWhatItReached) {
@@ -69,7 +81,7 @@ TEST(RefineReport, ABuildingStoppedAtRepairHasOnlyWhatItReached) {
   EXPECT_EQ(j["outcome"], "kept-invalid");
   EXPECT_EQ(j["reason"], r.reason);
   EXPECT_FALSE(r.reason.empty());
-  for (const char* key : {"repair", "cloud", "planes", "matches", "substitution", "replacements", "judgement"})
+  for (const char* key : {"repair", "cloud", "planes", "matches", "substitution", "replacements", "judgement", "selection"})
     EXPECT_FALSE(j.contains(key)) << key;
   EXPECT_EQ(j["seconds"].size(), 2u);  // repair, total
   EXPECT_EQ(j["faces"], 2u);

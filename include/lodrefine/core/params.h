@@ -38,8 +38,7 @@ namespace lodrefine {
   X(double, tau_cov, 0.3, 0.0, 1.0, "coverage threshold tau_cov: inflection of the sigmoid coverage cost") \
   X(double, lambda_coverage, 1.0, 0.0, 1e6, "weight of the coverage term")                               \
   X(double, lambda_complexity, 0.2, 0.0, 1e6, "weight of the complexity (sharp edge) term")               \
-  X(int, arrangement_only, 0, 0, 1, "1: move every wall through the local candidate arrangement and GLPK (the paper's method), never by substitution") \
-  X(double, mip_time_limit, 30.0, 0.001, 86400.0, "GLPK time limit per building, over all its wall replacements (s); past it the walls not yet replaced stay as they were") \
+  X(double, mip_time_limit, 2.0, 0.001, 86400.0, "GLPK time limit of a building's face selection (s); at the limit the best selection found, at least the starting shell, is taken") \
   X(double, mip_gap, 1e-4, 0.0, 1.0, "GLPK relative MIP gap")                                            \
   X(double, weld_tolerance, 0.01, 0.0, 1.0, "model repair: vertices closer than this are welded (m)")    \
   X(double, planarity_tolerance, 0.01, 0.0, 1.0, "validation: max vertex distance from its face plane (m)")

@@ -14,6 +14,7 @@
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/planes.h"
 #include "lodrefine/core/repair.h"
+#include "lodrefine/core/shell_selection.h"
 #include "lodrefine/core/types.h"
 #include "lodrefine/core/validate.h"
 
@@ -76,6 +77,8 @@ struct RefineTrace {
   std::optional<std::vector<Step>> replacements;  // set together with `facades`
   std::vector<FacadeMove> facades;
   std::optional<Judgement> judgement;  // never worse (judge.h), when a refinement was made
+  std::optional<ShellSelectionStats> selection;  // the program that chose the output's faces
+  std::string selection_reason;                  // why it gave no shell, when it did not
 
   double stage_seconds(const std::string& stage) const {  // 0 for a stage not reached
     for (const auto& [name, s] : seconds)

@@ -32,6 +32,11 @@ struct RepairReport {
 // only within weld_tolerance, so a face's own short edges never collapse.
 Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report = nullptr, double gap_tolerance = 0.0);
 
+// Orients the faces of a closed mesh with shared vertices consistently (across manifold edges)
+// and outward (each edge-connected component encloses a positive volume); no vertex moves.
+// Returns how many faces were reversed.
+int orient_outward(Mesh& mesh);
+
 // The repair of a building's input for the pipeline: a ladder of welds (see repair.cpp), the
 // first whose shell is valid (validate_mesh at params.planarity_tolerance) wins, else the first
 // that closed at all; warped faces come back split into triangles (counted in `report`).

@@ -32,14 +32,43 @@ struct SelectionResult {
   int glpk_code = 0;           // glp_intopt's return code
   std::string status_text() const { return status_name(status, glpk_code); }
   int variables = 0, constraints = 0, nonzeros = 0;
-  int fixed = 0;               // candidates fixed before solving
-  double objective = 0.0;
+  int fixed = 0;               // candidates fixed before solving (constants, not columns)
+  double objective = 0.0;      // of the free columns (fixed faces' costs are constants)
+  double gap = 0.0;            // relative MIP gap when the search ended (0: proven optimal)
   double seconds = 0.0;
+  // The starting selection (SelectionProgram::warm): handed to GLPK's heuristic callback, and
+  // whether GLPK accepted it as an incumbent (not needed: the search ended before asking).
+  bool warm_given = false, warm_feasible = false, warm_asked = false, warm_accepted = false;
+  std::string warm_text() const;  // "none", "infeasible", "accepted", "rejected", "not needed"
 };
 
-// `cost[f]`: coverage cost of candidate f (weighted here by lambda_coverage); `outside[e]`: 1
-// where the kept surface outside the region continues across edge e (counts as a selected
-// face), else 0; `fixed[f]`: -1 free, 0 or 1 to fix candidate f (presolve then removes it).
+// A selection program over `CandidateSet` (the paper's Sec. 3.4):
+// - `cost[f]`: coverage cost of candidate f (weighted here by lambda_coverage);
+// - `outside[e]`: 1 where a kept surface outside the region continues across edge e (counts as a
+//   selected face), else 0; empty: none;
+// - `fixed[f]`: -1 free, 0 or 1 fixed (folded into the edge constraints as constants); empty:
+//   all free;
+// - `sharp_cost[e]`: cost of edge e when it is sharp (two selected faces of different planes
+//   meet there); empty: the PolyFit complexity lambda_complexity * total area / edges on every
+//   edge;
+// - `warm[f]`: a starting selection (0/1 per candidate); empty: none. It must agree with
+//   `fixed`; if it satisfies every edge constraint it is given to GLPK as the first incumbent
+//   (presolve is then off: the callback works on the original columns).
+struct SelectionProgram {
+  std::vector<double> cost;
+  std::vector<int> outside;
+  std::vector<int> fixed;
+  std::vector<double> sharp_cost;
+  std::vector<char> warm;
+};
+SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& program, const Params& params);
+
+// Whether every edge of `cs` is used by 0 or 2 of the `selected` candidates (plus `outside[e]`;
+// empty: none): the program's constraint, for checking a starting point or a result.
+bool every_edge_used_0_or_2(const CandidateSet& cs, const std::vector<char>& selected,
+                            const std::vector<int>& outside = {});
+
+// The same with `cost`, `outside` and optionally `fixed` (see SelectionProgram).
 SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& cost, const std::vector<int>& outside,
                              const Params& params, const std::vector<int>* fixed = nullptr);
 

@@ -1,0 +1,60 @@
+// Stages 3-4 for the whole building (paper Sec. 3.2-3.4): one PolyFit-style candidate
+// arrangement over the building and the scan around it, and the GLPK binary selection that
+// decides every face of the output.
+//
+// Supporting planes: the planes of the starting shell (the substituted or coarse model: roofs,
+// ground, unscanned walls, walls already moved onto their scan planes) and every facade plane
+// the scan shows in front of or behind the building's footprint that no wall of the shell lies
+// on (a recess's back wall and returns, a bay's front and sides, a second facade line). Every
+// plane's section of the region is split by every other plane.
+//
+// Data term per candidate (confidence c in 0..1, the paper's sigmoid coverage cost):
+// - on a scanned plane, the share of its area the plane's points cover (an occupancy grid);
+// - where the starting shell has a face, 1 (the model's prior: unscanned parts stay), less the
+//   share of its area behind or before which the scan shows another parallel facade (the scan
+//   saw the facade elsewhere there).
+// Complexity: a cost per length of sharp edge. Constraint: every candidate edge is used by 0 or
+// 2 selected faces. Candidates that no scan evidence reaches are fixed to the starting shell.
+// The starting shell, as a selection of candidates, is GLPK's first incumbent (warm start).
+#pragma once
+#include <string>
+#include <vector>
+
+#include "lodrefine/core/candidates.h"
+#include "lodrefine/core/params.h"
+#include "lodrefine/core/planes.h"
+#include "lodrefine/core/selection.h"
+#include "lodrefine/core/types.h"
+
+namespace lodrefine {
+
+struct ShellSelectionStats {
+  int supporting_planes = 0;  // of the starting shell plus the scan's
+  int scan_planes_added = 0;  // facade planes on which no wall of the starting shell lies
+  int step_walls = 0;         // hypothesised walls across where a facade's points end (no points)
+  int candidates = 0, edges = 0;
+  SelectionResult selection;  // status, variables, constraints, gap, seconds, warm start
+  int faces_from_selection = 0;  // output faces (each assembled from selected candidates)
+  int candidates_changed = 0;    // selected differently from the starting shell
+  std::vector<Vec3> evidence;    // the scan points the selection used (its planes', near the footprint)
+  double seconds = 0.0;
+};
+
+struct ShellSelection {
+  bool ok = false;
+  std::string reason;  // why not, when !ok
+  Mesh mesh;           // closed, 2-manifold, outward, merged coplanar faces; semantics per face
+  ShellSelectionStats stats;
+};
+
+// Selects the building's faces. `start`: a valid closed shell (local frame); `cloud`: the local
+// cloud `planes` were detected in. Faces on the start's planes keep its semantic and source;
+// faces on added scan planes are WallSurface (source -1). A selection whose shell does not
+// validate is excluded and the program solved again (its changes fixed back, twice at most);
+// when the program chose the starting shell unchanged but its pieces do not validate, the result
+// is `start` itself (ok, with that said in `reason`). Never throws for geometry; !ok with the
+// reason when the program has no solution or no valid shell.
+ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
+                            const Params& params);
+
+}  // namespace lodrefine

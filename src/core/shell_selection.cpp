@@ -1,0 +1,478 @@
+// Stages 3-4 for the whole building (paper Sec. 3.2-3.4): see shell_selection.h.
+#include "lodrefine/core/shell_selection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <unordered_set>
+
+#include "lodrefine/core/confidence.h"
+#include "lodrefine/core/geometry.h"
+#include "lodrefine/core/matching.h"
+#include "lodrefine/core/repair.h"
+#include "lodrefine/core/topology.h"
+#include "lodrefine/core/validate.h"
+
+namespace lodrefine {
+namespace {
+
+// Occupancy grid cell (m): several MLS points wide, a fraction of a window.
+constexpr double kCell = 0.25;
+// The region reaches this far (m) beyond the building and its scan evidence, so that no face of
+// a building touches its boundary.
+constexpr double kRegionMargin = 1.0;
+// A parallel scanned facade at most this far (m) from a model face (in front or behind) says the
+// facade is there, not on the model face: the scan saw past it, or it lies inside the building.
+constexpr double kSeeThrough = 3.0;
+// A sharp edge costs lambda_complexity * its length * this width (m): the complexity term in the
+// coverage term's units (m²), independent of how large the region is.
+constexpr double kSharpEdgeWidth = 0.25;
+// Planes of the starting shell within kSurfaceAngleDeg and kSurfaceDistance are one supporting
+// plane (matching.h: the tolerance of a model surface).
+
+struct Frame2 {  // a plane's 2D frame
+  Vec3 o, u, v;
+  Vec2 operator()(const Vec3& p) const { return {(p - o).dot(u), (p - o).dot(v)}; }
+};
+
+Frame2 frame_of(const Plane& pl, const Vec3& centre) {
+  const auto [u, v] = pl.basis();
+  return {pl.project(centre), u, v};
+}
+
+using CellSet = std::unordered_set<std::int64_t>;
+std::int64_t cell_key(long long i, long long j) { return (std::int64_t(i) << 32) ^ std::int64_t(std::uint32_t(j)); }
+
+// A point marks its cell and those within kFill cells: a facade's windows and the gaps of its
+// scan lines (up to about a metre) count as scanned, so that a scanned facade's coverage is near
+// 1 and the coverage of a face it does not reach near 0.
+constexpr int kFill = 2;
+void mark(CellSet& cells, const Vec2& q) {
+  const long long i = (long long)std::floor(q.x() / kCell), j = (long long)std::floor(q.y() / kCell);
+  for (long long di = -kFill; di <= kFill; ++di)
+    for (long long dj = -kFill; dj <= kFill; ++dj) cells.insert(cell_key(i + di, j + dj));
+}
+
+// Share of a convex polygon's grid cells (by centre) that are in `cells`; a polygon holding no
+// cell centre is judged by the cell of its centroid.
+double share(const std::vector<Vec2>& poly, const CellSet& cells) {
+  if (cells.empty()) return 0.0;
+  const Eigen::AlignedBox2d box = bounding_box(poly);
+  const long long i0 = (long long)std::floor(box.min().x() / kCell), i1 = (long long)std::floor(box.max().x() / kCell);
+  const long long j0 = (long long)std::floor(box.min().y() / kCell), j1 = (long long)std::floor(box.max().y() / kCell);
+  long long total = 0, hit = 0;
+  for (long long i = i0; i <= i1; ++i)
+    for (long long j = j0; j <= j1; ++j) {
+      if (!point_in_polygon_2d(Vec2((i + 0.5) * kCell, (j + 0.5) * kCell), poly)) continue;
+      ++total;
+      hit += cells.count(cell_key(i, j));
+    }
+  if (total > 0) return double(hit) / double(total);
+  Vec2 c = Vec2::Zero();
+  for (const auto& p : poly) c += p;
+  c /= double(poly.size());
+  return cells.count(cell_key((long long)std::floor(c.x() / kCell), (long long)std::floor(c.y() / kCell))) ? 1.0 : 0.0;
+}
+
+// The supporting planes: the starting shell's, then the scan's facades that none of them carries.
+struct Supports {
+  std::vector<SupportPlane> planes;
+  int start_planes = 0;
+  std::vector<int> face_plane;                // start face -> supporting plane
+  std::vector<std::vector<Vec3>> points;      // per supporting plane: its scan points
+  int added = 0;
+};
+
+// A plane whose normal is within this of horizontal is a wall's (deg): the contradiction and the
+// represented-facade tests apply to walls only.
+constexpr double kVerticalTiltDeg = 10.0;
+bool near_vertical(const Plane& pl) { return std::abs(pl.n.z()) < std::sin(radians(kVerticalTiltDeg)); }
+
+void add_start_planes(const Mesh& start, Supports& s) {
+  const auto surfaces = model_surfaces(start);
+  std::vector<int> order(surfaces.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = int(i);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return surfaces[a].area > surfaces[b].area; });
+  s.face_plane.assign(start.faces.size(), -1);
+  for (int si : order) {
+    const ModelSurface& surf = surfaces[si];
+    int k = -1;
+    for (int j = 0; j < int(s.planes.size()) && k < 0; ++j) {
+      if (unoriented_angle_deg(s.planes[j].plane.n, surf.plane.n) > kSurfaceAngleDeg) continue;
+      double worst = 0.0;
+      for (int f : surf.faces)
+        for (int v : start.faces[f].v) worst = std::max(worst, std::abs(s.planes[j].plane.distance(start.vertices[v])));
+      if (worst <= kSurfaceDistance) k = j;
+    }
+    if (k < 0) {
+      k = int(s.planes.size());
+      s.planes.push_back({surf.plane, surf.sem, false, si});
+    }
+    for (int f : surf.faces) s.face_plane[f] = k;
+  }
+  s.start_planes = int(s.planes.size());
+  s.points.assign(s.planes.size(), {});
+}
+
+// The scan's facade planes near the footprint: each one's points within match_distance +
+// bbox_margin of the start's box (in the plane's own horizontal frame), when at least ransac_min_points, go to the
+// supporting plane of the start that they lie on, else to a new one.
+void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& scan, const Params& prm,
+                     Supports& s) {
+  const double reach = prm.match_distance + prm.bbox_margin;  // a wall off by up to match_distance, plus a bay
+  for (int i = 0; i < int(scan.size()); ++i) {
+    const ScanPlane& sp = scan[i];
+    if (!sp.facade) continue;
+    Vec3 n(sp.plane.n.x(), sp.plane.n.y(), 0.0);
+    if (n.norm() < 1e-9) continue;
+    n.normalize();
+    const Vec3 u(-n.y(), n.x(), 0.0);
+    Eigen::AlignedBox3d box;  // the start in (u, n, z)
+    for (const auto& p : start.vertices) box.extend(Vec3(u.dot(p), n.dot(p), p.z()));
+    std::vector<Vec3> near;
+    for (int idx : sp.inliers) {
+      const Vec3& p = cloud.points[idx];
+      const Vec3 q(u.dot(p), n.dot(p), p.z());
+      if ((q - box.min()).minCoeff() >= -reach && (box.max() - q).minCoeff() >= -reach) near.push_back(p);
+    }
+    if (int(near.size()) < prm.ransac_min_points) continue;
+    auto mean_distance = [&](const Plane& pl) {
+      double sum = 0.0;
+      for (const auto& p : near) sum += std::abs(pl.distance(p));
+      return sum / double(near.size());
+    };
+    int k = -1;
+    double best = prm.merge_distance;
+    for (int j = 0; j < int(s.planes.size()); ++j) {
+      if (!near_vertical(s.planes[j].plane) || unoriented_angle_deg(s.planes[j].plane.n, sp.plane.n) > prm.merge_angle_deg) continue;
+      const double d = mean_distance(s.planes[j].plane);
+      if (d <= best) best = d, k = j;
+    }
+    if (k < 0) {
+      k = int(s.planes.size());
+      s.planes.push_back({sp.plane, Semantic::Wall, true, i});
+      s.points.emplace_back();
+      ++s.added;
+    }
+    s.points[k].insert(s.points[k].end(), near.begin(), near.end());
+  }
+}
+
+// Where a scanned facade's points run along its horizontal direction `u` (positions along u;
+// gaps shorter than kRunGap are bridged: a window column still has wall above and below).
+struct Run {
+  double a, b;
+};
+constexpr double kRunGap = 2 * kCell;  // m
+std::vector<Run> runs_along(const std::vector<Vec3>& pts, const Vec3& u) {
+  std::vector<double> t;
+  for (const auto& p : pts) t.push_back(u.dot(p));
+  std::sort(t.begin(), t.end());
+  std::vector<Run> out;
+  for (double x : t) {
+    if (out.empty() || x - out.back().b > kRunGap) out.push_back({x, x});
+    else out.back().b = x;
+  }
+  return out;
+}
+
+// A facade line that steps, a recess or a bay needs the wall across the step, which the scan
+// often misses (seen edge-on, or in the shadow of the feature). Where the points of a facade
+// plane the start does not carry end inside the footprint, a vertical plane across that end is
+// a hypothesis, and one at each nearby end of a parallel scanned facade's points (the other side
+// of the step, where the points usually end more sharply). The selection takes such a wall only
+// where it closes what the scan shows.
+// Ends within kSideClear (m) of the footprint's ends are the building's own corners; other ends
+// within kStepReach (m) belong to the same step; a plane within kSameStep (m) of the end is there
+// already.
+constexpr double kSideClear = 0.3, kStepReach = 1.0, kSameStep = 0.1;
+void add_step_walls(const Mesh& start, const Params& prm, Supports& s) {
+  const int existing = int(s.planes.size());
+  for (int j = s.start_planes; j < existing; ++j) {
+    const Plane& pj = s.planes[j].plane;
+    if (!s.planes[j].from_scan || s.points[j].empty() || !near_vertical(pj)) continue;
+    const Vec3 u = Vec3(-pj.n.y(), pj.n.x(), 0.0).normalized();
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const auto& p : start.vertices) lo = std::min(lo, u.dot(p)), hi = std::max(hi, u.dot(p));
+    std::vector<double> ends;
+    for (const auto& r : runs_along(s.points[j], u)) ends.insert(ends.end(), {r.a, r.b});
+    std::vector<double> positions;
+    for (double e : ends) {
+      if (e < lo + kSideClear || e > hi - kSideClear) continue;
+      positions.push_back(e);
+      for (int k = 0; k < existing; ++k) {
+        if (k == j || s.points[k].empty() || unoriented_angle_deg(s.planes[k].plane.n, pj.n) > prm.merge_angle_deg) continue;
+        for (const auto& r : runs_along(s.points[k], u))
+          for (double f : {r.a, r.b})
+            if (std::abs(f - e) <= kStepReach && f > lo + kSideClear && f < hi - kSideClear) positions.push_back(f);
+      }
+    }
+    Vec3 c = Vec3::Zero();
+    for (const auto& p : s.points[j]) c += p;
+    c /= double(s.points[j].size());
+    for (double t : positions) {
+      const Vec3 x = c + (t - u.dot(c)) * u;
+      bool there = false;
+      for (const auto& sp : s.planes)
+        there = there || (near_vertical(sp.plane) && unoriented_angle_deg(sp.plane.n, u) <= prm.merge_angle_deg &&
+                          std::abs(sp.plane.distance(x)) <= kSameStep);
+      if (there) continue;
+      s.planes.push_back({Plane::through(x, u), Semantic::Wall, true, -1});
+      s.points.emplace_back();
+    }
+  }
+}
+
+// The region: the start and the scan evidence, in the axes of the start's largest wall.
+Region building_region(const Mesh& start, const Supports& s) {
+  Vec3 n = Vec3::UnitY();
+  for (const auto& sp : s.planes)  // the start's planes come in decreasing area: the first wall
+    if (!sp.from_scan && near_vertical(sp.plane)) {
+      n = Vec3(sp.plane.n.x(), sp.plane.n.y(), 0.0).normalized();
+      break;
+    }
+  Region r;
+  r.axes.col(0) = Vec3(-n.y(), n.x(), 0.0);
+  r.axes.col(1) = n;
+  r.axes.col(2) = Vec3::UnitZ();
+  Eigen::AlignedBox3d box;
+  for (const auto& p : start.vertices) box.extend(r.axes.transpose() * p);
+  for (const auto& pts : s.points)
+    for (const auto& p : pts) box.extend(r.axes.transpose() * p);
+  r.center = r.axes * box.center();
+  r.half = 0.5 * box.sizes() + Vec3::Constant(kRegionMargin);
+  return r;
+}
+
+// What the program knows of each candidate.
+struct CandidateData {
+  std::vector<char> in_start;   // the starting shell has a face there
+  std::vector<int> start_face;  // which one (-1: none)
+  std::vector<double> confidence;
+  std::vector<char> in_zone;    // scan evidence reaches it
+};
+
+CandidateData describe_candidates(const CandidateSet& cs, const Mesh& start, const Supports& s, const Params& prm) {
+  const int np = int(s.planes.size());
+  std::vector<Frame2> frames;
+  for (const auto& sp : s.planes) frames.push_back(frame_of(sp.plane, cs.region.center));
+  // Own occupancy and the cells where another parallel scanned facade lies near.
+  std::vector<CellSet> own(np), other(np);
+  for (int k = 0; k < np; ++k)
+    for (const auto& p : s.points[k]) mark(own[k], frames[k](p));
+  for (int k = 0; k < np; ++k) {
+    if (!near_vertical(s.planes[k].plane)) continue;
+    for (int j = 0; j < np; ++j) {
+      if (j == k || s.points[j].empty() || unoriented_angle_deg(s.planes[k].plane.n, s.planes[j].plane.n) > prm.merge_angle_deg)
+        continue;
+      double sum = 0.0;
+      for (const auto& p : s.points[j]) sum += std::abs(s.planes[k].plane.distance(p));
+      const double d = sum / double(s.points[j].size());
+      if (d <= prm.merge_distance || d > kSeeThrough) continue;
+      for (const auto& p : s.points[j]) mark(other[k], frames[k](p));
+    }
+  }
+  // The start's faces per plane, in that plane's frame.
+  std::vector<std::vector<std::pair<int, std::vector<Vec2>>>> start_faces(np);
+  for (int f = 0; f < int(start.faces.size()); ++f) {
+    const int k = s.face_plane[f];
+    if (k < 0) continue;
+    std::vector<Vec2> poly;
+    for (int v : start.faces[f].v) poly.push_back(frames[k](start.vertices[v]));
+    start_faces[k].emplace_back(f, std::move(poly));
+  }
+  // The evidence zone: each scanned plane's points' box (region axes), grown horizontally by the
+  // reach of the evidence (a wall the scan moves takes the roof edge above it along: the zone
+  // spans the whole height). Candidates with a vertex in it are free; the others stay as the
+  // starting shell has them (the program grows with the region: keep it to the evidence).
+  const double margin = prm.match_distance + prm.bbox_margin;
+  std::vector<Eigen::AlignedBox3d> zones;
+  for (const auto& pts : s.points) {
+    if (pts.empty()) continue;
+    Eigen::AlignedBox3d b;
+    for (const auto& p : pts) b.extend(cs.region.axes.transpose() * p);
+    const Vec3 grow(margin, margin, std::numeric_limits<double>::infinity());
+    zones.emplace_back(b.min() - grow, b.max() + grow);
+  }
+
+  CandidateData d;
+  const int nf = int(cs.faces.size());
+  d.in_start.assign(nf, 0);
+  d.start_face.assign(nf, -1);
+  d.confidence.assign(nf, 0.0);
+  d.in_zone.assign(nf, 0);
+  for (int f = 0; f < nf; ++f) {
+    const int k = cs.faces[f].plane;
+    std::vector<Vec2> poly;
+    for (int v : cs.faces[f].v) poly.push_back(frames[k](cs.vertices[v]));
+    const Vec2 c = frames[k](cs.faces[f].centroid);
+    for (const auto& [sf, sp] : start_faces[k])
+      if (point_in_polygon_2d(c, sp)) {
+        d.in_start[f] = 1;
+        d.start_face[f] = sf;
+        break;
+      }
+    const double scanned = share(poly, own[k]);
+    const double prior = d.in_start[f] ? 1.0 - share(poly, other[k]) : 0.0;
+    d.confidence[f] = std::max(scanned, prior);
+    std::vector<Vec3> pts{cs.faces[f].centroid};
+    for (int v : cs.faces[f].v) pts.push_back(cs.vertices[v]);
+    for (const auto& z : zones)
+      for (const auto& p : pts) d.in_zone[f] = d.in_zone[f] || z.contains(cs.region.axes.transpose() * p);
+  }
+  return d;
+}
+
+// Arrangement vertices closer than this (m) are one in the output: planes meeting almost at a
+// point leave edges of fractions of a millimetre, which CityJSON's millimetre grid or a
+// reader's weld collapses; the output is validated after this weld.
+constexpr double kOutputWeld = 1e-3;
+
+// The selected candidates as one mesh on the arrangement's own vertices (those within
+// kOutputWeld joined), oriented outward, coplanar neighbours merged.
+Mesh assemble(const CandidateSet& cs, const std::vector<char>& selected, const CandidateData& d, const Mesh& start,
+              const Supports& s) {
+  Mesh m;
+  m.id = start.id;
+  PointWelder welder(kOutputWeld);
+  for (int f = 0; f < int(cs.faces.size()); ++f) {
+    if (!selected[f]) continue;
+    Face face;
+    for (int v : cs.faces[f].v) face.v.push_back(welder.add(cs.vertices[v]));
+    drop_repeats(face.v);
+    const int k = cs.faces[f].plane;
+    face.sem = k < s.start_planes ? s.planes[k].sem : Semantic::Wall;
+    face.source = d.start_face[f] >= 0 ? start.faces[d.start_face[f]].source : -1;
+    if (face.v.size() >= 3) m.faces.push_back(std::move(face));
+  }
+  m.vertices = welder.points();
+  orient_outward(m);
+  return merge_coplanar_faces(m);
+}
+
+// The starting shell as a selection of candidates: its faces are unions of candidates up to
+// where its vertices sit off the planes' meets (a model within tolerance of its planes, planes
+// merged within kSurfaceDistance), which leaves some edges used once or thrice. Those are
+// mended by the nearest selection that closes: a small program over the candidates around each
+// such edge (kMendRings edge-rings, more while it has no solution), the others fixed, each
+// change costing its area. Empty when it cannot be mended.
+constexpr int kMendRings = 2, kMendTries = 3;
+constexpr int kRetries = 2;
+std::vector<char> mended_start(const CandidateSet& cs, const std::vector<char>& in_start, const Params& prm) {
+  if (every_edge_used_0_or_2(cs, in_start)) return in_start;
+  std::vector<char> near(cs.faces.size(), 0);
+  for (const auto& e : cs.edges) {
+    int n = 0;
+    for (int f : e.faces) n += in_start[f];
+    if (n != 0 && n != 2)
+      for (int f : e.faces) near[f] = 1;
+  }
+  for (int attempt = 0; attempt < kMendTries; ++attempt) {
+    for (int ring = 0; ring < kMendRings; ++ring) {
+      std::vector<char> grown = near;
+      for (const auto& e : cs.edges) {
+        bool touches = false;
+        for (int f : e.faces) touches = touches || near[f];
+        if (touches)
+          for (int f : e.faces) grown[f] = 1;
+      }
+      near.swap(grown);
+    }
+    SelectionProgram pg;
+    for (int f = 0; f < int(cs.faces.size()); ++f) {
+      pg.cost.push_back(in_start[f] ? -cs.faces[f].area : cs.faces[f].area);
+      pg.fixed.push_back(near[f] ? -1 : int(in_start[f]));
+    }
+    pg.sharp_cost.assign(cs.edges.size(), 0.0);
+    Params mend = prm;
+    mend.lambda_coverage = 1.0;
+    const SelectionResult r = select_faces(cs, pg, mend);
+    if (r.ok) return r.selected;
+  }
+  return {};
+}
+
+// Why the assembled shell cannot be written, or empty: validate_mesh's problem, or a face that
+// passes through one vertex twice (two pieces pinched together by the output weld or merge).
+std::string shell_problem(const Mesh& m, const Params& prm) {
+  const Validation v = validate_mesh(m, prm.planarity_tolerance);
+  if (!v.valid()) return v.problem.empty() ? "invalid" : v.problem;
+  for (const auto& f : m.faces) {
+    std::vector<int> ids = f.v;
+    std::sort(ids.begin(), ids.end());
+    if (std::adjacent_find(ids.begin(), ids.end()) != ids.end()) return "a face repeats a vertex";
+  }
+  return "";
+}
+
+}  // namespace
+
+ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
+                            const Params& prm) {
+  const auto t0 = Clock::now();
+  ShellSelection out;
+  auto& st = out.stats;
+  Supports s;
+  add_start_planes(start, s);
+  add_scan_planes(start, cloud, planes, prm, s);
+  const int before_steps = int(s.planes.size());
+  add_step_walls(start, prm, s);
+  st.step_walls = int(s.planes.size()) - before_steps;
+  st.supporting_planes = int(s.planes.size());
+  st.scan_planes_added = s.added;
+  for (const auto& pts : s.points) st.evidence.insert(st.evidence.end(), pts.begin(), pts.end());
+
+  const CandidateSet cs = build_candidates(s.planes, building_region(start, s));
+  st.candidates = int(cs.faces.size());
+  st.edges = int(cs.edges.size());
+  const CandidateData d = describe_candidates(cs, start, s, prm);
+
+  SelectionProgram pg;
+  for (int f = 0; f < int(cs.faces.size()); ++f) pg.cost.push_back(coverage_cost(cs.faces[f].area, d.confidence[f], prm.tau_cov));
+  for (const auto& e : cs.edges) pg.sharp_cost.push_back(prm.lambda_complexity * e.length * kSharpEdgeWidth);
+  // The starting shell (mended where it does not close on the candidates) is GLPK's first
+  // incumbent, and what no evidence reaches is fixed to it; without one everything is free.
+  const std::vector<char> warm = mended_start(cs, d.in_start, prm);
+  if (!warm.empty()) {
+    pg.warm = warm;
+    for (int f = 0; f < int(cs.faces.size()); ++f) pg.fixed.push_back(d.in_zone[f] ? -1 : int(warm[f]));
+  }
+  auto finish = [&](const std::string& reason) {
+    out.reason = reason;
+    st.seconds = seconds_since(t0);
+    return out;
+  };
+  // A selection whose shell does not validate (two shells touching, faces meeting at a point)
+  // is excluded: its changes from the starting shell are fixed back, and the program solved
+  // again (at most kRetries times).
+  const std::vector<char>& base = warm.empty() ? d.in_start : warm;
+  std::string problem;
+  for (int attempt = 0;; ++attempt) {
+    st.selection = select_faces(cs, pg, prm);
+    const auto& sel = st.selection;
+    if (!sel.ok) return finish("face selection " + sel.status_text());
+    st.candidates_changed = 0;
+    for (int f = 0; f < int(cs.faces.size()); ++f) st.candidates_changed += sel.selected[f] != base[f];
+    out.mesh = assemble(cs, sel.selected, d, start, s);
+    st.faces_from_selection = int(out.mesh.faces.size());
+    problem = shell_problem(out.mesh, prm);
+    if (problem.empty() || st.candidates_changed == 0 || warm.empty() || attempt == kRetries) break;
+    for (int f = 0; f < int(cs.faces.size()); ++f)
+      if (sel.selected[f] != base[f]) pg.fixed[f] = int(base[f]);
+  }
+  if (st.candidates_changed == 0) {
+    // The program chose its starting shell: it is written with the start's own faces, whose
+    // vertices the arrangement's pieces only approximate (plane meets of a model that is planar
+    // within tolerance; away from the scan a roof must not move by that).
+    out.mesh = start;
+    st.faces_from_selection = int(start.faces.size());
+    out.ok = true;
+    return finish(problem.empty() ? "" : "the starting shell was chosen (its pieces: " + problem + ")");
+  }
+  if (!problem.empty()) return finish("selected shell invalid: " + problem);
+  out.ok = true;
+  return finish("");
+}
+
+}  // namespace lodrefine

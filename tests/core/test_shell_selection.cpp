@@ -1,0 +1,108 @@
+// Stages 3-4 for the whole building: the selection adds the faces the model lacks.
+#include <gtest/gtest.h>
+
+#include "lodrefine/core/shell_selection.h"
+#include "lodrefine/core/validate.h"
+#include "support/mesh_fixtures.h"
+#include "support/scan_fixtures.h"
+
+using namespace lodrefine;
+using namespace lodrefine::fixtures;
+
+namespace {
+
+constexpr double kStep = 0.05;  // m between scan points
+
+// The street facade (y = 0, 10 m along x, 6 m high) of a box 10 x 8 x 6, scanned with a full-
+// height feature between x = 4 and x = 6 at depth `depth` (> 0: recessed into the building, < 0:
+// a bay in front of it): the facade, the feature's front and its two returns, as scan planes.
+struct Scan {
+  PointCloud cloud;
+  std::vector<ScanPlane> planes;
+};
+
+Scan facade_with_feature(double depth) {
+  Scan s;
+  const Vec3 x = Vec3::UnitX(), y = Vec3::UnitY();
+  s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 0, 0}, x, 4.0, 0.0, 6.0), kStep));
+  const auto right = grid_scan_plane(s.cloud, wall_patch({6, 0, 0}, x, 4.0, 0.0, 6.0), kStep);
+  s.planes[0].inliers.insert(s.planes[0].inliers.end(), right.inliers.begin(), right.inliers.end());
+  s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({4, depth, 0}, x, 2.0, 0.0, 6.0), kStep));
+  // Returns: normals facing the street side of the feature (the fixture's normal is along x e_z).
+  const double d = std::abs(depth);
+  const Vec3 in = depth > 0 ? y : -y;
+  s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({4, 0, 0}, in, d, 0.0, 6.0), kStep));
+  s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({6, 0, 0}, in, d, 0.0, 6.0), kStep));
+  return s;
+}
+
+// Every edge of `m` is used by exactly two faces in opposite directions (a closed, oriented
+// 2-manifold surface: what the 0-or-2 constraint guarantees).
+bool every_edge_twice(const Mesh& m) {
+  const Validation v = validate_mesh(m, 0.01);
+  return v.boundary_edges == 0 && v.nonmanifold_edges == 0 && v.inconsistent_edges == 0;
+}
+
+}  // namespace
+
+TEST(ShellSelection, AddsARecessTheModelLacks) {
+  const Mesh start = box({0, 0, 0}, {10, 8, 6});
+  const Scan scan = facade_with_feature(0.8);
+  Params prm;
+  const ShellSelection r = select_shell(start, scan.cloud, scan.planes, prm);
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_EQ(r.stats.scan_planes_added, 3);
+  EXPECT_TRUE(r.stats.selection.status == SolveStatus::Optimal || r.stats.selection.status == SolveStatus::Feasible)
+      << r.stats.selection.status_text();
+  EXPECT_EQ(r.stats.selection.warm_given, true);
+  EXPECT_EQ(r.stats.selection.warm_feasible, true);
+  EXPECT_TRUE(every_edge_twice(r.mesh));
+  const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
+  EXPECT_TRUE(v.valid()) << v.problem;
+  EXPECT_NEAR(v.volume, 10 * 8 * 6 - 2 * 0.8 * 6, 1e-6);
+  // Box 6 faces + back wall and two returns; the street facade split in two.
+  EXPECT_EQ(r.mesh.faces.size(), 10u);
+  EXPECT_EQ(r.stats.faces_from_selection, 10);
+  int walls = 0;
+  for (const auto& f : r.mesh.faces) walls += f.sem == Semantic::Wall;
+  EXPECT_EQ(walls, 8);
+}
+
+TEST(ShellSelection, AddsABayTheModelLacks) {
+  const Mesh start = box({0, 0, 0}, {10, 8, 6});
+  const Scan scan = facade_with_feature(-0.9);
+  Params prm;
+  const ShellSelection r = select_shell(start, scan.cloud, scan.planes, prm);
+  ASSERT_TRUE(r.ok) << r.reason;
+  const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
+  EXPECT_TRUE(v.valid()) << v.problem;
+  EXPECT_NEAR(v.volume, 10 * 8 * 6 + 2 * 0.9 * 6, 1e-6);
+  EXPECT_EQ(r.mesh.faces.size(), 10u);
+}
+
+TEST(ShellSelection, KeepsTheModelWhereTheScanAgrees) {
+  const Mesh start = box({0, 0, 0}, {10, 8, 6});
+  Scan s;
+  s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 10.0, 0.0, 6.0), kStep));
+  Params prm;
+  const ShellSelection r = select_shell(start, s.cloud, s.planes, prm);
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_EQ(r.stats.scan_planes_added, 0);
+  EXPECT_EQ(r.stats.candidates_changed, 0);
+  EXPECT_EQ(r.mesh.faces.size(), 6u);
+  EXPECT_NEAR(validate_mesh(r.mesh, prm.planarity_tolerance).volume, 480.0, 1e-6);
+}
+
+TEST(ShellSelection, MovesAWallOntoItsScanWithoutAStartingMove) {
+  // The coarse street wall is 0.5 m in front of the scanned one: the selection alone moves it.
+  const Mesh start = box({0, -0.5, 0}, {10, 8, 6});
+  Scan s;
+  s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 10.0, 0.0, 6.0), kStep));
+  Params prm;
+  const ShellSelection r = select_shell(start, s.cloud, s.planes, prm);
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_EQ(r.stats.scan_planes_added, 1);
+  const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
+  EXPECT_TRUE(v.valid()) << v.problem;
+  EXPECT_NEAR(v.volume, 480.0, 1e-6);
+}
