@@ -148,6 +148,7 @@ class Reader {
       const json* geom = best_lod2(obj);
       if (geom == nullptr) {
         ++out.objects_without_lod2;
+        out.ids_without_lod2.push_back(id);
         continue;
       }
       CityJsonBuilding b;

@@ -1125,7 +1125,9 @@ TEST(BadInputFiles, ConvertAccountsForEveryBuildingAndNeverOverwrites) {
   const std::string dir = temp_dir("convert_names");
   const std::string long_a(300, 'a'), long_b = std::string(299, 'a') + "b";
   const std::vector<std::string> ids = {"B 1", "B_1", "$(touch PWNED)", "-rf", long_a, long_b, "Flat roof"};
-  write_text(dir + "/city.json", box_city(ids, {"Flat roof"}));
+  json city = json::parse(box_city(ids, {"Flat roof"}));
+  city["CityObjects"]["Only LoD1"] = {{"type", "Building"}, {"geometry", json::array()}};  // no LoD 2.x geometry
+  write_text(dir + "/city.json", city.dump());
   const CliRun r = run_cli("convert --cityjson " + dir + "/city.json --out-dir " + dir + "/objs", dir);
   ASSERT_EQ(r.exit, 0) << r.err;
   EXPECT_FALSE(fs::exists(dir + "/PWNED"));
@@ -1140,6 +1142,8 @@ TEST(BadInputFiles, ConvertAccountsForEveryBuildingAndNeverOverwrites) {
   EXPECT_EQ(lines(r.out).size(), 7u) << r.out;  // one line per written building, then the total
   EXPECT_NE(r.out.find(".obj <- \"B 1\""), std::string::npos) << r.out;
   EXPECT_NE(r.err.find("Flat roof"), std::string::npos) << "the dropped building is named: " << r.err;
+  EXPECT_NE(r.err.find("\"Only LoD1\" has no LoD 2.x geometry, skipped"), std::string::npos)
+      << "the building without LoD 2 is named: " << r.err;
   // Again into the same folder: refused before anything is written, the files kept.
   const std::string before = read_text(dir + "/objs/B_1.obj");
   write_text(dir + "/objs/B_1.obj", "mine\n");

@@ -41,6 +41,7 @@ struct CityJsonFile {
   Vec3 translate = Vec3::Zero();
   std::vector<CityJsonBuilding> buildings;  // in file order (object order within a feature)
   int objects_without_lod2 = 0;             // Building/BuildingPart objects with no LoD 2.x geometry
+  std::vector<std::string> ids_without_lod2;  // their ids, in file order (every building by name)
   std::vector<std::string> notes;           // one line per thing worth knowing (holes dropped ...)
 };
 
