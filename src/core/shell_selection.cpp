@@ -351,6 +351,42 @@ Mesh assemble(const CandidateSet& cs, const std::vector<char>& selected, const C
   return merge_coplanar_faces(m);
 }
 
+// Output vertices within this (m) of a starting-shell vertex are put back on it: the plane meets
+// of the arrangement only approximate a model that is planar within tolerance, and where the
+// selection changed nothing a roof must not move by that. Used only when the shell still
+// validates after it.
+constexpr double kSnapBack = 0.03;
+
+Mesh snapped_to_start(const Mesh& m, const Mesh& start) {
+  PointGrid grid(kSnapBack);
+  for (int i = 0; i < int(start.vertices.size()); ++i) grid.insert(start.vertices[i], i);
+  Mesh out = m;
+  out.vertices.clear();
+  std::vector<int> index(m.vertices.size()), of_start(start.vertices.size(), -1);
+  for (std::size_t k = 0; k < m.vertices.size(); ++k) {
+    int best = -1;
+    double best_d = kSnapBack;
+    grid.visit_near(m.vertices[k], [&](int i) {
+      const double d = (start.vertices[i] - m.vertices[k]).norm();
+      if (d < best_d) best_d = d, best = i;
+      return false;
+    });
+    int& slot = best >= 0 ? of_start[best] : index[k];  // vertices snapped to one start vertex become one
+    if (best < 0 || slot < 0) {
+      slot = int(out.vertices.size());
+      out.vertices.push_back(best >= 0 ? start.vertices[best] : m.vertices[k]);
+    }
+    index[k] = slot;
+  }
+  out.faces.clear();
+  for (Face f : m.faces) {
+    for (int& v : f.v) v = index[v];
+    drop_repeats(f.v);
+    if (f.v.size() >= 3) out.faces.push_back(std::move(f));
+  }
+  return out;
+}
+
 // The starting shell as a selection of candidates: its faces are unions of candidates up to
 // where its vertices sit off the planes' meets (a model within tolerance of its planes, planes
 // merged within kSurfaceDistance), which leaves some edges used once or thrice. Those are
@@ -457,6 +493,10 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
     out.mesh = assemble(cs, sel.selected, d, start, s);
     st.faces_from_selection = int(out.mesh.faces.size());
     problem = shell_problem(out.mesh, prm);
+    if (problem.empty()) {
+      Mesh snapped = snapped_to_start(out.mesh, start);
+      if (shell_problem(snapped, prm).empty()) out.mesh = std::move(snapped);
+    }
     if (problem.empty() || st.candidates_changed == 0 || warm.empty() || attempt == kRetries) break;
     for (int f = 0; f < int(cs.faces.size()); ++f)
       if (sel.selected[f] != base[f]) pg.fixed[f] = int(base[f]);

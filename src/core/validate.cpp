@@ -11,7 +11,6 @@
 #include <CGAL/boost/graph/Euler_operations.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <iterator>
 #include <map>
@@ -64,10 +63,18 @@ std::string malformed(const Mesh& m) {
       if (i < 0 || std::size_t(i) >= m.vertices.size()) return face + " references missing vertex " + std::to_string(i);
     if (std::set<int>(v.begin(), v.end()).size() != v.size()) return face + " repeats a vertex";
   }
-  for (std::size_t k = 0; k < m.faces.size(); ++k)
-    if (degenerate(face_points(m, m.faces[k])))
+  for (std::size_t k = 0; k < m.faces.size(); ++k) {
+    std::vector<Vec3> pts = face_points(m, m.faces[k]);
+    if (degenerate(pts))
       return "face " + std::to_string(k) +
              " is degenerate (no area: its vertices are on one line or it folds onto itself)";
+    // Two vertices at one point make CGAL's constrained triangulation of the face crash.
+    std::sort(pts.begin(), pts.end(), [](const Vec3& a, const Vec3& b) {
+      return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+    });
+    if (std::adjacent_find(pts.begin(), pts.end()) != pts.end())
+      return "face " + std::to_string(k) + " has two vertices at one point";
+  }
   return {};
 }
 

@@ -189,6 +189,17 @@ TEST(Validate, FlatBuildingsAreReportedNotCrashed) {
       << validate_mesh(sheet, kPlanarity).problem;
 }
 
+// A face through two vertices at one point (distinct indices, as a weld can leave) crashed
+// CGAL's constrained triangulation inside validation; it is reported instead.
+TEST(Validate, TwoVerticesAtOnePointAreReportedNotCrashed) {
+  Mesh m = prism({{0, 0}, {10, 0}, {10, 8}, {0, 8}}, 0, 6);
+  m.vertices.push_back(m.vertices[m.faces[0].v[1]]);  // a copy of the bottom face's second vertex
+  m.faces[0].v.insert(m.faces[0].v.begin() + 2, int(m.vertices.size()) - 1);
+  const Validation v = validate_mesh(m, kPlanarity);
+  EXPECT_FALSE(v.valid());
+  EXPECT_EQ(v.problem, "face 0 has two vertices at one point");
+}
+
 TEST(Validate, EdgeUsesRecordDirection) {
   const EdgeUses uses = edge_uses(unit_cube().faces);
   EXPECT_EQ(uses.size(), 12u);
