@@ -13,7 +13,7 @@ import json, os, sys
 a, b = sys.argv[1], sys.argv[2]
 def strip(x):
     if isinstance(x, dict):
-        return {k: strip(v) for k, v in x.items() if k not in ("seconds", "written")}
+        return {k: strip(v) for k, v in x.items() if k not in ("seconds", "written") and not k.endswith("_seconds")}
     if isinstance(x, list):
         return [strip(v) for v in x]
     return x

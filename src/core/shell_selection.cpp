@@ -387,6 +387,31 @@ Mesh snapped_to_start(const Mesh& m, const Mesh& start) {
   return out;
 }
 
+// m: a changed candidate none of whose corners lies within this of a scan point the selection
+// used is a change the scan did not ask for (a roof re-cut far from every scanned facade): it
+// is fixed back to the starting shell and the program solved again.
+constexpr double kEvidenceReach = 2.0;
+
+// The changed candidates (selected != base) out of the evidence's reach.
+std::vector<int> changes_beyond_evidence(const CandidateSet& cs, const std::vector<char>& selected,
+                                         const std::vector<char>& base, const std::vector<Vec3>& evidence) {
+  PointGrid grid(kEvidenceReach);
+  for (int i = 0; i < int(evidence.size()); ++i) grid.insert(evidence[i], i);
+  std::vector<int> out;
+  for (int f = 0; f < int(cs.faces.size()); ++f) {
+    if (selected[f] == base[f]) continue;
+    bool reached = false;
+    for (int v : cs.faces[f].v) {
+      reached = grid.visit_near(cs.vertices[v], [&](int i) {
+        return (evidence[i] - cs.vertices[v]).norm() <= kEvidenceReach;
+      });
+      if (reached) break;
+    }
+    if (!reached) out.push_back(f);
+  }
+  return out;
+}
+
 // The starting shell as a selection of candidates: its faces are unions of candidates up to
 // where its vertices sit off the planes' meets (a model within tolerance of its planes, planes
 // merged within kSurfaceDistance), which leaves some edges used once or thrice. Those are
@@ -484,10 +509,19 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   // again (at most kRetries times).
   const std::vector<char>& base = warm.empty() ? d.in_start : warm;
   std::string problem;
+  int beyond_rounds = 0;  // solves redone for changes beyond the evidence (not counted as attempts)
   for (int attempt = 0;; ++attempt) {
     st.selection = select_faces(cs, pg, prm);
     const auto& sel = st.selection;
     if (!sel.ok) return finish("face selection " + sel.status_text());
+    if (!warm.empty() && beyond_rounds < kRetries) {
+      const std::vector<int> beyond = changes_beyond_evidence(cs, sel.selected, base, st.evidence);
+      if (!beyond.empty()) {
+        for (int f : beyond) pg.fixed[f] = int(base[f]);
+        ++beyond_rounds, --attempt;
+        continue;
+      }
+    }
     st.candidates_changed = 0;
     for (int f = 0; f < int(cs.faces.size()); ++f) st.candidates_changed += sel.selected[f] != base[f];
     out.mesh = assemble(cs, sel.selected, d, start, s);

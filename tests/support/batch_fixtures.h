@@ -72,11 +72,13 @@ inline std::string batch_command(const fs::path& run, const std::string& extra =
          shell_quoted(kBinary) + " -j2 " + extra;
 }
 
-// The report without timings (the only part of a refine that differs between runs).
+// The report without timings (the only part of a refine that differs between runs): every
+// "seconds" or "*_seconds" key.
 inline json without_timings(json j) {
   if (j.is_object()) {
     for (auto it = j.begin(); it != j.end();) {
-      if (it.key() == "seconds") {
+      const std::string& k = it.key();
+      if (k == "seconds" || (k.size() > 8 && k.compare(k.size() - 8, 8, "_seconds") == 0)) {
         it = j.erase(it);
       } else {
         *it = without_timings(*it);
