@@ -387,29 +387,46 @@ Mesh snapped_to_start(const Mesh& m, const Mesh& start) {
   return out;
 }
 
-// m: a changed candidate none of whose corners lies within this of a scan point the selection
-// used is a change the scan did not ask for (a roof re-cut far from every scanned facade): it
-// is fixed back to the starting shell and the program solved again.
+// m: a changed candidate with a corner farther than this from every scan point the selection
+// used, in plan, is a change the scan did not ask for (a roof re-cut far from every scanned
+// facade): it is fixed back to the starting shell and the program solved again. In plan, as the
+// roof above a moved facade must follow it however high it is.
 constexpr double kEvidenceReach = 2.0;
 
-// The changed candidates (selected != base) out of the evidence's reach.
+// The changed candidates (selected != base) reaching beyond the evidence.
 std::vector<int> changes_beyond_evidence(const CandidateSet& cs, const std::vector<char>& selected,
                                          const std::vector<char>& base, const std::vector<Vec3>& evidence) {
+  auto plan = [](const Vec3& p) { return Vec3(p.x(), p.y(), 0.0); };
   PointGrid grid(kEvidenceReach);
-  for (int i = 0; i < int(evidence.size()); ++i) grid.insert(evidence[i], i);
+  for (int i = 0; i < int(evidence.size()); ++i) grid.insert(plan(evidence[i]), i);
   std::vector<int> out;
   for (int f = 0; f < int(cs.faces.size()); ++f) {
     if (selected[f] == base[f]) continue;
-    bool reached = false;
     for (int v : cs.faces[f].v) {
-      reached = grid.visit_near(cs.vertices[v], [&](int i) {
-        return (evidence[i] - cs.vertices[v]).norm() <= kEvidenceReach;
-      });
-      if (reached) break;
+      const Vec3 q = plan(cs.vertices[v]);
+      if (!grid.visit_near(q, [&](int i) { return (plan(evidence[i]) - q).norm() <= kEvidenceReach; })) {
+        out.push_back(f);
+        break;
+      }
     }
-    if (!reached) out.push_back(f);
   }
   return out;
+}
+
+// Whether a vertex of `m` beyond kEvidenceReach (in plan) of every evidence point is not a
+// starting-shell vertex: the arrangement's plane meets stand in for the model there, and where
+// the scan says nothing the model must come out exactly as it went in.
+bool moves_beyond_evidence(const Mesh& m, const Mesh& start, const std::vector<Vec3>& evidence) {
+  auto plan = [](const Vec3& p) { return Vec3(p.x(), p.y(), 0.0); };
+  PointGrid near(kEvidenceReach), same(kSnapBack);
+  for (int i = 0; i < int(evidence.size()); ++i) near.insert(plan(evidence[i]), i);
+  for (int i = 0; i < int(start.vertices.size()); ++i) same.insert(start.vertices[i], i);
+  for (const Vec3& v : m.vertices) {
+    const Vec3 q = plan(v);
+    if (near.visit_near(q, [&](int i) { return (plan(evidence[i]) - q).norm() <= kEvidenceReach; })) continue;
+    if (!same.visit_near(v, [&](int i) { return start.vertices[i] == v; })) return true;
+  }
+  return false;
 }
 
 // The starting shell as a selection of candidates: its faces are unions of candidates up to
@@ -530,6 +547,8 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
     if (problem.empty()) {
       Mesh snapped = snapped_to_start(out.mesh, start);
       if (shell_problem(snapped, prm).empty()) out.mesh = std::move(snapped);
+      if (st.candidates_changed > 0 && moves_beyond_evidence(out.mesh, start, st.evidence))
+        problem = "it moves the model where the scan shows nothing";
     }
     if (problem.empty() || st.candidates_changed == 0 || warm.empty() || attempt == kRetries) break;
     for (int f = 0; f < int(cs.faces.size()); ++f)
