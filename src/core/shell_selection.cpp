@@ -42,7 +42,10 @@ Frame2 frame_of(const Plane& pl, const Vec3& centre) {
 }
 
 using CellSet = std::unordered_set<std::int64_t>;
-std::int64_t cell_key(long long i, long long j) { return (std::int64_t(i) << 32) ^ std::int64_t(std::uint32_t(j)); }
+// In unsigned arithmetic: shifting a negative index is undefined before C++20.
+std::int64_t cell_key(long long i, long long j) {
+  return std::int64_t((std::uint64_t(i) << 32) ^ std::uint64_t(std::uint32_t(j)));
+}
 
 // A point marks its cell and those within kFill cells: a facade's windows and the gaps of its
 // scan lines (up to about a metre) count as scanned, so that a scanned facade's coverage is near
