@@ -32,6 +32,20 @@ constexpr double kReturnStart = 0.1;
 constexpr double kMinReturnDepth = 0.3;
 // Adjacent walls turned less than this from the scanned one are no corner (cos 45 deg).
 constexpr double kMaxCornerCos = 0.707;
+// The open end: the strip past (and before) a facade's end that is looked at (m along the
+// facade), how far in front of the facade the street is looked at (m), and how much of it:
+// street ground past the end at least kStreetGoesOn of that before it (a tile edge or the end
+// of the drive cuts the ground too), things in front at the facade's height fewer than
+// kClearInFront of the facade's own points before the end (an occluder's shadow), nothing on
+// the facade's plane at its height past the end beyond stray points.
+constexpr double kStrip = 2.0;
+constexpr double kStreetNear = 0.3, kStreetFar = 10.0;
+constexpr double kGroundBand = 0.3;
+constexpr double kStreetGoesOn = 0.5;
+constexpr double kClearInFront = 0.05;
+// A facade the scan moves by this much on average is misplaced beyond doubt: scan planes are good
+// to a centimetre or two, airborne LoD2 facades are decimetres off.
+constexpr double kMisplacedFacade = 0.1;
 // Off the facade's plane means farther than this many RANSAC epsilons (its inliers lie within
 // one; two keep the plane's own noisy points out).
 constexpr double kOffPlaneEpsilons = 2.0;
@@ -86,6 +100,51 @@ bool shows_return(const PointCloud& cloud, const Plane& facade, const Plane& mov
          far - near >= kMinReturnDepth;
 }
 
+// The mean distance of a wall's vertices to a plane.
+double mean_offset(const Mesh& mesh, const ModelSurface& wall, const Plane& plane) {
+  double sum = 0.0;
+  int n = 0;
+  for (int f : wall.faces)
+    for (int v : mesh.faces[f].v) sum += std::abs(plane.distance(mesh.vertices[v])), ++n;
+  return n ? sum / n : 0.0;
+}
+
+// Points in the strips just past and just before a facade's end (t: position along the facade
+// towards the corner, measured from the wall's middle).
+struct EndStrips {
+  int street_past = 0, street_before = 0;  // ground in front of the facade
+  int front_past = 0;                      // in front of the facade at its height
+  int facade_past = 0, facade_before = 0;  // on the facade's plane at its height
+};
+
+EndStrips end_strips(const PointCloud& cloud, const Plane& facade, const Vec3& o, const Vec3& u, double s, double end,
+                     double z0, double z1, const Params& prm) {
+  const double za = z0 + kLowBand * (z1 - z0);
+  const double on_plane = std::max(kCornerTolerance, kOffPlaneEpsilons * prm.ransac_epsilon);
+  EndStrips e;
+  for (const auto& p : cloud.points) {
+    const double t = s * (p - o).dot(u) - end;
+    const bool past = t > kCornerTolerance && t <= kStrip, before = t < -kCornerTolerance && t >= -kStrip;
+    if (!past && !before) continue;
+    const double d = facade.distance(p);  // outwards: the street side
+    const bool in_front = d > kStreetNear && d < kStreetFar, high = p.z() > za && p.z() < z1;
+    if (in_front && p.z() < z0 + kGroundBand) ++(past ? e.street_past : e.street_before);
+    if (in_front && high && past) ++e.front_past;
+    if (std::abs(d) <= on_plane && high) ++(past ? e.facade_past : e.facade_before);
+  }
+  return e;
+}
+
+// Whether the facade's scan ends in the open: the scanner went on past the end (the street in
+// front continues), nothing in front hid the facade there, and no facade is seen beyond. This
+// is where a building ends -- or where a scan of a neighbour's facade was cut off, which looks
+// the same; so it counts only for a facade the scan itself found displaced, a building the
+// scan already shows mis-modelled (a correct building's facades all agree with the scan).
+bool ends_in_the_open(const EndStrips& e) {
+  return e.street_past >= kStreetGoesOn * e.street_before && e.front_past <= kClearInFront * e.facade_before &&
+         e.facade_past <= kStrayPoints;
+}
+
 }  // namespace
 
 std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
@@ -127,6 +186,7 @@ std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSu
         z1 = std::max(z1, p.z());
       }
     const double u_mid = 0.5 * (u0 + u1);
+    const bool facade_displaced = mean_offset(mesh, ws, w.plane) >= kMisplacedFacade;
     // The scan plane's points over the wall's height, along the facade.
     std::vector<double> pu, pz;
     for (int i : planes[w.scan_plane].inliers) {
@@ -165,7 +225,9 @@ std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSu
       // points end. A scan that just stops (tile edge, occlusion shadow, the vehicle turning)
       // or a neighbour's facade that runs on shows no return, and moves nothing.
       const Plane moved(as.plane.n, as.plane.d - as.plane.n.dot(s * gap * u));
-      if (!shows_return(cloud, w.plane, moved, side_of(mesh, as, w.plane), z0, z1, prm)) continue;
+      if (!shows_return(cloud, w.plane, moved, side_of(mesh, as, w.plane), z0, z1, prm) &&
+          !(facade_displaced && ends_in_the_open(end_strips(cloud, w.plane, o, u, s, end + s * u_mid, z0, z1, prm))))
+        continue;
       // The same end in every height band that has points.
       double lo = 1e300, hi = -1e300;
       int bands = 0;

@@ -139,6 +139,34 @@ const char* outcome_name(Outcome outcome) {
   return "?";
 }
 
+// The starting shell: every outdated wall takes its scan plane at once, the model's topology
+// kept (without the corner moves if those spoil it; else one wall at a time); none when no wall
+// is outdated or none could be moved. Records the moves made in `trace.facades`.
+std::optional<Mesh> starting_shell(const Mesh& current, const std::vector<ModelSurface>& surfaces,
+                                   const std::vector<WallMove>& moves, const std::vector<CornerMove>& corners,
+                                   const PointCloud& local, const std::vector<ScanPlane>& planes, const Params& prm,
+                                   RefineTrace& trace) {
+  std::vector<WallMove> all = moves;
+  for (const auto& c : corners) all.push_back(c.move);
+  std::optional<Mesh> refined;
+  trace.substitution.reset();
+  trace.substitution_without_corners.reset();
+  if (!all.empty())
+    refined = substitute_valid(current, surfaces, all, prm, trace.substitution.emplace(RefineTrace::Substitution{}));
+  if (refined) {
+    for (const auto& mv : moves) trace.facades.push_back(describe_move(current, surfaces, mv, "scan"));
+    for (const auto& c : corners) trace.facades.push_back(describe_move(current, surfaces, c.move, "corner"));
+  } else if (!corners.empty() && !moves.empty()) {
+    refined = substitute_valid(current, surfaces, moves, prm,
+                               trace.substitution_without_corners.emplace(RefineTrace::Substitution{}));
+    if (refined)
+      for (const auto& mv : moves) trace.facades.push_back(describe_move(current, surfaces, mv, "scan"));
+  }
+  trace.replacements.emplace();
+  if (!refined && !all.empty()) refined = one_wall_at_a_time(current, local, planes, prm, trace);
+  return refined;
+}
+
 Vec3 local_origin(const Mesh& model) {
   if (model.vertices.empty()) return Vec3::Zero();
   const Vec3 lo = bounding_box(model.vertices).min();
@@ -223,48 +251,42 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
   const auto corners = corner_moves(current, surfaces, scanned, local, planes, prm);
   lap("matching");
 
-  // The starting shell: every outdated wall takes its scan plane at once, the model's topology
-  // kept (without the corner moves if those spoil it; else one wall at a time); the input when
-  // no wall is outdated or none could be moved.
-  std::vector<WallMove> all = moves;
-  for (const auto& c : corners) all.push_back(c.move);
-  std::optional<Mesh> refined;
-  if (!all.empty())
-    refined = substitute_valid(current, surfaces, all, prm, trace.substitution.emplace(RefineTrace::Substitution{}));
-  if (refined) {
-    for (const auto& mv : moves) trace.facades.push_back(describe_move(current, surfaces, mv, "scan"));
-    for (const auto& c : corners) trace.facades.push_back(describe_move(current, surfaces, c.move, "corner"));
-  } else if (!corners.empty() && !moves.empty()) {
-    refined = substitute_valid(current, surfaces, moves, prm,
-                               trace.substitution_without_corners.emplace(RefineTrace::Substitution{}));
-    if (refined)
-      for (const auto& mv : moves) trace.facades.push_back(describe_move(current, surfaces, mv, "scan"));
-  }
-  trace.replacements.emplace();
-  if (!refined && !all.empty()) refined = one_wall_at_a_time(current, local, planes, prm, trace);
-  lap("substitution");
-
-  // The selection decides every face: the candidate arrangement over the starting shell's planes
-  // and the scan's facades, the starting shell as GLPK's first incumbent.
-  const ShellSelection chosen = select_shell(refined ? *refined : current, local, planes, prm);
-  trace.selection = chosen.stats;
-  trace.selection_reason = chosen.reason;
-  lap("selection");
-  if (!chosen.ok) return finish(Outcome::Kept, "the selection found no valid shell: " + chosen.reason, kept);
-  if (!refined && chosen.stats.candidates_changed == 0) {
+  // Substitution, selection and the never-worse judge, first with the corners the scan's ends
+  // show; the corners are the least certain evidence, so a refinement the judge refuses is tried
+  // once more on the walls' own points alone.
+  auto decide = [&](const std::vector<CornerMove>& with_corners) {
     trace.facades.clear();
-    return finish(Outcome::Kept, mr.matches.empty() ? "the selection kept the model (no wall matched a scan plane)"
-                                                    : "the selection kept the model (the scan agrees with it)", kept);
+    trace.judgement.reset();
+    const std::optional<Mesh> start = starting_shell(current, surfaces, moves, with_corners, local, planes, prm, trace);
+    lap("substitution");
+    // The selection decides every face: the candidate arrangement over the starting shell's
+    // planes and the scan's facades, the starting shell as GLPK's first incumbent.
+    const ShellSelection chosen = select_shell(start ? *start : current, local, planes, prm);
+    trace.selection = chosen.stats;
+    trace.selection_reason = chosen.reason;
+    lap("selection");
+    if (!chosen.ok) return finish(Outcome::Kept, "the selection found no valid shell: " + chosen.reason, kept);
+    if (!start && chosen.stats.candidates_changed == 0) {
+      trace.facades.clear();
+      return finish(Outcome::Kept, mr.matches.empty() ? "the selection kept the model (no wall matched a scan plane)"
+                                                      : "the selection kept the model (the scan agrees with it)", kept);
+    }
+    // Never worse: on every scan point near the building, and on each moved wall's own points.
+    std::vector<JudgedWall> moved;
+    for (const auto& f : trace.facades) moved.push_back(f.wall);
+    const Judgement& verdict = trace.judgement.emplace(judge_refinement(kept, chosen.mesh, moved, local, prm));
+    if (!verdict.ok)
+      return finish(Outcome::Kept, "not written: never worse, " + verdict.check + " check: " + verdict.detail, kept);
+    return finish(Outcome::Refined, std::to_string(chosen.stats.faces_from_selection) + " face(s) selected, " +
+                                        std::to_string(trace.facades.size()) + " wall(s) moved", chosen.mesh);
+  };
+  RefineResult result = decide(corners);
+  if (!corners.empty() && trace.judgement && !trace.judgement->ok) {
+    trace.corners_refused = trace.judgement->check + " check: " + trace.judgement->detail;
+    trace.seconds.pop_back();  // the first attempt's total
+    result = decide({});
   }
-
-  // Never worse: on every scan point near the building, and on each moved wall's own points.
-  std::vector<JudgedWall> moved;
-  for (const auto& f : trace.facades) moved.push_back(f.wall);
-  const Judgement& verdict = trace.judgement.emplace(judge_refinement(kept, chosen.mesh, moved, local, prm));
-  if (!verdict.ok)
-    return finish(Outcome::Kept, "not written: never worse, " + verdict.check + " check: " + verdict.detail, kept);
-  return finish(Outcome::Refined, std::to_string(chosen.stats.faces_from_selection) + " face(s) selected, " +
-                                      std::to_string(trace.facades.size()) + " wall(s) moved", chosen.mesh);
+  return result;
 }
 
 }  // namespace lodrefine

@@ -81,7 +81,7 @@ json refine_report(const RefineResult& r) {
   rep["output_validation"] = validation_json(t.output_validation);
   rep["faces"] = t.faces;
   json seconds = json::object();
-  for (const auto& [stage, s] : t.seconds) seconds[stage] = s;
+  for (const auto& [stage, s] : t.seconds) seconds[stage] = seconds.value(stage, 0.0) + s;  // a retry's laps add up
   rep["seconds"] = seconds;
   if (t.repair) {
     const RepairReport& rr = *t.repair;
@@ -139,6 +139,7 @@ json refine_report(const RefineResult& r) {
     for (const auto& w : t.judgement->walls) walls.push_back(fit(w));
     rep["judgement"] = {{"ok", t.judgement->ok}, {"check", t.judgement->check}, {"detail", t.judgement->detail},
                         {"building", fit(t.judgement->building)}, {"walls", walls}};
+    if (t.corners_refused) rep["judgement"]["corners_refused"] = *t.corners_refused;
   }
   if (t.selection) rep["selection"] = selection_json(*t.selection, t.selection_reason);
   return rep;

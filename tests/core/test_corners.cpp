@@ -38,9 +38,10 @@ struct Scene {
   std::vector<ScannedWall> scanned;
 };
 
-// The front facade scanned from x = 0 to x = `end`; optionally the right side wall seen
-// obliquely for `side` metres behind the facade at x = `end`.
-Scene scene(double end, double side) {
+// The front facade scanned from x = 0 to x = `end`, `offset` metres in front of the model's
+// (a misplaced model facade when > 0); optionally the right side wall seen obliquely for `side`
+// metres behind the facade at x = `end`.
+Scene scene(double end, double side, double offset = 0.0) {
   Scene s;
   s.mesh = box();
   s.surfaces = model_surfaces(s.mesh);
@@ -50,16 +51,22 @@ Scene scene(double end, double side) {
   for (double x = 0.02; x < end; x += 0.05)
     for (double z = 0.1; z < 5.9; z += 0.05) {
       sp.inliers.push_back(int(s.cloud.points.size()));
-      s.cloud.points.emplace_back(x, noise(rng), z);
+      s.cloud.points.emplace_back(x, -offset + noise(rng), z);
     }
   for (double y = 0.05; y < side; y += 0.05)
     for (double z = 0.1; z < 5.9; z += 0.05) s.cloud.points.emplace_back(end + noise(rng), y, z);
-  sp.plane = Plane(Vec3(0, -1, 0), 0.0);
+  sp.plane = Plane(Vec3(0, -1, 0), -offset);
   sp.facade = true;
   s.planes.push_back(sp);
   for (int k = 0; k < int(s.surfaces.size()); ++k)
     if (s.surfaces[k].plane.n.y() < -0.99) s.scanned.push_back({k, 0, sp.plane});
   return s;
+}
+
+// The street in front of the facade, scanned from x = -3 to x = `to`.
+void add_street(Scene& s, double to) {
+  for (double x = -3.0; x < to; x += 0.1)
+    for (double y = -1.0; y > -8.0; y -= 0.1) s.cloud.points.emplace_back(x, y, 0.02);
 }
 
 }  // namespace
@@ -129,5 +136,41 @@ TEST(Corners, PointsSeenBehindTheFacadePastItsEndAreNoEvidence) {
   Scene s = scene(11.8, 0.0);
   for (double x = 11.8; x < 16.0; x += 0.05)
     for (double z = 0.1; z < 5.9; z += 0.05) s.cloud.points.emplace_back(x, 2.0, z);
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
+}
+
+// A facade the scan moves 0.4 m, whose points end 0.7 m short of the model's corner with the
+// street scanned on past the end and nothing in front or beyond: the building ends there (the
+// side wall itself was not scanned), and the model is already known to be misplaced.
+TEST(Corners, AMisplacedFacadeEndingInTheOpenMovesTheSideWall) {
+  Scene s = scene(11.3, 0.0, 0.4);
+  add_street(s, 16.0);
+  const auto moves = corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{});
+  ASSERT_EQ(moves.size(), 1u);
+  EXPECT_NEAR(moves[0].move.plane.distance(Vec3(11.3, 0, 0)), 0.0, 0.06);
+  EXPECT_NEAR(moves[0].shift, -0.7, 0.06);
+}
+
+// The same end in the open on a facade the scan confirms: a correct building whose facade scan
+// was cut off (a neighbour's facade scanned in part, on the city tile) keeps its side wall.
+TEST(Corners, ACorrectFacadeEndingInTheOpenMovesNothing) {
+  Scene s = scene(11.3, 0.0);
+  add_street(s, 16.0);
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
+}
+
+// A misplaced facade cut at the tile's edge: the street ends where the facade's points do.
+TEST(Corners, AMisplacedFacadeCutAtTheTileEdgeMovesNothing) {
+  Scene s = scene(11.3, 0.0, 0.4);
+  add_street(s, 11.3);
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
+}
+
+// A misplaced facade whose last metre is hidden by a van parked in front of it.
+TEST(Corners, AMisplacedFacadeShadowedByAVanMovesNothing) {
+  Scene s = scene(11.3, 0.0, 0.4);
+  add_street(s, 16.0);
+  for (double x = 11.3; x < 13.5; x += 0.05)
+    for (double z = 0.1; z < 2.5; z += 0.05) s.cloud.points.emplace_back(x, -2.0, z);
   EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
 }

@@ -88,6 +88,28 @@ TEST(Refine, MovesAnOutdatedFacadeOntoTheScan) {
   for (const auto& p : r.mesh.vertices) EXPECT_LE(p.z() - kOrigin.z(), 7.0 + 1e-6);  // roof kept
 }
 
+// The front facade is 0.5 m out; its scan ends in the open 0.8 m short of the right corner (the
+// street goes on), but a few points of the side wall itself (too few for a plane) stand where
+// the model has it. The corner move makes those farther, so the judge refuses it, and the
+// building is refined once more on the facade's own points: the facade moves, the side stays.
+TEST(Refine, ACornerMoveTheJudgeRefusesIsDroppedAndTheFacadeStillMoves) {
+  const Mesh coarse = box_soup(0, 12, -0.5, 8, 7);
+  PointCloud cloud = scan_front(0.0, 0.02, 11.2, 5.0, 3);
+  for (double x = 11.3; x < 15.0; x += 0.1)  // the street goes on
+    for (double y = -6.0; y < -0.3; y += 0.1) cloud.points.push_back(Vec3(x, y, 0.0) + kOrigin);
+  for (double y = 0.2; y < 1.9; y += 0.2)
+    for (double z = 1.0; z < 5.1; z += 0.4) cloud.points.push_back(Vec3(12.0, y, z) + kOrigin);
+  const RefineResult r = refine_building(coarse, cloud, Params{});
+  ASSERT_TRUE(r.valid) << r.reason;
+  ASSERT_EQ(r.outcome, Outcome::Refined) << r.reason;
+  ASSERT_TRUE(r.trace.corners_refused.has_value());
+  EXPECT_NE(r.trace.corners_refused->find("wall check"), std::string::npos) << *r.trace.corners_refused;
+  EXPECT_LT(max_abs_y_of_front(r.mesh, 0.0), 0.02);
+  double x_max = -1e9;
+  for (const auto& p : r.mesh.vertices) x_max = std::max(x_max, p.x() - kOrigin.x());
+  EXPECT_NEAR(x_max, 12.0, 0.01) << "the side wall stays";
+}
+
 TEST(Refine, MovesAFacadeInwardsAndKeepsTheRest) {
   const Mesh coarse = box_soup(0, 12, 0.6, 8, 7);  // front wall 0.6 m too far in
   const PointCloud cloud = scan_front(0.0, 0.5, 11.5, 5.0, 2);

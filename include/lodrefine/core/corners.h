@@ -2,9 +2,14 @@
 // is; when it ends short of the model's corner (or runs on a little past it, then stops), the
 // adjacent wall that was not scanned is misplaced, and moves so that the corner is where the
 // scan says. Evidence must hold over the facade's height (an occluding car or tree does not),
-// and the scan must show the corner: points on the side wall's new plane where the facade's
-// points end (the return). A scan that just stops (tile or crop edge, occlusion shadow, the
-// vehicle turning) or a neighbour's facade running on past the outline moves no wall.
+// and the scan must show the corner, one of:
+//  - the return: points on the side wall's new plane where the facade's points end;
+//  - an open end on a facade the scan itself moves by decimetres: the street scanned on past the
+//    end, nothing in front hiding the facade there, no facade beyond. Open ends look the same
+//    where a scan of a correct neighbour was cut off, so they count only on a building the scan
+//    already shows mis-modelled.
+// A scan that just stops (tile or crop edge, occlusion shadow, the vehicle turning) or a
+// neighbour's facade running on past the outline moves no wall.
 #pragma once
 #include <vector>
 

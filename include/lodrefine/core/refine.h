@@ -77,6 +77,9 @@ struct RefineTrace {
   std::optional<std::vector<Step>> replacements;  // set together with `facades`
   std::vector<FacadeMove> facades;
   std::optional<Judgement> judgement;  // never worse (judge.h), when a refinement was made
+  // The judge's refusal of the refinement with the corner moves, when it was tried again
+  // without them (the judgement above is then the second attempt's).
+  std::optional<std::string> corners_refused;
   std::optional<ShellSelectionStats> selection;  // the program that chose the output's faces
   std::string selection_reason;                  // why it gave no shell, when it did not
 
