@@ -396,22 +396,36 @@ Mesh snapped_to_start(const Mesh& m, const Mesh& start) {
 // roof above a moved facade must follow it however high it is.
 constexpr double kEvidenceReach = 2.0;
 
+// The scan points the selection used, in plan: built once per building, asked whether a point
+// lies within kEvidenceReach of one.
+class EvidenceReach {
+ public:
+  explicit EvidenceReach(const std::vector<Vec3>& evidence) : grid_(kEvidenceReach) {
+    for (const auto& p : evidence) plan_.push_back(plan(p));
+    for (int i = 0; i < int(plan_.size()); ++i) grid_.insert(plan_[i], i);
+  }
+  bool reaches(const Vec3& p) const {
+    const Vec3 q = plan(p);
+    return grid_.visit_near(q, [&](int i) { return (plan_[i] - q).norm() <= kEvidenceReach; });
+  }
+
+ private:
+  static Vec3 plan(const Vec3& p) { return Vec3(p.x(), p.y(), 0.0); }
+  std::vector<Vec3> plan_;
+  PointGrid grid_;
+};
+
 // The changed candidates (selected != base) reaching beyond the evidence.
 std::vector<int> changes_beyond_evidence(const CandidateSet& cs, const std::vector<char>& selected,
-                                         const std::vector<char>& base, const std::vector<Vec3>& evidence) {
-  auto plan = [](const Vec3& p) { return Vec3(p.x(), p.y(), 0.0); };
-  PointGrid grid(kEvidenceReach);
-  for (int i = 0; i < int(evidence.size()); ++i) grid.insert(plan(evidence[i]), i);
+                                         const std::vector<char>& base, const EvidenceReach& evidence) {
   std::vector<int> out;
   for (int f = 0; f < int(cs.faces.size()); ++f) {
     if (selected[f] == base[f]) continue;
-    for (int v : cs.faces[f].v) {
-      const Vec3 q = plan(cs.vertices[v]);
-      if (!grid.visit_near(q, [&](int i) { return (plan(evidence[i]) - q).norm() <= kEvidenceReach; })) {
+    for (int v : cs.faces[f].v)
+      if (!evidence.reaches(cs.vertices[v])) {
         out.push_back(f);
         break;
       }
-    }
   }
   return out;
 }
@@ -419,14 +433,11 @@ std::vector<int> changes_beyond_evidence(const CandidateSet& cs, const std::vect
 // Whether a vertex of `m` beyond kEvidenceReach (in plan) of every evidence point is not a
 // starting-shell vertex: the arrangement's plane meets stand in for the model there, and where
 // the scan says nothing the model must come out exactly as it went in.
-bool moves_beyond_evidence(const Mesh& m, const Mesh& start, const std::vector<Vec3>& evidence) {
-  auto plan = [](const Vec3& p) { return Vec3(p.x(), p.y(), 0.0); };
-  PointGrid near(kEvidenceReach), same(kSnapBack);
-  for (int i = 0; i < int(evidence.size()); ++i) near.insert(plan(evidence[i]), i);
+bool moves_beyond_evidence(const Mesh& m, const Mesh& start, const EvidenceReach& evidence) {
+  PointGrid same(kSnapBack);
   for (int i = 0; i < int(start.vertices.size()); ++i) same.insert(start.vertices[i], i);
   for (const Vec3& v : m.vertices) {
-    const Vec3 q = plan(v);
-    if (near.visit_near(q, [&](int i) { return (plan(evidence[i]) - q).norm() <= kEvidenceReach; })) continue;
+    if (evidence.reaches(v)) continue;
     if (!same.visit_near(v, [&](int i) { return start.vertices[i] == v; })) return true;
   }
   return false;
@@ -528,6 +539,7 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   // is excluded: its changes from the starting shell are fixed back, and the program solved
   // again (at most kRetries times).
   const std::vector<char>& base = warm.empty() ? d.in_start : warm;
+  const EvidenceReach evidence(st.evidence);
   std::string problem;
   int beyond_rounds = 0;  // solves redone for changes beyond the evidence (not counted as attempts)
   for (int attempt = 0;; ++attempt) {
@@ -535,7 +547,7 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
     const auto& sel = st.selection;
     if (!sel.ok) return finish("face selection " + sel.status_text());
     if (!warm.empty() && beyond_rounds < kRetries) {
-      const std::vector<int> beyond = changes_beyond_evidence(cs, sel.selected, base, st.evidence);
+      const std::vector<int> beyond = changes_beyond_evidence(cs, sel.selected, base, evidence);
       if (!beyond.empty()) {
         for (int f : beyond) pg.fixed[f] = int(base[f]);
         ++beyond_rounds, --attempt;
@@ -550,7 +562,7 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
     if (problem.empty()) {
       Mesh snapped = snapped_to_start(out.mesh, start);
       if (shell_problem(snapped, prm).empty()) out.mesh = std::move(snapped);
-      if (st.candidates_changed > 0 && moves_beyond_evidence(out.mesh, start, st.evidence))
+      if (st.candidates_changed > 0 && moves_beyond_evidence(out.mesh, start, evidence))
         problem = "it moves the model where the scan shows nothing";
     }
     if (problem.empty() || st.candidates_changed == 0 || warm.empty() || attempt == kRetries) break;
