@@ -29,6 +29,7 @@ json selection_json(const ShellSelectionStats& st, const std::string& reason) {
   const SelectionResult& m = st.selection;
   json j = {{"status", m.status_text()},
             {"candidates", st.candidates},
+            {"candidates_pruned", st.candidates_pruned},
             {"edges", st.edges},
             {"supporting_planes", st.supporting_planes},
             {"scan_planes_added", st.scan_planes_added},
