@@ -51,15 +51,11 @@ void run(const BenchArgs& a) {
       const RefineTrace& t = r.trace;
       int cand = 0, vars = 0;
       double mip = 0.0;
-      if (t.replacements)
-        for (const auto& st : *t.replacements) {
-          if (!st.arrangement) continue;
-          cand += st.arrangement->candidates.value_or(0);
-          if (st.arrangement->selection) {
-            vars += st.arrangement->selection->variables;
-            mip += st.arrangement->selection->seconds;
-          }
-        }
+      if (t.selection) {
+        cand = t.selection->candidates;
+        vars = t.selection->selection.variables;
+        mip = t.selection->selection.seconds;
+      }
       // Accuracy in a local frame: points on the truth's scanned walls to each model.
       const Vec3 o = local_origin(b.truth);
       PointCloud local_cloud = b.cloud;

@@ -3,7 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
+#include <numeric>
 
 #include "lodrefine/core/topology.h"
 
@@ -47,9 +47,18 @@ Region Region::around(const std::vector<Vec3>& pts, double relative, double abso
   return r;
 }
 
+std::vector<int> CandidateSet::corners(int f) const {
+  std::vector<int> out;
+  if (f >= int(mesh.number_of_faces())) return out;
+  const auto point = mesh.property_map<CandidateMesh::Vertex_index, int>("v:point").first;
+  for (auto h : CGAL::halfedges_around_face(mesh.halfedge(CandidateMesh::Face_index(f)), mesh))
+    out.push_back(point[mesh.source(h)]);
+  return out;
+}
+
 std::vector<Vec3> CandidateSet::polygon(int f) const {
   std::vector<Vec3> pts;
-  for (int i : faces[f].v) pts.push_back(vertices[i]);
+  for (int i : corners(f)) pts.push_back(vertices[i]);
   return pts;
 }
 
@@ -141,6 +150,91 @@ std::vector<Vec3> region_section(const Plane& plane, const Region& region) {
   return w.p;
 }
 
+namespace {
+
+// The pieces as faces of `cs.mesh`, one component per supporting plane (`corners[f]`: piece f's
+// corners in `cs.vertices`, its plane cs.faces[f].plane; pieces come plane by plane). A piece the
+// component cannot take (it would make the component non-manifold: overlapping slivers, a corner
+// repeated) becomes a component of its own; the fans are by point, so its edges still count.
+void build_mesh(CandidateSet& cs, const std::vector<std::vector<int>>& corners) {
+  auto support = cs.mesh.add_property_map<CandidateMesh::Face_index, int>("f:support", -1).first;
+  auto point = cs.mesh.add_property_map<CandidateMesh::Vertex_index, int>("v:point", -1).first;
+  std::vector<CandidateMesh::Vertex_index> of_point(cs.vertices.size());
+  std::vector<int> plane_of_vertex(cs.vertices.size(), -1);
+  auto new_vertex = [&](int id) {
+    const Vec3& x = cs.vertices[id];
+    const auto v = cs.mesh.add_vertex(CandidateMesh::Point(x.x(), x.y(), x.z()));
+    point[v] = id;
+    return v;
+  };
+  for (int f = 0; f < int(corners.size()); ++f) {
+    const int k = cs.faces[f].plane;
+    std::vector<CandidateMesh::Vertex_index> vs;
+    for (int id : corners[f]) {
+      if (plane_of_vertex[id] != k) of_point[id] = new_vertex(id), plane_of_vertex[id] = k;
+      vs.push_back(of_point[id]);
+    }
+    auto face = cs.mesh.add_face(vs);
+    if (face == CandidateMesh::null_face()) {
+      for (auto& v : vs) v = new_vertex(point[v]);
+      face = cs.mesh.add_face(vs);
+    }
+    support[face] = k;
+  }
+}
+
+// The fans (CGAL's extract_adjacency): every halfedge of a face, by the points at its ends; the
+// edges in order of their first appearance (faces in order, each from its first corner).
+void build_fans(CandidateSet& cs, const std::vector<std::vector<int>>& corners) {
+  const auto point = cs.mesh.property_map<CandidateMesh::Vertex_index, int>("v:point").first;
+  struct Side {
+    int a, b, face, order;
+  };
+  std::vector<Side> sides;
+  for (auto f : cs.mesh.faces())
+    for (auto h : CGAL::halfedges_around_face(cs.mesh.halfedge(f), cs.mesh)) {
+      const int s = point[cs.mesh.source(h)], t = point[cs.mesh.target(h)];
+      sides.push_back({std::min(s, t), std::max(s, t), int(f), 0});
+    }
+  // halfedges_around_face starts where Surface_mesh put the face's halfedge: order each face's
+  // sides from its first corner, as the pieces were cut.
+  for (std::size_t i = 0, f = 0; i < sides.size(); ++f) {
+    const std::vector<int> c = cs.corners(int(f));  // from the face's halfedge
+    const int shift = int(std::find(c.begin(), c.end(), corners[f][0]) - c.begin());
+    const int n = int(c.size());
+    for (int k = 0; k < n; ++k) sides[i + k].order = int(i) + (k + n - shift) % n;
+    i += n;
+  }
+  std::vector<int> by_end(sides.size());
+  std::iota(by_end.begin(), by_end.end(), 0);
+  std::stable_sort(by_end.begin(), by_end.end(), [&](int x, int y) {
+    return std::tie(sides[x].a, sides[x].b, sides[x].order) < std::tie(sides[y].a, sides[y].b, sides[y].order);
+  });
+  std::vector<std::pair<int, CandidateEdge>> fans;  // first appearance, fan
+  const auto box = cs.region.planes();
+  for (std::size_t i = 0; i < by_end.size();) {
+    const Side& s = sides[by_end[i]];
+    CandidateEdge e;
+    e.a = s.a;
+    e.b = s.b;
+    e.length = (cs.vertices[s.a] - cs.vertices[s.b]).norm();
+    for (int bp = 0; bp < 6; ++bp)
+      if (std::abs(box[bp].distance(cs.vertices[s.a])) < kVertexWeld && std::abs(box[bp].distance(cs.vertices[s.b])) < kVertexWeld)
+        e.box_plane = bp;
+    int first = s.order;
+    for (; i < by_end.size() && sides[by_end[i]].a == s.a && sides[by_end[i]].b == s.b; ++i) {
+      e.faces.push_back(sides[by_end[i]].face);
+      first = std::min(first, sides[by_end[i]].order);
+    }
+    std::sort(e.faces.begin(), e.faces.end());
+    fans.emplace_back(first, std::move(e));
+  }
+  std::sort(fans.begin(), fans.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  for (auto& [first, e] : fans) cs.edges.push_back(std::move(e));
+}
+
+}  // namespace
+
 CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Region& region, double min_area) {
   CandidateSet cs;
   cs.planes = planes;
@@ -151,6 +245,7 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
   for (const auto& b : region.planes()) bank.all.push_back(b);
 
   PointWelder welder(kVertexWeld);
+  std::vector<std::vector<int>> corners;  // per piece, in `welder`
   for (int i = 0; i < int(planes.size()); ++i) {
     std::vector<WorkPolygon> pieces{section(i, bank, region, first_box)};
     if (pieces[0].p.size() < 3) continue;
@@ -168,54 +263,59 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
       if (polygon_area(w.p) < min_area) continue;
       Candidate c;
       c.plane = i;
-      for (const auto& x : w.p) c.v.push_back(welder.add(x));
-      drop_repeats(c.v);
-      if (c.v.size() < 3) continue;
+      std::vector<int> v;
+      for (const auto& x : w.p) v.push_back(welder.add(x));
+      drop_repeats(v);
+      if (v.size() < 3) continue;
       std::vector<Vec3> poly;
-      for (int id : c.v) poly.push_back(welder.points()[id]);
-      if (newell_normal(poly).dot(planes[i].plane.n) < 0) std::reverse(c.v.begin(), c.v.end());
+      for (int id : v) poly.push_back(welder.points()[id]);
+      if (newell_normal(poly).dot(planes[i].plane.n) < 0) std::reverse(v.begin(), v.end());
       c.area = polygon_area(poly);
       c.centroid = polygon_centroid(poly);
       cs.faces.push_back(std::move(c));
+      corners.push_back(std::move(v));
     }
   }
   cs.vertices = welder.points();
 
   // Where a vertex of one face lies inside another face's edge (several planes meeting at a
   // point along the line), split that edge so that adjacency is exact.
-  for (auto& f : cs.faces) {
+  for (auto& v : corners) {
     std::vector<int> out;
-    for (std::size_t k = 0; k < f.v.size(); ++k) {
-      const int a = f.v[k], b = f.v[(k + 1) % f.v.size()];
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      const int a = v[k], b = v[(k + 1) % v.size()];
       out.push_back(a);
       for (int x : vertices_on_segment(cs.vertices, a, b, SegmentRule{kVertexWeld, false, kEdgeEndShare})) out.push_back(x);
     }
-    f.v = out;
+    v = out;
   }
-
-  std::map<std::pair<int, int>, int> edge_index;
-  const auto box = region.planes();
-  for (int f = 0; f < int(cs.faces.size()); ++f) {
-    const auto& v = cs.faces[f].v;
-    for (std::size_t k = 0; k < v.size(); ++k) {
-      const int a = v[k], b = v[(k + 1) % v.size()];
-      const auto key = std::make_pair(std::min(a, b), std::max(a, b));
-      auto [it, fresh] = edge_index.emplace(key, int(cs.edges.size()));
-      if (fresh) {
-        CandidateEdge e;
-        e.a = key.first;
-        e.b = key.second;
-        e.length = (cs.vertices[a] - cs.vertices[b]).norm();
-        for (int bp = 0; bp < 6; ++bp)
-          if (std::abs(box[bp].distance(cs.vertices[a])) < kVertexWeld &&
-              std::abs(box[bp].distance(cs.vertices[b])) < kVertexWeld)
-            e.box_plane = bp;
-        cs.edges.push_back(e);
-      }
-      cs.edges[it->second].faces.push_back(f);
-    }
-  }
+  build_mesh(cs, corners);
+  build_fans(cs, corners);
   return cs;
+}
+
+CandidateSet kept_candidates(const CandidateSet& cs, const std::vector<char>& keep) {
+  CandidateSet out;
+  out.planes = cs.planes;
+  out.region = cs.region;
+  out.vertices = cs.vertices;
+  std::vector<int> index(cs.faces.size(), -1);
+  std::vector<std::vector<int>> corners;
+  for (int f = 0; f < int(cs.faces.size()); ++f) {
+    if (!keep[f]) continue;
+    index[f] = int(out.faces.size());
+    out.faces.push_back(cs.faces[f]);
+    corners.push_back(cs.corners(f));
+  }
+  build_mesh(out, corners);
+  for (const auto& e : cs.edges) {
+    CandidateEdge k = e;
+    k.faces.clear();
+    for (int f : e.faces)
+      if (index[f] >= 0) k.faces.push_back(index[f]);
+    if (!k.faces.empty()) out.edges.push_back(std::move(k));
+  }
+  return out;
 }
 
 }  // namespace lodrefine

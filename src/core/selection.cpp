@@ -4,6 +4,8 @@
 
 #include <glpk.h>
 
+#include "lodrefine/core/candidates.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -114,6 +116,7 @@ SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& pg,
     if (fixed_value(f) >= 0) ++res.fixed, res.selected[f] = char(fixed_value(f));
     else col[f] = ++free_faces;
   }
+  res.column = col;
   auto done = [&](SolveStatus status) {
     res.status = status;
     res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

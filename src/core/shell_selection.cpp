@@ -307,8 +307,9 @@ CandidateData describe_candidates(const CandidateSet& cs, const Mesh& start, con
   d.in_zone.assign(nf, 0);
   for (int f = 0; f < nf; ++f) {
     const int k = cs.faces[f].plane;
+    const std::vector<int> corners = cs.corners(f);
     std::vector<Vec2> poly;
-    for (int v : cs.faces[f].v) poly.push_back(frames[k](cs.vertices[v]));
+    for (int v : corners) poly.push_back(frames[k](cs.vertices[v]));
     const Vec2 c = frames[k](cs.faces[f].centroid);
     for (const auto& [sf, sp] : start_faces[k])
       if (point_in_polygon_2d(c, sp)) {
@@ -320,7 +321,7 @@ CandidateData describe_candidates(const CandidateSet& cs, const Mesh& start, con
     const double prior = d.in_start[f] ? 1.0 - share(poly, other[k]) : 0.0;
     d.confidence[f] = std::max(scanned, prior);
     std::vector<Vec3> pts{cs.faces[f].centroid};
-    for (int v : cs.faces[f].v) pts.push_back(cs.vertices[v]);
+    for (int v : corners) pts.push_back(cs.vertices[v]);
     for (const auto& z : zones)
       for (const auto& p : pts) d.in_zone[f] = d.in_zone[f] || z.contains(cs.region.axes.transpose() * p);
   }
@@ -332,17 +333,54 @@ CandidateData describe_candidates(const CandidateSet& cs, const Mesh& start, con
 // reader's weld collapses; the output is validated after this weld.
 constexpr double kOutputWeld = 1e-3;
 
-// The selected candidates as one mesh on the arrangement's own vertices (those within
-// kOutputWeld joined), oriented outward, coplanar neighbours merged.
-Mesh assemble(const CandidateSet& cs, const std::vector<char>& selected, const CandidateData& d, const Mesh& start,
-              const Supports& s) {
+// The candidates' own vectors for the faces and the program (kept_candidates for pruning).
+CandidateData kept(const CandidateData& d, const std::vector<char>& keep) {
+  CandidateData out;
+  for (std::size_t f = 0; f < keep.size(); ++f) {
+    if (!keep[f]) continue;
+    out.in_start.push_back(d.in_start[f]);
+    out.start_face.push_back(d.start_face[f]);
+    out.confidence.push_back(d.confidence[f]);
+    out.in_zone.push_back(d.in_zone[f]);
+  }
+  return out;
+}
+
+std::vector<char> kept(const std::vector<char>& v, const std::vector<char>& keep) {
+  std::vector<char> out;
+  for (std::size_t f = 0; f < v.size(); ++f)
+    if (keep[f]) out.push_back(v[f]);
+  return out;
+}
+
+// The program's figures per candidate as property maps of the candidate mesh: "f:confidence"
+// (the data term's c), "f:variable" (GLPK column, 0: fixed) and "f:chosen" (selected).
+using FaceIndex = CandidateMesh::Face_index;
+void record_confidence(CandidateSet& cs, const std::vector<double>& confidence) {
+  auto map = cs.mesh.add_property_map<FaceIndex, double>("f:confidence", 0.0).first;
+  for (auto f : cs.mesh.faces()) map[f] = confidence[std::size_t(f)];
+}
+
+void record_selection(CandidateSet& cs, const SelectionResult& sel) {
+  auto variable = cs.mesh.add_property_map<FaceIndex, int>("f:variable", 0).first;
+  auto chosen = cs.mesh.add_property_map<FaceIndex, bool>("f:chosen", false).first;
+  for (auto f : cs.mesh.faces()) {
+    variable[f] = sel.column.empty() ? 0 : sel.column[std::size_t(f)];
+    chosen[f] = sel.selected[std::size_t(f)] != 0;
+  }
+}
+
+// The chosen candidates (the mesh's "f:chosen") as one mesh on the arrangement's own vertices
+// (those within kOutputWeld joined), oriented outward, coplanar neighbours merged.
+Mesh assemble(const CandidateSet& cs, const CandidateData& d, const Mesh& start, const Supports& s) {
   Mesh m;
   m.id = start.id;
+  const auto chosen = cs.mesh.property_map<FaceIndex, bool>("f:chosen").first;
   PointWelder welder(kOutputWeld);
   for (int f = 0; f < int(cs.faces.size()); ++f) {
-    if (!selected[f]) continue;
+    if (!chosen[FaceIndex(f)]) continue;
     Face face;
-    for (int v : cs.faces[f].v) face.v.push_back(welder.add(cs.vertices[v]));
+    for (int v : cs.corners(f)) face.v.push_back(welder.add(cs.vertices[v]));
     drop_repeats(face.v);
     const int k = cs.faces[f].plane;
     face.sem = k < s.start_planes ? s.planes[k].sem : Semantic::Wall;
@@ -396,22 +434,36 @@ Mesh snapped_to_start(const Mesh& m, const Mesh& start) {
 // roof above a moved facade must follow it however high it is.
 constexpr double kEvidenceReach = 2.0;
 
+// The scan points the selection used, in plan: built once per building, asked whether a point
+// lies within kEvidenceReach of one.
+class EvidenceReach {
+ public:
+  explicit EvidenceReach(const std::vector<Vec3>& evidence) : grid_(kEvidenceReach) {
+    for (const auto& p : evidence) plan_.push_back(plan(p));
+    for (int i = 0; i < int(plan_.size()); ++i) grid_.insert(plan_[i], i);
+  }
+  bool reaches(const Vec3& p) const {
+    const Vec3 q = plan(p);
+    return grid_.visit_near(q, [&](int i) { return (plan_[i] - q).norm() <= kEvidenceReach; });
+  }
+
+ private:
+  static Vec3 plan(const Vec3& p) { return Vec3(p.x(), p.y(), 0.0); }
+  std::vector<Vec3> plan_;
+  PointGrid grid_;
+};
+
 // The changed candidates (selected != base) reaching beyond the evidence.
 std::vector<int> changes_beyond_evidence(const CandidateSet& cs, const std::vector<char>& selected,
-                                         const std::vector<char>& base, const std::vector<Vec3>& evidence) {
-  auto plan = [](const Vec3& p) { return Vec3(p.x(), p.y(), 0.0); };
-  PointGrid grid(kEvidenceReach);
-  for (int i = 0; i < int(evidence.size()); ++i) grid.insert(plan(evidence[i]), i);
+                                         const std::vector<char>& base, const EvidenceReach& evidence) {
   std::vector<int> out;
   for (int f = 0; f < int(cs.faces.size()); ++f) {
     if (selected[f] == base[f]) continue;
-    for (int v : cs.faces[f].v) {
-      const Vec3 q = plan(cs.vertices[v]);
-      if (!grid.visit_near(q, [&](int i) { return (plan(evidence[i]) - q).norm() <= kEvidenceReach; })) {
+    for (int v : cs.corners(f))
+      if (!evidence.reaches(cs.vertices[v])) {
         out.push_back(f);
         break;
       }
-    }
   }
   return out;
 }
@@ -419,14 +471,11 @@ std::vector<int> changes_beyond_evidence(const CandidateSet& cs, const std::vect
 // Whether a vertex of `m` beyond kEvidenceReach (in plan) of every evidence point is not a
 // starting-shell vertex: the arrangement's plane meets stand in for the model there, and where
 // the scan says nothing the model must come out exactly as it went in.
-bool moves_beyond_evidence(const Mesh& m, const Mesh& start, const std::vector<Vec3>& evidence) {
-  auto plan = [](const Vec3& p) { return Vec3(p.x(), p.y(), 0.0); };
-  PointGrid near(kEvidenceReach), same(kSnapBack);
-  for (int i = 0; i < int(evidence.size()); ++i) near.insert(plan(evidence[i]), i);
+bool moves_beyond_evidence(const Mesh& m, const Mesh& start, const EvidenceReach& evidence) {
+  PointGrid same(kSnapBack);
   for (int i = 0; i < int(start.vertices.size()); ++i) same.insert(start.vertices[i], i);
   for (const Vec3& v : m.vertices) {
-    const Vec3 q = plan(v);
-    if (near.visit_near(q, [&](int i) { return (plan(evidence[i]) - q).norm() <= kEvidenceReach; })) continue;
+    if (evidence.reaches(v)) continue;
     if (!same.visit_near(v, [&](int i) { return start.vertices[i] == v; })) return true;
   }
   return false;
@@ -504,17 +553,29 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   st.scan_planes_added = s.added;
   for (const auto& pts : s.points) st.evidence.insert(st.evidence.end(), pts.begin(), pts.end());
 
-  const CandidateSet cs = build_candidates(s.planes, building_region(start, s));
-  st.candidates = int(cs.faces.size());
-  st.edges = int(cs.edges.size());
-  const CandidateData d = describe_candidates(cs, start, s, prm);
-
-  SelectionProgram pg;
-  for (int f = 0; f < int(cs.faces.size()); ++f) pg.cost.push_back(coverage_cost(cs.faces[f].area, d.confidence[f], prm.tau_cov));
-  for (const auto& e : cs.edges) pg.sharp_cost.push_back(prm.lambda_complexity * e.length * kSharpEdgeWidth);
   // The starting shell (mended where it does not close on the candidates) is GLPK's first
   // incumbent, and what no evidence reaches is fixed to it; without one everything is free.
-  const std::vector<char> warm = mended_start(cs, d.in_start, prm);
+  // Candidates fixed unselected that way (no support's evidence reaches them, the starting shell
+  // has none there) are pruned: the program over the others is the same.
+  const CandidateSet all = build_candidates(s.planes, building_region(start, s));
+  const CandidateData all_d = describe_candidates(all, start, s, prm);
+  const std::vector<char> all_warm = mended_start(all, all_d.in_start, prm);
+  std::vector<char> keep(all.faces.size(), 1);
+  if (!all_warm.empty())
+    for (std::size_t f = 0; f < keep.size(); ++f) keep[f] = all_d.in_zone[f] || all_warm[f];
+  CandidateSet cs = kept_candidates(all, keep);
+  const CandidateData d = kept(all_d, keep);
+  const std::vector<char> warm = all_warm.empty() ? all_warm : kept(all_warm, keep);
+  st.candidates = int(cs.faces.size());
+  st.candidates_pruned = int(all.faces.size()) - st.candidates;
+  st.edges = int(cs.edges.size());
+  record_confidence(cs, d.confidence);
+
+  SelectionProgram pg;
+  const auto confidence = cs.mesh.property_map<FaceIndex, double>("f:confidence").first;
+  for (int f = 0; f < int(cs.faces.size()); ++f)
+    pg.cost.push_back(coverage_cost(cs.faces[f].area, confidence[FaceIndex(f)], prm.tau_cov));
+  for (const auto& e : cs.edges) pg.sharp_cost.push_back(prm.lambda_complexity * e.length * kSharpEdgeWidth);
   if (!warm.empty()) {
     pg.warm = warm;
     for (int f = 0; f < int(cs.faces.size()); ++f) pg.fixed.push_back(d.in_zone[f] ? -1 : int(warm[f]));
@@ -528,6 +589,7 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   // is excluded: its changes from the starting shell are fixed back, and the program solved
   // again (at most kRetries times).
   const std::vector<char>& base = warm.empty() ? d.in_start : warm;
+  const EvidenceReach evidence(st.evidence);
   std::string problem;
   int beyond_rounds = 0;  // solves redone for changes beyond the evidence (not counted as attempts)
   for (int attempt = 0;; ++attempt) {
@@ -535,7 +597,7 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
     const auto& sel = st.selection;
     if (!sel.ok) return finish("face selection " + sel.status_text());
     if (!warm.empty() && beyond_rounds < kRetries) {
-      const std::vector<int> beyond = changes_beyond_evidence(cs, sel.selected, base, st.evidence);
+      const std::vector<int> beyond = changes_beyond_evidence(cs, sel.selected, base, evidence);
       if (!beyond.empty()) {
         for (int f : beyond) pg.fixed[f] = int(base[f]);
         ++beyond_rounds, --attempt;
@@ -544,13 +606,14 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
     }
     st.candidates_changed = 0;
     for (int f = 0; f < int(cs.faces.size()); ++f) st.candidates_changed += sel.selected[f] != base[f];
-    out.mesh = assemble(cs, sel.selected, d, start, s);
+    record_selection(cs, sel);
+    out.mesh = assemble(cs, d, start, s);
     st.faces_from_selection = int(out.mesh.faces.size());
     problem = shell_problem(out.mesh, prm);
     if (problem.empty()) {
       Mesh snapped = snapped_to_start(out.mesh, start);
       if (shell_problem(snapped, prm).empty()) out.mesh = std::move(snapped);
-      if (st.candidates_changed > 0 && moves_beyond_evidence(out.mesh, start, st.evidence))
+      if (st.candidates_changed > 0 && moves_beyond_evidence(out.mesh, start, evidence))
         problem = "it moves the model where the scan shows nothing";
     }
     if (problem.empty() || st.candidates_changed == 0 || warm.empty() || attempt == kRetries) break;

@@ -22,20 +22,6 @@ json step_json(const RefineTrace::Step& s) {
   json j = {{"scan_plane", s.scan_plane}, {"wall_faces", s.wall_faces}, {"moved_by", s.moved_by}, {"ok", s.ok}};
   if (!s.method.empty()) j["method"] = s.method;
   if (!s.ok) j["reason"] = s.reason;
-  if (!s.arrangement) return j;
-  const ArrangementStats& a = *s.arrangement;
-  if (a.supporting_planes) j["supporting_planes"] = *a.supporting_planes;
-  if (a.candidates) j["candidates"] = *a.candidates;
-  if (a.edges) j["edges"] = *a.edges;
-  if (a.fixing_dropped) j["fixing_dropped"] = true;
-  if (a.selection) {
-    const SelectionResult& m = *a.selection;
-    j["mip"] = {{"variables", m.variables}, {"constraints", m.constraints}, {"nonzeros", m.nonzeros},
-                {"fixed_candidates", m.fixed}, {"status", m.status_text()}, {"objective", m.objective},
-                {"seconds", m.seconds}};
-  }
-  if (a.selected) j["selected"] = *a.selected;
-  if (a.seconds) j["seconds"] = *a.seconds;
   return j;
 }
 
@@ -43,6 +29,7 @@ json selection_json(const ShellSelectionStats& st, const std::string& reason) {
   const SelectionResult& m = st.selection;
   json j = {{"status", m.status_text()},
             {"candidates", st.candidates},
+            {"candidates_pruned", st.candidates_pruned},
             {"edges", st.edges},
             {"supporting_planes", st.supporting_planes},
             {"scan_planes_added", st.scan_planes_added},

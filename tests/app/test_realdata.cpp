@@ -198,15 +198,10 @@ void dump_case(const Mesh& soup, const PointCloud& scan, const Mesh& refined) {
 
 void record_trace(const RefineTrace& t, Row& row) {
   row.planes = t.planes ? int(t.planes->size()) : 0;
-  if (!t.replacements) return;
-  for (const auto& step : *t.replacements) {
-    if (!step.arrangement) continue;
-    row.candidates += step.arrangement->candidates.value_or(0);
-    if (const auto& mip = step.arrangement->selection) {
-      row.mip_vars = std::max(row.mip_vars, mip->variables);
-      row.mip_rows = std::max(row.mip_rows, mip->constraints);
-    }
-  }
+  if (!t.selection) return;
+  row.candidates = t.selection->candidates;
+  row.mip_vars = t.selection->selection.variables;
+  row.mip_rows = t.selection->selection.constraints;
 }
 
 // The moved-wall experiment on one georeferenced soup.

@@ -66,6 +66,10 @@ TEST(ShellSelection, AddsARecessTheModelLacks) {
   int walls = 0;
   for (const auto& f : r.mesh.faces) walls += f.sem == Semantic::Wall;
   EXPECT_EQ(walls, 8);
+  // Beyond the facade's reach (the back of the building and the region around it) the
+  // candidates the starting shell has no face on are pruned, not fixed columns.
+  EXPECT_GT(r.stats.candidates_pruned, 0);
+  EXPECT_GT(r.stats.candidates, 0);
 }
 
 TEST(ShellSelection, AddsABayTheModelLacks) {

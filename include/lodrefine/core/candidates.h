@@ -1,10 +1,15 @@
-// Stage 3 (fallback, used by the arrangement): PolyFit-style candidate faces. Every supporting
-// plane (the arrangement has already swept walls coplanar with the scan plane into it), cropped
-// to a convex region, is split by every other plane; the convex pieces are the candidates, with
-// their edge adjacency for the manifold constraint.
+// Stage 3 (paper Sec. 3.2): PolyFit-style candidate faces on a CGAL::Surface_mesh. Every
+// supporting plane, cropped to a convex region, is split by every other plane; the convex pieces
+// are the candidates. As in CGAL's Polygonal_surface_reconstruction (its hypothesis), each plane
+// is one component of the mesh (its pieces share halfedges), a property map gives each face its
+// supporting plane, and the edges of the manifold constraint are the fans of halfedges of all
+// components that run along one segment (where 2, 3 or more planes meet on a line).
 // Vertices are plane-triple meets (solved with pivoting) welded at 1e-6 m, so identity does
 // not depend on coordinate magnitude (callers work in a local frame).
 #pragma once
+#include <CGAL/Simple_cartesian.h>
+#include <CGAL/Surface_mesh.h>
+
 #include <array>
 #include <vector>
 
@@ -31,26 +36,36 @@ struct Region {
   static Region around(const std::vector<Vec3>& pts, double relative, double absolute);
 };
 
+using CandidateMesh = CGAL::Surface_mesh<CGAL::Simple_cartesian<double>::Point_3>;
+
+// What the program needs of candidate f (face f of CandidateSet::mesh): its plane and size.
 struct Candidate {
   int plane = -1;          // index into CandidateSet::planes
-  std::vector<int> v;      // convex polygon, CCW around planes[plane].plane.n
   double area = 0.0;
   Vec3 centroid = Vec3::Zero();
 };
 
+// One segment of the arrangement and the candidates along it (CGAL's hypothesis calls it an
+// Intersection): 2 in a plane's interior, more where 3+ planes share the line.
 struct CandidateEdge {
-  int a = -1, b = -1;
-  std::vector<int> faces;  // incident candidates (2, or more where 3+ planes share the line)
+  int a = -1, b = -1;      // its ends (CandidateSet::vertices), a < b
+  std::vector<int> faces;  // incident candidates, in face order
   int box_plane = -1;      // 0..5 when the edge lies on the region's boundary
   double length = 0.0;
 };
 
+// The candidates. `mesh` holds them: face f is candidate f, CCW about its plane's normal, with
+// the property maps "f:support" (the supporting plane) and "v:point" (the vertex's index in
+// `vertices`, the same point in every component). `faces` and `edges` are the program's view
+// (a program may also be built by hand, without a mesh: then corners() is empty).
 struct CandidateSet {
   std::vector<SupportPlane> planes;
   Region region;
   std::vector<Vec3> vertices;
+  CandidateMesh mesh;
   std::vector<Candidate> faces;
   std::vector<CandidateEdge> edges;
+  std::vector<int> corners(int f) const;     // indices into `vertices`, CCW
   std::vector<Vec3> polygon(int f) const;
 };
 
@@ -63,5 +78,10 @@ std::vector<Vec3> region_section(const Plane& plane, const Region& region);
 constexpr double kMinCandidateArea = 1e-6;  // m^2
 CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Region& region,
                               double min_area = kMinCandidateArea);
+
+// The candidates where keep[f], renumbered in order, on a mesh of their own; the edges in their
+// order, without the dropped faces (an edge left with none goes). Pruning candidates a program
+// fixes unselected leaves the program over the others the same.
+CandidateSet kept_candidates(const CandidateSet& cs, const std::vector<char>& keep);
 
 }  // namespace lodrefine

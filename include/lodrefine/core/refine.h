@@ -1,6 +1,6 @@
 // The whole method for one building: repair the coarse model, detect scan planes, match them to
-// walls, move the outdated walls (substitution first, the local candidate arrangement + GLPK as
-// the fallback), validate, and keep the input unless the result fits the scan better.
+// walls, move the outdated walls (substitution), let the candidate selection decide the faces
+// (shell_selection.h), validate, and keep the input unless the result fits the scan better.
 #pragma once
 #include <optional>
 #include <set>
@@ -8,7 +8,6 @@
 #include <utility>
 #include <vector>
 
-#include "lodrefine/core/arrangement.h"
 #include "lodrefine/core/judge.h"
 #include "lodrefine/core/matching.h"
 #include "lodrefine/core/params.h"
@@ -51,10 +50,9 @@ struct RefineTrace {
     int scan_plane = -1;
     std::vector<int> wall_faces;
     double moved_by = 0.0;
-    std::string method;  // "substitution", "arrangement"; empty when not tried
+    std::string method;  // "substitution"; empty when not tried
     bool ok = false;
     std::string reason;  // when !ok
-    std::optional<ArrangementStats> arrangement;
   };
   struct FacadeMove {  // a moved wall, described on the mesh it was moved on
     std::set<int> input_faces;  // Face::source of its faces

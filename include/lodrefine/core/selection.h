@@ -5,10 +5,11 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/core/candidates.h"
 #include "lodrefine/core/params.h"
 
 namespace lodrefine {
+
+struct CandidateSet;  // candidates.h (its Surface_mesh stays out of the headers that report)
 
 // What GLPK made of the program (glp_intopt's return code with glp_mip_status).
 enum class SolveStatus {
@@ -28,6 +29,7 @@ std::string status_name(SolveStatus status, int glpk_code = 0);
 struct SelectionResult {
   bool ok = false;             // a feasible selection satisfying every edge constraint
   std::vector<char> selected;  // per candidate
+  std::vector<int> column;     // per candidate: its GLPK column (1-based), 0 when fixed
   SolveStatus status = SolveStatus::NotRun;
   int glpk_code = 0;           // glp_intopt's return code
   std::string status_text() const { return status_name(status, glpk_code); }

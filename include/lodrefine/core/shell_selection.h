@@ -20,7 +20,6 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/core/candidates.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/planes.h"
 #include "lodrefine/core/selection.h"
@@ -32,7 +31,8 @@ struct ShellSelectionStats {
   int supporting_planes = 0;  // of the starting shell plus the scan's
   int scan_planes_added = 0;  // facade planes on which no wall of the starting shell lies
   int step_walls = 0;         // hypothesised walls across where a facade's points end (no points)
-  int candidates = 0, edges = 0;
+  int candidates = 0, edges = 0;  // after pruning
+  int candidates_pruned = 0;      // fixed out by the starting shell and no evidence: not in the program
   SelectionResult selection;  // status, variables, constraints, gap, seconds, warm start
   int faces_from_selection = 0;  // output faces (each assembled from selected candidates)
   int candidates_changed = 0;    // selected differently from the starting shell
