@@ -60,6 +60,7 @@ json validation_json(const Validation& v) {
 json refine_report(const RefineResult& r) {
   const RefineTrace& t = r.trace;
   json rep;
+  rep["report_version"] = kRefineReportVersion;
   rep["id"] = t.id;
   rep["origin"] = {t.origin.x(), t.origin.y(), t.origin.z()};
   rep["outcome"] = outcome_name(r.outcome);

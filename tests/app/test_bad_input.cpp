@@ -586,34 +586,11 @@ std::vector<Case> cases() {
 
 std::string first_line(const std::string& s) { return s.substr(0, s.find('\n')); }
 
-// Cases that still break the contract, with the diagnosis and the fix they wait for (in files
-// of other modules). They are skipped -- loudly -- so main stays green; run them all with
-// LODREFINE_BAD_INPUT_ALL=1, and delete an entry when its fix lands.
-const std::vector<std::pair<std::string, std::string>>& known_open() {
-  // All fixed so far: fuzzing findings landed in src/core/planes.cpp (repeated points), src/core/selection.cpp
-  // (repeated columns), src/io/ (coordinates beyond 1e9 m, property-less elements, printing
-  // any double) and apps/cmd_refine.cpp (output directories checked first).
-  static const std::vector<std::pair<std::string, std::string>> open = {};
-  return open;
-}
-
-// Skips a known-open case (see above) unless LODREFINE_BAD_INPUT_ALL is set.
-bool skip_known_open(const std::string& name) {
-  if (std::getenv("LODREFINE_BAD_INPUT_ALL") != nullptr) return false;
-  for (const auto& [n, why] : known_open())
-    if (n == name) {
-      add_row(name, "KNOWN OPEN (skipped): " + why, -1);
-      return true;
-    }
-  return false;
-}
-
 class BadInput : public testing::TestWithParam<std::size_t> {};
 
 TEST_P(BadInput, Contract) {
   static const std::vector<Case> all = cases();
   const Case& k = all[GetParam()];
-  if (skip_known_open(k.name)) GTEST_SKIP() << "known open: " << k.name;
   Paths p;
   p.dir = temp_dir("case_" + std::to_string(GetParam()));
   struct Cleanup {  // keep the files of a failed case for inspection
@@ -762,7 +739,6 @@ TEST(BadInputAtomic, KillAtAnyTimeLeavesNoPartialModel) {
 // coordinate, so write_obj must print any finite coordinate readably.
 TEST(BadInputRegression, ObjWriterRoundTripsHugeCoordinates) {
   // The writer prints any finite double readably; the reader refuses such a file in one line.
-  if (skip_known_open("write_obj round trip of |coordinate| >= 1e57")) GTEST_SKIP() << "known open";
   const std::string dir = temp_dir("huge_coordinate");
   Mesh m;
   m.id = "huge";
@@ -788,7 +764,6 @@ TEST(BadInputRegression, ObjWriterRoundTripsHugeCoordinates) {
 // glp_load_matrix aborted the process ("duplicate indices not allowed"). Run in a child, so a
 // regression kills the child, not the test binary.
 TEST(BadInputRegression, FaceListedTwiceOnAnEdgeDoesNotAbortTheSolver) {
-  if (skip_known_open("select_faces with a face listed twice on one edge")) GTEST_SKIP() << "known open";
   const pid_t pid = ::fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {
@@ -924,15 +899,9 @@ TEST(BadInputSolver, OneMillisecondLimitFailsEvenAnEasyProgram) {
 
 // The whole pipeline under a starved solver: refine_building must write a valid shell, either
 // the starting shell GLPK took as its incumbent ("feasible (time limit)" or better) or the
-// repaired input with the solver status as the reason. Needs Params to accept a 1 ms limit
-// (params.h: mip_time_limit min 0.001); skipped while the bound is higher.
+// repaired input with the solver status as the reason. The CLI half needs --mip-time-limit to
+// accept 1 ms (params.h's minimum), and fails if that bound ever rises.
 TEST(BadInputSolver, RefineUnderAStarvedSolverWritesAValidShell) {
-  double min_limit = 0;
-  for (const auto& info : param_table())
-    if (info.name == "mip_time_limit") min_limit = info.min;
-  if (min_limit > 0.001)
-    GTEST_SKIP() << "mip_time_limit cannot go below " << min_limit
-                 << " s: set its minimum to 0.001 in params.h to inject the GLPK time-limit fault";
   const std::string dir = temp_dir("solver_fallback");
   write_text(dir + "/m.obj", valid_model());
   const Mesh model = read_obj(dir + "/m.obj");

@@ -178,18 +178,13 @@ TEST_F(Batch, TileTableWorstFirstWithOutcomesAndMovedFacades) {
     EXPECT_LE(rmse, last_rmse) << id;
     last_rmse = rmse;
     const std::string outcome = report["outcome"];
-    EXPECT_EQ(row["outcome"], outcome.rfind("refined", 0) == 0 ? "refined" : "kept") << id;
-    // The report's moved facades: its "facades" list, or (older reports) its successful replacements.
+    EXPECT_EQ(row["outcome"], outcome == "refined" ? "refined" : "kept") << id;
+    EXPECT_EQ(report["report_version"], 1) << id;
+    // The report's moved facades: its "facades" list, each with its largest move.
     std::size_t moved = 0;
     double max_move = 0.0;
-    const bool refined = outcome.rfind("refined", 0) == 0;
-    if (refined && report.contains("facades")) {
-      for (const auto& f : report["facades"])
-        ++moved, max_move = std::max(max_move, std::abs(f.value("displacement", f.value("max_move", 0.0))));
-    } else if (refined) {
-      for (const auto& r : report["replacements"])
-        if (r.value("ok", false)) ++moved, max_move = std::max(max_move, std::abs(r["moved_by"].get<double>()));
-    }
+    if (outcome == "refined")
+      for (const auto& f : report["facades"]) ++moved, max_move = std::max(max_move, std::abs(f["max_move"].get<double>()));
     EXPECT_EQ(row["facades_moved"]["count"], moved) << id;
     if (moved) EXPECT_NEAR(row["facades_moved"]["max"].get<double>(), max_move, 1e-9) << id;
     for (const auto& f : row["facades_moved"]["facades"]) EXPECT_FALSE(f["surface"].is_null()) << id;
@@ -209,8 +204,9 @@ TEST_F(Batch, TileTableWorstFirstWithOutcomesAndMovedFacades) {
     EXPECT_EQ(line.substr(0, line.find(',')), row["id"].get<std::string>());
   }
 
-  // A report's "facades" list is read as such: surface ids with signed displacements, or input
-  // faces with their largest move; a kept building moved nothing whatever the list says.
+  // A report's "facades" list is read as such: input faces with their largest move (the retired
+  // "surface"/"displacement" spelling counts for nothing); a kept building moved nothing
+  // whatever the list says.
   const fs::path run = fresh_dir("batch_facades");
   copy_run(*done_, run);
   const std::string a = rows[0]["id"], b = rows[1]["id"], c = rows[2]["id"];
@@ -220,8 +216,10 @@ TEST_F(Batch, TileTableWorstFirstWithOutcomesAndMovedFacades) {
     report["facades"] = facades;
     std::ofstream(run / id / "report.json") << report.dump(2);
   };
-  edit_report(a, "refined", {{{"surface", "wall-7"}, {"displacement", 0.5}}, {{"surface", "wall-8"}, {"displacement", -0.25}}});
-  edit_report(b, "refined", {{{"input_faces", {3, 4}}, {"evidence", "scan"}, {"max_move", 0.6}, {"mean_move", 0.4}}});
+  edit_report(a, "refined", {{{"input_faces", {7}}, {"evidence", "scan"}, {"max_move", 0.5}, {"mean_move", 0.5}},
+                             {{"input_faces", {8}}, {"evidence", "corner"}, {"max_move", -0.25}, {"mean_move", 0.1}}});
+  edit_report(b, "refined", {{{"input_faces", {3, 4}}, {"evidence", "scan"}, {"max_move", 0.6}, {"mean_move", 0.4}},
+                             {{"surface", "wall-8"}, {"displacement", 0.9}}});
   edit_report(c, "kept", {{{"input_faces", {1}}, {"evidence", "scan"}, {"max_move", 0.9}, {"mean_move", 0.9}}});
   EXPECT_TRUE(rerun(run).empty());
   const json updated = json::parse(read_text(run / "summary.json"));
@@ -231,7 +229,7 @@ TEST_F(Batch, TileTableWorstFirstWithOutcomesAndMovedFacades) {
       EXPECT_EQ(m["count"], 2);
       EXPECT_DOUBLE_EQ(m["max"].get<double>(), 0.5);
       EXPECT_DOUBLE_EQ(m["mean"].get<double>(), 0.375);
-      EXPECT_EQ(m["facades"][1]["surface"], "wall-8");
+      EXPECT_EQ(m["facades"][1]["surface"], json({8}));
     } else if (row["id"] == b) {
       EXPECT_EQ(m["count"], 1);
       EXPECT_DOUBLE_EQ(m["max"].get<double>(), 0.6);

@@ -13,6 +13,7 @@
 #include "support/scan_fixtures.h"
 
 using namespace lodrefine;
+using namespace lodrefine::fixtures;
 
 // Validation at the parameter table's planarity tolerance.
 const double kPlanarity = Params{}.planarity_tolerance;
@@ -21,23 +22,10 @@ namespace {
 
 const Vec3 kOrigin(85000.0, 447000.0, 0.0);
 
-// A polygon soup box [x0,x1]x[y0,y1]x[0,h] with semantics, georeferenced.
+// The shared box [x0,x1]x[y0,y1]x[0,h] as an exported soup, georeferenced.
 Mesh box_soup(double x0, double x1, double y0, double y1, double h) {
-  const Vec3 c[8] = {{x0, y0, 0}, {x1, y0, 0}, {x1, y1, 0}, {x0, y1, 0},
-                     {x0, y0, h}, {x1, y0, h}, {x1, y1, h}, {x0, y1, h}};
-  const int quads[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
-  const Semantic sem[6] = {Semantic::Ground, Semantic::Roof, Semantic::Wall, Semantic::Wall, Semantic::Wall, Semantic::Wall};
-  Mesh m;
+  Mesh m = as_soup(translated(box(Vec3(x0, y0, 0), Vec3(x1, y1, h)), kOrigin));
   m.id = "box";
-  for (int f = 0; f < 6; ++f) {
-    Face face;
-    face.sem = sem[f];
-    for (int k = 0; k < 4; ++k) {
-      face.v.push_back(int(m.vertices.size()));
-      m.vertices.push_back(c[quads[f][k]] + kOrigin);
-    }
-    m.faces.push_back(face);
-  }
   return m;
 }
 

@@ -7,38 +7,18 @@
 #include "lodrefine/core/substitute.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/validate.h"
+#include "support/mesh_fixtures.h"
 
 using namespace lodrefine;
+using namespace lodrefine::fixtures;
 
 // Validation at the parameter table's planarity tolerance.
 const double kPlanarity = Params{}.planarity_tolerance;
 
 namespace {
 
-// A closed gable house: x in [0,12], y in [0,8], eaves at 6 m, ridge at 9 m along y = 4.
-Mesh gable_house() {
-  Mesh soup;
-  soup.id = "gable";
-  auto quad = [&](std::vector<Vec3> pts, Semantic sem) {
-    Face f;
-    f.sem = sem;
-    for (const auto& p : pts) {
-      f.v.push_back(int(soup.vertices.size()));
-      soup.vertices.push_back(p);
-    }
-    soup.faces.push_back(f);
-  };
-  const Vec3 a(0, 0, 0), b(12, 0, 0), c(12, 8, 0), d(0, 8, 0);
-  const Vec3 ae(0, 0, 6), be(12, 0, 6), ce(12, 8, 6), de(0, 8, 6), r0(0, 4, 9), r1(12, 4, 9);
-  quad({a, d, c, b}, Semantic::Ground);
-  quad({a, b, be, ae}, Semantic::Wall);          // front, y = 0
-  quad({b, c, ce, r1, be}, Semantic::Wall);      // gable end, x = 12
-  quad({c, d, de, ce}, Semantic::Wall);          // back, y = 8
-  quad({d, a, ae, r0, de}, Semantic::Wall);      // gable end, x = 0
-  quad({ae, be, r1, r0}, Semantic::Roof);        // front slope
-  quad({ce, de, r0, r1}, Semantic::Roof);        // back slope
-  return repair_model(soup, 0.01);
-}
+// The shared 10 x 8 m gable house (eaves 6 m, ridge 9 m along y = 4) as an exported soup, repaired.
+Mesh repaired_gable_house() { return repair_model(as_soup(gable_house()), 0.01); }
 
 int surface_with_normal(const std::vector<ModelSurface>& ss, const Vec3& n) {
   for (int s = 0; s < int(ss.size()); ++s)
@@ -49,12 +29,12 @@ int surface_with_normal(const std::vector<ModelSurface>& ss, const Vec3& n) {
 }  // namespace
 
 TEST(Substitute, MovedWallTakesItsPlaneAndNothingElseMoves) {
-  const Mesh m = gable_house();
+  const Mesh m = repaired_gable_house();
   const auto ss = model_surfaces(m);
   const int front = surface_with_normal(ss, Vec3(0, -1, 0));
   ASSERT_GE(front, 0);
   // 0.5 m out and turned 2 degrees about a vertical axis.
-  const double a = 2.0 * M_PI / 180.0;
+  const double a = radians(2.0);
   const Plane moved = Plane::through(Vec3(6, -0.5, 0), Vec3(std::sin(a), -std::cos(a), 0));
   const auto r = substitute_walls(m, ss, {{front, moved}}, 0.01);
   ASSERT_TRUE(r.ok) << r.reason;
@@ -65,8 +45,8 @@ TEST(Substitute, MovedWallTakesItsPlaneAndNothingElseMoves) {
     EXPECT_EQ(p.z(), q.z()) << "heights are kept";
     if (std::abs(p.y()) < 1e-9) {
       EXPECT_NEAR(moved.distance(q), 0.0, 1e-6) << "front vertex on the new plane";
-      // ...and still on its gable wall (x = 0 or 12): it slid along it.
-      EXPECT_NEAR(std::min(std::abs(q.x()), std::abs(q.x() - 12)), 0.0, 1e-6);
+      // ...and still on its gable wall (x = 0 or 10): it slid along it.
+      EXPECT_NEAR(std::min(std::abs(q.x()), std::abs(q.x() - 10)), 0.0, 1e-6);
     } else {
       EXPECT_EQ(p, q) << "vertex " << v << " is on no moved wall";
     }
@@ -74,7 +54,7 @@ TEST(Substitute, MovedWallTakesItsPlaneAndNothingElseMoves) {
 }
 
 TEST(Substitute, EaveKeepsItsHeightOrFollowsTheRoofPlane) {
-  const Mesh m = gable_house();
+  const Mesh m = repaired_gable_house();
   const auto ss = model_surfaces(m);
   const int front = surface_with_normal(ss, Vec3(0, -1, 0));
   const int roof = surface_with_normal(ss, Vec3(0, -3, 4).normalized());
@@ -97,7 +77,7 @@ TEST(Substitute, EaveKeepsItsHeightOrFollowsTheRoofPlane) {
 }
 
 TEST(Substitute, RefusesAMoveThatTurnsAFaceInsideOut) {
-  const Mesh m = gable_house();
+  const Mesh m = repaired_gable_house();
   const auto ss = model_surfaces(m);
   const int front = surface_with_normal(ss, Vec3(0, -1, 0));
   const auto r = substitute_walls(m, ss, {{front, Plane::through(Vec3(6, 9, 0), Vec3(0, -1, 0))}}, 0.01);

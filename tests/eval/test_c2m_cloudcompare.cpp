@@ -167,7 +167,7 @@ TEST_F(C2MCloudCompare, NeedleApexUnsignedAndTrueSign) {
   std::vector<Vec3> ring;  // just above and below the apex, all around it
   for (int k = 0; k < 36; ++k)
     for (double dz : {0.5, 0.05, -0.3}) {
-      const double a = k * M_PI / 18;
+      const double a = k * kPi / 18;
       ring.push_back(Vec3(0.5 * std::cos(a), 0.5 * std::sin(a), 10 + dz).cast<float>().cast<double>());
     }
   const Mesh m = needle();

@@ -5,29 +5,21 @@
 #include <cstdint>
 #include <string>
 
-#include "fuzz_common.h"
+#include "fuzz_las_common.h"
 #include "lodrefine/io/cloud.h"
-#include "lodrefine/io/files.h"
-#include "lodrefine/io/las.h"
+#include "lodrefine/io/files.h"  // kMaxCoordinate
 
 using namespace lodrefine;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const std::string path = fuzz::temp_file("in.las");
-  fuzz::write_bytes(path, data, size);
-
-  LasHeader header;
   std::string header_error;
-  try {
-    header = read_las_header(path);
-    FUZZ_CHECK(header.point_format >= 0 && header.point_format <= 10, "format %d accepted", header.point_format);
+  const LasHeader header = fuzz::las_header_of(path, data, size, header_error);
+  if (header_error.empty()) {
     FUZZ_CHECK(header.record_length >= las_min_record_length(header.point_format), "short record accepted");
     FUZZ_CHECK(header.compressed || header.point_offset + header.point_count * header.record_length <= size,
                "%llu points of %u bytes from offset %llu exceed %zu bytes", (unsigned long long)header.point_count,
                header.record_length, (unsigned long long)header.point_offset, size);
-  } catch (const InputError& e) {
-    fuzz::check_message(e.what(), path);
-    header_error = e.what();
   }
 
   PointCloud cloud;
@@ -41,7 +33,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (const auto& p : cloud.points)
     FUZZ_CHECK(p.allFinite() && p.cwiseAbs().maxCoeff() <= kMaxCoordinate, "bad point accepted");
   if (!header_error.empty() && size >= 4 && std::string(reinterpret_cast<const char*>(data), 4) == "LASF")
-    FUZZ_CHECK(read_error == header_error, "header says '%s', reader says '%s'", header_error.c_str(), read_error.c_str());
+    fuzz::check_same_refusal(header_error, read_error);
   if (header_error.empty() && read_error.empty())
     FUZZ_CHECK(cloud.points.size() == header.point_count, "%zu points, header %llu", cloud.points.size(),
                (unsigned long long)header.point_count);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "support/cli_fixtures.h"
+#include "support/io_fixtures.h"
 
 #include <algorithm>
 #include <cstring>
@@ -23,19 +24,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string temp_path(const std::string& name) { return cli_fixtures::test_dir("lodrefine_las") + "/" + name; }
+using fixtures::poke;
+using fixtures::temp_path;
+using fixtures::write_bytes;
 
 std::string read_bytes(const std::string& path) { return cli_fixtures::slurp(path); }
 
-std::string write_bytes(const std::string& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
-  return path;
-}
-
-template <class T>
-void poke(std::string& bytes, std::size_t at, T v) {
-  std::memcpy(&bytes[at], &v, sizeof v);  // the test machine is little-endian, as LAS is
-}
 
 // Georeferenced points on a millimetre grid (the LAS scale), so they read back exactly.
 PointCloud sample_points() {
@@ -66,16 +60,7 @@ std::string valid_las(int minor = 2, int format = 1) {
 }
 
 void expect_error(const std::string& bytes, const std::string& fault) {
-  const std::string path = write_bytes(temp_path("bad.las"), bytes);
-  try {
-    read_cloud(path);
-    ADD_FAILURE() << "no InputError (expected '" << fault << "')";
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.rfind(path, 0), 0u) << msg;
-    EXPECT_NE(msg.find(fault), std::string::npos) << msg;
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
-  }
+  fixtures::expect_bytes_refused("bad.las", bytes, fault, [](const std::string& path) { read_cloud(path); });
 }
 
 }  // namespace
@@ -129,7 +114,7 @@ TEST(Las, ClassificationWidthFollowsTheFormat) {
   std::string bytes = read_bytes(p1);
   const std::size_t off = 227, rec = 28;
   for (std::size_t i = 0; i < pts.points.size(); ++i) bytes[off + i * rec + 15] = char(bytes[off + i * rec + 15] | 0xE0);
-  write_bytes(p1, bytes);
+  write_bytes("f1.las", bytes);
   EXPECT_EQ(read_cloud(p1, {{8}}).points.size(), 16u);
 }
 
@@ -214,7 +199,7 @@ TEST(Las, LyingAndTruncatedHeadersAreOneClearError) {
   {
     std::string b = good;
     poke<std::uint32_t>(b, 107, 0);  // an empty cloud is read as empty, not an error
-    EXPECT_EQ(read_cloud(write_bytes(temp_path("empty.las"), b)).points.size(), 0u);
+    EXPECT_EQ(read_cloud(write_bytes("empty.las", b)).points.size(), 0u);
   }
 }
 
@@ -228,7 +213,7 @@ TEST(Las, CompressedBitsWithoutALaszipVlrAreOneClearError) {
 
 TEST(Las, OtherFilesGivenAsACloudSayWhatTheyAre) {
   const auto check = [](const std::string& content, const std::string& fault) {
-    const std::string path = write_bytes(temp_path("x.dat"), content);
+    const std::string path = write_bytes("x.dat", content);
     try {
       read_cloud(path);
       ADD_FAILURE() << "accepted: " << content.substr(0, 20);

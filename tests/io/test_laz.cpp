@@ -15,6 +15,7 @@
 #include "lodrefine/io/cloud.h"
 #include "lodrefine/io/las.h"
 #include "support/cli_fixtures.h"
+#include "support/io_fixtures.h"
 #include "support/realdata.h"
 
 using namespace lodrefine;
@@ -22,20 +23,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using fixtures::poke;
+using fixtures::temp_path;
+using fixtures::write_bytes;
+
 const char* const kAhn3 = "3dfier/example_data/ahn3/ahn3_cropped_1.laz";
 const char* const kAhn3Small = "3dfier/example_data/ahn3/ahn3_cropped_2.laz";
 
-std::string temp_path(const std::string& name) { return cli_fixtures::test_dir("lodrefine_laz") + "/" + name; }
-
-std::string write_bytes(const std::string& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
-  return path;
-}
-
-template <class T>
-void poke(std::string& bytes, std::size_t at, T v) {
-  std::memcpy(&bytes[at], &v, sizeof v);  // little-endian test machine, as LAS is
-}
 template <class T>
 T peek(const std::string& bytes, std::size_t at) {
   T v;
@@ -59,16 +53,7 @@ std::string records(const std::string& path) {
 }
 
 void expect_error(const std::string& bytes, const std::string& fault) {
-  const std::string path = write_bytes(temp_path("bad.laz"), bytes);
-  try {
-    records(path);
-    ADD_FAILURE() << "no InputError (expected '" << fault << "')";
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.rfind(path, 0), 0u) << msg;
-    EXPECT_NE(msg.find(fault), std::string::npos) << msg;
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
-  }
+  fixtures::expect_bytes_refused("bad.laz", bytes, fault, records);
 }
 
 // Where laz-perf's node module may be: $LODREFINE_LAZPERF_MODULES, else the scratch folder
@@ -196,7 +181,7 @@ TEST(Laz, LyingHeadersAndTruncatedChunksAreOneLine) {
     expect_error(b, fault);
     // read_las_header refuses the same way (the table is checked before any point).
     try {
-      read_las_header(write_bytes(temp_path("bad_header.laz"), b));
+      read_las_header(write_bytes("bad_header.laz", b));
       ADD_FAILURE() << "header accepted; expected " << fault;
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find(fault), std::string::npos) << e.what();
@@ -218,12 +203,12 @@ TEST(Laz, LyingHeadersAndTruncatedChunksAreOneLine) {
     // decodes other points; it never crashes or hangs.
     std::string b = good;
     poke<std::uint32_t>(b, 107, 50000);
-    const std::string first = records(write_bytes(temp_path("first_chunk.laz"), b));
+    const std::string first = records(write_bytes("first_chunk.laz", b));
     EXPECT_EQ(first, records(data_path.string()).substr(0, first.size()));
     EXPECT_EQ(first.size(), 50000u * 28u);
     std::fill(b.begin() + point_offset + 8 + 28, b.begin() + point_offset + 8 + 20000, '\0');
     try {
-      records(write_bytes(temp_path("zeroed.laz"), b));
+      records(write_bytes("zeroed.laz", b));
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find("truncated or corrupt"), std::string::npos) << e.what();
     }
@@ -274,7 +259,7 @@ TEST(Laz, EveryTruncationAndByteFlipIsOneLineOrTheSamePoints) {
     ASSERT_FALSE(good.empty()) << seed;
     const std::string want = records(corpus_dir() + "/" + seed);
     const auto check = [&](const std::string& bytes, bool truncated) {
-      const std::string path = write_bytes(temp_path("edit.laz"), bytes);
+      const std::string path = write_bytes("edit.laz", bytes);
       try {
         const LasHeader h = read_las_header(path);
         const std::string got = records(path);
@@ -333,7 +318,7 @@ TEST(Laz, HugeDeclaredCountsAllocateLittle) {
   ASSERT_EQ(b.substr(227 + 2, 14), "laszip encoded");
   poke<std::uint32_t>(b, 227 + 54 + 12, 0xfffffff0u);  // the VLR's chunk size
   poke<std::uint32_t>(b, 107, 0xffffff00u);
-  const std::string path = write_bytes(temp_path("huge.laz"), b);
+  const std::string path = write_bytes("huge.laz", b);
   EXPECT_EQ(read_las_header(path).point_count, 0xffffff00u);
   try {
     read_cloud(path);

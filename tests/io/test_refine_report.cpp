@@ -33,6 +33,7 @@ TEST(RefineReport, RefinedBuildingHasEveryStage) {
   ASSERT_EQ(r.outcome, Outcome::Refined) << r.reason;
   const nlohmann::json j = refine_report(r);
   EXPECT_EQ(j["id"], "box");
+  EXPECT_EQ(j["report_version"], 1);
   EXPECT_EQ(j["outcome"], "refined");
   EXPECT_EQ(j["refined"], true);
   EXPECT_EQ(j["origin"], nlohmann::json({85000.0, 447000.0, 0.0}));

@@ -4,9 +4,11 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include "lodrefine/core/types.h"
 
@@ -26,7 +28,7 @@ inline std::string write_bytes(const std::string& name, const std::string& conte
   return path;
 }
 
-// Expects InputError whose one-line message names the file and contains `fault`.
+// Expects InputError whose one-line message starts with the file's path and contains `fault`.
 template <class F>
 void expect_input_error(const std::string& path, const std::string& fault, F&& read) {
   try {
@@ -34,10 +36,23 @@ void expect_input_error(const std::string& path, const std::string& fault, F&& r
     ADD_FAILURE() << "no InputError for " << path << " (expected '" << fault << "')";
   } catch (const InputError& e) {
     const std::string msg = e.what();
-    EXPECT_NE(msg.find(path), std::string::npos) << msg;
+    EXPECT_EQ(msg.rfind(path, 0), 0u) << msg;
     EXPECT_NE(msg.find(fault), std::string::npos) << msg;
     EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
   }
+}
+
+// Writes `bytes` to the test's file `name` and expects `read` to refuse it (expect_input_error).
+template <class F>
+void expect_bytes_refused(const std::string& name, const std::string& bytes, const std::string& fault, F&& read) {
+  expect_input_error(write_bytes(name, bytes), fault, std::forward<F>(read));
+}
+
+// Overwrites sizeof(T) bytes at `at` with `v` (the test machine is little-endian, as LAS is):
+// header lies made to order.
+template <class T>
+void poke(std::string& bytes, std::size_t at, T v) {
+  std::memcpy(&bytes[at], &v, sizeof v);
 }
 
 }  // namespace lodrefine::fixtures

@@ -182,7 +182,7 @@ TEST_P(SynthAll, CoarseKeepsRoofPlanesAndMovesOnlyChosenWalls) {
         for (const auto& a : wp)
           for (const auto& bb : wp) len = std::max(len, (a - bb).head<2>().norm());
         const double bound =
-            std::abs(m.offset) + (len / 2 + 2) * std::tan(std::abs(m.rotation_deg) * M_PI / 180) + 0.01;
+            std::abs(m.offset) + (len / 2 + 2) * std::tan(radians(std::abs(m.rotation_deg))) + 0.01;
         near |= std::abs(pl.distance(q)) <= bound;
       }
       EXPECT_TRUE(near) << "coarse vertex " << q.transpose() << " moved away from the truth far from a moved wall";

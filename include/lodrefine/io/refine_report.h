@@ -8,7 +8,12 @@
 
 namespace lodrefine {
 
-// Keys: id, origin, outcome, reason, refined, faces, seconds, output_validation, and as far as
+// The report's format version, written as its top-level `report_version` (an integer). Raise it
+// when a key eval reads (outcome, reason, facades, seconds, selection) changes meaning or name;
+// `lodrefine eval` refuses reports of a newer version than this.
+constexpr int kRefineReportVersion = 1;
+
+// Keys: report_version, id, origin, outcome, reason, refined, faces, seconds, output_validation, and as far as
 // the building got: repair, input_validation, cloud, planes, matches, rejected_matches,
 // q_model, substitution, replacements, facades, judgement (never worse: ok, the refusing check
 // and why, the building's and each moved wall's fit). The command adds model, cloud.path,

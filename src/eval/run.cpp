@@ -1,0 +1,247 @@
+// A run folder evaluated building by building: discovery, reading into a local frame, the refine
+// record of each building, and the buildings on a TBB pool.
+#include "lodrefine/eval/run.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+
+#include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "lodrefine/core/geometry.h"
+#include "lodrefine/core/refine.h"
+#include "lodrefine/eval/plots.h"
+#include "lodrefine/io/files.h"
+#include "lodrefine/io/obj.h"
+#include "lodrefine/io/refine_report.h"
+
+namespace lodrefine {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// Points drawn in a footprint file (svg_footprint's default): dense enough to see each facade.
+constexpr std::size_t kFootprintFilePoints = 5000;
+
+json read_json_or_null(const std::string& path) {
+  if (path.empty() || !fs::exists(path)) return nullptr;
+  std::ifstream in(path);
+  return json::parse(in, nullptr, false);  // discarded (null-like) on a parse error
+}
+
+// Scanned truth faces listed by the generator, if present and plausible (walls of this truth).
+std::optional<std::vector<int>> meta_scanned_faces(const std::string& meta_path, const Mesh& truth) {
+  const json meta = read_json_or_null(meta_path);
+  if (!meta.is_object() || !meta.contains("scanned_truth_faces")) return std::nullopt;
+  std::vector<int> faces;
+  for (const auto& f : meta["scanned_truth_faces"]) {
+    const int i = f.get<int>();
+    if (i < 0 || std::size_t(i) >= truth.faces.size() || truth.faces[std::size_t(i)].sem != Semantic::Wall) {
+      std::fprintf(stderr, "lodrefine: warning: %s: scanned face %d is not a wall of the truth; detecting instead\n",
+                   meta_path.c_str(), i);
+      return std::nullopt;
+    }
+    faces.push_back(i);
+  }
+  return faces;
+}
+
+// A missing or unreadable refined model is a failure row, never an abort.
+Mesh read_refined(const std::string& path, std::string& error) {
+  if (path.empty() || !fs::exists(path)) {
+    error = "refined model missing (" + (path.empty() ? std::string("no path") : path) + ")";
+    return {};
+  }
+  try {
+    return read_obj(path);
+  } catch (const InputError& e) {
+    error = e.what();
+    return {};
+  }
+}
+
+std::string first_line(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  return line.empty() ? "failed (no reason recorded)" : line;
+}
+
+// Refuses a report written by a newer refine than this eval reads (absent: version 1).
+void check_report_version(const json& report, const std::string& source) {
+  const json version = report.value("report_version", json(1));
+  if (!version.is_number_integer() || version.get<long long>() < 1 ||
+      version.get<long long>() > kRefineReportVersion)
+    throw InputError(source + ": report_version " + version.dump() + " is not one this lodrefine reads (1.." +
+                     std::to_string(kRefineReportVersion) + ")");
+}
+
+// The moved facades of a refined building's report: its "facades", each named by its
+// "input_faces" and moved by its "max_move".
+std::vector<MovedFacade> moved_facades(const json& report) {
+  std::vector<MovedFacade> out;
+  const json facades = report.value("facades", json());
+  if (!facades.is_array()) return out;
+  for (const auto& f : facades) {
+    if (!f.is_object() || !f.value("max_move", json()).is_number()) continue;
+    out.push_back({f.value("input_faces", json()), std::abs(f["max_move"].get<double>())});
+  }
+  return out;
+}
+
+// Outcome, reason, moved facades and time of a report that is a JSON object.
+void read_report(RunRow& row, const json& report) {
+  row.outcome = row.refine_outcome == "refined" ? "refined" : "kept";
+  row.reason = report.value("reason", std::string());
+  if (row.outcome == "refined") row.moved = moved_facades(report);  // a kept building's model moved nothing
+  const json total = report.value("seconds", json::object()).value("total", json());
+  if (total.is_number()) row.refine_seconds = total.get<double>();
+}
+
+}  // namespace
+
+std::vector<BuildingFiles> discover_run(const std::string& dir) {
+  if (!fs::is_directory(dir)) throw InputError(dir + ": not a directory");
+  std::vector<BuildingFiles> out;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const fs::path d = entry.path();
+    if (!entry.is_directory() || !fs::exists(d / "coarse.obj")) continue;
+    auto optional_file = [&](const char* name) { return fs::exists(d / name) ? (d / name).string() : std::string(); };
+    out.push_back({d.filename().string(), (d / "coarse.obj").string(), (d / "refined.obj").string(),
+                   (d / "cloud.ply").string(), optional_file("truth.obj"), optional_file("meta.json"),
+                   optional_file("report.json"), optional_file("FAILED")});
+  }
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
+  if (out.empty()) throw InputError(dir + ": no building directories (<id>/coarse.obj) found");
+  return out;
+}
+
+std::vector<Vec3> facade_points(const BuildingEval& e, const PointCloud& cloud) {
+  std::vector<Vec3> pts;
+  for (int i : e.facade_index) pts.push_back(cloud.points[std::size_t(i)]);
+  return pts;
+}
+
+std::string building_footprint_svg(const BuildingEval& e, const LocalBuilding& b, std::size_t max_points) {
+  return svg_footprint(b.original, b.refined, facade_points(e, b.cloud),
+                       e.id + ": original vs refined, facade points (XY)", max_points);
+}
+
+LocalBuilding read_local(const BuildingFiles& f, const std::optional<Vec3>& origin, std::string& refined_error,
+                         const CloudOptions& cloud_options) {
+  LocalBuilding b;
+  b.original = read_obj(f.original);
+  b.origin = origin ? *origin : local_origin(b.original);
+  b.original = translated(std::move(b.original), -b.origin);
+  b.cloud = read_cloud(f.cloud, cloud_options);
+  for (auto& p : b.cloud.points) p -= b.origin;
+  b.refined = translated(read_refined(f.refined, refined_error), -b.origin);
+  return b;
+}
+
+RunRow evaluate_building_files(const BuildingFiles& f, const Params& params, const std::string& svg_dir,
+                               const CloudOptions& cloud_options) {
+  RunRow row;
+  row.files = f;
+  std::string refined_error;
+  const LocalBuilding b = read_local(f, std::nullopt, refined_error, cloud_options);
+  row.origin = b.origin;
+  std::optional<Mesh> truth;
+  std::optional<std::vector<int>> scanned;
+  if (!f.truth.empty()) {
+    truth = translated(read_obj(f.truth), -row.origin);
+    scanned = meta_scanned_faces(f.meta, *truth);
+    row.truth_faces_source = scanned ? "meta.json" : "detected";
+  }
+  row.eval = evaluate_building(b.original, b.refined, b.cloud, truth ? &*truth : nullptr, params,
+                               scanned ? &*scanned : nullptr);
+  if (!f.id.empty()) row.eval.id = f.id;
+  if (!refined_error.empty()) row.eval.error = refined_error;
+  if (!svg_dir.empty())
+    write_file_atomic((fs::path(svg_dir) / ("footprint_" + safe_name(row.eval.id) + ".svg")).string(),
+                      building_footprint_svg(row.eval, b, kFootprintFilePoints));
+  return row;
+}
+
+void add_refine_record(RunRow& row, const json& report, const std::string& failed_line, const std::string& source) {
+  if (report.is_object()) check_report_version(report, source);
+  const json outcome = report.is_object() ? report.value("outcome", json()) : json();
+  if (outcome.is_string()) row.refine_outcome = outcome.get<std::string>();
+  if (report.is_object() && report.contains("selection") && report["selection"].is_object()) {
+    const json status = report["selection"].value("status", json());
+    if (status.is_string()) row.selection = status.get<std::string>();
+  }
+  if (!failed_line.empty()) row.eval.error = failed_line;
+  if (!row.eval.ok()) {
+    row.outcome = "failed";
+    row.reason = row.eval.error;
+    return;
+  }
+  row.outcome = "kept";
+  if (!report.is_object()) {
+    row.reason = "no report.json";
+    return;
+  }
+  try {
+    read_report(row, report);
+  } catch (const json::exception& e) {  // a hand-edited or foreign report: keep the row
+    row.reason = std::string("unreadable report.json: ") + e.what();
+  }
+}
+
+RunRow failure_row(const std::string& id, const std::string& error) {
+  RunRow row;
+  row.eval.id = id;
+  row.eval.error = error;
+  row.eval.delta_d = std::nan("");
+  return row;
+}
+
+std::vector<RunRow> evaluate_run(const std::string& dir, const Params& params, const std::string& svg_dir, int jobs,
+                                 PooledSeries& series, Progress::Mode progress_mode) {
+  const auto buildings = discover_run(dir);
+  std::vector<RunRow> rows(buildings.size());
+  std::size_t finished = 0, failed = 0;
+  std::mutex mutex;  // guards series, the counts and the progress line
+  Progress progress("eval", "buildings", buildings.size(), progress_mode);
+  auto evaluate = [&](std::size_t k) {
+    const BuildingFiles& f = buildings[k];
+    RunRow& row = rows[k];
+    try {
+      row = evaluate_building_files(f, params, svg_dir);
+    } catch (const InputError& e) {
+      row = failure_row(f.id, e.what());
+    }
+    row.files = f;
+    // Only what the table needs is kept: a city's reports in full would weigh hundreds of MB.
+    add_refine_record(row, read_json_or_null(f.report), f.failed.empty() ? "" : first_line(f.failed), f.report);
+    const std::lock_guard<std::mutex> lock(mutex);
+    series.add(row.eval);
+    drop_series(row.eval);
+    failed += !row.eval.ok();
+    progress.update(++finished, std::to_string(failed) + " failed");
+  };
+  // TBB caps its threads at the cores: --jobs asks for exactly `jobs` (as io/cityfile does).
+  jobs = std::max(1, jobs);
+  const tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(jobs));
+  tbb::task_arena arena(jobs);
+  arena.execute([&] {
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, buildings.size(), 1),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+          for (std::size_t k = range.begin(); k != range.end(); ++k) evaluate(k);
+        },
+        tbb::simple_partitioner());  // one building per task: their costs differ widely
+  });
+  progress.finish();
+  return rows;
+}
+
+}  // namespace lodrefine

@@ -1,0 +1,178 @@
+// A run folder evaluated building by building: what eval reads of a refine report (current keys
+// only, report_version checked), discovery, and the buildings evaluated on a pool.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "lodrefine/eval/run.h"
+#include "lodrefine/io/refine_report.h"
+#include "support/cli_fixtures.h"
+#include "support/run_fixtures.h"
+
+using namespace lodrefine;
+using namespace lodrefine::fixtures;
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+// The refine record of an evaluated (ok) building from `report`.
+RunRow record_of(const json& report, const std::string& failed_line = "") {
+  RunRow row;
+  row.eval.id = "b";
+  add_refine_record(row, report, failed_line, "run/b/report.json");
+  return row;
+}
+
+}  // namespace
+
+TEST(RunRecord, RefinedReportGivesItsFacadesTimeAndSelection) {
+  json report = run_report("refined");
+  report["facades"].push_back({{"input_faces", {3, 4}}, {"evidence", "corner"}, {"max_move", 0.25}});
+  const RunRow r = record_of(report);
+  EXPECT_EQ(r.outcome, "refined");
+  EXPECT_EQ(r.refine_outcome, "refined");
+  EXPECT_EQ(r.reason, "");
+  EXPECT_EQ(r.selection, "optimal");
+  EXPECT_DOUBLE_EQ(r.refine_seconds, 1.25);
+  ASSERT_EQ(r.moved.size(), 2u);
+  EXPECT_EQ(r.moved[0].surface, json({2}));
+  EXPECT_DOUBLE_EQ(r.moved[0].displacement, kRunWallOffset);  // |max_move|
+  EXPECT_EQ(r.moved[1].surface, json({3, 4}));
+  EXPECT_DOUBLE_EQ(r.moved[1].displacement, 0.25);
+}
+
+TEST(RunRecord, KeptBuildingMovedNothingAndKeepsItsReason) {
+  json report = run_report("kept", "judge refused (gain): 12 points closer");
+  report["facades"].push_back({{"input_faces", {1}}, {"max_move", 0.9}});
+  const RunRow r = record_of(report);
+  EXPECT_EQ(r.outcome, "kept");
+  EXPECT_EQ(r.reason, "judge refused (gain): 12 points closer");
+  EXPECT_TRUE(r.moved.empty());
+  const RunRow invalid = record_of(run_report("kept-invalid", "not closed"));
+  EXPECT_EQ(invalid.outcome, "kept");
+  EXPECT_EQ(invalid.refine_outcome, "kept-invalid");
+}
+
+// The spellings of reports before the "facades" list settled are read no more: a facade without
+// max_move, a replacement's moved_by and an outcome with its reason in brackets count for nothing.
+TEST(RunRecord, RetiredSpellingsCountForNothing) {
+  json report = run_report("refined");
+  report["facades"] = {{{"surface", "wall-7"}, {"displacement", 0.5}}, {{"input_faces", {1}}, {"moved_by", 0.3}}};
+  EXPECT_TRUE(record_of(report).moved.empty());
+
+  report.erase("facades");
+  report["matches"] = {{{"scan_plane", 0}, {"surface", "wall-7"}}};
+  report["replacements"] = {{{"scan_plane", 0}, {"ok", true}, {"moved_by", 0.5}}};
+  EXPECT_TRUE(record_of(report).moved.empty());
+
+  const RunRow bracketed = record_of(run_report("refined (2 walls moved)"));
+  EXPECT_EQ(bracketed.outcome, "kept");
+  EXPECT_EQ(bracketed.reason, "");
+  EXPECT_TRUE(bracketed.moved.empty());
+}
+
+TEST(RunRecord, ReportWithoutVersionIsReadAsVersionOne) {
+  json report = run_report("refined");
+  report.erase("report_version");
+  const RunRow r = record_of(report);
+  EXPECT_EQ(r.outcome, "refined");
+  ASSERT_EQ(r.moved.size(), 1u);
+  EXPECT_DOUBLE_EQ(r.moved[0].displacement, kRunWallOffset);
+}
+
+TEST(RunRecord, ReportOfAnotherVersionIsRefusedInOneLine) {
+  for (const json& version : {json(kRefineReportVersion + 1), json(0), json("1"), json(1.5)}) {
+    json report = run_report("refined");
+    report["report_version"] = version;
+    try {
+      record_of(report);
+      ADD_FAILURE() << "report_version " << version.dump() << " was read";
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("run/b/report.json: report_version " + version.dump()), std::string::npos) << msg;
+      EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    }
+  }
+}
+
+TEST(RunRecord, FailedFileMissingReportAndWrongTypes) {
+  const RunRow failed = record_of(run_report("refined"), "lodrefine: error: cloud.ply: truncated");
+  EXPECT_EQ(failed.outcome, "failed");
+  EXPECT_EQ(failed.reason, "lodrefine: error: cloud.ply: truncated");
+  EXPECT_TRUE(failed.moved.empty());
+  EXPECT_EQ(failed.selection, "optimal");  // what the report says is still shown
+
+  const RunRow none = record_of(nullptr);
+  EXPECT_EQ(none.outcome, "kept");
+  EXPECT_EQ(none.reason, "no report.json");
+
+  json report = run_report("kept");
+  report["reason"] = 42;
+  const RunRow odd = record_of(report);
+  EXPECT_EQ(odd.outcome, "kept");
+  EXPECT_EQ(odd.reason.rfind("unreadable report.json: ", 0), 0u) << odd.reason;
+}
+
+TEST(RunDiscover, BuildingFoldersSortedWithTheirOptionalFiles) {
+  const fs::path run = cli_fixtures::test_dir("lodrefine_eval_run");
+  write_run_building(run, "b2", true, run_report("refined"));
+  write_run_building(run, "a1", false, nullptr);
+  fs::create_directories(run / "not-a-building");
+  std::ofstream(run / "a1" / "FAILED") << "boom\n";
+  const auto found = discover_run(run.string());
+  ASSERT_EQ(found.size(), 2u);
+  EXPECT_EQ(found[0].id, "a1");
+  EXPECT_EQ(found[0].failed, (run / "a1" / "FAILED").string());
+  EXPECT_EQ(found[0].report, "");
+  EXPECT_EQ(found[0].refined, (run / "a1" / "refined.obj").string());  // named even when absent
+  EXPECT_EQ(found[1].id, "b2");
+  EXPECT_EQ(found[1].report, (run / "b2" / "report.json").string());
+  EXPECT_EQ(found[1].truth, "");
+  EXPECT_THROW(discover_run((run / "not-a-building").string()), InputError);
+  EXPECT_THROW(discover_run((run / "no-such-dir").string()), InputError);
+}
+
+// Three buildings: refined (the front wall on the scan), refined model missing, unreadable
+// cloud. Rows in id order whatever the pool's order; one failure does not stop the run.
+TEST(RunEvaluate, RowsInIdOrderWithFiguresAndFailures) {
+  const fs::path run = cli_fixtures::test_dir("lodrefine_eval_run");
+  write_run_building(run, "a", true, run_report("refined"));
+  write_run_building(run, "b", false, run_report("kept", "nothing to change"));
+  write_run_building(run, "c", true, run_report("refined"));
+  std::ofstream(run / "c" / "cloud.ply") << "ply\nformat nonsense\n";
+  for (int jobs : {1, 3}) {
+    PooledSeries series;
+    const auto rows = evaluate_run(run.string(), Params{}, "", jobs, series, Progress::Mode::Off);
+    ASSERT_EQ(rows.size(), 3u);
+    EXPECT_EQ(rows[0].eval.id, "a");
+    EXPECT_EQ(rows[1].eval.id, "b");
+    EXPECT_EQ(rows[2].eval.id, "c");
+    const BuildingEval& a = rows[0].eval;
+    ASSERT_TRUE(a.ok()) << a.error;
+    EXPECT_GT(a.facade_points, 5000u);
+    EXPECT_NEAR(a.before.rmse, kRunWallOffset, 0.02);
+    EXPECT_LT(a.after.rmse, 0.02);
+    EXPECT_TRUE(a.watertight_after);
+    EXPECT_TRUE(a.c2m_after.empty()) << "the series go into the bins and are dropped";
+    EXPECT_EQ(series.c2m_after.count(), a.facade_points);
+    EXPECT_NEAR((rows[0].origin - kRunOrigin).norm(), 0.0, 1e-9);
+    EXPECT_EQ(rows[0].outcome, "refined");
+    ASSERT_EQ(rows[0].moved.size(), 1u);
+    EXPECT_EQ(rows[1].outcome, "failed");
+    EXPECT_NE(rows[1].reason.find("refined model missing"), std::string::npos) << rows[1].reason;
+    EXPECT_EQ(rows[2].outcome, "failed");
+    EXPECT_NE(rows[2].reason.find("cloud.ply"), std::string::npos) << rows[2].reason;
+  }
+}
+
+TEST(RunEvaluate, ANewerReportStopsTheRun) {
+  const fs::path run = cli_fixtures::test_dir("lodrefine_eval_run");
+  write_run_building(run, "a", true, run_report("refined"));
+  json newer = run_report("refined");
+  newer["report_version"] = kRefineReportVersion + 1;
+  write_run_building(run, "b", true, newer);
+  PooledSeries series;
+  EXPECT_THROW(evaluate_run(run.string(), Params{}, "", 2, series, Progress::Mode::Off), InputError);
+}
