@@ -1,14 +1,14 @@
-// From a Spec to one closed shell (see shapes.h): walls, roofs and ground per part, then
-// welded, T-junctions split, coplanar neighbours merged and redundant collinear vertices dropped.
+// From a Spec to one closed shell (see shapes.h): walls, roofs and ground per part, then the
+// core's repair (weld, T-junctions) and coplanar merge (which drops the vertices that only
+// continue a straight edge).
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
-#include <optional>
-#include <set>
+#include <stdexcept>
+#include <string>
 
 #include "lodrefine/core/geometry.h"
-#include "lodrefine/core/topology.h"
+#include "lodrefine/core/repair.h"
 #include "shapes.h"
 
 namespace lodrefine::synth {
@@ -16,11 +16,9 @@ namespace lodrefine::synth {
 namespace {
 
 constexpr double kWeldTol = 1e-6;  // building frame, metres
-// A vertex strictly inside a segment, closer than kWeldTol to it, lies on it.
-constexpr SegmentRule kOnEdge{kWeldTol, true};
-// Generated faces of one plane agree up to rounding: normals within this cosine, offsets within
-// kWeldTol (building frame).
-constexpr double kCoplanarCos = 1 - 1e-9;
+// Generated faces of one plane agree up to rounding; distinct planes of a building differ by
+// degrees, so the core's merge runs with tolerances far below those of a refined model.
+constexpr double kCoplanarAngleDeg = 0.01;
 
 struct Edge {
   Vec2 a, b;
@@ -220,115 +218,6 @@ void add_ground(const Spec& s, const Part& p, std::vector<RawFace>& out) {
   out.push_back(std::move(f));
 }
 
-// ---------------------------------------------------------------------------------------------
-// Turning raw faces into one shell.
-
-int weld(std::vector<Vec3>& verts, const Vec3& p) {
-  for (std::size_t i = 0; i < verts.size(); ++i)
-    if ((verts[i] - p).norm() < kWeldTol) return int(i);
-  verts.push_back(p);
-  return int(verts.size()) - 1;
-}
-
-// Inserts every vertex lying inside a face edge into that edge, so faces meet vertex to vertex.
-void split_t_junctions(Mesh& m) {
-  for (auto& f : m.faces) {
-    std::vector<int> out;
-    for (std::size_t i = 0; i < f.v.size(); ++i) {
-      out.push_back(f.v[i]);
-      const auto inside = vertices_on_segment(m.vertices, f.v[i], f.v[(i + 1) % f.v.size()], kOnEdge);
-      out.insert(out.end(), inside.begin(), inside.end());
-    }
-    f.v = out;
-  }
-}
-
-// The outline of a group of faces (shared edges cancel); nullopt unless it is one simple loop.
-std::optional<std::vector<int>> outline(const Mesh& m, const std::vector<int>& group) {
-  std::map<std::pair<int, int>, int> count;
-  for (int fi : group) {
-    const auto& v = m.faces[fi].v;
-    for (std::size_t i = 0; i < v.size(); ++i) ++count[{v[i], v[(i + 1) % v.size()]}];
-  }
-  std::map<int, int> next;
-  for (const auto& [e, c] : count) {
-    const auto rev = count.find({e.second, e.first});
-    if (rev != count.end() && rev->second > 0) continue;
-    if (c != 1 || next.count(e.first)) return std::nullopt;
-    next[e.first] = e.second;
-  }
-  if (next.empty()) return std::nullopt;
-  std::vector<int> loop{next.begin()->first};
-  while (true) {
-    const auto it = next.find(loop.back());
-    if (it == next.end()) return std::nullopt;
-    if (it->second == loop.front()) break;
-    loop.push_back(it->second);
-    if (loop.size() > next.size()) return std::nullopt;
-  }
-  if (loop.size() != next.size()) return std::nullopt;
-  return loop;
-}
-
-// Merges edge-adjacent coplanar faces of the same semantic (pieces of one wall, roofs of
-// parts of equal height, the parts' grounds) into single polygons.
-void merge_coplanar(Mesh& m) {
-  const int nf = int(m.faces.size());
-  std::vector<Plane> planes;
-  for (const auto& f : m.faces) planes.push_back(polygon_plane(face_points(m, f)));
-  DisjointSets sets(nf);
-  for (const auto& [e, fs] : edge_uses(m.faces)) {
-    if (fs.size() != 2) continue;
-    const int f = fs[0].face, g = fs[1].face;
-    if (m.faces[f].sem != m.faces[g].sem) continue;
-    if (planes[f].n.dot(planes[g].n) < kCoplanarCos || std::abs(planes[f].d - planes[g].d) > kWeldTol) continue;
-    sets.unite(f, g);
-  }
-  std::map<int, std::vector<int>> groups;
-  for (int fi = 0; fi < nf; ++fi) groups[sets.find(fi)].push_back(fi);
-  std::map<int, std::optional<std::vector<int>>> outlines;  // per group root; nullopt: keep members
-  for (const auto& [root, g] : groups)
-    if (g.size() > 1) outlines[root] = outline(m, g);
-  std::vector<Face> faces;
-  for (int fi = 0; fi < nf; ++fi) {
-    const int root = sets.find(fi);
-    const auto it = outlines.find(root);
-    if (it == outlines.end() || !it->second)
-      faces.push_back(m.faces[fi]);
-    else if (groups[root].front() == fi)
-      faces.push_back(Face{*it->second, m.faces[fi].sem, m.faces[fi].source});
-  }
-  m.faces = std::move(faces);
-}
-
-// Drops vertices that only continue a straight edge (two neighbours, collinear), then unused ones.
-void drop_collinear_vertices(Mesh& m) {
-  std::vector<std::set<int>> nb(m.vertices.size());
-  for (const auto& f : m.faces)
-    for (std::size_t i = 0; i < f.v.size(); ++i) {
-      const int a = f.v[i], b = f.v[(i + 1) % f.v.size()];
-      nb[a].insert(b);
-      nb[b].insert(a);
-    }
-  std::vector<bool> drop(m.vertices.size(), false);
-  for (std::size_t v = 0; v < nb.size(); ++v) {
-    if (nb[v].size() != 2) continue;
-    drop[v] = inside_segment(m.vertices[*nb[v].begin()], m.vertices[*nb[v].rbegin()], m.vertices[v], kOnEdge).has_value();
-  }
-  std::vector<int> remap(m.vertices.size(), -1);
-  std::vector<Vec3> verts;
-  for (auto& f : m.faces) {
-    std::vector<int> kept;
-    for (int v : f.v)
-      if (!drop[v]) {
-        if (remap[v] < 0) remap[v] = int(verts.size()), verts.push_back(m.vertices[v]);
-        kept.push_back(remap[v]);
-      }
-    f.v = kept;
-  }
-  m.vertices = std::move(verts);
-}
-
 }  // namespace
 
 int add_line(Spec& s, const Vec2& a, const Vec2& b) {
@@ -359,19 +248,24 @@ Mesh build_mesh(const Spec& s) {
     for (const auto& e : edges[pi]) add_walls(s, edges, pi, e, raw);
   for (const auto& p : s.parts) add_roofs(s, p, raw);
   for (const auto& p : s.parts) add_ground(s, p, raw);
-  Mesh m;
+  // Every raw face with its own corners, then the core's repair: weld, T-junctions, orientation.
+  Mesh soup;
   for (const auto& rf : raw) {
-    Face f;
-    for (const auto& p : rf.pts) f.v.push_back(weld(m.vertices, p));
-    drop_repeats(f.v);
-    f.sem = rf.sem;
-    f.source = rf.line;
-    if (f.v.size() >= 3) m.faces.push_back(std::move(f));
+    Face f{{}, rf.sem, rf.line};
+    for (const auto& p : rf.pts) f.v.push_back(int(soup.vertices.size())), soup.vertices.push_back(p);
+    soup.faces.push_back(std::move(f));
   }
-  split_t_junctions(m);
-  merge_coplanar(m);
-  drop_collinear_vertices(m);
-  return m;
+  RepairReport report;
+  Mesh m;
+  try {
+    m = repair_model(soup, kWeldTol, &report);
+  } catch (const InputError& e) {
+    throw ShapeError(std::string("the parts do not close: ") + e.what());
+  }
+  // The raw faces are outward and meet edge to edge: a filled hole or a flipped face is a bug here.
+  if (report.filled_holes > 0 || report.flipped_faces > 0)
+    throw std::logic_error("synth: the generated faces left a hole or ran against their neighbours");
+  return merge_coplanar_faces(m, kCoplanarAngleDeg, kWeldTol);
 }
 
 }  // namespace lodrefine::synth
