@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <set>
+#include <stdexcept>
 
 #include "lodrefine/core/geometry.h"
 
@@ -28,6 +29,10 @@ std::vector<WallInfo> wall_infos(const Mesh& m) {
 
 namespace {
 
+// The generalised front of the street-facade types moves by [kFrontShiftMin min_shift,
+// kFrontShiftMax max_shift]: 0.1-0.6 m with the default options, as the topo dev tile's models.
+constexpr double kFrontShiftMin = 0.5, kFrontShiftMax = 0.75;
+
 void move_line(Line& l, const Vec2& pivot, const Vec2& n_out, double offset, double rot_deg) {
   const Eigen::Rotation2Dd R(radians(rot_deg));
   l.p = pivot + R * (l.p - pivot) + offset * (R * n_out);
@@ -41,6 +46,25 @@ MovedWall random_move(const SynthOptions& o, Rng& r) {
   if (shift) mv.offset = r.sign() * r.uniform(o.min_shift, o.max_shift);
   if (rotate) mv.rotation_deg = r.sign() * r.uniform(0.3 * o.max_rotation_deg, o.max_rotation_deg);
   return mv;
+}
+
+// Moves the footprint line of walls[w] by mv about the wall's middle; mv gets the truth walls on
+// that line (walls[w] first) and whether walls[w] is scanned.
+MovedWall move_wall_line(Spec& s, const std::vector<WallInfo>& walls, int w, const std::vector<int>& scanned,
+                         MovedWall mv) {
+  const WallInfo& wi = walls[w];
+  for (const auto& x : walls)
+    if (x.line == wi.line && x.face != wi.face) mv.truth_faces.push_back(x.face);
+  mv.truth_faces.insert(mv.truth_faces.begin(), wi.face);
+  mv.scanned = std::count(scanned.begin(), scanned.end(), w) > 0;
+  move_line(s.lines[wi.line], wi.mid, wi.n, mv.offset, mv.rotation_deg);
+  return mv;
+}
+
+int first_wall_on(const std::vector<WallInfo>& walls, int line) {
+  for (int w = 0; w < int(walls.size()); ++w)
+    if (walls[w].line == line) return w;
+  return -1;
 }
 
 }  // namespace
@@ -58,16 +82,27 @@ std::vector<MovedWall> move_facades(Spec& s, const std::vector<WallInfo>& walls,
   std::vector<MovedWall> moves;
   std::set<int> moved_lines;
   for (int w : pick) {
-    const WallInfo& wi = walls[w];
-    if (moves.size() >= 3 || !moved_lines.insert(wi.line).second) continue;
-    MovedWall mv = random_move(o, r);
-    for (const auto& x : walls)
-      if (x.line == wi.line && x.face != wi.face) mv.truth_faces.push_back(x.face);
-    mv.truth_faces.insert(mv.truth_faces.begin(), wi.face);
-    mv.scanned = std::count(scanned.begin(), scanned.end(), w) > 0;
-    move_line(s.lines[wi.line], wi.mid, wi.n, mv.offset, mv.rotation_deg);
-    moves.push_back(mv);
+    if (moves.size() >= 3 || !moved_lines.insert(walls[w].line).second) continue;
+    moves.push_back(move_wall_line(s, walls, w, scanned, random_move(o, r)));
   }
+  return moves;
+}
+
+std::vector<MovedWall> move_generalised(Spec& s, const std::vector<WallInfo>& walls, const std::vector<int>& scanned,
+                                        const SynthOptions& o, Rng& r) {
+  std::vector<MovedWall> moves;
+  MovedWall front;
+  front.offset = r.sign() * r.uniform(kFrontShiftMin * o.min_shift, kFrontShiftMax * o.max_shift);
+  if (const int w = first_wall_on(walls, s.coarse_front); w >= 0)
+    moves.push_back(move_wall_line(s, walls, w, scanned, front));
+  if (r.chance(0.25)) {  // now and then a side or the back is off too
+    std::vector<int> others;
+    for (int l : s.generalised.front().lines)
+      if (l != s.coarse_front) others.push_back(l);
+    if (const int w = first_wall_on(walls, others[r.integer(0, int(others.size()) - 1)]); w >= 0)
+      moves.push_back(move_wall_line(s, walls, w, scanned, random_move(o, r)));
+  }
+  if (moves.empty()) throw std::logic_error("synth: the generalised front has no truth wall");
   return moves;
 }
 

@@ -24,6 +24,13 @@ std::vector<WallInfo> wall_infos(const Mesh& m);
 std::vector<MovedWall> move_facades(Spec& s, const std::vector<WallInfo>& walls, const std::vector<int>& scanned,
                                     const SynthOptions& o, Rng& r);
 
+// The street-facade types (s.generalised non-empty): moves the generalised front line
+// (s.coarse_front) by 0.1-0.6 m with the default options (no rotation: the detail the model
+// lacks is the error under test), and with a chance of 1/4 another generalised line as
+// move_facades does. The caller builds the coarse model from s.generalised.
+std::vector<MovedWall> move_generalised(Spec& s, const std::vector<WallInfo>& walls, const std::vector<int>& scanned,
+                                        const SynthOptions& o, Rng& r);
+
 // The shell as an exporter writes it: every face with its own copy of its corners.
 Mesh to_soup(const Mesh& m);
 

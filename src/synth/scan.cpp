@@ -22,31 +22,64 @@ int pick_weighted(const std::vector<double>& w, Rng& r) {
   return -1;
 }
 
-}  // namespace
+// Walls of the truth sharing an edge with a chosen wall, not chosen themselves, at least 2 m long.
+struct WallAdjacency {
+  std::vector<int> wall_of;  // per face: index into walls, -1 for other faces
+  EdgeUses edges;            // over the walls' faces
 
-std::vector<int> choose_scanned(const Mesh& m, const std::vector<WallInfo>& walls, int k, Rng& r) {
-  std::vector<int> wall_of(m.faces.size(), -1), faces;
-  for (std::size_t w = 0; w < walls.size(); ++w) wall_of[walls[w].face] = int(w), faces.push_back(walls[w].face);
-  const auto edge_walls = edge_uses(m.faces, faces);
-  std::vector<double> weight;
-  for (const auto& w : walls) weight.push_back(w.length >= 3 ? w.length : 0.0);
-  std::vector<int> chosen{pick_weighted(weight, r)};
-  while (int(chosen.size()) < k) {
+  WallAdjacency(const Mesh& m, const std::vector<WallInfo>& walls) : wall_of(m.faces.size(), -1) {
+    std::vector<int> faces;
+    for (std::size_t w = 0; w < walls.size(); ++w) wall_of[walls[w].face] = int(w), faces.push_back(walls[w].face);
+    edges = edge_uses(m.faces, faces);
+  }
+  std::set<int> next_to(const std::vector<int>& chosen, const std::vector<WallInfo>& walls) const {
     std::set<int> cand;
-    for (const auto& [e, uses] : edge_walls)
+    for (const auto& [e, uses] : edges)
       for (const EdgeUse& a : uses)
         if (std::count(chosen.begin(), chosen.end(), wall_of[a.face]))
           for (const EdgeUse& b : uses)
             if (!std::count(chosen.begin(), chosen.end(), wall_of[b.face]) && walls[wall_of[b.face]].length >= 2)
               cand.insert(wall_of[b.face]);
+    return cand;
+  }
+};
+
+}  // namespace
+
+std::vector<int> choose_scanned(const Mesh& m, const std::vector<WallInfo>& walls, int k, Rng& r) {
+  const WallAdjacency adjacency(m, walls);
+  std::vector<double> weight;
+  for (const auto& w : walls) weight.push_back(w.length >= 3 ? w.length : 0.0);
+  std::vector<int> chosen{pick_weighted(weight, r)};
+  while (int(chosen.size()) < k) {
+    const std::set<int> cand = adjacency.next_to(chosen, walls);
     if (cand.empty()) break;
     chosen.push_back(*std::next(cand.begin(), r.integer(0, int(cand.size()) - 1)));
   }
   return chosen;  // indices into walls
 }
 
+std::vector<int> choose_street(const Mesh& m, const std::vector<WallInfo>& walls, const std::vector<int>& street,
+                               Rng& r) {
+  std::vector<int> chosen;
+  for (int w = 0; w < int(walls.size()); ++w)
+    if (std::count(street.begin(), street.end(), walls[w].line)) chosen.push_back(w);
+  if (r.chance(0.4)) {  // the van turns a corner: one side wall too
+    const std::set<int> cand = WallAdjacency(m, walls).next_to(chosen, walls);
+    if (!cand.empty()) chosen.push_back(*std::next(cand.begin(), r.integer(0, int(cand.size()) - 1)));
+  }
+  return chosen;
+}
+
 
 namespace {
+
+// A wall turned more than 45 degrees from the street is seen obliquely (street-facade types).
+const double kFacingCos = std::cos(radians(45.0));
+// m: how far along the street the van is from an oblique wall's point when it records it.
+constexpr double kObliqueMin = 2.0, kObliqueMax = 8.0;
+// m: the sight line's end is taken this far in front of the wall, off the footprint's edge.
+constexpr double kClearOfWall = 0.01;
 
 struct Sphere {
   Vec3 c;
@@ -69,6 +102,10 @@ struct ScanWall {
   double smin, smax, zmin, zmax, zcut;
   std::vector<Window> windows;
   std::vector<Sphere> holes;  // occlusion blobs in (s, z, 0)
+  // Set on walls the van sees only obliquely from the street (a recess's returns, a bay's
+  // sides, a side wall at a corner): the street's side, the outward normal of the front.
+  Vec3 street = Vec3::Zero();
+  bool oblique() const { return !street.isZero(); }
 };
 
 ScanWall scan_wall(const Mesh& m, int face, double z0, Rng& r) {
@@ -132,7 +169,25 @@ struct Scene {
   std::vector<Vec3> pts;
   std::vector<int> labels;
   double scanner_dist = 6, spacing = 0.05;
+
+  // The walls the van drives along: clutter stands in front of these (all walls but the oblique).
+  std::vector<const ScanWall*> street_walls() const {
+    std::vector<const ScanWall*> out;
+    for (const auto& w : walls)
+      if (!w.oblique()) out.push_back(&w);
+    if (out.empty())
+      for (const auto& w : walls) out.push_back(&w);
+    return out;
+  }
 };
+
+// Whether the 2D sight line a-b crosses an edge of the building's footprint.
+bool crosses_footprint(const Scene& sc, const Vec3& a, const Vec3& b) {
+  const std::size_t n = sc.footprint.size();
+  for (std::size_t i = 0; i < n; ++i)
+    if (segments_cross(xy(a), xy(b), sc.footprint[i], sc.footprint[(i + 1) % n])) return true;
+  return false;
+}
 
 bool ray_hits_sphere(const Vec3& a, const Vec3& b, const Sphere& s) {
   const Vec3 ab = b - a;
@@ -192,7 +247,14 @@ void sample_facade(Scene& sc, const ScanWall& w, double noise, Rng& r) {
         }
       if (hole) continue;
       const Vec3 p = w.o + js * w.u + jz * Vec3::UnitZ() - depth * w.n;
-      const Vec3 scanner = w.o + js * w.u + sc.scanner_dist * w.n + (sc.z0 + 2.2) * Vec3::UnitZ();
+      Vec3 scanner = w.o + js * w.u + sc.scanner_dist * w.n + (sc.z0 + 2.2) * Vec3::UnitZ();
+      if (w.oblique()) {  // seen from the street a few metres along, through the recess's opening
+        scanner = p + sc.scanner_dist * w.street + r.uniform(kObliqueMin, kObliqueMax) * w.n;
+        scanner.z() = sc.z0 + 2.2;
+        const Vec3 ray = (scanner - p).normalized();
+        if (r.uniform() > ray.dot(w.n)) continue;  // grazing beams return fewer points
+        if (crosses_footprint(sc, p + kClearOfWall * w.n, scanner)) continue;  // the building hides it
+      }
       if (occluded(sc, scanner, p)) continue;
       sc.pts.push_back(p + r.noise(noise) * w.n);
       sc.labels.push_back(label);
@@ -275,10 +337,11 @@ void add_person(Scene& sc, const ScanWall& w, int budget, double noise, Rng& r) 
 
 void add_street(Scene& sc, int budget, double noise, Rng& r) {
   double total = 0;
-  for (const auto& w : sc.walls) total += w.smax - w.smin + 4;
-  for (const auto& w : sc.walls)
-    for (int k = int(budget * (w.smax - w.smin + 4) / total); k > 0; --k)
-      push_clutter(sc, street_point(w, r.uniform(w.smin - 2, w.smax + 2), r.uniform(0, 8), sc.z0), -3, noise, r);
+  const auto walls = sc.street_walls();
+  for (const ScanWall* w : walls) total += w->smax - w->smin + 4;
+  for (const ScanWall* w : walls)
+    for (int k = int(budget * (w->smax - w->smin + 4) / total); k > 0; --k)
+      push_clutter(sc, street_point(*w, r.uniform(w->smin - 2, w->smax + 2), r.uniform(0, 8), sc.z0), -3, noise, r);
 }
 
 // Pieces of the next building: a wall continuing past one end of a scanned facade (slightly
@@ -286,10 +349,10 @@ void add_street(Scene& sc, int budget, double noise, Rng& r) {
 // not continue itself (not at concave corners).
 void add_neighbour(Scene& sc, int budget, double noise, Rng& r) {
   std::vector<std::pair<const ScanWall*, double>> ends;  // wall, direction along u
-  for (const auto& w : sc.walls)
+  for (const ScanWall* w : sc.street_walls())
     for (double dir : {-1.0, 1.0}) {
-      const double end = dir > 0 ? w.smax : w.smin;
-      if (!point_in_polygon_2d(xy(street_point(w, end + 2 * dir, -1.0, 0)), sc.footprint)) ends.emplace_back(&w, dir);
+      const double end = dir > 0 ? w->smax : w->smin;
+      if (!point_in_polygon_2d(xy(street_point(*w, end + 2 * dir, -1.0, 0)), sc.footprint)) ends.emplace_back(w, dir);
     }
   if (ends.empty()) return;
   const auto [w, dir] = ends[r.integer(0, int(ends.size()) - 1)];
@@ -309,7 +372,8 @@ void add_neighbour(Scene& sc, int budget, double noise, Rng& r) {
 
 void add_nuisances(Scene& sc, const SynthOptions& o, Rng& r) {
   const int T = o.target_points;
-  auto wall = [&]() -> const ScanWall& { return sc.walls[r.integer(0, int(sc.walls.size()) - 1)]; };
+  const auto walls = sc.street_walls();
+  auto wall = [&]() -> const ScanWall& { return *walls[r.integer(0, int(walls.size()) - 1)]; };
   for (int k = r.integer(0, 2); k > 0; --k) add_tree(sc, wall(), int(0.03 * T), o.noise, r);
   for (int k = r.integer(0, 2); k > 0; --k) add_car(sc, wall(), int(0.02 * T), o.noise, r);
   for (int k = r.integer(0, 3); k > 0; --k) add_person(sc, wall(), int(0.004 * T), o.noise, r);
@@ -325,7 +389,8 @@ std::vector<int> wall_faces(const std::vector<int>& chosen, const std::vector<Wa
   return faces;
 }
 
-ScanResult simulate_scan(const Mesh& truth, const std::vector<int>& faces, double z0, const SynthOptions& o, Rng& r) {
+ScanResult simulate_scan(const Mesh& truth, const std::vector<int>& faces, double z0, const Vec2& street,
+                         const SynthOptions& o, Rng& r) {
   Scene sc;
   sc.z0 = z0;
   sc.scanner_dist = r.uniform(7.5, 9);  // beyond the cars, inside the street strip
@@ -335,6 +400,8 @@ ScanResult simulate_scan(const Mesh& truth, const std::vector<int>& faces, doubl
   double area = 0;
   for (int f : faces) {
     sc.walls.push_back(scan_wall(truth, f, z0, r));
+    if (!street.isZero() && sc.walls.back().n.head<2>().dot(street) < kFacingCos)
+      sc.walls.back().street = Vec3(street.x(), street.y(), 0.0);
     area += visible_area(sc.walls.back(), z0);
   }
   sc.spacing = std::max(0.03, std::sqrt(area / std::max(1, o.target_points)));
@@ -351,6 +418,5 @@ ScanResult simulate_scan(const Mesh& truth, const std::vector<int>& faces, doubl
   sc.labels.insert(sc.labels.end(), clutter_labels.begin(), clutter_labels.end());
   return {std::move(sc.pts), std::move(sc.labels), sc.spacing};
 }
-
 
 }  // namespace lodrefine::synth

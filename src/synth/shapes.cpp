@@ -1,5 +1,5 @@
 // The building types (see shapes.h). Building frame: metres, x/y axis-aligned where the type
-// allows, the street side at y = 0 facing -y.
+// allows. The street-facade types (recess, bay, setback) face the street at y = 0 (towards -y).
 #include <algorithm>
 #include <cmath>
 
@@ -123,6 +123,92 @@ Spec polygon_spec(Rng& r, double z0) {
   return single_part(lines, {roof}, s);
 }
 
+// ---------------------------------------------------------------------------------------------
+// Street-facade types: the truth's street facade has detail (a recess, a bay, a second facade
+// line) that the coarse model generalises away: its parts are the plain block [0,W]x[0,D]
+// (lines front, right, back, left), whose front line the perturbation moves.
+
+// Flat (half), mono-pitch rising away from the street or gabled with the ridge along it; one
+// roof for every part, so the parts' walls between each other are interior.
+std::vector<RoofPlane> street_roof(Rng& r, double z0, double D) {
+  const double u = r.uniform();
+  if (u < 0.5) return {flat_roof(z0 + r.uniform(4, 15))};
+  const double eave = z0 + r.uniform(4, 9);
+  if (u < 0.75) return {sloped_roof({0, 0}, {0, 1}, eave, std::tan(radians(r.uniform(8, 20))))};
+  const double k = std::tan(radians(r.uniform(25, 45)));
+  return {sloped_roof({0, 0}, {0, 1}, eave, k), sloped_roof({0, D}, {0, -1}, eave, k)};
+}
+
+struct Block {
+  Spec s;
+  double W, D;
+  int front, right, back, left;
+  std::vector<RoofPlane> roof;
+};
+
+Block street_block(Rng& r, double z0, double wmin, double wmax) {
+  Block b;
+  b.s.z0 = z0;
+  b.W = r.uniform(wmin, wmax), b.D = r.uniform(8, 14);
+  const auto l = rect_lines(b.s, 0, 0, b.W, b.D);
+  b.front = l[0], b.right = l[1], b.back = l[2], b.left = l[3];
+  b.roof = street_roof(r, z0, b.D);
+  b.s.generalised = {{{b.front, b.right, b.back, b.left}, b.roof}};
+  b.s.coarse_front = b.front;
+  b.s.street_normal = {0, -1};
+  return b;
+}
+
+// A full-height recess (entrance, loggia) 2.5-6 m wide and 1-2.5 m deep in the street facade:
+// a back wall and two returns. Parts: left of it, behind it, right of it.
+Spec recess_spec(Rng& r, double z0) {
+  Block b = street_block(r, z0, 12, 24);
+  Spec& s = b.s;
+  const double w = r.uniform(2.5, std::min(6.0, b.W - 6)), d = r.uniform(1.0, 2.5);
+  const double x0 = r.uniform(2.5, b.W - w - 2.5), x1 = x0 + w;
+  const int ra = add_line(s, {x0, 0}, {x0, b.D}), rb = add_line(s, {x1, b.D}, {x1, 0});
+  const int back_wall = add_line(s, {x0, d}, {x1, d});
+  s.parts = {{{b.front, ra, b.back, b.left}, b.roof},
+             {{back_wall, rb, b.back, ra}, b.roof},
+             {{b.front, b.right, b.back, rb}, b.roof}};
+  s.street = {b.front, ra, back_wall, rb};
+  return s;
+}
+
+// A bay / risalit 2.5-6 m wide standing 0.6-1.5 m out of the street facade, full height.
+Spec bay_spec(Rng& r, double z0) {
+  Block b = street_block(r, z0, 11, 24);
+  Spec& s = b.s;
+  const double w = r.uniform(2.5, std::min(6.0, b.W - 5)), d = r.uniform(0.6, 1.5);
+  const double x0 = r.uniform(2.0, b.W - w - 2.0), x1 = x0 + w;
+  const int bl = add_line(s, {x0, 0}, {x0, -d}), bf = add_line(s, {x0, -d}, {x1, -d});
+  const int br = add_line(s, {x1, -d}, {x1, 0});
+  s.parts = {{{b.front, b.right, b.back, b.left}, b.roof}, {{bf, br, b.front, bl}, b.roof}};
+  s.street = {b.front, bl, bf, br};
+  return s;
+}
+
+// A street facade line that steps back 0.8-2.5 m part-way along; the coarse model's generalised
+// front follows either of the two lines.
+Spec setback_spec(Rng& r, double z0) {
+  Block b = street_block(r, z0, 14, 26);
+  Spec& s = b.s;
+  const double xs = r.uniform(0.35, 0.65) * b.W, d = r.uniform(0.8, 2.5);
+  const int step = add_line(s, {xs, 0}, {xs, b.D});
+  if (r.chance(0.5)) {  // the left part stands forward
+    const int rear = add_line(s, {xs, d}, {b.W, d});
+    s.parts = {{{b.front, step, b.back, b.left}, b.roof}, {{rear, b.right, b.back, step}, b.roof}};
+    s.street = {b.front, step, rear};
+    if (r.chance(0.5)) s.generalised[0].lines[0] = s.coarse_front = rear;
+  } else {  // the right part stands forward
+    const int rear = add_line(s, {0, d}, {xs, d});
+    s.parts = {{{rear, step, b.back, b.left}, b.roof}, {{b.front, b.right, b.back, step}, b.roof}};
+    s.street = {b.front, step, rear};
+    if (r.chance(0.5)) s.generalised[0].lines[0] = s.coarse_front = rear;
+  }
+  return s;
+}
+
 }  // namespace
 
 Spec make_spec(BuildingType t, Rng& r, double z0) {
@@ -143,9 +229,14 @@ Spec make_spec(BuildingType t, Rng& r, double z0) {
       return tshape_spec(r, z0);
     case BuildingType::Polygon:
       return polygon_spec(r, z0);
+    case BuildingType::Recess:
+      return recess_spec(r, z0);
+    case BuildingType::Bay:
+      return bay_spec(r, z0);
+    case BuildingType::Setback:
+      return setback_spec(r, z0);
   }
   throw std::logic_error("synth: unknown building type");
 }
-
 
 }  // namespace lodrefine::synth

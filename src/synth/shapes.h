@@ -36,6 +36,13 @@ struct Spec {
   std::vector<Line> lines;
   std::vector<Part> parts;
   double z0 = 0.0;  // ground level
+  // Street-facade types only (empty / -1 otherwise): the coarse model's parts, which generalise
+  // the street facade away; the lines of the true street facade (all scanned); the generalised
+  // front line the coarse model moves; the street's side (outward normal of the front).
+  std::vector<Part> generalised;
+  std::vector<int> street;
+  int coarse_front = -1;
+  Vec2 street_normal = Vec2::Zero();
 };
 
 int add_line(Spec& s, const Vec2& a, const Vec2& b);
@@ -44,6 +51,9 @@ std::vector<int> rect_lines(Spec& s, double x0, double y0, double x1, double y1)
 RoofPlane flat_roof(double z);
 // Plane at height z_at through `at`, rising with slope k in direction `up`.
 RoofPlane sloped_roof(const Vec2& at, const Vec2& up, double z_at, double k);
+
+// Whether segments a-b and c-d cross (where one only touches the other, either answer).
+bool segments_cross(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d);
 
 // The closed shell of a spec: shared vertices, outward faces, coplanar pieces of one wall, roof or
 // ground merged, no T-junction and no vertex that only continues a straight edge.

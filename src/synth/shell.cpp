@@ -19,6 +19,7 @@ constexpr double kWeldTol = 1e-6;  // building frame, metres
 // Generated faces of one plane agree up to rounding; distinct planes of a building differ by
 // degrees, so the core's merge runs with tolerances far below those of a refined model.
 constexpr double kCoplanarAngleDeg = 0.01;
+constexpr double kMinPartArea = 1.0;  // m^2: a part's footprint below this has folded
 
 struct Edge {
   Vec2 a, b;
@@ -46,16 +47,11 @@ std::vector<Edge> part_edges(const Spec& s, const Part& p) {
   return e;
 }
 
-bool segments_cross(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
-  const double d1 = cross2(b - a, c - a), d2 = cross2(b - a, d - a), d3 = cross2(d - c, a - c),
-               d4 = cross2(d - c, b - c);
-  return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0));
-}
 
-// Counter-clockwise, not self-intersecting and not a sliver.
+// Counter-clockwise, not self-intersecting and not a sliver (a bay's part is 1.5 m^2 and up).
 bool valid_footprint(const std::vector<Vec2>& poly) {
   const std::size_t n = poly.size();
-  if (signed_area_2d(poly) < 4.0) return false;
+  if (signed_area_2d(poly) < kMinPartArea) return false;
   for (std::size_t i = 0; i < n; ++i) {
     if ((poly[(i + 1) % n] - poly[i]).norm() < 0.5) return false;
     for (std::size_t j = i + 2; j < n; ++j)
@@ -235,6 +231,12 @@ RoofPlane flat_roof(double z) { return {0.0, 0.0, z}; }
 RoofPlane sloped_roof(const Vec2& at, const Vec2& up, double z_at, double k) {
   const Vec2 g = k * up.normalized();
   return {g.x(), g.y(), z_at - g.dot(at)};
+}
+
+bool segments_cross(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
+  const double d1 = cross2(b - a, c - a), d2 = cross2(b - a, d - a), d3 = cross2(d - c, a - c),
+               d4 = cross2(d - c, b - c);
+  return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0));
 }
 
 Mesh build_mesh(const Spec& s) {

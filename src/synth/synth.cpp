@@ -47,7 +47,8 @@ void check_options(const SynthOptions& o) {
 constexpr std::pair<BuildingType, const char*> kBuildingTypes[] = {
     {BuildingType::Flat, "flat"},       {BuildingType::Gable, "gable"},   {BuildingType::Hip, "hip"},
     {BuildingType::Shed, "shed"},       {BuildingType::Stepped, "stepped"}, {BuildingType::LShape, "lshape"},
-    {BuildingType::TShape, "tshape"}, {BuildingType::Polygon, "polygon"}};
+    {BuildingType::TShape, "tshape"}, {BuildingType::Polygon, "polygon"}, {BuildingType::Recess, "recess"},
+    {BuildingType::Bay, "bay"},         {BuildingType::Setback, "setback"}};
 }  // namespace
 
 const char* building_type_name(BuildingType t) {
@@ -94,14 +95,24 @@ SynthBuilding make_building(BuildingType type, std::uint64_t seed, const SynthOp
   const Spec spec = make_spec(type, r, z0);
   const Mesh truth = build_mesh(spec);
   const auto walls = wall_infos(truth);
-  const int k = opt.scanned_facades > 0 ? opt.scanned_facades : r.integer(1, 3);
-  const auto scanned = choose_scanned(truth, walls, k, r);
+  std::vector<int> scanned;
+  if (spec.street.empty()) {
+    const int k = opt.scanned_facades > 0 ? opt.scanned_facades : r.integer(1, 3);
+    scanned = choose_scanned(truth, walls, k, r);
+  } else {
+    scanned = choose_street(truth, walls, spec.street, r);
+  }
   b.scanned_truth_faces = wall_faces(scanned, walls);
 
   Mesh coarse_local;
   for (int attempt = 0;; ++attempt) {  // large moves can fold a part or sink an eave: redraw
     Spec moved = spec;
-    b.moved_walls = move_facades(moved, walls, scanned, opt, r);
+    if (spec.generalised.empty()) {
+      b.moved_walls = move_facades(moved, walls, scanned, opt, r);
+    } else {
+      b.moved_walls = move_generalised(moved, walls, scanned, opt, r);
+      moved.parts = moved.generalised;
+    }
     try {
       coarse_local = build_mesh(moved);
       break;
@@ -116,7 +127,7 @@ SynthBuilding make_building(BuildingType type, std::uint64_t seed, const SynthOp
   if (opt.defects) b.defects = add_defects(coarse, r_defects);
   for (int i = 0; i < int(coarse.faces.size()); ++i) coarse.faces[i].source = i;
 
-  ScanResult sc = simulate_scan(truth, b.scanned_truth_faces, z0, opt, r_scan);
+  ScanResult sc = simulate_scan(truth, b.scanned_truth_faces, z0, spec.street_normal, opt, r_scan);
   b.point_spacing = sc.spacing;
   for (const auto& p : sc.pts) b.cloud.points.push_back(frame.apply(p));
   b.point_label = std::move(sc.labels);
