@@ -75,6 +75,10 @@ std::vector<BuildingType> all_building_types() {
   return all;
 }
 
+bool street_facade_type(BuildingType t) {
+  return t == BuildingType::Recess || t == BuildingType::Bay || t == BuildingType::Setback;
+}
+
 SynthBuilding make_building(BuildingType type, std::uint64_t seed, const SynthOptions& opt) {
   check_options(opt);
   // One stream per stage, so --no-defects / --no-nuisances leave the other outputs unchanged.

@@ -82,11 +82,6 @@ SynthOptions clean_options() {
   return o;
 }
 
-// The types whose truth has street-facade detail the coarse model generalises away.
-bool street_type(BuildingType t) {
-  return t == BuildingType::Recess || t == BuildingType::Bay || t == BuildingType::Setback;
-}
-
 class SynthAll : public ::testing::TestWithParam<BuildingType> {};
 
 }  // namespace
@@ -97,6 +92,11 @@ TEST(SynthNames, RoundTrip) {
   EXPECT_THROW(building_type_from_name("castle"), InputError);
   EXPECT_EQ(all_building_types().size(), 11u);
   EXPECT_EQ(building_type_from_name("setback"), BuildingType::Setback);
+  int street = 0;
+  for (auto t : all_building_types()) street += street_facade_type(t);
+  EXPECT_EQ(street, 3);
+  EXPECT_TRUE(street_facade_type(BuildingType::Bay));
+  EXPECT_FALSE(street_facade_type(BuildingType::Stepped));
 }
 
 TEST(SynthOptionsCheck, RejectsInvertedShiftRange) {
@@ -174,7 +174,7 @@ TEST_P(SynthAll, CoarseKeepsRoofPlanesAndMovesOnlyChosenWalls) {
       EXPECT_LE(std::abs(m.offset), o.max_shift + 1e-12);
       EXPECT_LE(std::abs(m.rotation_deg), o.max_rotation_deg + 1e-12);
       // A street type's generalised front moves by 0.1-0.6 m (half the minimum shift and up).
-      const double min_shift = street_type(GetParam()) ? 0.5 * o.min_shift : o.min_shift;
+      const double min_shift = street_facade_type(GetParam()) ? 0.5 * o.min_shift : o.min_shift;
       EXPECT_TRUE(std::abs(m.offset) >= min_shift - 1e-12 || m.offset == 0.0);
       EXPECT_GT(std::abs(m.offset) + std::abs(m.rotation_deg), 0.0);
     }
@@ -210,7 +210,7 @@ TEST_P(SynthAll, CloudLiesOnScannedWallsWithinNoise) {
     const auto b = make_building(GetParam(), seed, o);
     ASSERT_EQ(b.cloud.points.size(), b.point_label.size());
     ASSERT_GE(b.scanned_truth_faces.size(), 1u);
-    ASSERT_LE(b.scanned_truth_faces.size(), street_type(GetParam()) ? 6u : 3u);
+    ASSERT_LE(b.scanned_truth_faces.size(), street_facade_type(GetParam()) ? 6u : 3u);
     for (int f : b.scanned_truth_faces) EXPECT_EQ(b.truth.faces[f].sem, Semantic::Wall);
     std::map<int, Plane> planes;
     for (int f : b.scanned_truth_faces) planes[f] = polygon_plane(pts_of(b.truth, b.truth.faces[f]));

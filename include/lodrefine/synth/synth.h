@@ -17,6 +17,8 @@ enum class BuildingType { Flat, Gable, Hip, Shed, Stepped, LShape, TShape, Polyg
 const char* building_type_name(BuildingType t);          // "flat", "gable", ...
 BuildingType building_type_from_name(const std::string&); // throws InputError
 std::vector<BuildingType> all_building_types();
+// Recess, Bay, Setback: the coarse model lacks faces of the truth's street facade.
+bool street_facade_type(BuildingType t);
 
 struct SynthOptions {
   double max_shift = 0.8;        // facade offset, uniform in [min_shift, max_shift] with random sign (m);
