@@ -195,17 +195,12 @@ Spec setback_spec(Rng& r, double z0) {
   Spec& s = b.s;
   const double xs = r.uniform(0.35, 0.65) * b.W, d = r.uniform(0.8, 2.5);
   const int step = add_line(s, {xs, 0}, {xs, b.D});
-  if (r.chance(0.5)) {  // the left part stands forward
-    const int rear = add_line(s, {xs, d}, {b.W, d});
-    s.parts = {{{b.front, step, b.back, b.left}, b.roof}, {{rear, b.right, b.back, step}, b.roof}};
-    s.street = {b.front, step, rear};
-    if (r.chance(0.5)) s.generalised[0].lines[0] = s.coarse_front = rear;
-  } else {  // the right part stands forward
-    const int rear = add_line(s, {0, d}, {xs, d});
-    s.parts = {{{rear, step, b.back, b.left}, b.roof}, {{b.front, b.right, b.back, step}, b.roof}};
-    s.street = {b.front, step, rear};
-    if (r.chance(0.5)) s.generalised[0].lines[0] = s.coarse_front = rear;
-  }
+  const bool left_forward = r.chance(0.5);
+  const int rear = left_forward ? add_line(s, {xs, d}, {b.W, d}) : add_line(s, {0, d}, {xs, d});
+  const int left_front = left_forward ? b.front : rear, right_front = left_forward ? rear : b.front;
+  s.parts = {{{left_front, step, b.back, b.left}, b.roof}, {{right_front, b.right, b.back, step}, b.roof}};
+  s.street = {b.front, step, rear};
+  if (r.chance(0.5)) s.generalised[0].lines[0] = s.coarse_front = rear;
   return s;
 }
 
