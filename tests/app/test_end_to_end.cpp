@@ -92,7 +92,16 @@ TEST_P(EndToEnd, ScannedFacadesLandOnTheTruthAndTheShellIsValid) {
   EXPECT_LT(facade_after.rms(), facade_before.rms());
 }
 
-INSTANTIATE_TEST_SUITE_P(AllTypes, EndToEnd, ::testing::ValuesIn(all_building_types()),
+// The shape types, whose scanned walls the model has (moved): the street-facade types need faces
+// the model lacks and are run by SelectionAddsFaces (test_selection_decides.cpp).
+static std::vector<BuildingType> shape_types() {
+  std::vector<BuildingType> out;
+  for (auto t : all_building_types())
+    if (!street_facade_type(t)) out.push_back(t);
+  return out;
+}
+
+INSTANTIATE_TEST_SUITE_P(AllTypes, EndToEnd, ::testing::ValuesIn(shape_types()),
                          [](const auto& info) { return std::string(building_type_name(info.param)); });
 
 TEST(EndToEndDeterminism, SameInputSameOutput) {

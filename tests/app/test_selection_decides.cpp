@@ -2,15 +2,20 @@
 // generated building type. Each refined shell is closed and 2-manifold (every edge used by two
 // faces in opposite directions), its report's selection solved, its faces are the selection's,
 // it is nowhere worse than the coarse model on the truth's scanned walls, and the walls the
-// scan moved sit on the truth.
+// scan moved sit on the truth. The street-facade types (recess, bay, setback) need faces the
+// model lacks: SelectionAddsFaces runs ten of each (some seeds are marked KNOWN SHORT there).
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <map>
+#include <set>
 
 #include "lodrefine/core/distance.h"
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/core/refine.h"
+#include "lodrefine/core/topology.h"
 #include "lodrefine/core/validate.h"
 #include "lodrefine/eval/eval.h"
 #include "lodrefine/io/cloud.h"
@@ -34,10 +39,27 @@ double rms(const std::vector<double>& d) {
   return d.empty() ? 0.0 : std::sqrt(s / double(d.size()));
 }
 
-void expect_selection_decided(const Mesh& coarse, const Mesh& truth, const PointCloud& cloud) {
+// Every edge used by exactly two faces, once in each direction (core/topology's edge map).
+int edges_not_used_twice(const Mesh& m) {
+  int bad = 0;
+  for (const auto& [e, uses] : edge_uses(m.faces))
+    bad += uses.size() != 2 || uses[0].forward == uses[1].forward;
+  return bad;
+}
+
+struct Figures {
+  bool refined = false;
+  double before = 0.0, after = 0.0;  // truth facade RMSE of the coarse model and of the output (m)
+};
+
+// `figures`: also assert the figures (not worse than the coarse model, on the truth when refined);
+// without it only the shell and the selection's status are asserted.
+Figures expect_selection_decided(const Mesh& coarse, const Mesh& truth, const PointCloud& cloud, bool figures = true) {
+  Figures fig;
   const RefineResult r = refine_building(coarse, cloud, Params{});
   SCOPED_TRACE(coarse.id + ": " + outcome_name(r.outcome) + " (" + r.reason + ")");
-  ASSERT_TRUE(r.valid);
+  EXPECT_TRUE(r.valid);
+  if (!r.valid) return fig;
   const Vec3 o = local_origin(truth);
   const Mesh refined = translated(r.mesh, -o), local_truth = translated(truth, -o), local_coarse = translated(coarse, -o);
   const Validation v = validate_mesh(refined, Params{}.planarity_tolerance);
@@ -45,23 +67,29 @@ void expect_selection_decided(const Mesh& coarse, const Mesh& truth, const Point
   EXPECT_EQ(v.boundary_edges, 0);
   EXPECT_EQ(v.nonmanifold_edges, 0);
   EXPECT_EQ(v.inconsistent_edges, 0);
+  EXPECT_EQ(edges_not_used_twice(refined), 0);
 
   std::vector<Vec3> local_points;
   for (const auto& p : cloud.points) local_points.push_back(p - o);
   const std::vector<int> scanned = scanned_walls(local_truth, local_points);
-  ASSERT_FALSE(scanned.empty());
+  EXPECT_FALSE(scanned.empty());
+  if (scanned.empty()) return fig;
   const auto samples = sample_faces(local_truth, scanned, 0.25);
-  const double before = rms(cloud_to_mesh(local_coarse, samples)), after = rms(cloud_to_mesh(refined, samples));
-  EXPECT_LE(after, before + kNotWorse) << "truth facade RMSE " << before << " -> " << after;
-  if (!r.refined()) return;
+  fig.before = rms(cloud_to_mesh(local_coarse, samples)), fig.after = rms(cloud_to_mesh(refined, samples));
+  fig.refined = r.refined();
+  if (figures) EXPECT_LE(fig.after, fig.before + kNotWorse) << "truth facade RMSE " << fig.before << " -> " << fig.after;
+  if (!r.refined()) return fig;
 
-  ASSERT_TRUE(r.trace.selection.has_value());
+  EXPECT_TRUE(r.trace.selection.has_value());
+  if (!r.trace.selection) return fig;
   const auto& sel = *r.trace.selection;
   EXPECT_TRUE(sel.selection.status == SolveStatus::Optimal || sel.selection.status == SolveStatus::Feasible ||
               sel.selection.status == SolveStatus::FeasibleTimeLimit)
       << sel.selection.status_text();
+  EXPECT_GT(sel.faces_from_selection, 0);
   EXPECT_EQ(sel.faces_from_selection, int(r.mesh.faces.size()));
-  EXPECT_LT(after, kOnTruth) << "truth facade RMSE " << before << " -> " << after;
+  if (figures) EXPECT_LT(fig.after, kOnTruth) << "truth facade RMSE " << fig.before << " -> " << fig.after;
+  return fig;
 }
 
 }  // namespace
@@ -89,4 +117,49 @@ TEST_P(SelectionDecidesType, GeneratedBuilding) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllTypes, SelectionDecidesType, ::testing::ValuesIn(all_building_types()),
+                         [](const auto& info) { return std::string(building_type_name(info.param)); });
+
+// The street-facade types: the truth has faces the coarse model lacks (a recess's back wall and
+// returns, a bay's front and sides, a facade line stepping back). Moving the model's walls
+// cannot reach them; the selection must add them: each building is refined, its scanned walls
+// within kOnTruth of the truth.
+//
+// KNOWN SHORT (measured 2026-12-01 on main + this generator, target_points 20000): the
+// pipeline does not reach the truth on these seeds. They are still checked for a valid, closed,
+// 2-manifold shell and a solved selection, but NOT for being refined, on the truth or not worse;
+// their figures are printed. Truth facade RMSE coarse -> output (m), "kept" when not refined:
+//   recess 1: 0.754 -> 0.310   recess 2: 0.976 -> 0.340   recess 9: 0.402 -> 0.406
+//   bay 1: 0.462 kept          bay 3: 0.896 -> 0.471      bay 7: 0.505 -> 0.386
+//   setback 1: 1.367 -> 1.262  setback 3: 1.378 -> 1.555 (WORSE than the coarse model)
+//   setback 4: 1.157 -> 0.585  setback 7: 1.182 kept      setback 8: 1.654 -> 1.237
+//   setback 9: 0.568 kept
+// Remove a seed from kKnownShort when the pipeline reaches it (the test prints "now reaches").
+const std::map<BuildingType, std::set<std::uint64_t>> kKnownShort{
+    {BuildingType::Recess, {1, 2, 9}}, {BuildingType::Bay, {1, 3, 7}}, {BuildingType::Setback, {1, 3, 4, 7, 8, 9}}};
+constexpr std::uint64_t kStreetSeeds = 10;
+
+class SelectionAddsFaces : public ::testing::TestWithParam<BuildingType> {};
+
+TEST_P(SelectionAddsFaces, RefinedOntoTheTruth) {
+  SynthOptions opt;
+  opt.target_points = 20000;
+  int reached = 0;
+  for (std::uint64_t seed = 1; seed <= kStreetSeeds; ++seed) {
+    const SynthBuilding b = make_building(GetParam(), seed, opt);
+    SCOPED_TRACE(b.id);
+    const bool known_short = kKnownShort.at(GetParam()).count(seed) > 0;
+    const Figures fig = expect_selection_decided(b.coarse, b.truth, b.cloud, !known_short);
+    const bool on_truth = fig.refined && fig.after < kOnTruth;
+    reached += on_truth;
+    if (known_short)
+      std::printf("KNOWN SHORT %s: %s %.3f -> %.3f m%s\n", b.id.c_str(), fig.refined ? "refined" : "kept", fig.before,
+                  fig.after, on_truth ? " (now reaches the truth: remove it from kKnownShort)" : "");
+    else
+      EXPECT_TRUE(fig.refined) << "truth facade RMSE " << fig.before;
+  }
+  EXPECT_GE(reached, int(kStreetSeeds - kKnownShort.at(GetParam()).size()));
+}
+
+INSTANTIATE_TEST_SUITE_P(StreetFacades, SelectionAddsFaces,
+                         ::testing::Values(BuildingType::Recess, BuildingType::Bay, BuildingType::Setback),
                          [](const auto& info) { return std::string(building_type_name(info.param)); });

@@ -90,7 +90,13 @@ TEST(SynthNames, RoundTrip) {
   for (auto t : all_building_types()) EXPECT_EQ(building_type_from_name(building_type_name(t)), t);
   EXPECT_EQ(building_type_from_name("L-Shape"), BuildingType::LShape);
   EXPECT_THROW(building_type_from_name("castle"), InputError);
-  EXPECT_EQ(all_building_types().size(), 8u);
+  EXPECT_EQ(all_building_types().size(), 11u);
+  EXPECT_EQ(building_type_from_name("setback"), BuildingType::Setback);
+  int street = 0;
+  for (auto t : all_building_types()) street += street_facade_type(t);
+  EXPECT_EQ(street, 3);
+  EXPECT_TRUE(street_facade_type(BuildingType::Bay));
+  EXPECT_FALSE(street_facade_type(BuildingType::Stepped));
 }
 
 TEST(SynthOptionsCheck, RejectsInvertedShiftRange) {
@@ -167,7 +173,9 @@ TEST_P(SynthAll, CoarseKeepsRoofPlanesAndMovesOnlyChosenWalls) {
     for (const auto& m : b.moved_walls) {
       EXPECT_LE(std::abs(m.offset), o.max_shift + 1e-12);
       EXPECT_LE(std::abs(m.rotation_deg), o.max_rotation_deg + 1e-12);
-      EXPECT_TRUE(std::abs(m.offset) >= o.min_shift - 1e-12 || m.offset == 0.0);
+      // A street type's generalised front moves by 0.1-0.6 m (half the minimum shift and up).
+      const double min_shift = street_facade_type(GetParam()) ? 0.5 * o.min_shift : o.min_shift;
+      EXPECT_TRUE(std::abs(m.offset) >= min_shift - 1e-12 || m.offset == 0.0);
       EXPECT_GT(std::abs(m.offset) + std::abs(m.rotation_deg), 0.0);
     }
     for (const auto& q : c.vertices) {
@@ -202,7 +210,7 @@ TEST_P(SynthAll, CloudLiesOnScannedWallsWithinNoise) {
     const auto b = make_building(GetParam(), seed, o);
     ASSERT_EQ(b.cloud.points.size(), b.point_label.size());
     ASSERT_GE(b.scanned_truth_faces.size(), 1u);
-    ASSERT_LE(b.scanned_truth_faces.size(), 3u);
+    ASSERT_LE(b.scanned_truth_faces.size(), street_facade_type(GetParam()) ? 6u : 3u);
     for (int f : b.scanned_truth_faces) EXPECT_EQ(b.truth.faces[f].sem, Semantic::Wall);
     std::map<int, Plane> planes;
     for (int f : b.scanned_truth_faces) planes[f] = polygon_plane(pts_of(b.truth, b.truth.faces[f]));
@@ -274,8 +282,50 @@ TEST(SynthStepped, SharedWallAboveLowRoofIsPartOfOneClosedShell) {
   }
 }
 
+// The street-facade types: the truth's street facade has a recess (back wall and two returns), a
+// bay (front and two sides) or a second facade line; the coarse model is the plain block with
+// its front 0.1-0.6 m off; the van scans every street wall, the oblique ones (returns, bay
+// sides) more sparsely than the front.
+TEST(SynthStreetFacade, TruthHasTheDetailTheGeneralisedModelLacks) {
+  const SynthOptions o = clean_options();
+  const std::map<BuildingType, std::size_t> street_walls{
+      {BuildingType::Recess, 5}, {BuildingType::Bay, 5}, {BuildingType::Setback, 3}};
+  for (const auto& [type, n_street] : street_walls)
+    for (auto seed : kSeeds) {
+      SCOPED_TRACE(std::string(building_type_name(type)) + " seed " + std::to_string(seed));
+      const auto b = make_building(type, seed, o);
+      int truth_walls = 0, coarse_walls = 0;
+      for (const auto& f : b.truth.faces) truth_walls += f.sem == Semantic::Wall;
+      for (const auto& f : b.coarse.faces) coarse_walls += f.sem == Semantic::Wall;
+      EXPECT_EQ(truth_walls, int(n_street) + 3);  // the street walls, two sides and the back
+      EXPECT_EQ(coarse_walls, 4);                 // the generalised block
+      ASSERT_GE(b.moved_walls.size(), 1u);
+      const MovedWall& front = b.moved_walls.front();
+      EXPECT_TRUE(front.scanned);
+      EXPECT_EQ(front.rotation_deg, 0.0);
+      EXPECT_GE(std::abs(front.offset), 0.1 - 1e-12);
+      EXPECT_LE(std::abs(front.offset), 0.6 + 1e-12);
+      // Every street wall scanned (one side wall may be too), the street-facing ones densely.
+      ASSERT_GE(b.scanned_truth_faces.size(), n_street);
+      ASSERT_LE(b.scanned_truth_faces.size(), n_street + 1);
+      const Vec3 street = newell_normal(pts_of(b.truth, b.truth.faces[front.truth_faces.front()])).normalized();
+      std::map<int, int> points;
+      for (int l : b.point_label)
+        if (l >= 0) ++points[l];
+      double front_density = 0.0, oblique_density = 1e9;
+      for (int f : b.scanned_truth_faces) {
+        const auto p = pts_of(b.truth, b.truth.faces[f]);
+        const double density = points[f] / polygon_area(p);
+        EXPECT_GT(points[f], 30) << "truth wall " << f << " has no scan";
+        if (newell_normal(p).normalized().dot(street) > 0.9) front_density = std::max(front_density, density);
+        else oblique_density = std::min(oblique_density, density);
+      }
+      EXPECT_LT(oblique_density, front_density);
+    }
+}
+
 TEST(SynthDeterminism, SameSeedSameBuilding) {
-  for (auto t : {BuildingType::Gable, BuildingType::Stepped, BuildingType::Polygon}) {
+  for (auto t : {BuildingType::Gable, BuildingType::Stepped, BuildingType::Polygon, BuildingType::Recess}) {
     const auto a = make_building(t, 5), b = make_building(t, 5), c = make_building(t, 6);
     ASSERT_EQ(a.cloud.points.size(), b.cloud.points.size());
     for (std::size_t i = 0; i < a.cloud.points.size(); ++i) ASSERT_EQ(a.cloud.points[i], b.cloud.points[i]);

@@ -1,0 +1,150 @@
+// Writing generated buildings (see synth.h): one folder per building, or a city tile whose
+// clouds stream into one PLY.
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "lodrefine/core/geometry.h"
+#include "lodrefine/io/files.h"
+#include "lodrefine/io/obj.h"
+#include "lodrefine/io/ply.h"
+#include "lodrefine/synth/synth.h"
+
+namespace lodrefine {
+
+namespace {
+
+using Json = nlohmann::ordered_json;  // keeps the fields in a readable order
+
+Json vec_json(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+
+Json meta_json(const SynthBuilding& b) {
+  using json = Json;
+  const auto& o = b.options;
+  json moved = json::array();
+  for (const auto& m : b.moved_walls)
+    moved.push_back({{"truth_faces", m.truth_faces},
+                     {"offset", m.offset},
+                     {"rotation_deg", m.rotation_deg},
+                     {"scanned", m.scanned}});
+  std::map<std::string, int> by_label;
+  for (int l : b.point_label)
+    by_label[l >= 0 ? "facade" : l == -1 ? "window_recess" : l == -2 ? "clutter" : l == -3 ? "ground" : "neighbour"]++;
+  return {
+      {"id", b.id},
+      {"type", building_type_name(b.type)},
+      {"seed", b.seed},
+      {"origin", vec_json(o.origin)},
+      {"frame_origin", vec_json(b.frame_origin)},
+      {"frame_rotation_deg", b.frame_rotation_deg},
+      {"options",
+       {{"min_shift", o.min_shift},
+        {"max_shift", o.max_shift},
+        {"max_rotation_deg", o.max_rotation_deg},
+        {"global_shift", o.global_shift},
+        {"scanned_facades", o.scanned_facades},
+        {"noise", o.noise},
+        {"target_points", o.target_points},
+        {"defects", o.defects},
+        {"nuisances", o.nuisances}}},
+      {"moved_walls", moved},
+      {"coarse_shift", vec_json(b.coarse_shift)},
+      {"defects", b.defects},
+      {"scanned_truth_faces", b.scanned_truth_faces},
+      {"point_spacing", b.point_spacing},
+      {"point_labels",
+       "cloud.ply property 'label': truth face index for facade points, -1 window recess, "
+       "-2 clutter (trees, cars, people), -3 street ground, -4 neighbouring building"},
+      {"counts",
+       {{"truth_faces", b.truth.faces.size()},
+        {"truth_vertices", b.truth.vertices.size()},
+        {"coarse_faces", b.coarse.faces.size()},
+        {"points", b.cloud.points.size()},
+        {"points_by_label", by_label}}},
+  };
+}
+
+}  // namespace
+
+void write_synth_building(const std::string& dir, const SynthBuilding& b, bool with_cloud) {
+  const std::filesystem::path out = std::filesystem::path(dir) / b.id;
+  std::filesystem::create_directories(out);
+  write_obj((out / "truth.obj").string(), b.truth);
+  write_obj((out / "coarse.obj").string(), b.coarse);
+  if (with_cloud) {
+    const std::vector<float> labels(b.point_label.begin(), b.point_label.end());
+    write_ply((out / "cloud.ply").string(), b.cloud, Vec3::Zero(), &labels, "label");
+  }
+  write_file_atomic((out / "meta.json").string(),
+                    meta_json(b).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+}
+
+#if !defined(__BYTE_ORDER__) || __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
+#error "write_synth_tile writes the host's doubles as binary_little_endian"
+#endif
+
+std::uint64_t write_synth_tile(const std::string& dir, const std::string& tile_ply, int count, std::uint64_t first_seed,
+                               double spacing, const SynthOptions& opt,
+                               const std::function<void(const SynthBuilding&)>& progress) {
+  std::string tmp;  // created exclusively beside the tile (a planted link is never followed)
+  const int fd = create_temp_file(std::filesystem::path(tile_ply).parent_path().string(), tile_ply, tmp);
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(::fdopen(fd, "wb"), std::fclose);
+  if (!f) {
+    ::close(fd), std::remove(tmp.c_str());
+    throw InputError("cannot write " + tile_ply + ": " + std::strerror(errno));
+  }
+  // The count is only known at the end: a fixed-width field, rewritten in place.
+  constexpr int kCountWidth = 15;
+  const std::string head = "ply\nformat binary_little_endian 1.0\ncomment lodrefine synth tile\nelement vertex ";
+  const std::string tail = "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
+  auto header = [&](std::uint64_t n) {
+    char num[32];
+    std::snprintf(num, sizeof num, "%0*llu", kCountWidth, static_cast<unsigned long long>(n));
+    return head + num + tail;
+  };
+  auto fail = [&] {
+    const std::string reason = std::strerror(errno);
+    f.reset();
+    std::remove(tmp.c_str());
+    throw InputError("cannot write " + tmp + ": " + reason);
+  };
+  auto put = [&](const void* data, std::size_t bytes) {
+    if (std::fwrite(data, 1, bytes, f.get()) != bytes) fail();
+  };
+  put(header(0).data(), header(0).size());
+  const auto types = all_building_types();
+  const int columns = std::max(1, int(std::ceil(std::sqrt(double(count)))));
+  std::uint64_t points = 0;
+  for (int i = 0; i < count; ++i) {
+    SynthBuilding b = make_building(types[std::size_t(i) % types.size()], first_seed + std::uint64_t(i), opt);
+    // Onto its grid cell: a pure translation, so truth, model, scan and meta stay consistent.
+    const Vec3 cell = opt.origin + Vec3(spacing * (i % columns), spacing * (i / columns), 0.0);
+    const Vec3 shift(cell.x() - b.frame_origin.x(), cell.y() - b.frame_origin.y(), 0.0);
+    b.truth = translated(std::move(b.truth), shift);
+    b.coarse = translated(std::move(b.coarse), shift);
+    for (auto& p : b.cloud.points) p += shift;
+    b.frame_origin += shift;
+    write_synth_building(dir, b, false);
+    std::vector<double> xyz;
+    xyz.reserve(3 * b.cloud.points.size());
+    for (const auto& p : b.cloud.points) xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
+    put(xyz.data(), xyz.size() * sizeof(double));
+    points += b.cloud.points.size();
+    if (progress) progress(b);
+  }
+  if (std::fseek(f.get(), 0, SEEK_SET) != 0) fail();
+  put(header(points).data(), header(points).size());
+  if (std::fflush(f.get()) != 0 || ::fsync(::fileno(f.get())) != 0) fail();
+  f.reset();
+  std::filesystem::rename(tmp, tile_ply);
+  return points;
+}
+
+}  // namespace lodrefine
