@@ -23,6 +23,7 @@
 #include "lodrefine/io/obj.h"
 #include "lodrefine/io/files.h"
 #include "lodrefine/io/progress.h"
+#include "lodrefine/io/refine_report.h"
 #include "lodrefine/eval/plots.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/eval/report.h"
@@ -426,13 +427,6 @@ json pooled_json(const PooledEval& p) {
           {"truth_buildings", p.truth_buildings}};
 }
 
-json params_json(const Params& p) {
-  json j;
-#define LODREFINE_PARAM_JSON(type, name, def, lo, hi, help) j[#name] = p.name;
-  LODREFINE_PARAMS(LODREFINE_PARAM_JSON)
-#undef LODREFINE_PARAM_JSON
-  return j;
-}
 
 std::string csv_field(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;

@@ -327,10 +327,11 @@ ArrangementResult replace_walls(const Mesh& mesh, const std::vector<ModelSurface
   if (sel.status == SolveStatus::Infeasible && sel.fixed > 0 && prm.mip_time_limit > sel.seconds) {
     // A model only approximately consistent with its planes (warped faces, snapped vertices)
     // can make the fixed cells contradict each other: then the whole region is free.
-    Params rest = prm;
-    rest.mip_time_limit = prm.mip_time_limit - sel.seconds;
+    SelectionProgram free_region;
+    free_region.cost = cost;
+    free_region.outside = outside;
     const double first = sel.seconds;
-    sel = select_faces(cs, cost, outside, rest);
+    sel = select_faces(cs, free_region, prm, prm.mip_time_limit - first);
     sel.seconds += first;
     res.stats.fixing_dropped = true;
   }

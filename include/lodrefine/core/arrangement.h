@@ -1,4 +1,5 @@
-// Stage 3 (fallback): one outdated wall replaced through the paper's method. A region around the
+// Not in the pipeline (kept for its tests; stage 4 over one wall): one outdated wall replaced
+// through the paper's method. A region around the
 // old and the new wall; the scan plane and every kept surface reaching into it as supporting
 // planes; their PolyFit-style candidate faces, scored by confidence and coverage; GLPK selects
 // the faces that close the shell with the kept model outside the region.

@@ -1,4 +1,5 @@
-// Stage 3 (fallback, used by the arrangement): PolyFit-style candidate faces. Every supporting
+// Stage 4 (README's numbering): PolyFit-style candidate faces, for the whole building's
+// arrangement (shell_selection.h) and the local one (arrangement.h). Every supporting
 // plane (the arrangement has already swept walls coplanar with the scan plane into it), cropped
 // to a convex region, is split by every other plane; the convex pieces are the candidates, with
 // their edge adjacency for the manifold constraint.
