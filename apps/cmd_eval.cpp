@@ -7,20 +7,13 @@
 
 #include "commands.h"
 #include "lodrefine/eval/run_eval.h"
+#include "lodrefine/io/refine_report.h"
 #include "options.h"
 
 namespace lodrefine::app {
 namespace {
 
 using nlohmann::json;
-
-json params_json(const Params& p) {
-  json j;
-#define LODREFINE_PARAM_JSON(type, name, def, lo, hi, help) j[#name] = p.name;
-  LODREFINE_PARAMS(LODREFINE_PARAM_JSON)
-#undef LODREFINE_PARAM_JSON
-  return j;
-}
 
 void add_gate_options(CLI::App* cmd, EvalOptions& a, CLI::Option* dir) {
   cmd->add_option("--write-baseline", a.baseline_out, "With --dir: write the run's figures per building and pooled "

@@ -81,13 +81,6 @@ void write_review(const RefineArgs& a, const CityRefineSummary& s, ReviewCollect
   write_file_atomic(a.html, city_review_html(c.review));
 }
 
-nlohmann::json params_json(const Params& p) {
-  nlohmann::json j;
-#define LODREFINE_PARAM_JSON(type, name, def, lo, hi, help) j[#name] = p.name;
-  LODREFINE_PARAMS(LODREFINE_PARAM_JSON)
-#undef LODREFINE_PARAM_JSON
-  return j;
-}
 
 // Fails before any work when an output could not be written (so nothing is left half done):
 // its folder must exist and take a new file (a temporary is created and removed again).

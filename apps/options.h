@@ -23,16 +23,13 @@ CLI::Option* add_ranged_option(CLI::App* cmd, const std::string& name, T& value,
   return cmd->add_option(name, value, help)->capture_default_str()->check(CLI::Range(lo, hi));
 }
 
-// Adds one option per parameter to `cmd`, bound to `params` (which must outlive parsing).
-inline void add_param_options(CLI::App* cmd, Params& params) {
-  const auto& table = param_table();
-  std::size_t i = 0;
-#define LODREFINE_PARAM_OPTION(type, name, def, lo, hi, help)                                            \
-  add_ranged_option(cmd, option_name(#name), params.name, table[i].description, type(lo), type(hi))        \
-      ->group("Method parameters");                                                                       \
-  ++i;
-  LODREFINE_PARAMS(LODREFINE_PARAM_OPTION)
-#undef LODREFINE_PARAM_OPTION
+// Adds one option per parameter to `cmd`, bound to `config` (which must outlive parsing), in
+// one help group per stage.
+inline void add_param_options(CLI::App* cmd, RefineConfig& config) {
+  for_each_field(config, [&](const auto& field, auto& value) {
+    add_ranged_option(cmd, option_name(field.name), value, field.description, field.min, field.max)
+        ->group(std::string("Method parameters: ") + field.stage);
+  });
 }
 
 // The default of --jobs: every core the machine has (1 when it cannot tell).

@@ -25,7 +25,9 @@ def timed_out(report_path):
         r = json.load(open(report_path))
     except (OSError, ValueError):
         return False
-    return any("time limit" in s.get("mip", {}).get("status", "") for s in r.get("replacements", []))
+    if "time limit" in (r.get("selection") or {}).get("status", ""):
+        return True  # the whole building's selection (select_shell)
+    return any("time limit" in s.get("mip", {}).get("status", "") for s in r.get("replacements") or [])
 names = sorted(files(a) | files(b))
 bad = timing = 0
 for n in names:
@@ -39,6 +41,8 @@ for n in names:
     if same:
         continue
     stem = os.path.splitext(n)[0] + ".json"
+    if stem.startswith("eval_"):
+        stem = "sample_" + stem[len("eval_"):]  # the evaluation of that refined sample
     if timed_out(os.path.join(a, stem)) or timed_out(os.path.join(b, stem)):
         print("differs, GLPK time limit reached (load-dependent; rerun unloaded):", n); timing += 1
     else:

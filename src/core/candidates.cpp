@@ -1,4 +1,4 @@
-// Stage 3 (paper Sec. 3.2): candidate faces from pairwise plane intersections in a region.
+// Stage 4 (paper Sec. 3.2): candidate faces from pairwise plane intersections in a region.
 #include "lodrefine/core/candidates.h"
 
 #include <algorithm>

@@ -33,7 +33,7 @@ double box_overlap(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
 }
 
 double model_score(const std::vector<Vec3>& cand, const Plane& cplane, double carea, const ModelReference& ref,
-                   const Plane& rplane, const Params& prm) {
+                   const Plane& rplane, const ConfidenceConfig& prm) {
   if (unoriented_angle_deg(cplane.n, rplane.n) > prm.conf_angle_deg) return 0.0;
   double dmax = 0.0;
   for (const auto& p : cand) dmax = std::max(dmax, std::abs(rplane.distance(p)));
@@ -59,7 +59,7 @@ struct CloudView {
   std::vector<Vec2> hull;
 };
 
-CloudView view_cloud(const Plane& cplane, const CloudInfo& ref, const Params& prm) {
+CloudView view_cloud(const Plane& cplane, const CloudInfo& ref, const ConfidenceConfig& prm) {
   CloudView view;
   if (unoriented_angle_deg(cplane.n, ref.plane.n) > prm.conf_angle_deg) return view;
   double sum = 0.0, sum2 = 0.0;
@@ -90,7 +90,7 @@ double coverage_cost(double area, double c, double tau) {
 }
 
 std::vector<Confidence> candidate_confidence(const CandidateSet& cs, const std::vector<ModelReference>& model,
-                                             const std::vector<CloudReference>& cloud, const Params& prm) {
+                                             const std::vector<CloudReference>& cloud, const ConfidenceConfig& prm) {
   std::vector<Plane> model_planes;
   for (const auto& r : model) model_planes.push_back(polygon_plane(r.polygon));
   std::vector<CloudInfo> clouds;

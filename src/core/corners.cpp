@@ -77,7 +77,7 @@ double side_of(const Mesh& mesh, const ModelSurface& wall, const Plane& facade) 
 // `side`, over the upper part of the facade's height [z0, z1] (ground and clutter below do not
 // count): the return the scanner saw where the facade turns the corner.
 bool shows_return(const PointCloud& cloud, const Plane& facade, const Plane& moved, double side, double z0,
-                  double z1, const Params& prm) {
+                  double z1, const PlaneConfig& prm) {
   const double on_plane = std::max(kCornerTolerance, kOffPlaneEpsilons * prm.ransac_epsilon);
   const double za = z0 + kLowBand * (z1 - z0);
   const double off = kOffPlaneEpsilons * prm.ransac_epsilon;
@@ -118,7 +118,7 @@ struct EndStrips {
 };
 
 EndStrips end_strips(const PointCloud& cloud, const Plane& facade, const Vec3& o, const Vec3& u, double s, double end,
-                     double z0, double z1, const Params& prm) {
+                     double z0, double z1, const PlaneConfig& prm) {
   const double za = z0 + kLowBand * (z1 - z0);
   const double on_plane = std::max(kCornerTolerance, kOffPlaneEpsilons * prm.ransac_epsilon);
   EndStrips e;
@@ -149,7 +149,8 @@ bool ends_in_the_open(const EndStrips& e) {
 
 std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
                                      const std::vector<ScannedWall>& scanned, const PointCloud& cloud,
-                                     const std::vector<ScanPlane>& planes, const Params& prm) {
+                                     const std::vector<ScanPlane>& planes, const MatchConfig& prm,
+                                     const PlaneConfig& detection) {
   std::vector<int> face_surface(mesh.faces.size(), -1);
   for (int s = 0; s < int(surfaces.size()); ++s)
     for (int f : surfaces[s].faces) face_surface[f] = s;
@@ -225,8 +226,8 @@ std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSu
       // points end. A scan that just stops (tile edge, occlusion shadow, the vehicle turning)
       // or a neighbour's facade that runs on shows no return, and moves nothing.
       const Plane moved(as.plane.n, as.plane.d - as.plane.n.dot(s * gap * u));
-      if (!shows_return(cloud, w.plane, moved, side_of(mesh, as, w.plane), z0, z1, prm) &&
-          !(facade_displaced && ends_in_the_open(end_strips(cloud, w.plane, o, u, s, end + s * u_mid, z0, z1, prm))))
+      if (!shows_return(cloud, w.plane, moved, side_of(mesh, as, w.plane), z0, z1, detection) &&
+          !(facade_displaced && ends_in_the_open(end_strips(cloud, w.plane, o, u, s, end + s * u_mid, z0, z1, detection))))
         continue;
       // The same end in every height band that has points.
       double lo = 1e300, hi = -1e300;

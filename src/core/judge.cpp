@@ -116,9 +116,10 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
 }  // namespace
 
 Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vector<JudgedWall>& walls,
-                           const PointCloud& cloud, const Params& prm) {
+                           const PointCloud& cloud, const MatchConfig& prm,
+                           const PlaneConfig& detection) {
   Judgement j;
-  const double cap = prm.match_distance, changed = prm.ransac_epsilon;
+  const double cap = prm.match_distance, changed = detection.ransac_epsilon;
   std::vector<PointFit> points;
   try {
     points = judged_points(before, after, cloud, cap);
@@ -144,7 +145,7 @@ Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vec
   for (std::size_t k = 0; k < walls.size(); ++k) {
     const Judgement::Fit& f = j.walls[k];
     std::string why;
-    if (f.points < std::size_t(prm.ransac_min_points)) {
+    if (f.points < std::size_t(detection.ransac_min_points)) {
       if (!walls[k].corner) why = "moved with " + std::to_string(f.points) + " scan points in front of it and no corner evidence";
     } else {
       why = worse_reason(f, kWallRmsSlack, false);

@@ -15,6 +15,12 @@ constexpr double kMinCornerAngleDeg = 30.0;
 constexpr double kMinCornerSin = 0.5;
 // Areas in ratios are at least this (m^2): an empty or flat box divides by no zero.
 constexpr double kMinArea = 1e-12;
+// A wall needs this many of a plane's points in front of it to be matched (as many as RANSAC's
+// default minimum of a plane: fewer is a stray patch, not the wall's scan).
+constexpr int kMinOwnedPoints = 150;
+// Wall surfaces smaller than this (m^2) are slivers (e.g. hole fills), no facades: a large scan
+// box would "cover" them. The default minimum area of a scan plane.
+constexpr double kMinWallArea = 1.0;
 
 // In-plane extent [min u, max u] x [min v, max v] of points in a surface's frame.
 struct Rect {
@@ -76,6 +82,33 @@ double corner_gap(const Plane& plane, const ScanPlane& adjacent_scan, const Poin
   return std::max({0.0, uc - hi, lo - uc});
 }
 
+// The surface of faces `members`: PCA plane oriented outward, area, area-weighted centroid,
+// and the semantic covering most of its area (one plane, one surface: a mislabelled piece, a
+// repaired hole say, takes its surface's).
+ModelSurface describe_surface(const Mesh& mesh, const std::vector<int>& members) {
+  ModelSurface s;
+  s.faces = members;
+  std::map<Semantic, double> sem_area;
+  std::vector<Vec3> pts;
+  Vec3 nsum = Vec3::Zero(), csum = Vec3::Zero();
+  for (int f : members) {
+    const auto poly = face_points(mesh, mesh.faces[f]);
+    pts.insert(pts.end(), poly.begin(), poly.end());
+    const double a = polygon_area(poly);
+    s.area += a;
+    sem_area[mesh.faces[f].sem] += a;
+    nsum += newell_normal(poly);
+    csum += a * polygon_centroid(poly);
+  }
+  s.sem = std::max_element(sem_area.begin(), sem_area.end(), [](const auto& a, const auto& b) {
+            return a.second < b.second;
+          })->first;
+  s.plane = fit_plane(pts);
+  if (s.plane.n.dot(nsum) < 0) s.plane = s.plane.flipped();
+  s.centroid = s.area > 0 ? Vec3(csum / s.area) : pts.front();
+  return s;
+}
+
 }  // namespace
 
 std::vector<ModelSurface> model_surfaces(const Mesh& mesh, double angle_deg, double distance) {
@@ -117,49 +150,27 @@ std::vector<ModelSurface> model_surfaces(const Mesh& mesh, double angle_deg, dou
         }
       }
     }
-    ModelSurface s;
-    s.faces = members;
-    std::map<Semantic, double> sem_area;
-    std::vector<Vec3> pts;
-    Vec3 nsum = Vec3::Zero(), csum = Vec3::Zero();
-    for (int f : members) {
-      const auto poly = face_points(mesh, mesh.faces[f]);
-      pts.insert(pts.end(), poly.begin(), poly.end());
-      const double a = polygon_area(poly);
-      s.area += a;
-      sem_area[mesh.faces[f].sem] += a;
-      nsum += newell_normal(poly);
-      csum += a * polygon_centroid(poly);
-    }
-    // One plane, one surface: a mislabelled piece (a repaired hole, say) takes the semantic
-    // that covers most of it.
-    s.sem = std::max_element(sem_area.begin(), sem_area.end(), [](const auto& a, const auto& b) {
-              return a.second < b.second;
-            })->first;
-    s.plane = fit_plane(pts);
-    if (s.plane.n.dot(nsum) < 0) s.plane = s.plane.flipped();
-    s.centroid = s.area > 0 ? Vec3(csum / s.area) : pts.front();
-    surfaces.push_back(std::move(s));
+    surfaces.push_back(describe_surface(mesh, members));
   }
   return surfaces;
 }
 
-MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& surfaces, const PointCloud& cloud,
-                           const std::vector<ScanPlane>& planes, const Params& prm) {
-  MatchResult result;
-  const double cos_max = std::cos(radians(prm.match_angle_deg));
-  // The candidate walls, each with its outline in its own plane frame.
-  struct Wall {
-    int surface;
-    Vec3 u, v;
-    Rect box;
-    std::vector<std::vector<Vec2>> outline;
-  };
+namespace {
+
+// A candidate wall, with its outline in its own plane frame (u, v) around its centroid.
+struct Wall {
+  int surface;
+  Vec3 u, v;
+  Rect box;
+  std::vector<std::vector<Vec2>> outline;
+};
+
+// The model's wall surfaces that can be matched (no slivers).
+std::vector<Wall> candidate_walls(const Mesh& mesh, const std::vector<ModelSurface>& surfaces) {
   std::vector<Wall> walls;
   for (int s = 0; s < int(surfaces.size()); ++s) {
     const ModelSurface& surf = surfaces[s];
-    // Slivers (e.g. hole fills) are no facades: a large scan box would "cover" them.
-    if (surf.sem != Semantic::Wall || surf.area < prm.min_plane_area) continue;
+    if (surf.sem != Semantic::Wall || surf.area < kMinWallArea) continue;
     Wall w{s, Vec3::Zero(), Vec3::Zero(), surface_rect(mesh, surf), {}};
     std::tie(w.u, w.v) = surf.plane.basis();
     for (int f : surf.faces) {
@@ -172,110 +183,143 @@ MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& su
     }
     walls.push_back(std::move(w));
   }
-  auto in_outline = [&](const Wall& w, const Vec2& q) {
-    const double m = prm.match_margin;
-    if (q.x() < w.box.u0 - m || q.x() > w.box.u1 + m || q.y() < w.box.v0 - m || q.y() > w.box.v1 + m) return false;
-    for (const auto& poly : w.outline) {
-      if (point_in_polygon_2d(q, poly)) return true;
-      for (std::size_t k = 0; k < poly.size(); ++k)
-        if (segment_distance_2d(q, poly[k], poly[(k + 1) % poly.size()]) <= m) return true;
-    }
-    return false;
-  };
+  return walls;
+}
 
-  // Each facade point belongs to the nearest wall facing its way whose outline (grown by
-  // match_margin) it lies in front of: a plane spanning several walls, a setback or a flush
-  // neighbour then gives each wall only its own points, never those of a parallel wall.
-  for (int p = 0; p < int(planes.size()); ++p) {
-    const ScanPlane& sp = planes[p];
-    if (!sp.facade) continue;
-    std::vector<int> cand;
-    for (int k = 0; k < int(walls.size()); ++k)
-      if (std::abs(sp.plane.n.dot(surfaces[walls[k].surface].plane.n)) >= cos_max) cand.push_back(k);
-    if (cand.empty()) continue;
-    std::vector<Rect> owned(walls.size());
-    std::vector<int> count(walls.size(), 0);
-    std::vector<Vec3> sum(walls.size(), Vec3::Zero());
-    std::vector<std::vector<int>> owned_idx(walls.size());
-    for (int i : sp.inliers) {
-      const Vec3& x = cloud.points[i];
-      int best = -1;
-      double best_d = prm.match_distance;
-      for (int k : cand) {
-        const ModelSurface& surf = surfaces[walls[k].surface];
-        const double d = std::abs(surf.plane.distance(x));
-        if (d > best_d) continue;
-        const Vec3 q = x - surf.centroid;
-        const Vec2 q2(q.dot(walls[k].u), q.dot(walls[k].v));
-        if (!in_outline(walls[k], q2)) continue;
-        best = k;
-        best_d = d;
-      }
-      if (best < 0) continue;
-      const ModelSurface& surf = surfaces[walls[best].surface];
-      const Vec3 q = x - surf.centroid;
-      owned[best].add(q.dot(walls[best].u), q.dot(walls[best].v));
-      ++count[best];
-      sum[best] += x;
-      owned_idx[best].push_back(i);
-    }
+// Whether in-plane point `q` lies in the wall's outline grown by `margin`.
+bool in_outline(const Wall& w, const Vec2& q, double margin) {
+  const double m = margin;
+  if (q.x() < w.box.u0 - m || q.x() > w.box.u1 + m || q.y() < w.box.v0 - m || q.y() > w.box.v1 + m) return false;
+  for (const auto& poly : w.outline) {
+    if (point_in_polygon_2d(q, poly)) return true;
+    for (std::size_t k = 0; k < poly.size(); ++k)
+      if (segment_distance_2d(q, poly[k], poly[(k + 1) % poly.size()]) <= m) return true;
+  }
+  return false;
+}
+
+// The points of one scan plane that a wall owns: their in-plane box, sum and indices.
+struct Owned {
+  Rect box;
+  Vec3 sum = Vec3::Zero();
+  std::vector<int> idx;
+};
+
+// Each inlier of `sp` belongs to the nearest candidate wall (within match_distance) whose
+// outline, grown by match_margin, it lies in front of: a plane spanning several walls, a
+// setback or a flush neighbour then gives each wall only its own points, never those of a
+// parallel wall. Indexed like `walls`.
+std::vector<Owned> owned_points(const ScanPlane& sp, const std::vector<int>& cand, const std::vector<Wall>& walls,
+                                const std::vector<ModelSurface>& surfaces, const PointCloud& cloud, const MatchConfig& cfg) {
+  std::vector<Owned> owned(walls.size());
+  for (int i : sp.inliers) {
+    const Vec3& x = cloud.points[i];
+    int best = -1;
+    double best_d = cfg.match_distance;
     for (int k : cand) {
-      if (count[k] < prm.ransac_min_points) continue;
       const ModelSurface& surf = surfaces[walls[k].surface];
-      const Rect& model_box = walls[k].box;
-      const double inter = overlap_area(model_box, owned[k]);
-      const double uni = model_box.area() + owned[k].area() - inter;
-      const double iou = uni > 0 ? inter / uni : 0.0;
-      const double coverage = std::max({iou, inter / std::max(kMinArea, owned[k].area()),
-                                        inter / std::max(kMinArea, model_box.area())});
-      if (coverage < prm.match_min_overlap) {
-        result.rejected.push_back("scan plane " + std::to_string(p) + " / wall surface " + std::to_string(walls[k].surface) +
-                                  ": its points cover too little of the wall (" + std::to_string(coverage) + ")");
-        continue;
-      }
-      const double s_normal = sp.plane.n.dot(surf.plane.n);
-      const double d_c = std::abs(surf.plane.distance(sum[k] / count[k]));
-      const double score = prm.w_normal * std::abs(s_normal) + prm.w_coverage * iou;
-      result.matches.push_back(Match{p, walls[k].surface, s_normal, d_c, iou, score, std::move(owned_idx[k])});
+      const double d = std::abs(surf.plane.distance(x));
+      if (d > best_d) continue;
+      const Vec3 q = x - surf.centroid;
+      if (!in_outline(walls[k], Vec2(q.dot(walls[k].u), q.dot(walls[k].v)), cfg.match_margin)) continue;
+      best = k;
+      best_d = d;
     }
+    if (best < 0) continue;
+    const Vec3 q = x - surfaces[walls[best].surface].centroid;
+    owned[best].box.add(q.dot(walls[best].u), q.dot(walls[best].v));
+    owned[best].sum += x;
+    owned[best].idx.push_back(i);
   }
-  // One scan plane per wall: the one with the most points in front of it.
-  {
-    std::map<int, Match> best;
-    for (const auto& m : result.matches) {
-      auto it = best.find(m.surface);
-      if (it == best.end() || m.owned.size() > it->second.owned.size()) best[m.surface] = m;
+  return owned;
+}
+
+// The matches of scan plane `p` with the candidate walls whose points cover enough of them
+// (the largest of the boxes' IoU and the share of either box inside the other); the rest are
+// turned down with a line in `rejected`.
+void match_plane(int p, const ScanPlane& sp, const std::vector<Wall>& walls, const std::vector<ModelSurface>& surfaces,
+                 const PointCloud& cloud, const MatchConfig& cfg, MatchResult& result) {
+  const double cos_max = std::cos(radians(cfg.match_angle_deg));
+  std::vector<int> cand;
+  for (int k = 0; k < int(walls.size()); ++k)
+    if (std::abs(sp.plane.n.dot(surfaces[walls[k].surface].plane.n)) >= cos_max) cand.push_back(k);
+  if (cand.empty()) return;
+  std::vector<Owned> owned = owned_points(sp, cand, walls, surfaces, cloud, cfg);
+  for (int k : cand) {
+    Owned& o = owned[k];
+    const int count = int(o.idx.size());
+    if (count < kMinOwnedPoints) continue;
+    const ModelSurface& surf = surfaces[walls[k].surface];
+    const Rect& model_box = walls[k].box;
+    const double inter = overlap_area(model_box, o.box);
+    const double uni = model_box.area() + o.box.area() - inter;
+    const double iou = uni > 0 ? inter / uni : 0.0;
+    const double coverage = std::max({iou, inter / std::max(kMinArea, o.box.area()),
+                                      inter / std::max(kMinArea, model_box.area())});
+    if (coverage < cfg.match_min_overlap) {
+      result.rejected.push_back("scan plane " + std::to_string(p) + " / wall surface " + std::to_string(walls[k].surface) +
+                                ": its points cover too little of the wall (" + std::to_string(coverage) + ")");
+      continue;
     }
-    result.matches.clear();
-    for (const auto& [s, m] : best) result.matches.push_back(m);
+    const double s_normal = sp.plane.n.dot(surf.plane.n);
+    const double d_c = std::abs(surf.plane.distance(o.sum / count));
+    const double score = cfg.w_normal * std::abs(s_normal) + cfg.w_coverage * iou;
+    result.matches.push_back(Match{p, walls[k].surface, s_normal, d_c, iou, score, std::move(o.idx)});
   }
-  // A scan plane sees one side of a wall: the surfaces it replaces must all face the way of
-  // the surface it fits best (else a notch's opposite wall would be pulled onto it).
-  {
-    std::vector<Match> same_side;
-    for (const auto& m : result.matches) {
-      const Match* ref = &m;
-      for (const auto& o : result.matches)
-        if (o.scan_plane == m.scan_plane && o.d_centroid < ref->d_centroid) ref = &o;
-      if (surfaces[m.surface].plane.n.dot(surfaces[ref->surface].plane.n) > 0) same_side.push_back(m);
-      else result.rejected.push_back("scan plane " + std::to_string(m.scan_plane) + " / wall surface " + std::to_string(m.surface) +
-                                     ": faces away from the wall the plane fits best");
-    }
-    result.matches = same_side;
+}
+
+// One scan plane per wall: the one with the most points in front of it.
+std::vector<Match> best_plane_per_wall(const std::vector<Match>& matches) {
+  std::map<int, Match> best;
+  for (const auto& m : matches) {
+    auto it = best.find(m.surface);
+    if (it == best.end() || m.owned.size() > it->second.owned.size()) best[m.surface] = m;
   }
-  // Corner consistency with the adjacent matched facades (beyond the paper: rejects walls of
-  // neighbouring buildings seen across a gap). A wrong match also makes its correct
-  // neighbours look inconsistent, so the match with the most conflicts goes first.
-  const int nm = int(result.matches.size());
+  std::vector<Match> out;
+  for (const auto& [s, m] : best) out.push_back(m);
+  return out;
+}
+
+// A scan plane sees one side of a wall: the surfaces it replaces must all face the way of the
+// surface it fits best (else a notch's opposite wall would be pulled onto it).
+std::vector<Match> facing_the_fitted_side(const std::vector<Match>& matches, const std::vector<ModelSurface>& surfaces,
+                                          std::vector<std::string>& rejected) {
+  std::vector<Match> same_side;
+  for (const auto& m : matches) {
+    const Match* ref = &m;
+    for (const auto& o : matches)
+      if (o.scan_plane == m.scan_plane && o.d_centroid < ref->d_centroid) ref = &o;
+    if (surfaces[m.surface].plane.n.dot(surfaces[ref->surface].plane.n) > 0) same_side.push_back(m);
+    else rejected.push_back("scan plane " + std::to_string(m.scan_plane) + " / wall surface " + std::to_string(m.surface) +
+                            ": faces away from the wall the plane fits best");
+  }
+  return same_side;
+}
+
+// Pairs of matches of adjacent walls (meeting at a corner) whose corner lies more than
+// corner_gap beyond the adjacent facade's points.
+std::vector<std::vector<char>> corner_conflicts(const std::vector<Match>& matches, const Mesh& mesh,
+                                                const std::vector<ModelSurface>& surfaces,
+                                                const std::vector<ScanPlane>& planes, const PointCloud& cloud,
+                                                double max_gap) {
+  const int nm = int(matches.size());
   std::vector<std::vector<char>> conflict(nm, std::vector<char>(nm, 0));
   for (int i = 0; i < nm; ++i)
     for (int j = 0; j < nm; ++j) {
-      const Match &m = result.matches[i], &a = result.matches[j];
+      const Match &m = matches[i], &a = matches[j];
       if (i == j || a.scan_plane == m.scan_plane) continue;
       if (unoriented_angle_deg(surfaces[a.surface].plane.n, surfaces[m.surface].plane.n) < kMinCornerAngleDeg) continue;
       if (!adjacent(mesh, surfaces[a.surface], surfaces[m.surface])) continue;
-      if (corner_gap(planes[m.scan_plane].plane, planes[a.scan_plane], cloud) > prm.corner_gap) conflict[i][j] = conflict[j][i] = 1;
+      if (corner_gap(planes[m.scan_plane].plane, planes[a.scan_plane], cloud) > max_gap) conflict[i][j] = conflict[j][i] = 1;
     }
+  return conflict;
+}
+
+// Corner consistency (beyond the paper: rejects walls of neighbouring buildings seen across a
+// gap). A wrong match also makes its correct neighbours look inconsistent, so the match with
+// the most conflicts goes first (the lower S_match on a tie), until none is left; sums Q_model.
+void drop_corner_conflicts(const std::vector<std::vector<char>>& conflict, MatchResult& result) {
+  const int nm = int(result.matches.size());
   std::vector<char> alive(nm, 1);
   for (;;) {
     int worst = -1, worst_count = 0;
@@ -300,6 +344,19 @@ MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& su
       result.q_model += result.matches[i].s_match;
     }
   result.matches = kept;
+}
+
+}  // namespace
+
+MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& surfaces, const PointCloud& cloud,
+                           const std::vector<ScanPlane>& planes, const MatchConfig& cfg) {
+  MatchResult result;
+  const std::vector<Wall> walls = candidate_walls(mesh, surfaces);
+  for (int p = 0; p < int(planes.size()); ++p)
+    if (planes[p].facade) match_plane(p, planes[p], walls, surfaces, cloud, cfg, result);
+  result.matches = best_plane_per_wall(result.matches);
+  result.matches = facing_the_fitted_side(result.matches, surfaces, result.rejected);
+  drop_corner_conflicts(corner_conflicts(result.matches, mesh, surfaces, planes, cloud, cfg.corner_gap), result);
   return result;
 }
 

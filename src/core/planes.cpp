@@ -59,7 +59,7 @@ Plane fit_vertical_plane(const std::vector<Vec3>& pts) {
   return Plane::through(Vec3(c.x(), c.y(), 0.0), Vec3(n2.x(), n2.y(), 0.0));
 }
 
-ScanPlane describe(const std::vector<Vec3>& all, std::vector<int> inliers, const Params& prm) {
+ScanPlane describe(const std::vector<Vec3>& all, std::vector<int> inliers, const PlaneConfig& prm) {
   ScanPlane sp;
   sp.inliers = std::move(inliers);
   std::vector<Vec3> pts;
@@ -86,7 +86,7 @@ ScanPlane describe(const std::vector<Vec3>& all, std::vector<int> inliers, const
 
 // RANSAC's connectivity split one facade into pieces wherever a gap (a window column, an
 // occluding tree) is wider than the cluster epsilon: the pieces of one plane are one surface.
-std::vector<ScanPlane> merge_coplanar(std::vector<ScanPlane> planes, const std::vector<Vec3>& all, const Params& prm) {
+std::vector<ScanPlane> merge_coplanar(std::vector<ScanPlane> planes, const std::vector<Vec3>& all, const PlaneConfig& prm) {
   const double tol = kMergeEpsilons * prm.ransac_epsilon;
   auto mean_distance = [&](const ScanPlane& a, const Plane& b) {
     double s = 0.0;
@@ -111,7 +111,7 @@ std::vector<ScanPlane> merge_coplanar(std::vector<ScanPlane> planes, const std::
 
 }  // namespace
 
-std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm) {
+std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const PlaneConfig& prm) {
   std::vector<ScanPlane> result;
   const std::size_t n = cloud.points.size();
   if (n < std::size_t(std::max(prm.ransac_min_points, prm.normal_neighbors + 1))) return result;

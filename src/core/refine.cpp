@@ -25,7 +25,7 @@ constexpr double kPositionSteps = 100.0;
 
 // The cloud near the model, in its local frame (crops may carry whole streets): the model's
 // box grown by the matching distance and the arrangement's region margins.
-PointCloud cloud_near(const Mesh& local_model, const PointCloud& cloud, const Vec3& origin, const Params& prm) {
+PointCloud cloud_near(const Mesh& local_model, const PointCloud& cloud, const Vec3& origin, const RefineConfig& prm) {
   const Eigen::AlignedBox3d box = bounding_box(local_model.vertices);
   const Vec3 pad = Vec3::Constant(prm.match_distance + prm.bbox_margin) + prm.bbox_expand * box.sizes();
   const Eigen::AlignedBox3d near(box.min() - pad, box.max() + pad);
@@ -56,7 +56,7 @@ RefineTrace::FacadeMove describe_move(const Mesh& mesh, const std::vector<ModelS
 
 // Substitution on `mesh`, merged and validated; `attempt` says what happened.
 std::optional<Mesh> substitute_valid(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
-                                     const std::vector<WallMove>& moves, const Params& prm,
+                                     const std::vector<WallMove>& moves, const RepairConfig& prm,
                                      RefineTrace::Substitution& attempt) {
   const SubstitutionResult sub = substitute_walls(mesh, surfaces, moves, prm.planarity_tolerance);
   attempt = {};
@@ -83,7 +83,7 @@ std::optional<Mesh> substitute_valid(const Mesh& mesh, const std::vector<ModelSu
 // by substitution, re-matching on the new model after each. Returns the model once any wall
 // moved.
 std::optional<Mesh> one_wall_at_a_time(const Mesh& start, const PointCloud& local, const std::vector<ScanPlane>& planes,
-                                       const Params& prm, RefineTrace& trace) {
+                                       const RefineConfig& prm, RefineTrace& trace) {
   // Each (scan plane, wall position) is tried once: a wall that would not move is not retried,
   // and the loop ends even when moves undo each other.
   const int max_steps = 4 * int(planes.size()) + 4;
@@ -128,29 +128,94 @@ std::optional<Mesh> one_wall_at_a_time(const Mesh& start, const PointCloud& loca
   return step_mesh;
 }
 
-}  // namespace
-
-const char* outcome_name(Outcome outcome) {
-  switch (outcome) {
-    case Outcome::Refined: return "refined";
-    case Outcome::Kept: return "kept";
-    case Outcome::KeptInvalid: return "kept-invalid";
+// One building's run: the result being filled, its local frame and the stage timer.
+class Run {
+ public:
+  Run(const Mesh& model, double planarity_tolerance) : planarity_tolerance_(planarity_tolerance) {
+    out_.trace.id = model.id;
+    origin_ = local_origin(model);
+    out_.trace.origin = origin_;
+    id_ = model.id;
   }
-  return "?";
+  const Vec3& origin() const { return origin_; }
+  RefineTrace& trace() { return out_.trace; }
+  // Records the time since the last lap as `stage`'s.
+  void lap(const char* stage) {
+    out_.trace.seconds.emplace_back(stage, seconds_since(t_));
+    t_ = Clock::now();
+  }
+  // The result: `local_mesh` validated and written back in the input frame.
+  RefineResult finish(Outcome outcome, const std::string& reason, const Mesh& local_mesh, bool single_shell = true) {
+    out_.outcome = outcome;
+    out_.reason = reason;
+    RefineTrace& trace = out_.trace;
+    trace.output_validation = validate_mesh(local_mesh, planarity_tolerance_, true, single_shell);
+    out_.valid = trace.output_validation.valid();
+    trace.faces = local_mesh.faces.size();
+    trace.seconds.emplace_back("total", seconds_since(t_start_));
+    out_.mesh = translated(local_mesh, origin_);
+    out_.mesh.id = id_;
+    return out_;
+  }
+
+ private:
+  RefineResult out_;
+  Vec3 origin_;
+  std::string id_;
+  double planarity_tolerance_;
+  Clock::time_point t_start_ = Clock::now(), t_ = t_start_;
+};
+
+// Repairs the exported soup into a closed shell (`kept`). Returns the building's result when
+// it ends here: a model that cannot be made one solid is written as read (kept-invalid) with
+// the reason; several closed shells (a multi-part export) are each valid and kept whole.
+std::optional<RefineResult> repair_or_stop(const Mesh& local_model, const RepairConfig& cfg, Run& run, Mesh& kept) {
+  RepairReport rr;
+  try {
+    kept = repair_input(local_model, cfg, rr);
+  } catch (const InputError& e) {
+    run.lap("repair");
+    return run.finish(Outcome::KeptInvalid, e.what(), local_model);
+  }
+  kept.id = local_model.id;
+  run.trace().repair = rr;
+  const Validation v0 = validate_mesh(kept, cfg.planarity_tolerance);
+  run.trace().input_validation = v0;
+  run.lap("repair");
+  if (!v0.valid() && v0.components > 1 && validate_mesh(kept, cfg.planarity_tolerance, true, false).valid())
+    return run.finish(Outcome::Kept, std::to_string(v0.components) + " separate closed shells: kept whole", kept, false);
+  if (!v0.valid()) return run.finish(Outcome::KeptInvalid, "the input is no valid solid: " + v0.problem, local_model);
+  return std::nullopt;
+}
+
+// The walls the scan sees, each on its scan plane (oriented like the wall), and of those the
+// outdated ones (off their plane by more than change_tolerance) as moves; recorded in the trace.
+void outdated_walls(const Mesh& current, const std::vector<ModelSurface>& surfaces, const MatchResult& mr,
+                    const std::vector<ScanPlane>& planes, const PointCloud& local, const MatchConfig& cfg,
+                    RefineTrace& trace, std::vector<WallMove>& moves, std::vector<ScannedWall>& scanned) {
+  RefineTrace::Matching& matching = trace.matching.emplace(RefineTrace::Matching{});
+  for (const auto& m : mr.matches) {
+    Plane pl = planes[m.scan_plane].plane;
+    if (pl.n.dot(surfaces[m.surface].plane.n) < 0) pl = pl.flipped();
+    scanned.push_back({m.surface, m.scan_plane, pl});
+    const double dev = surface_deviation(current, surfaces[m.surface], pl);
+    if (dev > cfg.change_tolerance) moves.push_back({m.surface, pl, eave_follows_roof(current, surfaces, m, pl, local)});
+    matching.walls.push_back({m, dev, surfaces[m.surface].faces});
+  }
+  matching.rejected = mr.rejected;
+  matching.q_model = mr.q_model;
 }
 
 // The starting shell: every outdated wall takes its scan plane at once, the model's topology
-// kept (without the corner moves if those spoil it; else one wall at a time); none when no wall
-// is outdated or none could be moved. Records the moves made in `trace.facades`.
+// kept (without the corner moves if those spoil it; else one wall at a time); none when no
+// wall is outdated or none could be moved. The moved walls go to trace.facades.
 std::optional<Mesh> starting_shell(const Mesh& current, const std::vector<ModelSurface>& surfaces,
                                    const std::vector<WallMove>& moves, const std::vector<CornerMove>& corners,
-                                   const PointCloud& local, const std::vector<ScanPlane>& planes, const Params& prm,
-                                   RefineTrace& trace) {
+                                   const PointCloud& local, const std::vector<ScanPlane>& planes,
+                                   const RefineConfig& prm, RefineTrace& trace) {
   std::vector<WallMove> all = moves;
   for (const auto& c : corners) all.push_back(c.move);
   std::optional<Mesh> refined;
-  trace.substitution.reset();
-  trace.substitution_without_corners.reset();
   if (!all.empty())
     refined = substitute_valid(current, surfaces, all, prm, trace.substitution.emplace(RefineTrace::Substitution{}));
   if (refined) {
@@ -167,6 +232,44 @@ std::optional<Mesh> starting_shell(const Mesh& current, const std::vector<ModelS
   return refined;
 }
 
+// The selection decides every face: the candidate arrangement over the starting shell's planes
+// and the scan's facades, the starting shell as GLPK's first incumbent. The result is written
+// only when it is never worse, on every scan point near the building and on each moved wall's
+// own points (judge.h).
+RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::optional<Mesh>& refined,
+                              bool any_match, const PointCloud& local, const std::vector<ScanPlane>& planes,
+                              const RefineConfig& prm, Run& run) {
+  RefineTrace& trace = run.trace();
+  const ShellSelection chosen = select_shell(refined ? *refined : current, local, planes, prm);
+  trace.selection = chosen.stats;
+  trace.selection_reason = chosen.reason;
+  run.lap("selection");
+  if (!chosen.ok) return run.finish(Outcome::Kept, "the selection found no valid shell: " + chosen.reason, kept);
+  if (!refined && chosen.stats.candidates_changed == 0) {
+    trace.facades.clear();
+    return run.finish(Outcome::Kept, !any_match ? "the selection kept the model (no wall matched a scan plane)"
+                                                : "the selection kept the model (the scan agrees with it)", kept);
+  }
+  std::vector<JudgedWall> moved;
+  for (const auto& f : trace.facades) moved.push_back(f.wall);
+  const Judgement& verdict = trace.judgement.emplace(judge_refinement(kept, chosen.mesh, moved, local, prm, prm));
+  if (!verdict.ok)
+    return run.finish(Outcome::Kept, "not written: never worse, " + verdict.check + " check: " + verdict.detail, kept);
+  return run.finish(Outcome::Refined, std::to_string(chosen.stats.faces_from_selection) + " face(s) selected, " +
+                                          std::to_string(trace.facades.size()) + " wall(s) moved", chosen.mesh);
+}
+
+}  // namespace
+
+const char* outcome_name(Outcome outcome) {
+  switch (outcome) {
+    case Outcome::Refined: return "refined";
+    case Outcome::Kept: return "kept";
+    case Outcome::KeptInvalid: return "kept-invalid";
+  }
+  return "?";
+}
+
 Vec3 local_origin(const Mesh& model) {
   if (model.vertices.empty()) return Vec3::Zero();
   const Vec3 lo = bounding_box(model.vertices).min();
@@ -174,61 +277,23 @@ Vec3 local_origin(const Mesh& model) {
   return (lo / kOriginGrid).array().floor().matrix() * kOriginGrid;
 }
 
-RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const Params& prm) {
+RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const RefineConfig& prm) {
   prm.validate();
-  const auto t_start = Clock::now();
-  RefineResult out;
-  RefineTrace& trace = out.trace;
-  trace.id = model.id;
-  const Vec3 origin = local_origin(model);
-  trace.origin = origin;
-  auto t = Clock::now();
-  auto lap = [&](const char* stage) {
-    trace.seconds.emplace_back(stage, seconds_since(t));
-    t = Clock::now();
-  };
-  auto finish = [&](Outcome outcome, const std::string& reason, const Mesh& local_mesh, bool single_shell = true) {
-    out.outcome = outcome;
-    out.reason = reason;
-    trace.output_validation = validate_mesh(local_mesh, prm.planarity_tolerance, true, single_shell);
-    out.valid = trace.output_validation.valid();
-    trace.faces = local_mesh.faces.size();
-    trace.seconds.emplace_back("total", seconds_since(t_start));
-    out.mesh = translated(local_mesh, origin);
-    out.mesh.id = model.id;
-    return out;
-  };
-
-  // Repair the exported soup into a closed shell; a model that cannot be made one is written as
-  // read (kept-invalid) with the reason.
-  const Mesh local_model = translated(model, -origin);
-  RepairReport rr;
+  Run run(model, prm.planarity_tolerance);
+  RefineTrace& trace = run.trace();
+  const Mesh local_model = translated(model, -run.origin());
   Mesh kept;
-  try {
-    kept = repair_input(local_model, prm, rr);
-  } catch (const InputError& e) {
-    lap("repair");
-    return finish(Outcome::KeptInvalid, e.what(), local_model);
-  }
-  kept.id = model.id;
-  trace.repair = rr;
-  const Validation v0 = validate_mesh(kept, prm.planarity_tolerance);
-  trace.input_validation = v0;
-  lap("repair");
-  if (!v0.valid() && v0.components > 1 && validate_mesh(kept, prm.planarity_tolerance, true, false).valid())
-    // Several closed shells (a multi-part export): each valid, the building kept whole.
-    return finish(Outcome::Kept, std::to_string(v0.components) + " separate closed shells: kept whole", kept, false);
-  if (!v0.valid()) return finish(Outcome::KeptInvalid, "the input is no valid solid: " + v0.problem, local_model);
+  if (auto stopped = repair_or_stop(local_model, prm, run, kept)) return *stopped;
   Mesh current = merge_coplanar_faces(kept);
   current.id = model.id;
 
   // Planes of the scan near the model.
-  const PointCloud local = cloud_near(current, cloud, origin, prm);
+  const PointCloud local = cloud_near(current, cloud, run.origin(), prm);
   trace.cloud = {cloud.points.size(), local.points.size()};
   const auto planes = detect_planes(local, prm);
-  lap("planes");
+  run.lap("planes");
   trace.planes = planes;
-  if (planes.empty()) return finish(Outcome::Kept, "no planes found in the cloud near the model", kept);
+  if (planes.empty()) return run.finish(Outcome::Kept, "no planes found in the cloud near the model", kept);
 
   // Matching on the input: which walls the scan sees, where, and by which points; the outdated
   // ones move onto their planes, and unscanned walls at a scanned facade's end to where the
@@ -237,54 +302,27 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const P
   const MatchResult mr = match_surfaces(current, surfaces, local, planes, prm);
   std::vector<WallMove> moves;
   std::vector<ScannedWall> scanned;
-  RefineTrace::Matching& matching = trace.matching.emplace(RefineTrace::Matching{});
-  for (const auto& m : mr.matches) {
-    Plane pl = planes[m.scan_plane].plane;
-    if (pl.n.dot(surfaces[m.surface].plane.n) < 0) pl = pl.flipped();
-    scanned.push_back({m.surface, m.scan_plane, pl});
-    const double dev = surface_deviation(current, surfaces[m.surface], pl);
-    if (dev > prm.change_tolerance) moves.push_back({m.surface, pl, eave_follows_roof(current, surfaces, m, pl, local)});
-    matching.walls.push_back({m, dev, surfaces[m.surface].faces});
-  }
-  matching.rejected = mr.rejected;
-  matching.q_model = mr.q_model;
-  const auto corners = corner_moves(current, surfaces, scanned, local, planes, prm);
-  lap("matching");
+  outdated_walls(current, surfaces, mr, planes, local, prm, trace, moves, scanned);
+  const auto corners = corner_moves(current, surfaces, scanned, local, planes, prm, prm);
+  run.lap("matching");
 
-  // Substitution, selection and the never-worse judge, first with the corners the scan's ends
-  // show; the corners are the least certain evidence, so a refinement the judge refuses is tried
-  // once more on the walls' own points alone.
-  auto decide = [&](const std::vector<CornerMove>& with_corners) {
+  // The corners are the least certain evidence: a refinement the judge refuses with them is
+  // tried once more on the walls' own points alone.
+  auto attempt = [&](const std::vector<CornerMove>& with_corners) {
     trace.facades.clear();
-    trace.judgement.reset();
-    const std::optional<Mesh> start = starting_shell(current, surfaces, moves, with_corners, local, planes, prm, trace);
-    lap("substitution");
-    // The selection decides every face: the candidate arrangement over the starting shell's
-    // planes and the scan's facades, the starting shell as GLPK's first incumbent.
-    const ShellSelection chosen = select_shell(start ? *start : current, local, planes, prm);
-    trace.selection = chosen.stats;
-    trace.selection_reason = chosen.reason;
-    lap("selection");
-    if (!chosen.ok) return finish(Outcome::Kept, "the selection found no valid shell: " + chosen.reason, kept);
-    if (!start && chosen.stats.candidates_changed == 0) {
-      trace.facades.clear();
-      return finish(Outcome::Kept, mr.matches.empty() ? "the selection kept the model (no wall matched a scan plane)"
-                                                      : "the selection kept the model (the scan agrees with it)", kept);
-    }
-    // Never worse: on every scan point near the building, and on each moved wall's own points.
-    std::vector<JudgedWall> moved;
-    for (const auto& f : trace.facades) moved.push_back(f.wall);
-    const Judgement& verdict = trace.judgement.emplace(judge_refinement(kept, chosen.mesh, moved, local, prm));
-    if (!verdict.ok)
-      return finish(Outcome::Kept, "not written: never worse, " + verdict.check + " check: " + verdict.detail, kept);
-    return finish(Outcome::Refined, std::to_string(chosen.stats.faces_from_selection) + " face(s) selected, " +
-                                        std::to_string(trace.facades.size()) + " wall(s) moved", chosen.mesh);
+    trace.substitution.reset();
+    trace.substitution_without_corners.reset();
+    const std::optional<Mesh> refined =
+        starting_shell(current, surfaces, moves, with_corners, local, planes, prm, trace);
+    run.lap("substitution");
+    return select_and_judge(kept, current, refined, !mr.matches.empty(), local, planes, prm, run);
   };
-  RefineResult result = decide(corners);
+  RefineResult result = attempt(corners);
   if (!corners.empty() && trace.judgement && !trace.judgement->ok) {
     trace.corners_refused = trace.judgement->check + " check: " + trace.judgement->detail;
-    trace.seconds.pop_back();  // the first attempt's total
-    result = decide({});
+    trace.judgement.reset();
+    trace.seconds.pop_back();  // the first attempt's total; its other laps add up in the report
+    result = attempt({});
   }
   return result;
 }

@@ -564,7 +564,7 @@ Mesh merge_coplanar_faces(const Mesh& mesh, double angle_deg, double distance) {
   return compact(mesh.vertices, std::move(faces), mesh.id);
 }
 
-Mesh repair_input(const Mesh& local_model, const Params& prm, RepairReport& rr) {
+Mesh repair_input(const Mesh& local_model, const RepairConfig& prm, RepairReport& rr) {
   // Welds tried in turn, relative to weld_tolerance: the tolerance itself; gaps between faces
   // up to 1.5x and 2x it (corners jittered a little more than the tolerance); then 10x and 100x
   // finer for detailed models whose features are shorter than it.

@@ -102,7 +102,8 @@ bool every_edge_used_0_or_2(const CandidateSet& cs, const std::vector<char>& sel
   return true;
 }
 
-SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& pg, const Params& prm) {
+SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& pg, const SelectionConfig& prm,
+                             double time_limit) {
   const auto t0 = std::chrono::steady_clock::now();
   SelectionResult res;
   const int nf = int(cs.faces.size()), ne = int(cs.edges.size());
@@ -226,7 +227,7 @@ SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& pg,
   parm.cov_cuts = GLP_ON;
   parm.clq_cuts = GLP_ON;
   parm.mip_gap = prm.mip_gap;
-  parm.tm_lim = int(std::min(kMaxTimeLimitMs, std::ceil(prm.mip_time_limit * 1000.0)));
+  parm.tm_lim = int(std::min(kMaxTimeLimitMs, std::ceil(time_limit * 1000.0)));
   parm.msg_lev = GLP_MSG_OFF;
   parm.cb_func = on_search;
   parm.cb_info = &search;
@@ -263,12 +264,16 @@ SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& pg,
 }
 
 SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& cost, const std::vector<int>& outside,
-                             const Params& prm, const std::vector<int>* fixed) {
+                             const SelectionConfig& prm, const std::vector<int>* fixed) {
   SelectionProgram pg;
   pg.cost = cost;
   pg.outside = outside;
   if (fixed != nullptr) pg.fixed = *fixed;
   return select_faces(cs, pg, prm);
+}
+
+SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& program, const SelectionConfig& config) {
+  return select_faces(cs, program, config, config.mip_time_limit);
 }
 
 }  // namespace lodrefine

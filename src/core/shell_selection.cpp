@@ -515,7 +515,7 @@ std::vector<char> mended_start(const CandidateSet& cs, const std::vector<char>& 
       pg.fixed.push_back(near[f] ? -1 : int(in_start[f]));
     }
     pg.sharp_cost.assign(cs.edges.size(), 0.0);
-    Params mend = prm;
+    SelectionConfig mend = prm;  // the costs are areas: weight 1
     mend.lambda_coverage = 1.0;
     const SelectionResult r = select_faces(cs, pg, mend);
     if (r.ok) return r.selected;

@@ -219,6 +219,11 @@ std::vector<int> scanned_walls(const Mesh& truth, const std::vector<Vec3>& point
   return out;
 }
 
+// m: the facade points of a matched wall are its scan plane's inliers in front of it, grown by
+// this in its plane (a plane may run on along a flush neighbour; the value matching used to
+// share through --corner-gap, now the evaluation's own so tuning matching leaves it alone).
+constexpr double kFacadeMargin = 0.6;
+
 std::vector<int> select_facade_points(const Mesh& input, const PointCloud& cloud, const Params& prm) {
   Mesh mesh = input;
   try {
@@ -229,7 +234,7 @@ std::vector<int> select_facade_points(const Mesh& input, const PointCloud& cloud
   const auto planes = detect_planes(cloud, prm);
   const auto surfaces = model_surfaces(mesh);
   const auto matched = match_surfaces(mesh, surfaces, cloud, planes, prm);
-  return points_in_front(mesh, surfaces, planes, matched, cloud, prm.corner_gap);
+  return points_in_front(mesh, surfaces, planes, matched, cloud, kFacadeMargin);
 }
 
 BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const PointCloud& cloud,

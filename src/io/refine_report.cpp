@@ -133,4 +133,10 @@ json refine_report(const RefineResult& r) {
   return rep;
 }
 
+json params_json(const RefineConfig& config) {
+  json j = json::object();
+  for_each_field(config, [&](const auto& field, auto value) { j[field.name] = value; });
+  return j;
+}
+
 }  // namespace lodrefine

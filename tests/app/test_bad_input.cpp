@@ -853,6 +853,16 @@ TEST(BadInputSolver, TimeLimitWithoutSolutionIsReported) {
     EXPECT_EQ(r.status_text(), "feasible (time limit)");
   }
   EXPECT_LT(r.seconds, 5.0) << "the time limit was not honoured";
+  // The budget is an argument (what is left of mip_time_limit after an earlier solve), not a
+  // mutated copy of the config: it rules whatever config.mip_time_limit says.
+  SelectionConfig patient = prm;
+  patient.mip_time_limit = 3600.0;
+  SelectionProgram pg;
+  pg.cost = cost;
+  pg.outside = outside;
+  const SelectionResult budget = select_faces(cs, pg, patient, 0.01);
+  EXPECT_NE(budget.status_text().find("time limit"), std::string::npos) << budget.status_text();
+  EXPECT_LT(budget.seconds, 5.0) << "the budget argument was not honoured";
   add_row("select_faces: 3000-face parity program, 10 ms limit",
           "ok=" + std::string(r.ok ? "true" : "false") + ", status '" + r.status_text() + "', " + fmt(r.seconds) + " s", 0);
 }

@@ -73,7 +73,7 @@ void add_street(Scene& s, double to) {
 
 TEST(Corners, SideWallMovesToWhereTheFacadeEnds) {
   Scene s = scene(11.3, 1.0);  // the building really ends at x = 11.3
-  const auto moves = corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{});
+  const auto moves = corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{});
   ASSERT_EQ(moves.size(), 1u);
   const Plane& p = moves[0].move.plane;
   EXPECT_GT(s.surfaces[moves[0].move.surface].plane.n.x(), 0.99) << "the right side wall";
@@ -83,12 +83,12 @@ TEST(Corners, SideWallMovesToWhereTheFacadeEnds) {
 
 TEST(Corners, AScanThatJustStopsIsNoEvidence) {
   Scene s = scene(11.3, 0.0);  // nothing seen where the facade's points end
-  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}).empty());
 }
 
 TEST(Corners, AFacadeRunningPastTheCornerIntoAReturnMovesItOut) {
   Scene s = scene(12.5, 1.0);  // the building really ends at x = 12.5, its side wall seen
-  const auto moves = corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{});
+  const auto moves = corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{});
   ASSERT_EQ(moves.size(), 1u);
   EXPECT_NEAR(moves[0].shift, 0.5, 0.06);
   EXPECT_NEAR(moves[0].move.plane.distance(Vec3(12.5, 0, 0)), 0.0, 0.06);
@@ -98,7 +98,7 @@ TEST(Corners, AFacadeRunningPastTheCornerIntoAReturnMovesItOut) {
 // scan ends there, the building does not.
 TEST(Corners, AFacadeCutAtTheTileEdgePastTheCornerIsNoEvidence) {
   Scene s = scene(12.5, 0.0);
-  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}).empty());
 }
 
 // A van parked across the corner hides the last 0.7 m of the facade over its whole height;
@@ -107,7 +107,7 @@ TEST(Corners, AnOccluderAtTheCornerIsNoEvidence) {
   Scene s = scene(11.3, 0.0);
   for (double x = 11.3; x < 13.5; x += 0.05)
     for (double z = 0.1; z < 5.9; z += 0.05) s.cloud.points.emplace_back(x, -1.0, z);
-  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}).empty());
 }
 
 // Terraced houses: the neighbour's facade starts at the true corner x = 12, 0.4 m behind this
@@ -119,12 +119,12 @@ TEST(Corners, ASetBackNeighbourBeyondAShadowIsNoEvidence) {
     for (double x = 12.0; x < 20.0; x += 0.05) s.cloud.points.emplace_back(x, 0.4, z);
     for (double y = 0.05; y < 0.4; y += 0.05) s.cloud.points.emplace_back(12.0, y, z);
   }
-  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}).empty());
 }
 
 TEST(Corners, AFacadeRunningOnIntoANeighbourIsNoEvidence) {
   Scene s = scene(20.0, 0.0);  // a flush neighbour: the plane runs far past the corner
-  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}).empty());
 }
 
 // See-through is no corner evidence: on the city dev tile, scans of correct buildings' facades
@@ -136,7 +136,7 @@ TEST(Corners, PointsSeenBehindTheFacadePastItsEndAreNoEvidence) {
   Scene s = scene(11.8, 0.0);
   for (double x = 11.8; x < 16.0; x += 0.05)
     for (double z = 0.1; z < 5.9; z += 0.05) s.cloud.points.emplace_back(x, 2.0, z);
-  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}).empty());
 }
 
 // A facade the scan moves 0.4 m, whose points end 0.7 m short of the model's corner with the
@@ -145,7 +145,7 @@ TEST(Corners, PointsSeenBehindTheFacadePastItsEndAreNoEvidence) {
 TEST(Corners, AMisplacedFacadeEndingInTheOpenMovesTheSideWall) {
   Scene s = scene(11.3, 0.0, 0.4);
   add_street(s, 16.0);
-  const auto moves = corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{});
+  const auto moves = corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{});
   ASSERT_EQ(moves.size(), 1u);
   EXPECT_NEAR(moves[0].move.plane.distance(Vec3(11.3, 0, 0)), 0.0, 0.06);
   EXPECT_NEAR(moves[0].shift, -0.7, 0.06);
@@ -156,14 +156,14 @@ TEST(Corners, AMisplacedFacadeEndingInTheOpenMovesTheSideWall) {
 TEST(Corners, ACorrectFacadeEndingInTheOpenMovesNothing) {
   Scene s = scene(11.3, 0.0);
   add_street(s, 16.0);
-  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}).empty());
 }
 
 // A misplaced facade cut at the tile's edge: the street ends where the facade's points do.
 TEST(Corners, AMisplacedFacadeCutAtTheTileEdgeMovesNothing) {
   Scene s = scene(11.3, 0.0, 0.4);
   add_street(s, 11.3);
-  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}).empty());
 }
 
 // A misplaced facade whose last metre is hidden by a van parked in front of it.
@@ -172,5 +172,5 @@ TEST(Corners, AMisplacedFacadeShadowedByAVanMovesNothing) {
   add_street(s, 16.0);
   for (double x = 11.3; x < 13.5; x += 0.05)
     for (double z = 0.1; z < 2.5; z += 0.05) s.cloud.points.emplace_back(x, -2.0, z);
-  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, Params{}).empty());
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}).empty());
 }

@@ -42,7 +42,7 @@ TEST(Judge, AWallMovedOntoItsScanIsBetter) {
   const Mesh coarse = box({0, -0.5, 0}, {12, 8, 6}), refined = box({0, 0, 0}, {12, 8, 6});
   PointCloud cloud;
   scan_front(cloud, 0.0, 0.5, 11.5);
-  const Judgement j = judge_refinement(coarse, refined, {front_wall(-0.5, 0.0)}, cloud, Params{});
+  const Judgement j = judge_refinement(coarse, refined, {front_wall(-0.5, 0.0)}, cloud, MatchConfig{}, PlaneConfig{});
   EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
   EXPECT_EQ(j.building.points, cloud.points.size());
   EXPECT_NEAR(j.building.rms_before, 0.5, 0.01);
@@ -60,7 +60,7 @@ TEST(Judge, StreetGroundDoesNotCountAgainstAWallMovedInwards) {
   scan_front(cloud, 0.0, 0.5, 11.5);
   const std::size_t facade = cloud.points.size();
   scan_ground(cloud, -0.6);
-  const Judgement j = judge_refinement(coarse, refined, {front_wall(-0.6, 0.0)}, cloud, Params{});
+  const Judgement j = judge_refinement(coarse, refined, {front_wall(-0.6, 0.0)}, cloud, MatchConfig{}, PlaneConfig{});
   EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
   EXPECT_EQ(j.building.points, facade);
 }
@@ -73,20 +73,20 @@ TEST(Judge, AWallMovedOntoABaysPlaneIsRefused) {
   scan_front(cloud, 0.0, 0.0, 5.0, 1);
   scan_front(cloud, -0.5, 5.0, 7.0, 2);
   scan_front(cloud, 0.0, 7.0, 12.0, 3);
-  const Judgement j = judge_refinement(coarse, refined, {front_wall(-0.2, -0.5)}, cloud, Params{});
+  const Judgement j = judge_refinement(coarse, refined, {front_wall(-0.2, -0.5)}, cloud, MatchConfig{}, PlaneConfig{});
   EXPECT_FALSE(j.ok);
   EXPECT_EQ(j.check, "building");
   EXPECT_NE(j.detail.find("RMS"), std::string::npos) << j.detail;
   EXPECT_GT(j.building.rms_after, j.building.rms_before);
   // Onto the facade's own plane it is better.
-  const Judgement k = judge_refinement(coarse, box({0, 0, 0}, {12, 8, 6}), {front_wall(-0.2, 0.0)}, cloud, Params{});
+  const Judgement k = judge_refinement(coarse, box({0, 0, 0}, {12, 8, 6}), {front_wall(-0.2, 0.0)}, cloud, MatchConfig{}, PlaneConfig{});
   EXPECT_TRUE(k.ok) << k.check << ": " << k.detail;
   // A bay twice as wide: no plane of the model's wall fits better than where it is.
   PointCloud wide;
   scan_front(wide, 0.0, 0.0, 4.0, 1);
   scan_front(wide, -0.5, 4.0, 8.0, 2);
   scan_front(wide, 0.0, 8.0, 12.0, 3);
-  EXPECT_FALSE(judge_refinement(coarse, box({0, 0, 0}, {12, 8, 6}), {front_wall(-0.2, 0.0)}, wide, Params{}).ok);
+  EXPECT_FALSE(judge_refinement(coarse, box({0, 0, 0}, {12, 8, 6}), {front_wall(-0.2, 0.0)}, wide, MatchConfig{}, PlaneConfig{}).ok);
 }
 
 // The right side wall (x = 12) moves in by 0.7 m while only the front is scanned: the points do
@@ -99,15 +99,15 @@ TEST(Judge, AnUnscannedWallMovesOnlyOnCornerEvidence) {
   side.polygons = {{{12, 0, 0}, {12, 8, 0}, {12, 8, 6}, {12, 0, 6}}};
   side.from = Plane(kX, -12.0);
   side.to = Plane(kX, -11.3);
-  const Judgement j = judge_refinement(coarse, refined, {side}, cloud, Params{});
+  const Judgement j = judge_refinement(coarse, refined, {side}, cloud, MatchConfig{}, PlaneConfig{});
   EXPECT_FALSE(j.ok);
   EXPECT_EQ(j.check, "wall");
   EXPECT_NE(j.detail.find("no corner evidence"), std::string::npos) << j.detail;
   side.corner = true;
-  EXPECT_EQ(judge_refinement(coarse, refined, {side}, cloud, Params{}).check, "gain");  // nothing shows it
+  EXPECT_EQ(judge_refinement(coarse, refined, {side}, cloud, MatchConfig{}, PlaneConfig{}).check, "gain");  // nothing shows it
   // The return onto the side wall where the facade ends (corners.h): now the scan shows it.
   add_grid(cloud, wall_patch({11.3, 0.05, 0}, kY, 0.6, 1.0, 5.5), 0.05);
-  const Judgement k = judge_refinement(coarse, refined, {side}, cloud, Params{});
+  const Judgement k = judge_refinement(coarse, refined, {side}, cloud, MatchConfig{}, PlaneConfig{});
   EXPECT_TRUE(k.ok) << k.check << ": " << k.detail;
 }
 
@@ -120,7 +120,7 @@ TEST(Judge, AWallMovedAwayFromItsPointsIsRefused) {
   left.polygons = {{{0, 8, 0}, {0, 0, 0}, {0, 0, 6}, {0, 8, 6}}};
   left.from = Plane(-kX, 0.0);
   left.to = Plane(-kX, 1.0);
-  const Judgement j = judge_refinement(coarse, refined, {left}, cloud, Params{});
+  const Judgement j = judge_refinement(coarse, refined, {left}, cloud, MatchConfig{}, PlaneConfig{});
   EXPECT_FALSE(j.ok);
   EXPECT_EQ(j.check, "building");
   EXPECT_EQ(j.building.worse, cloud.points.size());
@@ -131,7 +131,7 @@ TEST(Judge, NoPointsNearTheBuildingChangesNothingButAMovedWallNeedsEvidence) {
   const Mesh coarse = box({0, -0.5, 0}, {12, 8, 6}), refined = box({0, 0, 0}, {12, 8, 6});
   PointCloud cloud;
   cloud.points.push_back({100, 100, 3});
-  const Judgement j = judge_refinement(coarse, refined, {front_wall(-0.5, 0.0)}, cloud, Params{});
+  const Judgement j = judge_refinement(coarse, refined, {front_wall(-0.5, 0.0)}, cloud, MatchConfig{}, PlaneConfig{});
   EXPECT_EQ(j.building.points, 0u);
   EXPECT_FALSE(j.ok);
   EXPECT_EQ(j.check, "wall");
@@ -142,7 +142,7 @@ TEST(Judge, AMoveWithinTheScansNoiseIsNoGain) {
   const Mesh coarse = box({0, 0, 0}, {12, 8, 6}), refined = box({0, -0.025, 0}, {12, 8, 6});
   PointCloud cloud;
   scan_front(cloud, -0.0125, 0.5, 11.5);  // halfway: as far from either
-  const Judgement j = judge_refinement(coarse, refined, {front_wall(0.0, -0.025)}, cloud, Params{});
+  const Judgement j = judge_refinement(coarse, refined, {front_wall(0.0, -0.025)}, cloud, MatchConfig{}, PlaneConfig{});
   EXPECT_FALSE(j.ok);
   EXPECT_EQ(j.check, "gain");
   EXPECT_EQ(j.building.better, 0u);

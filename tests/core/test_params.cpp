@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <set>
+#include <string>
+
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/types.h"
 
@@ -34,4 +37,61 @@ TEST(Params, TableListsEveryParameter) {
     EXPECT_LE(p.min, p.default_value) << p.name;
     EXPECT_GE(p.max, p.default_value) << p.name;
   }
+}
+
+TEST(Params, ValidateNamesTheStage) {
+  RefineConfig c;
+  c.ransac_epsilon = 5.0;
+  try {
+    c.validate();
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("plane: parameter ransac_epsilon = 5 ", 0), 0u) << e.what();
+  }
+  c = RefineConfig{};
+  c.conf_bbox_iou = -1.0;
+  EXPECT_THROW(c.confidence().validate(), InputError);
+  EXPECT_NO_THROW(c.plane().validate());  // a stage checks only its own rows
+  try {
+    c.validate();
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("confidence: ", 0), 0u) << e.what();
+  }
+}
+
+TEST(Params, EveryRowBelongsToOneStageInPipelineOrder) {
+  const auto& stages = stage_table();
+  ASSERT_EQ(stages.size(), 5u);
+  EXPECT_EQ(stages.front().name, "repair");
+  std::set<std::string> names;
+  std::size_t stage = 0;
+  for (const auto& p : param_table()) {
+    EXPECT_TRUE(names.insert(p.name).second) << p.name << " twice";
+    while (stage < stages.size() && stages[stage].name != p.stage) ++stage;  // rows grouped, in stage order
+    EXPECT_LT(stage, stages.size()) << p.name << " of stage " << p.stage;
+  }
+  EXPECT_EQ(param_table().size(), names.size());
+}
+
+TEST(Params, ForEachFieldVisitsEveryRowWithItsValue) {
+  RefineConfig c;
+  c.match_distance = 2.5;
+  c.seed = 7;
+  std::size_t n = 0;
+  for_each_field(c, [&](const auto& field, auto& value) {
+    EXPECT_EQ(field.name, param_table()[n].name);
+    if (std::string(field.name) == "match_distance") {
+      EXPECT_DOUBLE_EQ(double(value), 2.5);
+      EXPECT_STREQ(field.stage, "match");
+      value = 3.0;  // the field is the config's member
+    }
+    if (std::string(field.name) == "seed") EXPECT_EQ(double(value), 7.0);
+    ++n;
+  });
+  EXPECT_EQ(n, param_table().size());
+  EXPECT_DOUBLE_EQ(c.match_distance, 3.0);
+  std::size_t in_match = 0;
+  for_each_field(c.match(), [&](const auto& field, auto) { in_match += std::string(field.stage) == "match"; });
+  EXPECT_EQ(in_match, 8u);  // a stage config visits its own rows only
 }

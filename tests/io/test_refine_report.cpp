@@ -98,3 +98,15 @@ TEST(RefineReport, ValidationJsonNamesTheProblem) {
   EXPECT_EQ(j["boundary_edges"], 3);
   EXPECT_EQ(j["problem"], "3 boundary edges");
 }
+
+TEST(RefineReport, ParamsJsonHasEveryRowByNameWithItsValue) {
+  RefineConfig c;
+  c.corner_gap = 0.75;
+  c.seed = 3;
+  const nlohmann::json j = params_json(c);
+  EXPECT_EQ(j.size(), param_table().size());
+  for (const auto& p : param_table()) EXPECT_TRUE(j.contains(p.name)) << p.name;
+  EXPECT_DOUBLE_EQ(j["corner_gap"].get<double>(), 0.75);
+  EXPECT_TRUE(j["seed"].is_number_integer());
+  EXPECT_EQ(j["seed"].get<int>(), 3);
+}

@@ -24,7 +24,7 @@ struct Confidence {
 };
 
 std::vector<Confidence> candidate_confidence(const CandidateSet& cs, const std::vector<ModelReference>& model,
-                                             const std::vector<CloudReference>& cloud, const Params& params);
+                                             const std::vector<CloudReference>& cloud, const ConfidenceConfig& config);
 
 // The paper's sigmoid coverage cost of a face of area `area` and confidence `c`:
 // A * (1 / (1 + exp(-(1 - c) + (1 - tau))) - 0.5); negative (a reward) above tau.

@@ -35,6 +35,7 @@ struct CornerMove {
 
 std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
                                      const std::vector<ScannedWall>& scanned, const PointCloud& cloud,
-                                     const std::vector<ScanPlane>& planes, const Params& params);
+                                     const std::vector<ScanPlane>& planes, const MatchConfig& match,
+                                     const PlaneConfig& detection);
 
 }  // namespace lodrefine

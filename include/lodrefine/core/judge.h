@@ -5,7 +5,7 @@
 // may move only on the scan's corner evidence (corners.h).
 //
 // Inputs are in one (local) frame; distances in metres. A point is judged when it lies within
-// Params::match_distance of either model (the cap: farther points are another object's) and
+// MatchConfig::match_distance of either model (the cap: farther points are another object's) and
 // above the lowest model vertex + kGroundBand (street ground in front of a wall moved inwards
 // would count against a right move). Its distance to each model is capped at match_distance.
 #pragma once
@@ -31,7 +31,7 @@ struct JudgedWall {
 struct Judgement {
   struct Fit {
     std::size_t points = 0;              // judged points
-    std::size_t better = 0, worse = 0;   // closer / farther by more than Params::ransac_epsilon
+    std::size_t better = 0, worse = 0;   // closer / farther by more than PlaneConfig::ransac_epsilon
     double rms_before = 0.0, rms_after = 0.0;  // of the capped distances
   };
   bool ok = true;
@@ -44,11 +44,11 @@ struct Judgement {
 // Whether `after` may replace `before` (both closed meshes, same frame as `cloud`).
 // - building: refused when the capped RMS of every judged point grows by more than kRmsSlack,
 //   or when more than kWorseShare of the points that changed (by more than
-//   Params::ransac_epsilon) got farther;
+//   PlaneConfig::ransac_epsilon) got farther;
 // - wall: each moved wall's region (the judged points whose nearest face is the wall, before
 //   the move or after it) must not grow in RMS by more than kWallRmsSlack (its region also
 //   holds points of whatever stands near the wall, so it is judged on the RMS only); a region
-//   with fewer than Params::ransac_min_points points is unscanned and passes only when the
+//   with fewer than PlaneConfig::ransac_min_points points is unscanned and passes only when the
 //   wall moved on corner evidence.
 // - gain: fewer than kMinGain points got closer and no moved wall's region RMS dropped by
 //   kMinRmsGain (a move within the scan's noise, e.g. a correct wall refitted a few cm off by
@@ -61,6 +61,6 @@ constexpr double kWorseShare = 0.25;
 constexpr int kMinGain = 50;
 constexpr double kMinRmsGain = 0.001;  // m
 Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vector<JudgedWall>& walls,
-                           const PointCloud& cloud, const Params& params);
+                           const PointCloud& cloud, const MatchConfig& match, const PlaneConfig& detection);
 
 }  // namespace lodrefine

@@ -1,6 +1,5 @@
 // Stage 2: model-to-surface matching. Groups the model's faces into planar surfaces, matches
-// scan planes to wall surfaces (normal + centroid-distance hard filters, OBB IoU, S_match),
-// scores the model by Q_model.
+// scan planes to wall surfaces and scores the model by Q_model (sum of S_match).
 #pragma once
 #include <string>
 #include <vector>
@@ -50,9 +49,17 @@ struct MatchResult {
   std::vector<std::string> rejected;
 };
 
+// A facade plane and a wall surface match when (hard filters) their normals are within
+// match_angle_deg, at least 150 of the plane's inliers belong to the wall (each point goes to the
+// nearest wall within match_distance of it whose outline, grown by match_margin, it lies in
+// front of), and those points cover match_min_overlap of the wall (the largest of the in-plane
+// boxes' IoU and the share of either box inside the other). Of the matches, each wall keeps the
+// plane with most points, walls facing away from the one the plane fits best are dropped, and
+// so are matches whose corner with an adjacent matched facade lies over corner_gap beyond that
+// facade's points. S_match = w_normal |S_normal| + w_coverage IoU.
 MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
                            const PointCloud& cloud, const std::vector<ScanPlane>& planes,
-                           const Params& params);
+                           const MatchConfig& config);
 
 // The inliers of each matched scan plane that lie in front of its wall, grown by `margin` (a
 // plane may run on along a flush neighbouring facade, whose points are not this building's);

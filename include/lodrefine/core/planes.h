@@ -17,7 +17,7 @@ struct ScanPlane {
   bool facade = false;       // near-vertical
 };
 
-// Detects planes in `cloud` (local frame). Deterministic for a given Params::seed.
-std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& params);
+// Detects planes in `cloud` (local frame). Deterministic for a given PlaneConfig::seed.
+std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const PlaneConfig& config);
 
 }  // namespace lodrefine

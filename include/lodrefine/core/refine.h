@@ -100,7 +100,7 @@ struct RefineResult {
 // Every model gets an output: the refined building, the repaired input, or the input as read,
 // with the outcome and its reason. Never throws for a bad model (only for parameters out of
 // range).
-RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const Params& params);
+RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const RefineConfig& config);
 
 // The local origin used for a model: its bounding-box minimum rounded down to 100 m, so
 // that all computation runs on small coordinates.

@@ -41,7 +41,7 @@ int orient_outward(Mesh& mesh);
 // first whose shell is valid (validate_mesh at params.planarity_tolerance) wins, else the first
 // that closed at all; warped faces come back split into triangles (counted in `report`).
 // Throws InputError (the first weld's) when no weld closes a shell.
-Mesh repair_input(const Mesh& soup, const Params& params, RepairReport& report);
+Mesh repair_input(const Mesh& soup, const RepairConfig& config, RepairReport& report);
 
 // Splits every face farther than `tolerance` from planar into triangles, keeping its semantic
 // and source; no vertex moves. Ear clipping, unless one of its diagonals is already an edge of

@@ -63,7 +63,12 @@ struct SelectionProgram {
   std::vector<double> sharp_cost;
   std::vector<char> warm;
 };
-SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& program, const Params& params);
+// `time_limit` (s, > 0): GLPK's budget for this program, explicit so that a caller that solved
+// before passes what is left of mip_time_limit.
+SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& program, const SelectionConfig& config,
+                             double time_limit);
+// The same with the whole budget, config.mip_time_limit.
+SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& program, const SelectionConfig& config);
 
 // Whether every edge of `cs` is used by 0 or 2 of the `selected` candidates (plus `outside[e]`;
 // empty: none): the program's constraint, for checking a starting point or a result.
@@ -72,6 +77,6 @@ bool every_edge_used_0_or_2(const CandidateSet& cs, const std::vector<char>& sel
 
 // The same with `cost`, `outside` and optionally `fixed` (see SelectionProgram).
 SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& cost, const std::vector<int>& outside,
-                             const Params& params, const std::vector<int>* fixed = nullptr);
+                             const SelectionConfig& config, const std::vector<int>* fixed = nullptr);
 
 }  // namespace lodrefine

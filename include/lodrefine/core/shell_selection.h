@@ -1,4 +1,5 @@
-// Stages 3-4 for the whole building (paper Sec. 3.2-3.4): one PolyFit-style candidate
+// Stage 4 (4 candidates, 4a data term, 4b selection) for the whole building (paper Sec.
+// 3.2-3.4): one PolyFit-style candidate
 // arrangement over the building and the scan around it, and the GLPK binary selection that
 // decides every face of the output.
 //

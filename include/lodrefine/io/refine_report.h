@@ -22,4 +22,7 @@ nlohmann::json refine_report(const RefineResult& result);
 
 nlohmann::json validation_json(const Validation& v);
 
+// Every parameter's value by name (flat, the CLI's snake_case names): a report's "params".
+nlohmann::json params_json(const RefineConfig& config);
+
 }  // namespace lodrefine
