@@ -203,4 +203,15 @@ void decode_pointwise_chunk(const std::vector<Item>& items, ByteReader& in, std:
 void decode_layered_chunk(const std::vector<Item>& items, ByteReader& in, std::uint64_t n, unsigned char* record,
                           std::uint64_t& done, const RecordSink& on_record);
 
+// Their shared loop, over a chunk class with a constructor (items, in) and decode(record).
+template <class Chunk>
+void decode_points(const std::vector<Item>& items, ByteReader& in, std::uint64_t n, unsigned char* record,
+                   std::uint64_t& done, const RecordSink& on_record) {
+  Chunk chunk(items, in);
+  for (std::uint64_t k = 0; k < n; ++k, ++done) {
+    chunk.decode(record);
+    on_record(record);
+  }
+}
+
 }  // namespace lodrefine::laz

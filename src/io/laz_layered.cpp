@@ -325,11 +325,7 @@ class LayeredChunk {
 
 void decode_layered_chunk(const std::vector<Item>& items, ByteReader& in, std::uint64_t n, unsigned char* record,
                           std::uint64_t& done, const RecordSink& on_record) {
-  LayeredChunk chunk(items, in);
-  for (std::uint64_t k = 0; k < n; ++k, ++done) {
-    chunk.decode(record);
-    on_record(record);
-  }
+  decode_points<LayeredChunk>(items, in, n, record, done, on_record);
 }
 
 }  // namespace lodrefine::laz

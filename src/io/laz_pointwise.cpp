@@ -157,11 +157,7 @@ class PointwiseChunk {
 
 void decode_pointwise_chunk(const std::vector<Item>& items, ByteReader& in, std::uint64_t n, unsigned char* record,
                             std::uint64_t& done, const RecordSink& on_record) {
-  PointwiseChunk chunk(items, in);
-  for (std::uint64_t k = 0; k < n; ++k, ++done) {
-    chunk.decode(record);
-    on_record(record);
-  }
+  decode_points<PointwiseChunk>(items, in, n, record, done, on_record);
 }
 
 }  // namespace lodrefine::laz
