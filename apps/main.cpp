@@ -5,6 +5,7 @@
 
 #include "commands.h"
 #include "lodrefine/core/types.h"
+#include "lodrefine/version.h"
 
 namespace lodrefine::app {
 int& exit_code() {
@@ -17,7 +18,7 @@ int main(int argc, char** argv) {
   using namespace lodrefine;
   CLI::App app{"lodrefine: refine coarse LoD2 building models with mobile laser scanning point clouds"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "lodrefine 0.1.0");
+  app.set_version_flag("--version", "lodrefine " LODREFINE_VERSION);
   app::add_refine_command(app);
   app::add_synth_command(app);
   app::add_eval_command(app);

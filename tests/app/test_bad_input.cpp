@@ -263,7 +263,7 @@ struct Case {
   std::string name;       // the table's "input" column
   std::function<void(Paths&)> make;
   Expect expect;
-  std::string fragment;   // must appear in the error line (Error) or the report's reason (Kept*), if set
+  std::string fragment = {};  // must appear in the error line (Error) or the report's reason (Kept*), if set
   double max_seconds = 300;
 };
 
@@ -640,8 +640,9 @@ TEST_P(BadInput, Contract) {
     EXPECT_FALSE(fs::exists(out) && fs::is_regular_file(out)) << "a failed run left an output file";
     add_row(k.name, first_line(r.err), r.exit);
     EXPECT_TRUE(k.expect == Expect::Error || k.expect == Expect::ErrorOrValid) << "refused, expected success";
-    if (k.expect == Expect::Error && !k.fragment.empty())
+    if (k.expect == Expect::Error && !k.fragment.empty()) {
       EXPECT_NE(r.err.find(k.fragment), std::string::npos) << "message should mention '" << k.fragment << "'";
+    }
     return;
   }
 
@@ -657,7 +658,7 @@ TEST_P(BadInput, Contract) {
     EXPECT_TRUE(k.expect == Expect::KeptInvalid || k.expect == Expect::ErrorOrValid) << outcome << ": " << reason;
     EXPECT_EQ(outcome, "kept-invalid");
     EXPECT_FALSE(reason.empty());
-    if (!k.fragment.empty()) EXPECT_NE(reason.find(k.fragment), std::string::npos) << reason;
+    if (!k.fragment.empty()) { EXPECT_NE(reason.find(k.fragment), std::string::npos) << reason; }
     EXPECT_EQ(read_obj(out).faces.size(), read_obj(p.model).faces.size()) << "kept-invalid is the input as read";
     return;
   }
@@ -679,7 +680,7 @@ TEST_P(BadInput, Contract) {
   if (k.expect == Expect::Kept) {
     EXPECT_EQ(outcome, "kept") << reason;
     EXPECT_FALSE(report.value("refined", true));
-    if (!k.fragment.empty()) EXPECT_NE(reason.find(k.fragment), std::string::npos) << reason;
+    if (!k.fragment.empty()) { EXPECT_NE(reason.find(k.fragment), std::string::npos) << reason; }
   }
 }
 

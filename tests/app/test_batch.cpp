@@ -186,7 +186,7 @@ TEST_F(Batch, TileTableWorstFirstWithOutcomesAndMovedFacades) {
     if (outcome == "refined")
       for (const auto& f : report["facades"]) ++moved, max_move = std::max(max_move, std::abs(f["max_move"].get<double>()));
     EXPECT_EQ(row["facades_moved"]["count"], moved) << id;
-    if (moved) EXPECT_NEAR(row["facades_moved"]["max"].get<double>(), max_move, 1e-9) << id;
+    if (moved) { EXPECT_NEAR(row["facades_moved"]["max"].get<double>(), max_move, 1e-9) << id; }
     for (const auto& f : row["facades_moved"]["facades"]) EXPECT_FALSE(f["surface"].is_null()) << id;
     EXPECT_GT(row["refine_seconds"].get<double>(), 0.0);
     moved_total += moved;
@@ -344,12 +344,13 @@ TEST(BatchIds, UnsafeFolderNamesAreRefusedBeforeAnythingRuns) {
     const std::string message = read_text(err);
     EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
     EXPECT_NE(message.find("is not a safe name"), std::string::npos) << message;
-    if (shell("command -v parallel > /dev/null") == 0)
+    if (shell("command -v parallel > /dev/null") == 0) {
       EXPECT_NE(shell("cd " + shell_quoted(base) + " && LODREFINE=" + shell_quoted(kBinary) + " HOME=" + shell_quoted(base) +
                       " " + shell_quoted(kSource / "scripts" / "parallel_batch.sh") + " " + shell_quoted(run) +
                       " --sshlogin : > /dev/null 2>&1"),
                 0)
           << name;
+    }
     EXPECT_EQ(shell("cd " + shell_quoted(base) + " && " + shell_quoted(kSource / "scripts" / "refine_one.sh") + " " +
                     shell_quoted(run) + " " + shell_quoted(name) + " 2> /dev/null"),
               2)

@@ -446,7 +446,7 @@ TEST(RealData, RotterdamCorrectTerracedHouseBesideAMisplacedOne) {
     return poly;
   };
   int ia = -1, ib = -1;
-  Vec3 shared;
+  Vec3 shared = Vec3::Zero();  // set with ia, ib below
   for (int i = 0; i < int(ms.size()) && ia < 0; ++i) {
     const auto pa = wall_of(ms[i]);
     const Plane pla = polygon_plane(pa);

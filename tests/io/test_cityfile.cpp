@@ -175,7 +175,7 @@ void check_city_output(const json& in, const std::string& out_path, const CityRe
     EXPECT_GE(grounds, 1) << b.mesh.id;
   }
   const std::string verdict = schema_verdict(out_path);
-  if (!verdict.empty()) EXPECT_EQ(verdict, "valid");
+  if (!verdict.empty()) { EXPECT_EQ(verdict, "valid"); }
   std::printf("  %s: %d building(s): %d refined, %d kept, %d kept-invalid, %d untouched; schema: %s\n", out_path.c_str(),
               s.buildings, s.refined, s.kept, s.kept_invalid, s.untouched,
               verdict.empty() ? "not checked (validator or schemas absent)" : verdict.c_str());
@@ -214,7 +214,7 @@ TEST(CityFile, GeneratedCityRefinedIntoCityJson2) {
   EXPECT_GE(s.refined, 2);
   EXPECT_EQ(s.cloud_points, cloud.points.size());
   for (const auto& o : s.outcomes)
-    if (o.outcome == "refined") EXPECT_GE(o.facades_moved, 1) << o.id;
+    if (o.outcome == "refined") { EXPECT_GE(o.facades_moved, 1) << o.id; }
   check_city_output(in, dir + "/out.city.json", s);
   // The refined LoD 2.2 geometry replaced in place; the LoD 1 geometry before it kept.
   const json out = load(dir + "/out.city.json");
@@ -361,7 +361,7 @@ TEST(CityFile, RotterdamDelfshaven) {
   CityRefineSummary s;
   s.buildings = rep["buildings"], s.refined = rep["refined"], s.kept = rep["kept"];
   s.kept_invalid = rep["kept_invalid"], s.untouched = rep["untouched"];
-  for (const auto& o : rep["outcomes"]) s.outcomes.push_back({o["id"], o["outcome"], o["reason"], o["facades_moved"]});
+  for (const auto& o : rep["outcomes"]) s.outcomes.push_back({o["id"], o["outcome"], o["reason"], o["facades_moved"], {}});
   EXPECT_EQ(s.buildings, 853);
   EXPECT_GE(s.refined, 1);
   check_city_output(load(path.string()), dir + "/rotterdam.city.json", s);
@@ -427,14 +427,14 @@ TEST(CityFile, CityJsonSeqStreamedThrough) {
   ASSERT_EQ(back.buildings.size(), 3u);
   for (const auto& o : s.outcomes)
     for (const auto& b : back.buildings)
-      if (b.mesh.id == o.id && o.outcome == "refined") EXPECT_EQ(geometry_problem(b.mesh), "") << b.mesh.id;
+      if (b.mesh.id == o.id && o.outcome == "refined") { EXPECT_EQ(geometry_problem(b.mesh), "") << b.mesh.id; }
   const fs::path schemas = shared_dir() / "schemas" / "cityjson-2.0.2";
   if (fs::exists(schemas) && fs::exists("/usr/bin/python3")) {
     const int st = std::system(("/usr/bin/python3 " + std::string(LODREFINE_SOURCE_DIR) + "/scripts/validate_cityjson.py " +
                                 schemas.string() + " " + dir + "/out.city.jsonl --seq >" + dir + "/v.txt 2>&1").c_str());
     std::ifstream v(dir + "/v.txt");
     const std::string verdict((std::istreambuf_iterator<char>(v)), {});
-    if (!(WIFEXITED(st) && WEXITSTATUS(st) == 2)) EXPECT_EQ(verdict, "valid\n");
+    if (!(WIFEXITED(st) && WEXITSTATUS(st) == 2)) { EXPECT_EQ(verdict, "valid\n"); }
   }
 }
 
@@ -459,7 +459,7 @@ TEST(CityFile, CityJson1xUpgradedTo2) {
   EXPECT_EQ(out["metadata"]["pointOfContact"]["address"]["addressLine"], "Julianalaan 134, Delft");
   for (const auto& [id, obj] : out["CityObjects"].items()) EXPECT_EQ(obj["geometry"][1]["lod"], "2.2") << id;
   const std::string verdict = schema_verdict(dir + "/out.city.json");
-  if (!verdict.empty()) EXPECT_EQ(verdict, "valid");
+  if (!verdict.empty()) { EXPECT_EQ(verdict, "valid"); }
 }
 
 TEST(CityFile, LodPicksTheGeometryToRefine) {

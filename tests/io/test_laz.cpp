@@ -263,7 +263,7 @@ TEST(Laz, EveryTruncationAndByteFlipIsOneLineOrTheSamePoints) {
       try {
         const LasHeader h = read_las_header(path);
         const std::string got = records(path);
-        if (truncated) EXPECT_EQ(got, want) << seed << ": truncated at " << bytes.size();
+        if (truncated) { EXPECT_EQ(got, want) << seed << ": truncated at " << bytes.size(); }
         EXPECT_EQ(got.size(), h.point_count * h.record_length);
       } catch (const InputError& e) {
         const std::string msg = e.what();

@@ -126,9 +126,9 @@ TEST_P(SynthAll, TruthIsClosedPlanarOutwardAndGeoreferenced) {
       walls += f.sem == Semantic::Wall;
       roofs += f.sem == Semantic::Roof;
       grounds += f.sem == Semantic::Ground;
-      if (f.sem == Semantic::Wall) EXPECT_LT(std::abs(n.z()), 1e-6);
-      if (f.sem == Semantic::Roof) EXPECT_GT(n.z(), 0.3);
-      if (f.sem == Semantic::Ground) EXPECT_LT(n.z(), -1 + 1e-9);
+      if (f.sem == Semantic::Wall) { EXPECT_LT(std::abs(n.z()), 1e-6); }
+      if (f.sem == Semantic::Roof) { EXPECT_GT(n.z(), 0.3); }
+      if (f.sem == Semantic::Ground) { EXPECT_LT(n.z(), -1 + 1e-9); }
     }
     EXPECT_GE(walls, 3);
     EXPECT_GE(roofs, 1);

@@ -1,0 +1,217 @@
+// Internal to the io library's LAZ decoder (laz.h): the item types, the field decoders both
+// compressors share (the x/y medians, GPS time, RGB) and the two chunk decoders: laz_pointwise.cpp
+// (compressor 2, point formats 0-3) and laz_layered.cpp (compressor 3, formats 6-8). GPS time
+// bits and coordinates are unsigned where the format wraps, so no input overflows a signed value.
+#pragma once
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "laz.h"
+#include "laz_coder.h"
+
+namespace lodrefine::laz {
+
+// Item types of the LASzip VLR.
+enum ItemType : std::uint16_t {
+  kByte = 0, kPoint10 = 6, kGpsTime11 = 7, kRgb12 = 8, kWavePacket13 = 9,
+  kPoint14 = 10, kRgb14 = 11, kRgbNir14 = 12, kWavePacket14 = 13, kByte14 = 14
+};
+
+// Median of the last five values, kept sorted with LASzip's insertion rule.
+class Median5 {
+ public:
+  std::int32_t get() const { return v_[2]; }
+  void add(std::int32_t x) {
+    if (high_) {
+      if (x < v_[2]) {
+        v_[4] = v_[3], v_[3] = v_[2];
+        if (x < v_[0]) v_[2] = v_[1], v_[1] = v_[0], v_[0] = x;
+        else if (x < v_[1]) v_[2] = v_[1], v_[1] = x;
+        else v_[2] = x;
+      } else {
+        if (x < v_[3]) v_[4] = v_[3], v_[3] = x;
+        else v_[4] = x;
+        high_ = false;
+      }
+    } else {
+      if (v_[2] < x) {
+        v_[0] = v_[1], v_[1] = v_[2];
+        if (v_[4] < x) v_[2] = v_[3], v_[3] = v_[4], v_[4] = x;
+        else if (v_[3] < x) v_[2] = v_[3], v_[3] = x;
+        else v_[2] = x;
+      } else {
+        if (v_[1] < x) v_[0] = v_[1], v_[1] = x;
+        else v_[0] = x;
+        high_ = true;
+      }
+    }
+  }
+
+ private:
+  std::array<std::int32_t, 5> v_{};
+  bool high_ = true;
+};
+
+// GPSTIME11 v2 and the GPS time of POINT14 v3: the double's bits as an integer, predicted
+// from up to four interleaved time sequences by a multiple of their last difference. v3 codes
+// "unchanged" outside (a flag of the point), so its codes from "unchanged" on are one lower.
+class GpsTimeDecoder {
+ public:
+  explicit GpsTimeDecoder(bool v3 = false)
+      : v3_(v3), multi_(v3 ? kMultiTotal - 1 : kMultiTotal), zero_diff_(v3 ? 5 : 6) {}
+  void first(ByteReader& in, unsigned char* out) {
+    in.bytes(out, 8);
+    time_[0] = get_u64(out);
+  }
+  void next(ArithmeticDecoder& dec, unsigned char* out) {
+    // A switch to another sequence is followed by that sequence's own code: a loop, as the
+    // switches could otherwise nest as deep as a corrupt stream likes.
+    while (!decode_one(dec)) {
+    }
+    for (int i = 0; i < 8; ++i) out[i] = (unsigned char)(time_[last_] >> (8 * i));
+  }
+  std::uint64_t last() const { return time_[last_]; }
+  void seed(std::uint64_t t) { time_[0] = t; }
+
+ private:
+  static constexpr int kMulti = 500, kMultiMinus = -10, kMultiUnchanged = kMulti - kMultiMinus + 1,
+                       kMultiCodeFull = kMulti - kMultiMinus + 2, kMultiTotal = kMulti - kMultiMinus + 6;
+
+  // Decodes one code; false when it only switched to another sequence.
+  bool decode_one(ArithmeticDecoder& dec) {
+    if (diff_[last_] == 0) {
+      const std::uint32_t multi = dec.symbol(zero_diff_) + (v3_ ? 1 : 0);
+      if (multi == 1) {
+        diff_[last_] = ic_.decode(dec, 0, 0);
+        time_[last_] += std::uint64_t(std::int64_t(diff_[last_]));
+        extreme_[last_] = 0;
+      } else if (multi == 2) {
+        start_full_sequence(dec);
+      } else if (multi > 2) {
+        last_ = (last_ + multi - 2) & 3;
+        return false;
+      }
+      return true;
+    }
+    int multi = int(dec.symbol(multi_));
+    if (v3_ && multi >= kMultiUnchanged) ++multi;
+    if (multi == 1) {
+      time_[last_] += std::uint64_t(std::int64_t(ic_.decode(dec, diff_[last_], 1)));
+      extreme_[last_] = 0;
+    } else if (multi < kMultiUnchanged) {
+      std::int32_t diff;
+      if (multi == 0) {
+        diff = ic_.decode(dec, 0, 7);
+        count_extreme(diff);
+      } else if (multi < kMulti) {
+        diff = ic_.decode(dec, times(multi, diff_[last_]), multi < 10 ? 2 : 3);
+      } else if (multi == kMulti) {
+        diff = ic_.decode(dec, times(kMulti, diff_[last_]), 4);
+        count_extreme(diff);
+      } else {
+        const int minus = kMulti - multi;
+        if (minus > kMultiMinus) {
+          diff = ic_.decode(dec, times(minus, diff_[last_]), 5);
+        } else {
+          diff = ic_.decode(dec, times(kMultiMinus, diff_[last_]), 6);
+          count_extreme(diff);
+        }
+      }
+      time_[last_] += std::uint64_t(std::int64_t(diff));
+    } else if (multi == kMultiCodeFull) {
+      start_full_sequence(dec);
+    } else if (multi > kMultiCodeFull) {
+      last_ = (last_ + std::uint32_t(multi - kMultiCodeFull)) & 3;
+      return false;
+    }
+    return true;
+  }
+  static std::int32_t times(int a, std::int32_t b) { return std::int32_t(std::uint32_t(a) * std::uint32_t(b)); }
+  void count_extreme(std::int32_t diff) {
+    if (++extreme_[last_] > 3) diff_[last_] = diff, extreme_[last_] = 0;
+  }
+  void start_full_sequence(ArithmeticDecoder& dec) {
+    next_ = (next_ + 1) & 3;
+    const std::int32_t high = ic_.decode(dec, std::int32_t(std::uint32_t(time_[last_] >> 32)), 8);
+    time_[next_] = std::uint64_t(std::uint32_t(high)) << 32 | dec.u32();
+    last_ = next_;
+    diff_[last_] = 0;
+    extreme_[last_] = 0;
+  }
+
+  bool v3_;
+  std::array<std::uint64_t, 4> time_{};
+  std::array<std::int32_t, 4> diff_{}, extreme_{};
+  std::uint32_t last_ = 0, next_ = 0;
+  SymbolModel multi_, zero_diff_;
+  IntegerDecoder ic_{32, 9};
+};
+
+// The colour models of RGB12 v2 and RGB14 v3 (one set per scanner channel there).
+struct RgbModels {
+  SymbolModel byte_used{128};
+  std::array<SymbolModel, 6> diff{SymbolModel(256), SymbolModel(256), SymbolModel(256),
+                                  SymbolModel(256), SymbolModel(256), SymbolModel(256)};
+};
+
+// One colour: which bytes changed (bit 6: green and blue differ from red), then each changed
+// byte as a correction of a prediction from red's change.
+inline std::array<std::uint32_t, 3> decode_rgb(ArithmeticDecoder& dec, RgbModels& m, const std::array<std::uint32_t, 3>& last) {
+  const std::uint32_t sym = dec.symbol(m.byte_used);
+  std::array<std::uint32_t, 3> c{};
+  const auto clamp8 = [](int v) { return std::uint32_t(std::clamp(v, 0, 255)); };
+  const auto low = [](std::uint32_t v) { return int(v & 0xff); };
+  const auto high = [](std::uint32_t v) { return int(v >> 8); };
+  c[0] = sym & 1 ? (dec.symbol(m.diff[0]) + last[0]) & 0xff : last[0] & 0xff;
+  c[0] |= sym & 2 ? ((dec.symbol(m.diff[1]) + (last[0] >> 8)) & 0xff) << 8 : last[0] & 0xff00;
+  if (!(sym & 64)) return {c[0], c[0], c[0]};
+  int diff = low(c[0]) - low(last[0]);
+  c[1] = sym & 4 ? (dec.symbol(m.diff[2]) + clamp8(diff + low(last[1]))) & 0xff : last[1] & 0xff;
+  if (sym & 16) {
+    const std::uint32_t corr = dec.symbol(m.diff[4]);
+    diff = (diff + low(c[1]) - low(last[1])) / 2;
+    c[2] = (corr + clamp8(diff + low(last[2]))) & 0xff;
+  } else {
+    c[2] = last[2] & 0xff;
+  }
+  diff = high(c[0]) - high(last[0]);
+  c[1] |= sym & 8 ? ((dec.symbol(m.diff[3]) + clamp8(diff + high(last[1]))) & 0xff) << 8 : last[1] & 0xff00;
+  if (sym & 32) {
+    const std::uint32_t corr = dec.symbol(m.diff[5]);
+    diff = (diff + high(c[1]) - high(last[1])) / 2;
+    c[2] |= ((corr + clamp8(diff + high(last[2]))) & 0xff) << 8;
+  } else {
+    c[2] |= last[2] & 0xff00;
+  }
+  return c;
+}
+
+inline std::array<std::uint32_t, 3> get_rgb(const unsigned char* p) { return {get_u16(p), get_u16(p + 2), get_u16(p + 4)}; }
+inline void put_rgb(unsigned char* p, const std::array<std::uint32_t, 3>& c) {
+  for (int i = 0; i < 3; ++i) put_u16(p + 2 * i, std::uint16_t(c[i]));
+}
+
+// The chunk decoders: decode the first `n` points of one chunk (its compressed bytes in `in`,
+// its items checked by read_layout) into `record` one at a time, call on_record after each and
+// count it in `done`. Throw OutOfData when the chunk's bytes end first.
+using RecordSink = std::function<void(const unsigned char*)>;
+void decode_pointwise_chunk(const std::vector<Item>& items, ByteReader& in, std::uint64_t n, unsigned char* record,
+                            std::uint64_t& done, const RecordSink& on_record);
+void decode_layered_chunk(const std::vector<Item>& items, ByteReader& in, std::uint64_t n, unsigned char* record,
+                          std::uint64_t& done, const RecordSink& on_record);
+
+// Their shared loop, over a chunk class with a constructor (items, in) and decode(record).
+template <class Chunk>
+void decode_points(const std::vector<Item>& items, ByteReader& in, std::uint64_t n, unsigned char* record,
+                   std::uint64_t& done, const RecordSink& on_record) {
+  Chunk chunk(items, in);
+  for (std::uint64_t k = 0; k < n; ++k, ++done) {
+    chunk.decode(record);
+    on_record(record);
+  }
+}
+
+}  // namespace lodrefine::laz

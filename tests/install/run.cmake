@@ -1,0 +1,30 @@
+# CTest `install`: installs the build tree into a fresh prefix, then configures, builds and runs
+# tests/install/consumer against it with find_package(lodrefine). Catches a package that no
+# longer installs a header, exports a target or finds a dependency.
+#   cmake -DBUILD=<build dir> -DSOURCE=<source dir> -DWORK=<scratch dir> -P tests/install/run.cmake
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+
+function(run what)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "install test: ${what} failed (${rc}):\n${out}\n${err}")
+  endif()
+  set(last_output "${out}" PARENT_SCOPE)
+endfunction()
+
+run("install" ${CMAKE_COMMAND} --install ${BUILD} --prefix ${WORK}/prefix)
+foreach(f include/lodrefine/version.h include/lodrefine/core/types.h include/lodrefine/io/obj.h
+          include/lodrefine/eval/eval.h lib/cmake/lodrefine/lodrefineConfig.cmake bin/lodrefine)
+  if(NOT EXISTS ${WORK}/prefix/${f})
+    message(FATAL_ERROR "install test: ${f} not installed")
+  endif()
+endforeach()
+if(EXISTS ${WORK}/prefix/include/lodrefine/synth)
+  message(FATAL_ERROR "install test: the synth headers are installed, their library is not")
+endif()
+run("configure the consumer" ${CMAKE_COMMAND} -S ${SOURCE}/tests/install/consumer -B ${WORK}/build
+    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${WORK}/prefix)
+run("build the consumer" ${CMAKE_COMMAND} --build ${WORK}/build)
+run("run the consumer" ${WORK}/build/consumer ${WORK}/box.obj)
+message(STATUS "${last_output}")
