@@ -7,9 +7,9 @@
 #include <cstdio>
 
 #include "commands.h"
-#include "lodrefine/eval/eval.h"
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/core/refine.h"
+#include "lodrefine/eval/eval.h"
 #include "lodrefine/synth/synth.h"
 #include "options.h"
 
@@ -61,8 +61,8 @@ void run(const BenchArgs& a) {
       PointCloud local_cloud = b.cloud;
       for (auto& p : local_cloud.points) p -= o;
       const Mesh truth = translated(b.truth, -o);
-      const BuildingEval ev = evaluate_building(translated(b.coarse, -o), translated(r.mesh, -o), local_cloud, &truth, a.params,
-                                                &b.scanned_truth_faces);
+      const BuildingEval ev = evaluate_building(translated(b.coarse, -o), translated(r.mesh, -o), local_cloud, &truth,
+                                                a.params, &b.scanned_truth_faces);
       const double f0 = ev.truth_facade_before ? ev.truth_facade_before->rmse : -1;
       const double f1 = ev.truth_facade_after ? ev.truth_facade_after->rmse : -1;
       if (ev.truth_facade_after) {
@@ -82,11 +82,11 @@ void run(const BenchArgs& a) {
     }
   struct rusage ru {};
   getrusage(RUSAGE_SELF, &ru);
-  std::printf("\n%d buildings, %d refined, %d valid+watertight; mean %.3f s per building; peak RSS %.0f MB\n", n, refined,
-              valid, n ? total_time / n : 0.0, ru.ru_maxrss / 1024.0);
+  std::printf("\n%d buildings, %d refined, %d valid+watertight; mean %.3f s per building; peak RSS %.0f MB\n", n,
+              refined, valid, n ? total_time / n : 0.0, ru.ru_maxrss / 1024.0);
   if (n_after)
-    std::printf("truth scanned-facade RMSE: before %.4f m, after %.4f m (%zu samples)\n", std::sqrt(sum_sq_before / n_after),
-                std::sqrt(sum_sq_after / n_after), n_after);
+    std::printf("truth scanned-facade RMSE: before %.4f m, after %.4f m (%zu samples)\n",
+                std::sqrt(sum_sq_before / n_after), std::sqrt(sum_sq_after / n_after), n_after);
 }
 
 }  // namespace
@@ -98,7 +98,8 @@ void add_bench_command(CLI::App& app) {
   add_ranged_option(cmd, "--count", args.count, "Buildings per type", 1, 100000);
   cmd->add_option("--first-seed", args.seed, "First building seed (the RANSAC seed is --seed)")->capture_default_str();
   add_ranged_option(cmd, "--points", args.points, "Target facade points per building", 100, 10000000);
-  add_ranged_option(cmd, "--facades", args.facades, "Scanned facades per building (0: random 1..3, as in the generator)", 0, 20);
+  add_ranged_option(cmd, "--facades", args.facades,
+                    "Scanned facades per building (0: random 1..3, as in the generator)", 0, 20);
   add_param_options(cmd, args.params);
   cmd->callback([] { run(args); });
 }

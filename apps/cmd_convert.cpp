@@ -32,7 +32,8 @@ std::vector<fs::path> output_paths(const std::vector<const CityJsonBuilding*>& c
       throw InputError(out.back().string() + ": would overwrite the input file; give another --out-dir");
     std::error_code ec;
     if (fs::exists(fs::symlink_status(out.back(), ec)))
-      throw InputError(out.back().string() + ": already exists (convert never overwrites); give an empty or new --out-dir");
+      throw InputError(out.back().string() +
+                       ": already exists (convert never overwrites); give an empty or new --out-dir");
   }
   return out;
 }
@@ -63,11 +64,13 @@ void run(const ConvertArgs& a) {
   for (const auto& b : file.buildings)
     if (wanted.empty() || wanted.count(b.mesh.id)) chosen.push_back(&b), found.insert(b.mesh.id);
   for (const auto& id : wanted)
-    if (!found.count(id)) throw InputError(path + ": no Building/BuildingPart " + shown_id(id) + " with an LoD 2.x geometry");
+    if (!found.count(id))
+      throw InputError(path + ": no Building/BuildingPart " + shown_id(id) + " with an LoD 2.x geometry");
   if (chosen.empty())
     throw InputError(path + ": no Building/BuildingPart with " +
                      (a.lod.empty() ? std::string("an LoD 2.x") : "an LoD " + a.lod) + " geometry (" +
-                     std::to_string(file.objects_without_lod2) + " building object(s) without one); nothing to convert");
+                     std::to_string(file.objects_without_lod2) +
+                     " building object(s) without one); nothing to convert");
   const std::vector<fs::path> paths = output_paths(chosen, a, path);
   write_all(chosen, paths, a);
   // Every building by name: the ones written (file <- id), then what the reader dropped or changed.
@@ -75,8 +78,8 @@ void run(const ConvertArgs& a) {
     std::printf("%s <- %s\n", paths[i].filename().string().c_str(), shown_id(chosen[i]->mesh.id).c_str());
   for (const auto& note : file.notes) std::fprintf(stderr, "lodrefine: note: %s: %s\n", path.c_str(), note.c_str());
   for (const auto& id : file.ids_without_lod2)
-    std::fprintf(stderr, "lodrefine: note: %s: %s has no LoD %s geometry, skipped\n", path.c_str(), shown_id(id).c_str(),
-                 a.lod.empty() ? "2.x" : a.lod.c_str());
+    std::fprintf(stderr, "lodrefine: note: %s: %s has no LoD %s geometry, skipped\n", path.c_str(),
+                 shown_id(id).c_str(), a.lod.empty() ? "2.x" : a.lod.c_str());
   std::printf("%zu building(s) written to %s (%s %s%s, %s; %d object(s) without LoD %s skipped)\n", chosen.size(),
               a.out_dir.c_str(), file.format.c_str(), file.version.c_str(), file.sequence ? " sequence" : "",
               file.crs.empty() ? "no CRS" : file.crs.c_str(), file.objects_without_lod2,
@@ -87,7 +90,8 @@ void run(const ConvertArgs& a) {
 
 void add_convert_command(CLI::App& app) {
   static ConvertArgs args;
-  auto* cmd = app.add_subcommand("convert", "Write each LoD2 building of a CityJSON (Seq) or CityGML file as its own OBJ");
+  auto* cmd =
+      app.add_subcommand("convert", "Write each LoD2 building of a CityJSON (Seq) or CityGML file as its own OBJ");
   auto* json_in = cmd->add_option("--cityjson", args.cityjson, "CityJSON 1.0/1.1/2.0 file or CityJSONSeq (.jsonl)")
                       ->check(CLI::ExistingFile);
   cmd->add_option("--citygml", args.citygml, "CityGML 1.0/2.0 file (Building, BuildingPart)")
@@ -95,7 +99,11 @@ void add_convert_command(CLI::App& app) {
       ->excludes(json_in);
   cmd->add_option("--lod", args.lod, "The LoD geometry to write, e.g. 2.2 or 1.2 (default: the highest 2.x)");
   cmd->add_option("--id", args.ids, "Only these CityObject ids (repeatable; default: every building)");
-  cmd->add_option("--out-dir", args.out_dir, "Directory for <name>.obj (created if missing; existing files are never overwritten). <name> is the id when it is a safe file name ([A-Za-z0-9._-], at most 100 bytes), else a safe form with a hash; the id stays inside the file")->required();
+  cmd->add_option("--out-dir", args.out_dir,
+                  "Directory for <name>.obj (created if missing; existing files are never overwritten). <name> is the "
+                  "id when it is a safe file name ([A-Za-z0-9._-], at most 100 bytes), else a safe form with a hash; "
+                  "the id stays inside the file")
+      ->required();
   cmd->callback([] { run(args); });
 }
 

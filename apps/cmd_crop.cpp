@@ -2,9 +2,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <tuple>
-#include <memory>
 
 #include "commands.h"
 #include "lodrefine/io/crop.h"
@@ -42,11 +42,13 @@ struct Model {
 std::vector<Model> find_models(const fs::path& dir) {
   std::vector<Model> found;
   for (const auto& e : fs::directory_iterator(dir)) {
-    if (e.is_regular_file() && e.path().extension() == ".obj") found.push_back({e.path().stem().string(), e.path(), "", ""});
+    if (e.is_regular_file() && e.path().extension() == ".obj")
+      found.push_back({e.path().stem().string(), e.path(), "", ""});
     if (e.is_directory() && fs::exists(e.path() / "coarse.obj"))
       found.push_back({e.path().filename().string(), e.path() / "coarse.obj", "", ""});
   }
-  std::sort(found.begin(), found.end(), [](const Model& a, const Model& b) { return std::tie(a.id, a.path) < std::tie(b.id, b.path); });
+  std::sort(found.begin(), found.end(),
+            [](const Model& a, const Model& b) { return std::tie(a.id, a.path) < std::tie(b.id, b.path); });
   for (std::size_t i = 1; i < found.size(); ++i)
     if (found[i].id == found[i - 1].id)
       throw InputError(dir.string() + ": two models for building " + shown_id(found[i].id) + " (" +
@@ -61,7 +63,8 @@ void check_outputs(const std::vector<Model>& kept, const CropArgs& a) {
   for (const auto& m : kept)
     for (const char* name : {"cloud.ply", "coarse.obj"})
       if (same_file((fs::path(a.out) / m.folder / name).string(), a.tile))
-        throw InputError(a.tile + ": the tile would be overwritten by " + shown_id(m.id) + "'s " + name + "; give another --out");
+        throw InputError(a.tile + ": the tile would be overwritten by " + shown_id(m.id) + "'s " + name +
+                         "; give another --out");
 }
 
 // A building's coarse.obj in the run folder: the model's bytes, with a `# id:` line in front when
@@ -127,7 +130,8 @@ void run(const CropArgs& a) {
     std::unique_ptr<Progress> progress;  // made once the tile reads (its header count is the total)
     n = crop_tile_to_files(a.tile, targets, clouds, a.buffer_points, counts, a.cloud_options, [&](std::uint64_t read) {
       if (!progress)
-        progress = std::make_unique<Progress>("crop", "points", cloud_point_count(a.tile), Progress::mode_for_stderr(a.quiet));
+        progress =
+            std::make_unique<Progress>("crop", "points", cloud_point_count(a.tile), Progress::mode_for_stderr(a.quiet));
       progress->update(read);
     });
     if (progress) progress->update(n), progress->finish();
@@ -138,10 +142,8 @@ void run(const CropArgs& a) {
   }
   for (std::size_t i = 0; i < kept.size(); ++i) {
     const std::string& id = kept[i].own_id.empty() ? kept[i].id : kept[i].own_id;
-    if (kept[i].folder == id)
-      std::printf("%s: %zu points\n", kept[i].folder.c_str(), counts[i]);
-    else
-      std::printf("%s: %zu points (building %s)\n", kept[i].folder.c_str(), counts[i], shown_id(id).c_str());
+    if (kept[i].folder == id) std::printf("%s: %zu points\n", kept[i].folder.c_str(), counts[i]);
+    else std::printf("%s: %zu points (building %s)\n", kept[i].folder.c_str(), counts[i], shown_id(id).c_str());
   }
   std::printf("%zu tile points, %zu buildings cropped, %d skipped\n", n, targets.size(), skipped);
   if (skipped) exit_code() = 1;
@@ -154,10 +156,15 @@ void add_crop_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("crop", "Cut one cloud per building from a large PLY or LAS tile (streaming)");
   cmd->add_option("--tile", args.tile, "Large point cloud tile (PLY or LAS)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--models", args.models, "Folder of models: *.obj or <id>/coarse.obj")->required();
-  cmd->add_option("--out", args.out, "Run folder: writes <name>/cloud.ply and <name>/coarse.obj (<name>: the id when it is a safe folder name, else a safe form with a hash)")->required();
+  cmd->add_option("--out", args.out,
+                  "Run folder: writes <name>/cloud.ply and <name>/coarse.obj (<name>: the id when it is a safe folder "
+                  "name, else a safe form with a hash)")
+      ->required();
   add_ranged_option(cmd, "--expand", args.expand, "Relative box growth on each side", 0.0, 10.0);
   add_ranged_option(cmd, "--margin", args.margin, "Absolute box growth on each side (m)", 0.0, 1000.0);
-  add_ranged_option(cmd, "--buffer-points", args.buffer_points, "Points held in memory before spilling to disk (memory bound)", std::size_t(1), std::size_t(1) << 40);
+  add_ranged_option(cmd, "--buffer-points", args.buffer_points,
+                    "Points held in memory before spilling to disk (memory bound)", std::size_t(1),
+                    std::size_t(1) << 40);
   add_cloud_options(cmd, args.cloud_options);
   cmd->add_flag("--quiet", args.quiet, "No progress line on stderr");
   cmd->callback([] { run(args); });

@@ -17,14 +17,15 @@ void add_params_command(CLI::App& app) {
         std::printf("%s**%s**: %s\n\n| option | default | range | meaning |\n|---|---|---|---|\n",
                     &stage == &stage_table().front() ? "" : "\n", stage.name.c_str(), stage.summary.c_str());
       else
-        std::printf("%s%s: %s\n", &stage == &stage_table().front() ? "" : "\n", stage.name.c_str(), stage.summary.c_str());
+        std::printf("%s%s: %s\n", &stage == &stage_table().front() ? "" : "\n", stage.name.c_str(),
+                    stage.summary.c_str());
       for (const auto& p : param_table()) {
         if (p.stage != stage.name) continue;
         const std::string opt = option_name(p.name);
         if (markdown)
-          std::printf("| `%s` | %g | %g … %g | %s |\n", opt.c_str(), p.default_value, p.min, p.max, p.description.c_str());
-        else
-          std::printf("  %-28s %-8g %s\n", opt.c_str(), p.default_value, p.description.c_str());
+          std::printf("| `%s` | %g | %g … %g | %s |\n", opt.c_str(), p.default_value, p.min, p.max,
+                      p.description.c_str());
+        else std::printf("  %-28s %-8g %s\n", opt.c_str(), p.default_value, p.description.c_str());
       }
     }
   });

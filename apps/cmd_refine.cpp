@@ -2,19 +2,19 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <optional>
-#include <memory>
 
 #include "commands.h"
+#include "lodrefine/core/refine.h"
+#include "lodrefine/eval/review.h"
 #include "lodrefine/io/cityfile.h"
 #include "lodrefine/io/cloud.h"
-#include "lodrefine/io/obj.h"
 #include "lodrefine/io/files.h"
-#include "lodrefine/core/refine.h"
+#include "lodrefine/io/obj.h"
 #include "lodrefine/io/progress.h"
 #include "lodrefine/io/refine_report.h"
-#include "lodrefine/eval/review.h"
 #include "options.h"
 
 namespace lodrefine::app {
@@ -72,22 +72,24 @@ void write_review(const RefineArgs& a, const CityRefineSummary& s, ReviewCollect
   c.review.title = "lodrefine city refine: " + std::filesystem::path(a.model).filename().string() + " with " +
                    std::filesystem::path(a.cloud).filename().string();
   char line[512];
-  std::snprintf(line, sizeof line, "%s: %d building(s): %d refined, %d kept, %d kept-invalid, %d untouched (no cloud "
+  std::snprintf(line, sizeof line,
+                "%s: %d building(s): %d refined, %d kept, %d kept-invalid, %d untouched (no cloud "
                 "points)\ncloud: %llu points, %llu in building crops\ntime: read %.1f s, crop %.1f s, refine %.1f s, "
-                "write %.1f s\n", s.input_format.c_str(), s.buildings, s.refined, s.kept, s.kept_invalid, s.untouched,
-                (unsigned long long)s.cloud_points, (unsigned long long)s.cropped_points, s.seconds_read, s.seconds_crop,
-                s.seconds_refine, s.seconds_write);
+                "write %.1f s\n",
+                s.input_format.c_str(), s.buildings, s.refined, s.kept, s.kept_invalid, s.untouched,
+                (unsigned long long)s.cloud_points, (unsigned long long)s.cropped_points, s.seconds_read,
+                s.seconds_crop, s.seconds_refine, s.seconds_write);
   c.review.summary = line;
   write_file_atomic(a.html, city_review_html(c.review));
 }
-
 
 // Fails before any work when an output could not be written (so nothing is left half done):
 // its folder must exist and take a new file (a temporary is created and removed again).
 void check_output_dir(const std::string& path) {
   if (path.empty()) return;
   const std::filesystem::path dir = std::filesystem::absolute(path).parent_path();
-  if (!std::filesystem::is_directory(dir)) throw InputError(path + ": output directory " + dir.string() + " does not exist");
+  if (!std::filesystem::is_directory(dir))
+    throw InputError(path + ": output directory " + dir.string() + " does not exist");
   if (std::filesystem::is_directory(path)) throw InputError(path + ": is a directory");
   try {
     AtomicFile probe(path);
@@ -140,17 +142,33 @@ void run_city(const RefineArgs& a) {
   if (refine) refine->finish();
   if (!a.html.empty()) write_review(a, s, review);
   if (!a.report.empty()) {
-    nlohmann::json j = {{"model", a.model}, {"cloud", a.cloud}, {"written", a.out}, {"input", s.input_format},
-                        {"buildings", s.buildings}, {"refined", s.refined}, {"kept", s.kept},
-                        {"kept_invalid", s.kept_invalid}, {"untouched", s.untouched},
-                        {"objects_without_lod", s.objects_without_lod}, {"cloud_points", s.cloud_points},
-                        {"cropped_points", s.cropped_points}, {"refused", s.refused},
-                        {"seconds", {{"read", s.seconds_read}, {"crop", s.seconds_crop}, {"refine", s.seconds_refine},
-                                     {"write", s.seconds_write}}},
-                        {"params", params_json(a.params)}, {"outcomes", nlohmann::json::array()}};
+    nlohmann::json j = {{"model", a.model},
+                        {"cloud", a.cloud},
+                        {"written", a.out},
+                        {"input", s.input_format},
+                        {"buildings", s.buildings},
+                        {"refined", s.refined},
+                        {"kept", s.kept},
+                        {"kept_invalid", s.kept_invalid},
+                        {"untouched", s.untouched},
+                        {"objects_without_lod", s.objects_without_lod},
+                        {"cloud_points", s.cloud_points},
+                        {"cropped_points", s.cropped_points},
+                        {"refused", s.refused},
+                        {"seconds",
+                         {{"read", s.seconds_read},
+                          {"crop", s.seconds_crop},
+                          {"refine", s.seconds_refine},
+                          {"write", s.seconds_write}}},
+                        {"params", params_json(a.params)},
+                        {"outcomes", nlohmann::json::array()}};
     for (const auto& b : s.outcomes)
-      j["outcomes"].push_back({{"id", b.id}, {"outcome", b.outcome}, {"reason", b.reason},
-                               {"facades_moved", b.facades_moved}, {"refused_by", b.refused_by}, {"points", b.points},
+      j["outcomes"].push_back({{"id", b.id},
+                               {"outcome", b.outcome},
+                               {"reason", b.reason},
+                               {"facades_moved", b.facades_moved},
+                               {"refused_by", b.refused_by},
+                               {"points", b.points},
                                {"seconds", b.seconds}});
     write_file_atomic(a.report, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   }
@@ -160,13 +178,13 @@ void run_city(const RefineArgs& a) {
     refused += (refused.empty() ? "" : ", ") + check + " " + std::to_string(n);
     n_refused += n;
   }
-  std::printf("%s: %d building(s), %llu cloud points (%llu in building crops): %d refined, %d kept (never worse "
-              "refused %d%s), %d kept-invalid, %d untouched (no cloud points) -> %s (read %.1f s, crop %.1f s, "
-              "refine %.1f s, write %.1f s)\n",
-              s.input_format.c_str(), s.buildings, (unsigned long long)s.cloud_points,
-              (unsigned long long)s.cropped_points, s.refined, s.kept, n_refused,
-              refused.empty() ? "" : (": " + refused).c_str(), s.kept_invalid, s.untouched, a.out.c_str(),
-              s.seconds_read, s.seconds_crop, s.seconds_refine, s.seconds_write);
+  std::printf(
+      "%s: %d building(s), %llu cloud points (%llu in building crops): %d refined, %d kept (never worse "
+      "refused %d%s), %d kept-invalid, %d untouched (no cloud points) -> %s (read %.1f s, crop %.1f s, "
+      "refine %.1f s, write %.1f s)\n",
+      s.input_format.c_str(), s.buildings, (unsigned long long)s.cloud_points, (unsigned long long)s.cropped_points,
+      s.refined, s.kept, n_refused, refused.empty() ? "" : (": " + refused).c_str(), s.kept_invalid, s.untouched,
+      a.out.c_str(), s.seconds_read, s.seconds_crop, s.seconds_refine, s.seconds_write);
 }
 
 bool is_city_file(const std::string& path) {
@@ -186,9 +204,11 @@ void run(const RefineArgs& a) {
       throw InputError(a.out + ": a city file in gives a CityJSON city file out; name it e.g. refined.city.json");
     return run_city(a);
   }
-  if (!a.html.empty()) throw InputError(a.html + ": --html is the review page of a city refine (a city file as --model)");
+  if (!a.html.empty())
+    throw InputError(a.html + ": --html is the review page of a city refine (a city file as --model)");
   if (!a.building.empty() || !a.lod.empty())
-    throw InputError(a.model + ": --building and --lod pick buildings of a city file (CityJSON, CityGML), not of an OBJ");
+    throw InputError(a.model +
+                     ": --building and --lod pick buildings of a city file (CityJSON, CityGML), not of an OBJ");
   const Mesh model = read_obj(a.model);
   const std::uint64_t declared = cloud_point_count(a.cloud);
   if (declared > a.max_points)
@@ -223,19 +243,27 @@ void add_refine_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("refine", "Refine one building model with an MLS point cloud");
   cmd->add_option("--model", args.model,
                   "Coarse building model (OBJ, CityGML fan-out export), or a city file (CityJSON, CityJSONSeq, "
-                  "CityGML): then --out is a CityJSON 2.0 city file")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--cloud", args.cloud, "MLS point cloud crop around the building (PLY or LAS)")->required()->check(CLI::ExistingFile);
+                  "CityGML): then --out is a CityJSON 2.0 city file")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--cloud", args.cloud, "MLS point cloud crop around the building (PLY or LAS)")
+      ->required()
+      ->check(CLI::ExistingFile);
   cmd->add_option("--out", args.out, "Refined model (OBJ; CityJSON for a city file), written atomically")->required();
   cmd->add_option("--building", args.building, "City file: refine only this CityObject id");
   cmd->add_option("--lod", args.lod, "City file: the LoD geometry to refine, e.g. 2.2 (default: the highest 2.x)");
-  cmd->add_option("--html", args.html, "City file: write a review page (self-contained HTML, three.js embedded): "
-                                        "summary, the buildings the cloud reached, a district map, each refined "
-                                        "building in 3D over its scan");
-  add_ranged_option(cmd, "--jobs", args.jobs, "City file: buildings refined at once, one thread each (default: "
-                    "all cores; the output is the same whatever the number)", 1, 1024);
+  cmd->add_option("--html", args.html,
+                  "City file: write a review page (self-contained HTML, three.js embedded): "
+                  "summary, the buildings the cloud reached, a district map, each refined "
+                  "building in 3D over its scan");
+  add_ranged_option(cmd, "--jobs", args.jobs,
+                    "City file: buildings refined at once, one thread each (default: "
+                    "all cores; the output is the same whatever the number)",
+                    1, 1024);
   cmd->add_flag("--quiet", args.quiet, "City file: no progress line on stderr");
   cmd->add_option("--report", args.report, "JSON report: matches, planes, candidates, MIP, timings, validation");
-  cmd->add_option("--max-points", args.max_points, "Refuse clouds with more points (a tile, not a crop)")->capture_default_str();
+  cmd->add_option("--max-points", args.max_points, "Refuse clouds with more points (a tile, not a crop)")
+      ->capture_default_str();
   add_cloud_options(cmd, args.cloud_options);
   add_param_options(cmd, args.params);
   cmd->callback([] { run(args); });

@@ -70,19 +70,23 @@ void add_synth_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("synth",
                                  "Generate synthetic buildings with known truth: truth.obj, coarse.obj, "
                                  "cloud.ply, meta.json per building");
-  cmd->add_option("--type", a.type, "flat|gable|hip|shed|stepped|lshape|tshape|polygon|recess|bay|setback|all")->capture_default_str();
+  cmd->add_option("--type", a.type, "flat|gable|hip|shed|stepped|lshape|tshape|polygon|recess|bay|setback|all")
+      ->capture_default_str();
   cmd->add_option("--seed", a.seed, "first seed (seeds seed..seed+count-1)")->capture_default_str();
   add_ranged_option(cmd, "--count", a.count, "buildings per type", 1, 100000);
   cmd->add_option("--out", a.out, "output directory (one subdirectory per building)")->required();
-  cmd->add_option("--tile", a.tile, "city tile: --count buildings in all (types cycling) on a grid, their clouds "
-                                    "streamed into this one PLY instead of <id>/cloud.ply (cut with `lodrefine crop`)");
+  cmd->add_option("--tile", a.tile,
+                  "city tile: --count buildings in all (types cycling) on a grid, their clouds "
+                  "streamed into this one PLY instead of <id>/cloud.ply (cut with `lodrefine crop`)");
   add_ranged_option(cmd, "--grid", a.grid, "with --tile: grid spacing between buildings (m)", 10.0, 10000.0);
   auto& o = a.opt;
   add_ranged_option(cmd, "--shift-min", o.min_shift, "min facade offset (m)", 0.0, 3.0);
   add_ranged_option(cmd, "--shift-max", o.max_shift, "max facade offset (m)", 0.0, 3.0);
-  add_ranged_option(cmd, "--rotation-max", o.max_rotation_deg, "max facade rotation about a vertical axis (deg)", 0.0, 15.0);
+  add_ranged_option(cmd, "--rotation-max", o.max_rotation_deg, "max facade rotation about a vertical axis (deg)", 0.0,
+                    15.0);
   add_ranged_option(cmd, "--global-shift", o.global_shift, "max shift of the whole coarse model (m)", 0.0, 10.0);
-  add_ranged_option(cmd, "--facades", o.scanned_facades, "scanned facades (0: random 1..3; recess/bay/setback: the street walls)", 0, 20);
+  add_ranged_option(cmd, "--facades", o.scanned_facades,
+                    "scanned facades (0: random 1..3; recess/bay/setback: the street walls)", 0, 20);
   add_ranged_option(cmd, "--noise", o.noise, "MLS range noise sigma (m)", 0.0, 0.5);
   add_ranged_option(cmd, "--points", o.target_points, "points on the scanned facades before nuisances", 100, 10000000);
   cmd->add_option("--origin-x", o.origin.x(), "georeferenced origin x")->capture_default_str();

@@ -6,8 +6,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "lodrefine/io/cloud.h"
 #include "lodrefine/core/params.h"
+#include "lodrefine/io/cloud.h"
 
 namespace lodrefine::app {
 

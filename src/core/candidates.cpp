@@ -101,18 +101,28 @@ std::pair<WorkPolygon, WorkPolygon> split(const WorkPolygon& poly, int self, int
   for (int i = 0; i < n; ++i) {
     const int j = (i + 1) % n;
     // Vertex i belongs to the sides it lies on; the edge i->j keeps its line on each side.
-    if (d[i] <= 0) { lo.p.push_back(poly.p[i]); lo.line.push_back(poly.line[i]); }
-    if (d[i] >= 0) { hi.p.push_back(poly.p[i]); hi.line.push_back(poly.line[i]); }
+    if (d[i] <= 0) {
+      lo.p.push_back(poly.p[i]);
+      lo.line.push_back(poly.line[i]);
+    }
+    if (d[i] >= 0) {
+      hi.p.push_back(poly.p[i]);
+      hi.line.push_back(poly.line[i]);
+    }
     if ((d[i] < 0 && d[j] > 0) || (d[i] > 0 && d[j] < 0)) {
       const double t = d[i] / (d[i] - d[j]);
       const Vec3 x = bank.meet3(self, poly.line[i], cut, poly.p[i] + t * (poly.p[j] - poly.p[i]));
       // The piece that continues along edge i->j after x keeps line[i]; the cut edge is `cut`.
       if (d[i] < 0) {
-        lo.p.push_back(x); lo.line.push_back(cut);
-        hi.p.push_back(x); hi.line.push_back(poly.line[i]);
+        lo.p.push_back(x);
+        lo.line.push_back(cut);
+        hi.p.push_back(x);
+        hi.line.push_back(poly.line[i]);
       } else {
-        hi.p.push_back(x); hi.line.push_back(cut);
-        lo.p.push_back(x); lo.line.push_back(poly.line[i]);
+        hi.p.push_back(x);
+        hi.line.push_back(cut);
+        lo.p.push_back(x);
+        lo.line.push_back(poly.line[i]);
       }
     }
     if (d[i] == 0.0) {
@@ -219,7 +229,8 @@ void build_fans(CandidateSet& cs, const std::vector<std::vector<int>>& corners) 
     e.b = s.b;
     e.length = (cs.vertices[s.a] - cs.vertices[s.b]).norm();
     for (int bp = 0; bp < 6; ++bp)
-      if (std::abs(box[bp].distance(cs.vertices[s.a])) < kVertexWeld && std::abs(box[bp].distance(cs.vertices[s.b])) < kVertexWeld)
+      if (std::abs(box[bp].distance(cs.vertices[s.a])) < kVertexWeld &&
+          std::abs(box[bp].distance(cs.vertices[s.b])) < kVertexWeld)
         e.box_plane = bp;
     int first = s.order;
     for (; i < by_end.size() && sides[by_end[i]].a == s.a && sides[by_end[i]].b == s.b; ++i) {
@@ -285,7 +296,8 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
     for (std::size_t k = 0; k < v.size(); ++k) {
       const int a = v[k], b = v[(k + 1) % v.size()];
       out.push_back(a);
-      for (int x : vertices_on_segment(cs.vertices, a, b, SegmentRule{kVertexWeld, false, kEdgeEndShare})) out.push_back(x);
+      for (int x : vertices_on_segment(cs.vertices, a, b, SegmentRule{kVertexWeld, false, kEdgeEndShare}))
+        out.push_back(x);
     }
     v = out;
   }

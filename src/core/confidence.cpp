@@ -79,8 +79,8 @@ CloudView view_cloud(const Plane& cplane, const CloudInfo& ref, const Confidence
 
 double cloud_score(const std::vector<Vec3>& cand, const Plane& cplane, double carea, const CloudView& view) {
   if (!view.valid) return 0.0;
-  return std::min(1.0, polygon_convex_intersection_area(to_2d(cand, cplane, view.origin), view.hull) /
-                           std::max(kMinArea, carea));
+  return std::min(
+      1.0, polygon_convex_intersection_area(to_2d(cand, cplane, view.origin), view.hull) / std::max(kMinArea, carea));
 }
 
 }  // namespace

@@ -76,8 +76,8 @@ double side_of(const Mesh& mesh, const ModelSurface& wall, const Plane& facade) 
 // Whether points lie on the side wall's new plane `moved`, off the facade plane on the wall's
 // `side`, over the upper part of the facade's height [z0, z1] (ground and clutter below do not
 // count): the return the scanner saw where the facade turns the corner.
-bool shows_return(const PointCloud& cloud, const Plane& facade, const Plane& moved, double side, double z0,
-                  double z1, const PlaneConfig& prm) {
+bool shows_return(const PointCloud& cloud, const Plane& facade, const Plane& moved, double side, double z0, double z1,
+                  const PlaneConfig& prm) {
   const double on_plane = std::max(kCornerTolerance, kOffPlaneEpsilons * prm.ransac_epsilon);
   const double za = z0 + kLowBand * (z1 - z0);
   const double off = kOffPlaneEpsilons * prm.ransac_epsilon;
@@ -127,7 +127,7 @@ EndStrips end_strips(const PointCloud& cloud, const Plane& facade, const Vec3& o
     const bool past = t > kCornerTolerance && t <= kStrip, before = t < -kCornerTolerance && t >= -kStrip;
     if (!past && !before) continue;
     const double d = facade.distance(p);  // outwards: the street side
-    const bool in_front = d > kStreetNear && d < kStreetFar, high = p.z() > za && p.z() < z1;
+    const bool in_front = d > kStreetNear && d<kStreetFar, high = p.z()> za && p.z() < z1;
     if (in_front && p.z() < z0 + kGroundBand) ++(past ? e.street_past : e.street_before);
     if (in_front && high && past) ++e.front_past;
     if (std::abs(d) <= on_plane && high) ++(past ? e.facade_past : e.facade_before);
@@ -227,7 +227,8 @@ std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSu
       // or a neighbour's facade that runs on shows no return, and moves nothing.
       const Plane moved(as.plane.n, as.plane.d - as.plane.n.dot(s * gap * u));
       if (!shows_return(cloud, w.plane, moved, side_of(mesh, as, w.plane), z0, z1, detection) &&
-          !(facade_displaced && ends_in_the_open(end_strips(cloud, w.plane, o, u, s, end + s * u_mid, z0, z1, detection))))
+          !(facade_displaced &&
+            ends_in_the_open(end_strips(cloud, w.plane, o, u, s, end + s * u_mid, z0, z1, detection))))
         continue;
       // The same end in every height band that has points.
       double lo = 1e300, hi = -1e300;

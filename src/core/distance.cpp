@@ -54,8 +54,7 @@ Closest closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
   const double vb = d5 * d2 - d1 * d6;
   if (vb <= 0 && d2 >= 0 && d6 <= 0) return {a + ac * (d2 / (d2 - d6)), kPi};
   const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return {b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))), kPi};
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return {b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))), kPi};
   const double denom = 1.0 / (va + vb + vc);
   return {a + ab * (vb * denom) + ac * (vc * denom), 2 * kPi};
 }

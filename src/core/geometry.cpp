@@ -162,9 +162,8 @@ bool point_in_polygon_2d(const Vec2& p, const std::vector<Vec2>& poly) {
 }
 
 std::vector<Vec2> convex_hull_2d(std::vector<Vec2> pts) {
-  std::sort(pts.begin(), pts.end(), [](const Vec2& a, const Vec2& b) {
-    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
-  });
+  std::sort(pts.begin(), pts.end(),
+            [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
   pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
   if (pts.size() < 3) return pts;
   auto cross = [](const Vec2& o, const Vec2& a, const Vec2& b) {
@@ -248,7 +247,10 @@ std::vector<std::array<int, 3>> triangulate_polygon(const std::vector<Vec3>& pol
       if (cross(a, b, c) <= 1e-14) continue;
       bool ear = true;
       for (int q : idx)
-        if (q != a && q != b && q != c && inside(a, b, c, q)) { ear = false; break; }
+        if (q != a && q != b && q != c && inside(a, b, c, q)) {
+          ear = false;
+          break;
+        }
       if (!ear) continue;
       tris.push_back({a, b, c});
       idx.erase(idx.begin() + i);

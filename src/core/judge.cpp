@@ -87,7 +87,8 @@ struct Region {
       const Vec2 q(c.dot(u), c.dot(v));
       for (const auto& ring : outline) {
         bool in = point_in_polygon_2d(q, ring);
-        for (std::size_t k = 0; k < ring.size() && !in; ++k) in = segment_distance_2d(q, ring[k], ring[(k + 1) % ring.size()]) <= grow;
+        for (std::size_t k = 0; k < ring.size() && !in; ++k)
+          in = segment_distance_2d(q, ring[k], ring[(k + 1) % ring.size()]) <= grow;
         if (in) on[f] = 1;
       }
     }
@@ -116,8 +117,7 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
 }  // namespace
 
 Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vector<JudgedWall>& walls,
-                           const PointCloud& cloud, const MatchConfig& prm,
-                           const PlaneConfig& detection) {
+                           const PointCloud& cloud, const MatchConfig& prm, const PlaneConfig& detection) {
   Judgement j;
   const double cap = prm.match_distance, changed = detection.ransac_epsilon;
   std::vector<PointFit> points;
@@ -146,7 +146,8 @@ Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vec
     const Judgement::Fit& f = j.walls[k];
     std::string why;
     if (f.points < std::size_t(detection.ransac_min_points)) {
-      if (!walls[k].corner) why = "moved with " + std::to_string(f.points) + " scan points in front of it and no corner evidence";
+      if (!walls[k].corner)
+        why = "moved with " + std::to_string(f.points) + " scan points in front of it and no corner evidence";
     } else {
       why = worse_reason(f, kWallRmsSlack, false);
     }

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <map>
 
-
 namespace lodrefine {
 namespace {
 
@@ -26,8 +25,10 @@ constexpr double kMinWallArea = 1.0;
 struct Rect {
   double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
   void add(double u, double v) {
-    u0 = std::min(u0, u); u1 = std::max(u1, u);
-    v0 = std::min(v0, v); v1 = std::max(v1, v);
+    u0 = std::min(u0, u);
+    u1 = std::max(u1, u);
+    v0 = std::min(v0, v);
+    v1 = std::max(v1, v);
   }
   double area() const { return std::max(0.0, u1 - u0) * std::max(0.0, v1 - v0); }
 };
@@ -210,7 +211,8 @@ struct Owned {
 // setback or a flush neighbour then gives each wall only its own points, never those of a
 // parallel wall. Indexed like `walls`.
 std::vector<Owned> owned_points(const ScanPlane& sp, const std::vector<int>& cand, const std::vector<Wall>& walls,
-                                const std::vector<ModelSurface>& surfaces, const PointCloud& cloud, const MatchConfig& cfg) {
+                                const std::vector<ModelSurface>& surfaces, const PointCloud& cloud,
+                                const MatchConfig& cfg) {
   std::vector<Owned> owned(walls.size());
   for (int i : sp.inliers) {
     const Vec3& x = cloud.points[i];
@@ -254,11 +256,12 @@ void match_plane(int p, const ScanPlane& sp, const std::vector<Wall>& walls, con
     const double inter = overlap_area(model_box, o.box);
     const double uni = model_box.area() + o.box.area() - inter;
     const double iou = uni > 0 ? inter / uni : 0.0;
-    const double coverage = std::max({iou, inter / std::max(kMinArea, o.box.area()),
-                                      inter / std::max(kMinArea, model_box.area())});
+    const double coverage =
+        std::max({iou, inter / std::max(kMinArea, o.box.area()), inter / std::max(kMinArea, model_box.area())});
     if (coverage < cfg.match_min_overlap) {
-      result.rejected.push_back("scan plane " + std::to_string(p) + " / wall surface " + std::to_string(walls[k].surface) +
-                                ": its points cover too little of the wall (" + std::to_string(coverage) + ")");
+      result.rejected.push_back("scan plane " + std::to_string(p) + " / wall surface " +
+                                std::to_string(walls[k].surface) + ": its points cover too little of the wall (" +
+                                std::to_string(coverage) + ")");
       continue;
     }
     const double s_normal = sp.plane.n.dot(surf.plane.n);
@@ -290,8 +293,9 @@ std::vector<Match> facing_the_fitted_side(const std::vector<Match>& matches, con
     for (const auto& o : matches)
       if (o.scan_plane == m.scan_plane && o.d_centroid < ref->d_centroid) ref = &o;
     if (surfaces[m.surface].plane.n.dot(surfaces[ref->surface].plane.n) > 0) same_side.push_back(m);
-    else rejected.push_back("scan plane " + std::to_string(m.scan_plane) + " / wall surface " + std::to_string(m.surface) +
-                            ": faces away from the wall the plane fits best");
+    else
+      rejected.push_back("scan plane " + std::to_string(m.scan_plane) + " / wall surface " + std::to_string(m.surface) +
+                         ": faces away from the wall the plane fits best");
   }
   return same_side;
 }
@@ -310,7 +314,8 @@ std::vector<std::vector<char>> corner_conflicts(const std::vector<Match>& matche
       if (i == j || a.scan_plane == m.scan_plane) continue;
       if (unoriented_angle_deg(surfaces[a.surface].plane.n, surfaces[m.surface].plane.n) < kMinCornerAngleDeg) continue;
       if (!adjacent(mesh, surfaces[a.surface], surfaces[m.surface])) continue;
-      if (corner_gap(planes[m.scan_plane].plane, planes[a.scan_plane], cloud) > max_gap) conflict[i][j] = conflict[j][i] = 1;
+      if (corner_gap(planes[m.scan_plane].plane, planes[a.scan_plane], cloud) > max_gap)
+        conflict[i][j] = conflict[j][i] = 1;
     }
   return conflict;
 }
@@ -335,7 +340,8 @@ void drop_corner_conflicts(const std::vector<std::vector<char>>& conflict, Match
     if (worst < 0) break;
     alive[worst] = 0;
     result.rejected.push_back("scan plane " + std::to_string(result.matches[worst].scan_plane) + " / wall surface " +
-                              std::to_string(result.matches[worst].surface) + ": its corner with an adjacent scanned facade lies beyond that facade's points");
+                              std::to_string(result.matches[worst].surface) +
+                              ": its corner with an adjacent scanned facade lies beyond that facade's points");
   }
   std::vector<Match> kept;
   for (int i = 0; i < nm; ++i)

@@ -86,7 +86,8 @@ ScanPlane describe(const std::vector<Vec3>& all, std::vector<int> inliers, const
 
 // RANSAC's connectivity split one facade into pieces wherever a gap (a window column, an
 // occluding tree) is wider than the cluster epsilon: the pieces of one plane are one surface.
-std::vector<ScanPlane> merge_coplanar(std::vector<ScanPlane> planes, const std::vector<Vec3>& all, const PlaneConfig& prm) {
+std::vector<ScanPlane> merge_coplanar(std::vector<ScanPlane> planes, const std::vector<Vec3>& all,
+                                      const PlaneConfig& prm) {
   const double tol = kMergeEpsilons * prm.ransac_epsilon;
   auto mean_distance = [&](const ScanPlane& a, const Plane& b) {
     double s = 0.0;
@@ -98,7 +99,8 @@ std::vector<ScanPlane> merge_coplanar(std::vector<ScanPlane> planes, const std::
     for (std::size_t i = 0; i < planes.size() && !merged; ++i)
       for (std::size_t j = i + 1; j < planes.size() && !merged; ++j) {
         if (unoriented_angle_deg(planes[i].plane.n, planes[j].plane.n) > kMergeAngleDeg) continue;
-        if (mean_distance(planes[j], planes[i].plane) > tol || mean_distance(planes[i], planes[j].plane) > tol) continue;
+        if (mean_distance(planes[j], planes[i].plane) > tol || mean_distance(planes[i], planes[j].plane) > tol)
+          continue;
         std::vector<int> inl = planes[i].inliers;
         inl.insert(inl.end(), planes[j].inliers.begin(), planes[j].inliers.end());
         planes[i] = describe(all, std::move(inl), prm);
@@ -139,7 +141,8 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const PlaneConfig&
   auto key = [&](const Vec3& p) -> std::uint64_t {
     if (voxel <= 0) return 0;
     const Vec3 q = (p - lo) / voxel;
-    return (std::uint64_t(q.x()) << (2 * kVoxelKeyBits)) | (std::uint64_t(q.y()) << kVoxelKeyBits) | std::uint64_t(q.z());
+    return (std::uint64_t(q.x()) << (2 * kVoxelKeyBits)) | (std::uint64_t(q.y()) << kVoxelKeyBits) |
+           std::uint64_t(q.z());
   };
   std::vector<int> reps;  // indices into the cloud
   std::unordered_map<std::uint64_t, int> voxel_rep;
@@ -156,8 +159,8 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const PlaneConfig&
     const auto& p = cloud.points[i];
     pts.emplace_back(Point(p.x(), p.y(), p.z()), Vector(0, 0, 0), i);
   }
-  CGAL::pca_estimate_normals<CGAL::Sequential_tag>(
-      pts, prm.normal_neighbors, CGAL::parameters::point_map(PointMap()).normal_map(NormalMap()));
+  CGAL::pca_estimate_normals<CGAL::Sequential_tag>(pts, prm.normal_neighbors,
+                                                   CGAL::parameters::point_map(PointMap()).normal_map(NormalMap()));
 
   // Efficient RANSAC draws from CGAL's default generator: seed it for reproducible runs. The
   // generator is thread-local (CGAL_HAS_THREADS), so buildings refined at once do not share it.
@@ -168,8 +171,9 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const PlaneConfig&
   Ransac::Parameters rp;
   rp.probability = prm.ransac_probability;
   // min_points counts points of the full cloud: scaled to the voxel representatives.
-  rp.min_points = std::max<std::size_t>(std::size_t(prm.normal_neighbors) + 1,
-                                        std::size_t(double(prm.ransac_min_points) * double(reps.size()) / double(order.size())));
+  rp.min_points =
+      std::max<std::size_t>(std::size_t(prm.normal_neighbors) + 1,
+                            std::size_t(double(prm.ransac_min_points) * double(reps.size()) / double(order.size())));
   rp.epsilon = prm.ransac_epsilon;
   rp.cluster_epsilon = prm.ransac_cluster_epsilon;
   rp.normal_threshold = std::cos(radians(prm.ransac_normal_deg));
@@ -204,7 +208,8 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const PlaneConfig&
       const auto it = voxel_rep.find(key(cloud.points[i]));
       if (it == voxel_rep.end()) continue;
       const int sh = rep_shape[it->second];
-      if (sh >= 0 && std::abs(fitted[sh].distance(cloud.points[i])) <= prm.ransac_epsilon) shape_inliers[sh].push_back(i);
+      if (sh >= 0 && std::abs(fitted[sh].distance(cloud.points[i])) <= prm.ransac_epsilon)
+        shape_inliers[sh].push_back(i);
     }
   }
   for (auto& inl : shape_inliers) {

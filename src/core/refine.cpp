@@ -14,14 +14,12 @@
 namespace lodrefine {
 namespace {
 
-
 // m: local frames have their origin on this grid (the model's box minimum rounded down), so all
 // computation runs on coordinates of a few hundred metres and reports show a readable origin.
 constexpr double kOriginGrid = 100.0;
 // A wall's position for "tried already" in the fallback: its centroid's squared norm in 1/this m²
 // steps (the same wall re-found after another moved has the same position within rounding).
 constexpr double kPositionSteps = 100.0;
-
 
 // The cloud near the model, in its local frame (crops may carry whole streets): the model's
 // box grown by the matching distance and the arrangement's region margins.
@@ -36,8 +34,8 @@ PointCloud cloud_near(const Mesh& local_model, const PointCloud& cloud, const Ve
 }
 
 // A moved wall for the report, on the mesh (and its surfaces) the move was made on.
-RefineTrace::FacadeMove describe_move(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
-                                      const WallMove& move, const char* evidence) {
+RefineTrace::FacadeMove describe_move(const Mesh& mesh, const std::vector<ModelSurface>& surfaces, const WallMove& move,
+                                      const char* evidence) {
   const ModelSurface& s = surfaces[move.surface];
   double mean = 0.0, n = 0.0;
   for (int f : s.faces)
@@ -91,7 +89,9 @@ std::optional<Mesh> one_wall_at_a_time(const Mesh& start, const PointCloud& loca
   Mesh step_mesh = start;
   bool any = false;
   std::set<std::pair<int, long long>> tried;  // (scan plane, rounded wall position)
-  auto position = [](const ModelSurface& s) { return (long long)std::llround(s.centroid.squaredNorm() * kPositionSteps); };
+  auto position = [](const ModelSurface& s) {
+    return (long long)std::llround(s.centroid.squaredNorm() * kPositionSteps);
+  };
   for (int iter = 0; iter < max_steps; ++iter) {
     const auto ss = model_surfaces(step_mesh);
     const MatchResult mi = match_surfaces(step_mesh, ss, local, planes, prm);
@@ -183,7 +183,8 @@ std::optional<RefineResult> repair_or_stop(const Mesh& local_model, const Repair
   run.trace().input_validation = v0;
   run.lap("repair");
   if (!v0.valid() && v0.components > 1 && validate_mesh(kept, cfg.planarity_tolerance, true, false).valid())
-    return run.finish(Outcome::Kept, std::to_string(v0.components) + " separate closed shells: kept whole", kept, false);
+    return run.finish(Outcome::Kept, std::to_string(v0.components) + " separate closed shells: kept whole", kept,
+                      false);
   if (!v0.valid()) return run.finish(Outcome::KeptInvalid, "the input is no valid solid: " + v0.problem, local_model);
   return std::nullopt;
 }
@@ -199,7 +200,8 @@ void outdated_walls(const Mesh& current, const std::vector<ModelSurface>& surfac
     if (pl.n.dot(surfaces[m.surface].plane.n) < 0) pl = pl.flipped();
     scanned.push_back({m.surface, m.scan_plane, pl});
     const double dev = surface_deviation(current, surfaces[m.surface], pl);
-    if (dev > cfg.change_tolerance) moves.push_back({m.surface, pl, eave_follows_roof(current, surfaces, m, pl, local)});
+    if (dev > cfg.change_tolerance)
+      moves.push_back({m.surface, pl, eave_follows_roof(current, surfaces, m, pl, local)});
     matching.walls.push_back({m, dev, surfaces[m.surface].faces});
   }
   matching.rejected = mr.rejected;
@@ -236,9 +238,9 @@ std::optional<Mesh> starting_shell(const Mesh& current, const std::vector<ModelS
 // and the scan's facades, the starting shell as GLPK's first incumbent. The result is written
 // only when it is never worse, on every scan point near the building and on each moved wall's
 // own points (judge.h).
-RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::optional<Mesh>& refined,
-                              bool any_match, const PointCloud& local, const std::vector<ScanPlane>& planes,
-                              const RefineConfig& prm, Run& run) {
+RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::optional<Mesh>& refined, bool any_match,
+                              const PointCloud& local, const std::vector<ScanPlane>& planes, const RefineConfig& prm,
+                              Run& run) {
   RefineTrace& trace = run.trace();
   const ShellSelection chosen = select_shell(refined ? *refined : current, local, planes, prm);
   trace.selection = chosen.stats;
@@ -247,16 +249,20 @@ RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::
   if (!chosen.ok) return run.finish(Outcome::Kept, "the selection found no valid shell: " + chosen.reason, kept);
   if (!refined && chosen.stats.candidates_changed == 0) {
     trace.facades.clear();
-    return run.finish(Outcome::Kept, !any_match ? "the selection kept the model (no wall matched a scan plane)"
-                                                : "the selection kept the model (the scan agrees with it)", kept);
+    return run.finish(Outcome::Kept,
+                      !any_match ? "the selection kept the model (no wall matched a scan plane)"
+                                 : "the selection kept the model (the scan agrees with it)",
+                      kept);
   }
   std::vector<JudgedWall> moved;
   for (const auto& f : trace.facades) moved.push_back(f.wall);
   const Judgement& verdict = trace.judgement.emplace(judge_refinement(kept, chosen.mesh, moved, local, prm, prm));
   if (!verdict.ok)
     return run.finish(Outcome::Kept, "not written: never worse, " + verdict.check + " check: " + verdict.detail, kept);
-  return run.finish(Outcome::Refined, std::to_string(chosen.stats.faces_from_selection) + " face(s) selected, " +
-                                          std::to_string(trace.facades.size()) + " wall(s) moved", chosen.mesh);
+  return run.finish(Outcome::Refined,
+                    std::to_string(chosen.stats.faces_from_selection) + " face(s) selected, " +
+                        std::to_string(trace.facades.size()) + " wall(s) moved",
+                    chosen.mesh);
 }
 
 }  // namespace

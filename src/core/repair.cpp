@@ -127,8 +127,8 @@ bool is_degenerate(const std::vector<int>& v, const std::vector<Vec3>& V, double
 
 // Remaps faces to welded vertices and drops degenerate faces and duplicates (same vertex set,
 // either orientation; the first one is kept).
-std::vector<Face> clean_faces(const Mesh& soup, const std::vector<int>& cluster, const std::vector<Vec3>& V,
-                              double tol, RepairReport& r) {
+std::vector<Face> clean_faces(const Mesh& soup, const std::vector<int>& cluster, const std::vector<Vec3>& V, double tol,
+                              RepairReport& r) {
   std::vector<Face> faces;
   std::set<std::vector<int>> seen;
   for (const Face& in : soup.faces) {
@@ -171,7 +171,8 @@ int split_t_junctions(const std::vector<Vec3>& V, std::vector<Face>& faces, doub
       const int a = f.v[i], b = f.v[(i + 1) % f.v.size()];
       const Vec3 lo = V[a].cwiseMin(V[b]).array() - tol, hi = V[a].cwiseMax(V[b]).array() + tol;
       near.clear();
-      for (auto k = std::size_t(std::lower_bound(xs.begin(), xs.end(), lo.x()) - xs.begin()); k < xs.size() && xs[k] <= hi.x(); ++k) {
+      for (auto k = std::size_t(std::lower_bound(xs.begin(), xs.end(), lo.x()) - xs.begin());
+           k < xs.size() && xs[k] <= hi.x(); ++k) {
         const Vec3& p = V[std::size_t(by_x[k])];
         if (p.y() >= lo.y() && p.y() <= hi.y() && p.z() >= lo.z() && p.z() <= hi.z()) near.push_back(by_x[k]);
       }
@@ -494,7 +495,8 @@ Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report,
   const Validation val = validate_mesh(out, std::numeric_limits<double>::infinity(), false);
   r.closed = out.faces.size() >= kMinClosedFaces && val.watertight() && val.inconsistent_edges == 0 && val.volume > 0;
   if (report) *report = r;
-  if (out.faces.size() < kMinClosedFaces) reject(soup, "only " + std::to_string(out.faces.size()) + " usable faces after repair");
+  if (out.faces.size() < kMinClosedFaces)
+    reject(soup, "only " + std::to_string(out.faces.size()) + " usable faces after repair");
   if (!r.closed) reject(soup, "not closable: " + (val.problem.empty() ? "zero volume" : val.problem));
   return out;
 }
@@ -502,8 +504,7 @@ Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report,
 int split_warped_faces(Mesh& mesh, double tolerance) {
   std::set<std::pair<int, int>> edges;
   for (const auto& f : mesh.faces)
-    for (std::size_t k = 0; k < f.v.size(); ++k)
-      edges.insert(std::minmax(f.v[k], f.v[(k + 1) % f.v.size()]));
+    for (std::size_t k = 0; k < f.v.size(); ++k) edges.insert(std::minmax(f.v[k], f.v[(k + 1) % f.v.size()]));
   std::vector<Face> faces;
   int split = 0;
   for (const auto& f : mesh.faces) {

@@ -71,9 +71,7 @@ void on_search(glp_tree* tree, void* info) {
       }
       break;
     case GLP_IBINGO:
-    case GLP_ISELECT:
-      s.gap = glp_ios_mip_gap(tree);
-      break;
+    case GLP_ISELECT: s.gap = glp_ios_mip_gap(tree); break;
     default: break;
   }
 }
@@ -93,7 +91,8 @@ std::vector<std::pair<int, double>> combined(std::vector<std::pair<int, double>>
 
 }  // namespace
 
-bool every_edge_used_0_or_2(const CandidateSet& cs, const std::vector<char>& selected, const std::vector<int>& outside) {
+bool every_edge_used_0_or_2(const CandidateSet& cs, const std::vector<char>& selected,
+                            const std::vector<int>& outside) {
   for (std::size_t e = 0; e < cs.edges.size(); ++e) {
     int n = outside.empty() ? 0 : outside[e];
     for (int f : cs.edges[e].faces) n += selected[f];
@@ -129,7 +128,8 @@ SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& pg,
   res.warm_given = !pg.warm.empty();
   if (res.warm_given) {
     res.warm_feasible = every_edge_used_0_or_2(cs, pg.warm, pg.outside);
-    for (int f = 0; f < nf; ++f) res.warm_feasible = res.warm_feasible && (fixed_value(f) < 0 || fixed_value(f) == pg.warm[f]);
+    for (int f = 0; f < nf; ++f)
+      res.warm_feasible = res.warm_feasible && (fixed_value(f) < 0 || fixed_value(f) == pg.warm[f]);
   }
 
   double total_area = 0.0;

@@ -82,8 +82,8 @@ double share(const std::vector<Vec2>& poly, const CellSet& cells) {
 struct Supports {
   std::vector<SupportPlane> planes;
   int start_planes = 0;
-  std::vector<int> face_plane;                // start face -> supporting plane
-  std::vector<std::vector<Vec3>> points;      // per supporting plane: its scan points
+  std::vector<int> face_plane;            // start face -> supporting plane
+  std::vector<std::vector<Vec3>> points;  // per supporting plane: its scan points
   int added = 0;
 };
 
@@ -148,7 +148,9 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
     int k = -1;
     double best = prm.merge_distance;
     for (int j = 0; j < int(s.planes.size()); ++j) {
-      if (!near_vertical(s.planes[j].plane) || unoriented_angle_deg(s.planes[j].plane.n, sp.plane.n) > prm.merge_angle_deg) continue;
+      if (!near_vertical(s.planes[j].plane) ||
+          unoriented_angle_deg(s.planes[j].plane.n, sp.plane.n) > prm.merge_angle_deg)
+        continue;
       const double d = mean_distance(s.planes[j].plane);
       if (d <= best) best = d, k = j;
     }
@@ -205,7 +207,8 @@ void add_step_walls(const Mesh& start, const Params& prm, Supports& s) {
       if (e < lo + kSideClear || e > hi - kSideClear) continue;
       positions.push_back(e);
       for (int k = 0; k < existing; ++k) {
-        if (k == j || s.points[k].empty() || unoriented_angle_deg(s.planes[k].plane.n, pj.n) > prm.merge_angle_deg) continue;
+        if (k == j || s.points[k].empty() || unoriented_angle_deg(s.planes[k].plane.n, pj.n) > prm.merge_angle_deg)
+          continue;
         for (const auto& r : runs_along(s.points[k], u))
           for (double f : {r.a, r.b})
             if (std::abs(f - e) <= kStepReach && f > lo + kSideClear && f < hi - kSideClear) positions.push_back(f);
@@ -253,7 +256,7 @@ struct CandidateData {
   std::vector<char> in_start;   // the starting shell has a face there
   std::vector<int> start_face;  // which one (-1: none)
   std::vector<double> confidence;
-  std::vector<char> in_zone;    // scan evidence reaches it
+  std::vector<char> in_zone;  // scan evidence reaches it
 };
 
 CandidateData describe_candidates(const CandidateSet& cs, const Mesh& start, const Supports& s, const Params& prm) {
@@ -267,7 +270,8 @@ CandidateData describe_candidates(const CandidateSet& cs, const Mesh& start, con
   for (int k = 0; k < np; ++k) {
     if (!near_vertical(s.planes[k].plane)) continue;
     for (int j = 0; j < np; ++j) {
-      if (j == k || s.points[j].empty() || unoriented_angle_deg(s.planes[k].plane.n, s.planes[j].plane.n) > prm.merge_angle_deg)
+      if (j == k || s.points[j].empty() ||
+          unoriented_angle_deg(s.planes[k].plane.n, s.planes[j].plane.n) > prm.merge_angle_deg)
         continue;
       double sum = 0.0;
       for (const auto& p : s.points[j]) sum += std::abs(s.planes[k].plane.distance(p));

@@ -171,7 +171,7 @@ bool eave_follows_roof(const Mesh& mesh, const std::vector<ModelSurface>& surfac
   // followed one and closer to it than to the kept one by kMargin (a scan may stop short of
   // the eave under an overhang).
   constexpr double kDiffer = 0.2, kAgree = 0.3, kMargin = 0.15;
-  constexpr double kTopQuantile = 0.99;          // the wall's points' top, robust to a few strays
+  constexpr double kTopQuantile = 0.99;  // the wall's points' top, robust to a few strays
   if (m.owned.empty()) return false;
   constexpr double kNoSplit = 1e300;  // planarity tolerance: only the wall's top matters here
   auto top = [&](bool follow) {
@@ -191,6 +191,5 @@ bool eave_follows_roof(const Mesh& mesh, const std::vector<ModelSurface>& surfac
   const double scan_top = z[k];
   return std::abs(scan_top - follow) <= kAgree && std::abs(scan_top - follow) + kMargin < std::abs(scan_top - keep);
 }
-
 
 }  // namespace lodrefine

@@ -1,7 +1,6 @@
 // The paper's evaluation metrics, on the core's point-to-mesh distances.
 #include "lodrefine/eval/eval.h"
 
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -101,8 +100,8 @@ struct TruthSamples {
   std::vector<Vec3> facade, roof;
 };
 
-TruthSamples truth_samples(const Mesh& truth, const std::vector<Vec3>& facade_pts,
-                           const std::vector<int>* scanned, std::vector<int>& scanned_out) {
+TruthSamples truth_samples(const Mesh& truth, const std::vector<Vec3>& facade_pts, const std::vector<int>* scanned,
+                           std::vector<int>& scanned_out) {
   scanned_out = scanned ? *scanned : scanned_walls(truth, facade_pts);
   for (int f : scanned_out)
     if (f < 0 || std::size_t(f) >= truth.faces.size())
@@ -117,8 +116,8 @@ std::optional<DistanceStats> stats_if_any(const std::vector<double>& d) {
 }
 
 // Fills the "after" side: C2M, watertightness, centroid and truth distances of the refined model.
-void evaluate_refined(BuildingEval& e, const Mesh& refined, const std::vector<Vec3>& pts,
-                      const TruthSamples* samples, const Params& params) {
+void evaluate_refined(BuildingEval& e, const Mesh& refined, const std::vector<Vec3>& pts, const TruthSamples* samples,
+                      const Params& params) {
   if (refined.faces.empty()) throw InputError("refined model has no faces");
   if (!pts.empty()) e.c2m_after = cloud_to_mesh(refined, pts);
   e.after = summarize_distances(e.c2m_after);
@@ -161,7 +160,8 @@ double percentile(std::vector<double>& values, double q) {
   const std::size_t lo = std::size_t(std::floor(pos));
   std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(lo), values.end());
   const double a = values[lo];
-  const double b = lo + 1 < values.size() ? *std::min_element(values.begin() + std::ptrdiff_t(lo) + 1, values.end()) : a;
+  const double b =
+      lo + 1 < values.size() ? *std::min_element(values.begin() + std::ptrdiff_t(lo) + 1, values.end()) : a;
   return a + (pos - double(lo)) * (b - a);
 }
 
@@ -237,14 +237,13 @@ std::vector<int> select_facade_points(const Mesh& input, const PointCloud& cloud
   return points_in_front(mesh, surfaces, planes, matched, cloud, kFacadeMargin);
 }
 
-BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const PointCloud& cloud,
-                               const Mesh* truth, const Params& params) {
+BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const PointCloud& cloud, const Mesh* truth,
+                               const Params& params) {
   return evaluate_building(original, refined, cloud, truth, params, nullptr);
 }
 
-BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const PointCloud& cloud,
-                               const Mesh* truth, const Params& params,
-                               const std::vector<int>* scanned_truth_faces) {
+BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const PointCloud& cloud, const Mesh* truth,
+                               const Params& params, const std::vector<int>* scanned_truth_faces) {
   BuildingEval e;
   e.id = original.id.empty() ? refined.id : original.id;
   e.facade_index = select_facade_points(original, cloud, params);

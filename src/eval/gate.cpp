@@ -88,7 +88,8 @@ struct Checker {
   void distance(const std::string& building, const std::string& check, const char* figure,
                 const std::optional<double>& old_value, const std::optional<double>& new_value) {
     if (!old_value) return;
-    if (!new_value) return fail(building, check, figure, std::string(figure) + " " + metres(old_value) + " -> not measured");
+    if (!new_value)
+      return fail(building, check, figure, std::string(figure) + " " + metres(old_value) + " -> not measured");
     const double worse = *new_value - *old_value;
     if (worse > tolerance)
       fail(building, check, figure,
@@ -98,8 +99,9 @@ struct Checker {
 
   void building(const BuildingFigures& now, const BuildingFigures& old) {
     if (outcome_rank(now.outcome) < outcome_rank(old.outcome))
-      return fail(now.id, "baseline", "outcome",
-                  "outcome " + old.outcome + " -> " + now.outcome + (now.reason.empty() ? "" : " (" + now.reason + ")"));
+      return fail(
+          now.id, "baseline", "outcome",
+          "outcome " + old.outcome + " -> " + now.outcome + (now.reason.empty() ? "" : " (" + now.reason + ")"));
     for (const auto& [name, field] : kBuildingDistances) distance(now.id, "baseline", name, old.*field, now.*field);
     if (old.watertight && !now.watertight) fail(now.id, "baseline", "watertight", "watertight yes -> no");
   }
@@ -156,10 +158,8 @@ void check_gates(const RunFigures& run, const Gates& gates, Checker& c) {
     const GateFigure g = gate_figure(gate, run);
     if (!g.per_building) {
       c.verdict.pooled_checks.push_back(gate);
-      if (!g.pooled)
-        c.fail("", gate, gate, gate + " not measured in this run");
-      else if (breaches(gate, *g.pooled, limit))
-        c.fail("", gate, gate, limit_text(gate, *g.pooled, limit));
+      if (!g.pooled) c.fail("", gate, gate, gate + " not measured in this run");
+      else if (breaches(gate, *g.pooled, limit)) c.fail("", gate, gate, limit_text(gate, *g.pooled, limit));
       continue;
     }
     for (const BuildingFigures& b : run.buildings) {
@@ -206,19 +206,25 @@ int outcome_rank(const std::string& outcome) {
 }
 
 std::string baseline_json(const RunFigures& run) {
-  json pooled = {{"buildings", run.buildings.size()}, {"failed", run.failed},
-                 {"refined", run.refined},            {"watertight_rate", run.watertight_rate},
+  json pooled = {{"buildings", run.buildings.size()},
+                 {"failed", run.failed},
+                 {"refined", run.refined},
+                 {"watertight_rate", run.watertight_rate},
                  {"c2m_rmse_original", optional_json(run.c2m_rmse_original)}};
   for (const auto& [name, field] : kPooledDistances) pooled[name] = optional_json(run.*field);
   json buildings = json::array();
   for (const BuildingFigures& b : run.buildings) {
-    json j = {{"id", b.id}, {"outcome", b.outcome}, {"reason", b.reason}, {"watertight", b.watertight},
-              {"facades_moved", b.facades_moved}, {"moved_max", optional_json(b.moved_max)}};
+    json j = {{"id", b.id},
+              {"outcome", b.outcome},
+              {"reason", b.reason},
+              {"watertight", b.watertight},
+              {"facades_moved", b.facades_moved},
+              {"moved_max", optional_json(b.moved_max)}};
     for (const auto& [name, field] : kBuildingDistances) j[name] = optional_json(b.*field);
     buildings.push_back(std::move(j));
   }
-  const json doc = {{"format", "lodrefine-baseline"}, {"version", kBaselineVersion}, {"pooled", pooled},
-                    {"buildings", buildings}};
+  const json doc = {
+      {"format", "lodrefine-baseline"}, {"version", kBaselineVersion}, {"pooled", pooled}, {"buildings", buildings}};
   return doc.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
 }
 
@@ -322,7 +328,8 @@ RunFigures with_utf8_ids(RunFigures run) {
 GateVerdict check_run(const RunFigures& run_as_read, const RunFigures* baseline_as_read, const Gates* gates,
                       double tolerance) {
   const RunFigures run = with_utf8_ids(run_as_read);
-  const std::optional<RunFigures> baseline_ids = baseline_as_read ? std::optional(with_utf8_ids(*baseline_as_read)) : std::nullopt;
+  const std::optional<RunFigures> baseline_ids =
+      baseline_as_read ? std::optional(with_utf8_ids(*baseline_as_read)) : std::nullopt;
   const RunFigures* baseline = baseline_ids ? &*baseline_ids : nullptr;
   GateVerdict verdict;
   Checker c{tolerance, verdict};
@@ -332,10 +339,8 @@ GateVerdict check_run(const RunFigures& run_as_read, const RunFigures* baseline_
     for (const auto& b : baseline->buildings) old[b.id] = &b;
     for (const auto& b : run.buildings) {
       const auto it = old.find(b.id);
-      if (it == old.end())
-        verdict.new_buildings.push_back(b.id);
-      else
-        c.building(b, *it->second);
+      if (it == old.end()) verdict.new_buildings.push_back(b.id);
+      else c.building(b, *it->second);
     }
     add_missing(run, *baseline, c);
     verdict.pooled_checks.push_back("baseline");
@@ -351,7 +356,8 @@ std::string junit_xml(const GateVerdict& v, const std::string& name) {
   auto lines_of = [&](bool pooled, const std::string& key) {
     std::vector<const GateLine*> out;
     for (const GateLine& l : v.failures)
-      if (pooled ? (l.building.empty() && l.check == key) : (!l.building.empty() && l.building == key)) out.push_back(&l);
+      if (pooled ? (l.building.empty() && l.check == key) : (!l.building.empty() && l.building == key))
+        out.push_back(&l);
     return out;
   };
   std::string buildings, pooled;

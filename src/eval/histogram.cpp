@@ -13,7 +13,7 @@ namespace {
 constexpr double kLinearWidth = 1e-4;  // m: 0.1 mm, well below any scanner's noise
 constexpr double kLinearEnd = 10.0;    // m: |d| beyond this is a gross outlier, binned relatively
 constexpr double kRelativeWidth = 1e-3;
-constexpr double kLargest = 1e9;       // m: kMaxCoordinate; larger |d| share the last bin
+constexpr double kLargest = 1e9;  // m: kMaxCoordinate; larger |d| share the last bin
 const std::size_t kLinearBins = std::size_t(std::llround(kLinearEnd / kLinearWidth));
 const double kLogStep = std::log1p(kRelativeWidth);
 const std::size_t kBins = kLinearBins + std::size_t(std::ceil(std::log(kLargest / kLinearEnd) / kLogStep)) + 1;
@@ -23,10 +23,8 @@ const std::size_t kBins = kLinearBins + std::size_t(std::ceil(std::log(kLargest 
 DistanceHistogram::Bin DistanceHistogram::bin_of(double d) {
   const double u = std::abs(d);
   std::size_t j;
-  if (u < kLinearEnd)
-    j = std::min(kLinearBins - 1, std::size_t(u / kLinearWidth));
-  else
-    j = std::min(kBins - 1, kLinearBins + std::size_t(std::log(u / kLinearEnd) / kLogStep));
+  if (u < kLinearEnd) j = std::min(kLinearBins - 1, std::size_t(u / kLinearWidth));
+  else j = std::min(kBins - 1, kLinearBins + std::size_t(std::log(u / kLinearEnd) / kLogStep));
   return {d < 0 ? -1 : 1, j};
 }
 
@@ -108,8 +106,8 @@ double DistanceHistogram::abs_quantile(double q) const {
     for (std::size_t j = 0; j < kBins; ++j) {
       const std::uint64_t c = neg_[j] + pos_[j];
       if (k < below + c)
-        return std::min(max_abs(), lower_edge(j) + (double(k - below) + 0.5) / double(c) *
-                                                       (upper_edge(j) - lower_edge(j)));
+        return std::min(max_abs(),
+                        lower_edge(j) + (double(k - below) + 0.5) / double(c) * (upper_edge(j) - lower_edge(j)));
       below += c;
     }
     return max_abs();

@@ -38,13 +38,13 @@ std::string escape(const std::string& s) {
 class Svg {
  public:
   Svg(double w, double h) : w_(w), h_(h) {
-    s_ << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << w << "\" height=\"" << h << "\" viewBox=\"0 0 "
-       << w << ' ' << h << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
+    s_ << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << w << "\" height=\"" << h << "\" viewBox=\"0 0 " << w
+       << ' ' << h << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
        << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
   }
   void line(double x1, double y1, double x2, double y2, const std::string& style) {
-    s_ << "<line x1=\"" << num(x1) << "\" y1=\"" << num(y1) << "\" x2=\"" << num(x2) << "\" y2=\"" << num(y2)
-       << "\" " << style << "/>\n";
+    s_ << "<line x1=\"" << num(x1) << "\" y1=\"" << num(y1) << "\" x2=\"" << num(x2) << "\" y2=\"" << num(y2) << "\" "
+       << style << "/>\n";
   }
   void rect(double x, double y, double w, double h, const std::string& style) {
     s_ << "<rect x=\"" << num(x) << "\" y=\"" << num(y) << "\" width=\"" << num(std::max(0.0, w)) << "\" height=\""
@@ -164,8 +164,8 @@ HistogramSeries histogram_series(const DistanceHistogram& d, double range, int b
   return s;
 }
 
-std::string draw_histogram(const HistogramSeries& hb, const HistogramSeries& ha, const std::string& title,
-                           double range, int bins) {
+std::string draw_histogram(const HistogramSeries& hb, const HistogramSeries& ha, const std::string& title, double range,
+                           int bins) {
   const double top = std::max(*std::max_element(hb.shares.begin(), hb.shares.end()),
                               *std::max_element(ha.shares.begin(), ha.shares.end()));
   Svg svg(760, 440);
@@ -176,8 +176,9 @@ std::string draw_histogram(const HistogramSeries& hb, const HistogramSeries& ha,
   auto bars = [&](const std::vector<double>& h, const char* color) {
     for (int i = 0; i < bins; ++i) {
       const double x = -range + i * bw;
-      svg.rect(f.px(x), f.py(h[std::size_t(i)]), f.px(x + bw) - f.px(x), f.py(0) - f.py(h[std::size_t(i)]),
-               std::string("fill=\"") + color + "\" fill-opacity=\"0.5\" stroke=\"" + color + "\" stroke-width=\"0.5\"");
+      svg.rect(
+          f.px(x), f.py(h[std::size_t(i)]), f.px(x + bw) - f.px(x), f.py(0) - f.py(h[std::size_t(i)]),
+          std::string("fill=\"") + color + "\" fill-opacity=\"0.5\" stroke=\"" + color + "\" stroke-width=\"0.5\"");
     }
   };
   bars(hb.shares, kBlue);
@@ -194,8 +195,8 @@ std::string draw_histogram(const HistogramSeries& hb, const HistogramSeries& ha,
 
 }  // namespace
 
-std::string svg_histogram(const std::vector<double>& before, const std::vector<double>& after,
-                          const std::string& title, double range, int bins) {
+std::string svg_histogram(const std::vector<double>& before, const std::vector<double>& after, const std::string& title,
+                          double range, int bins) {
   if (!(range > 0)) range = auto_range(before, after);
   bins = std::max(1, bins);
   return draw_histogram(histogram_series(before, range, bins), histogram_series(after, range, bins), title, range,
@@ -268,7 +269,6 @@ void draw_box(Svg& svg, const Frame& f, double cx, const BoxStats& b, const char
   svg.line(cx - 5, my + 5, cx + 5, my - 5, "stroke=\"black\"");
 }
 
-
 std::string draw_boxplot(const BoxStats& bb, const BoxStats& ba, const std::string& title) {
   double lo = std::min({bb.lo, ba.lo, 0.0}), hi = std::max({bb.hi, ba.hi, 0.0});
   const double pad = std::max(0.02, 0.08 * (hi - lo));
@@ -284,7 +284,8 @@ std::string draw_boxplot(const BoxStats& bb, const BoxStats& ba, const std::stri
     svg.text(cx, f.top + f.height + 20, name, "text-anchor=\"middle\"");
     const std::string small = "text-anchor=\"middle\" font-size=\"10\"";
     svg.text(cx, f.top + f.height + 34, "median " + num(b.median, 3) + " m, IQR " + num(b.q3 - b.q1, 3) + " m", small);
-    svg.text(cx, f.top + f.height + 47, std::to_string(b.outliers) + " of " + std::to_string(b.n) + " beyond whiskers", small);
+    svg.text(cx, f.top + f.height + 47, std::to_string(b.outliers) + " of " + std::to_string(b.n) + " beyond whiskers",
+             small);
   };
   caption(c1, "original", bb);
   caption(c2, "refined", ba);
@@ -372,16 +373,17 @@ std::string svg_footprint(const Mesh& original, const Mesh& refined, const std::
   svg.title(title);
   legend_entry(svg, margin, 46, kBlue, "original");
   legend_entry(svg, margin + 100, 46, kOrange, "refined");
-  legend_entry(svg, margin + 200, 46, kGreen,
-               "facade points (" + std::to_string(facade_points.size()) + ", at most " + std::to_string(max_points) +
-                   " drawn)");
+  legend_entry(
+      svg, margin + 200, 46, kGreen,
+      "facade points (" + std::to_string(facade_points.size()) + ", at most " + std::to_string(max_points) + " drawn)");
 
   const std::size_t cap = std::max<std::size_t>(1, max_points);
   const std::size_t stride = std::max<std::size_t>(1, (facade_points.size() + cap - 1) / cap);
   std::ostringstream dots;
   dots << "<g fill=\"" << kGreen << "\">";
   for (std::size_t i = 0; i < facade_points.size(); i += stride)
-    dots << "<circle cx=\"" << num(v.px(facade_points[i])) << "\" cy=\"" << num(v.py(facade_points[i])) << "\" r=\"1.2\"/>";
+    dots << "<circle cx=\"" << num(v.px(facade_points[i])) << "\" cy=\"" << num(v.py(facade_points[i]))
+         << "\" r=\"1.2\"/>";
   dots << "</g>";
   svg.raw(dots.str());
   svg.raw(outline_path(original, v, kBlue, "stroke-dasharray=\"6 3\""));
@@ -415,8 +417,9 @@ std::string svg_district_map(const std::vector<MapOutline>& buildings, const std
   };
   double x = margin;
   for (const auto& [name, colour] : styles) {
-    const auto n = std::count_if(buildings.begin(), buildings.end(),
-                                 [&, name = name](const MapOutline& b) { return colour_of(b.outcome) == colour_of(name); });
+    const auto n = std::count_if(buildings.begin(), buildings.end(), [&, name = name](const MapOutline& b) {
+      return colour_of(b.outcome) == colour_of(name);
+    });
     const std::string label = std::string(name) + " (" + std::to_string(n) + ")";
     legend_entry(svg, x, 46, colour, label);
     x += 40 + 7.0 * double(label.size());
@@ -431,8 +434,10 @@ std::string svg_district_map(const std::vector<MapOutline>& buildings, const std
       if (!ring.empty()) d << "Z ";
     }
     const std::string colour = colour_of(b.outcome);
-    std::string path = "<path d=\"" + d.str() + "\" fill=\"" + colour + "\" fill-opacity=\"0.75\" stroke=\"#555\" "
-                       "stroke-width=\"0.6\"><title>" + escape(b.id + ": " + b.outcome) + "</title></path>";
+    std::string path = "<path d=\"" + d.str() + "\" fill=\"" + colour +
+                       "\" fill-opacity=\"0.75\" stroke=\"#555\" "
+                       "stroke-width=\"0.6\"><title>" +
+                       escape(b.id + ": " + b.outcome) + "</title></path>";
     if (b.linked) path = "<a href=\"#view-" + escape(b.id) + "\">" + path + "</a>";
     svg.raw(path);
   }

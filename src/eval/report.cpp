@@ -42,8 +42,10 @@ std::string html_escape(const std::string& s) {
 std::string script_safe(std::string s) {
   for (const std::string from : {"</", "<!--"})
     for (std::size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + 6)) s.replace(at, 1, "\\u003c");
-  for (const auto& [from, to] : {std::pair<std::string, std::string>{"\xE2\x80\xA8", "\\u2028"}, {"\xE2\x80\xA9", "\\u2029"}})
-    for (std::size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size())) s.replace(at, from.size(), to);
+  for (const auto& [from, to] :
+       {std::pair<std::string, std::string>{"\xE2\x80\xA8", "\\u2028"}, {"\xE2\x80\xA9", "\\u2029"}})
+    for (std::size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size()))
+      s.replace(at, from.size(), to);
   return s;
 }
 
@@ -214,11 +216,14 @@ std::string html_report(const HtmlReport& r) {
            html_escape(v.caption) + "</h3>\n<div class=\"view\"><div class=\"footprint\">" + v.footprint_svg +
            "</div><div><canvas class=\"view3d\" width=\"560\" height=\"420\"></canvas><div class=\"legend\">";
       for (const char* layer : {"original", "refined", "points"})
-        h += std::string("<label><input type=\"checkbox\" checked data-layer=\"") + layer + "\"> " + layer + "</label> ";
+        h +=
+            std::string("<label><input type=\"checkbox\" checked data-layer=\"") + layer + "\"> " + layer + "</label> ";
       h += "</div></div></div></section>\n";
-      views.push_back({{"id", v.id}, {"original", v.original}, {"refined", v.refined}, {"points", v.points}, {"c2m", v.c2m}});
+      views.push_back(
+          {{"id", v.id}, {"original", v.original}, {"refined", v.refined}, {"points", v.points}, {"c2m", v.c2m}});
     }
-    h += "<script type=\"application/json\" id=\"lodrefine-views\">" + script_safe(views.dump(-1, ' ', false, json::error_handler_t::replace)) + "</script>\n";
+    h += "<script type=\"application/json\" id=\"lodrefine-views\">" +
+         script_safe(views.dump(-1, ' ', false, json::error_handler_t::replace)) + "</script>\n";
     h += "<script type=\"text/plain\" id=\"three-module\">" + script_safe(three_module_js()) + "</script>\n";
     h += std::string("<script type=\"module\">") + kViewer + "</script>\n";
   } else {

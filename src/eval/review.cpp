@@ -56,14 +56,14 @@ std::vector<const CityReviewBuilding*> reached_worst_first(const CityReview& r) 
 }
 
 const json kColumns = json::array({{"id", "building"},
-                                    {"outcome", "outcome"},
-                                    {"reason", "reason"},
-                                    {"points", "cloud points"},
-                                    {"moved", "facades moved"},
-                                    {"moved_max", "max move (m)"},
-                                    {"moved_mean", "mean move (m)"},
-                                    {"fit_before", "fit before (m)"},
-                                    {"fit_after", "fit after (m)"}});
+                                   {"outcome", "outcome"},
+                                   {"reason", "reason"},
+                                   {"points", "cloud points"},
+                                   {"moved", "facades moved"},
+                                   {"moved_max", "max move (m)"},
+                                   {"moved_mean", "mean move (m)"},
+                                   {"fit_before", "fit before (m)"},
+                                   {"fit_after", "fit after (m)"}});
 
 json row(const CityReviewBuilding& b) {
   return {{"id", b.id},
@@ -92,7 +92,8 @@ std::string check_of(const std::string& id, std::string reason) {
   std::string key = reason.substr(0, std::min(reason.find(':'), reason.find('(')));
   std::string out;
   for (std::size_t i = 0; i < key.size(); ++i) {
-    const bool digit = std::isdigit(static_cast<unsigned char>(key[i])) || (key[i] == '.' && !out.empty() && out.back() == 'N');
+    const bool digit =
+        std::isdigit(static_cast<unsigned char>(key[i])) || (key[i] == '.' && !out.empty() && out.back() == 'N');
     if (!digit) out += key[i];
     else if (out.empty() || out.back() != 'N') out += 'N';
   }
@@ -160,10 +161,11 @@ std::string city_review_html(const CityReview& r) {
   h.table1 = r.summary + refusals_text(r);
   h.summary_heading = "City summary";
   h.table_heading = "Buildings the cloud reached, worst first";
-  h.views_legend = "Each refined building. Left: top view, coarse (blue, dashed) and refined (orange) over its scan "
-                   "points. Right: 3D, drag to turn, wheel to zoom; coarse blue (transparent), refined orange, scan "
-                   "points within 1 m coloured by their signed distance to the refined model (blue -0.3 m, green 0, "
-                   "red +0.3 m).";
+  h.views_legend =
+      "Each refined building. Left: top view, coarse (blue, dashed) and refined (orange) over its scan "
+      "points. Right: 3D, drag to turn, wheel to zoom; coarse blue (transparent), refined orange, scan "
+      "points within 1 m coloured by their signed distance to the refined model (blue -0.3 m, green 0, "
+      "red +0.3 m).";
   h.columns = kColumns;
   h.rows = json::array();
   std::vector<MapOutline> map;

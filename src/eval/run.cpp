@@ -77,8 +77,7 @@ std::string first_line(const std::string& path) {
 // Refuses a report written by a newer refine than this eval reads (absent: version 1).
 void check_report_version(const json& report, const std::string& source) {
   const json version = report.value("report_version", json(1));
-  if (!version.is_number_integer() || version.get<long long>() < 1 ||
-      version.get<long long>() > kRefineReportVersion)
+  if (!version.is_number_integer() || version.get<long long>() < 1 || version.get<long long>() > kRefineReportVersion)
     throw InputError(source + ": report_version " + version.dump() + " is not one this lodrefine reads (1.." +
                      std::to_string(kRefineReportVersion) + ")");
 }

@@ -125,10 +125,8 @@ int run_eval(const EvalOptions& a, std::FILE* out) {
   if (!a.svg_dir.empty()) fs::create_directories(a.svg_dir);
   std::vector<RunRow> rows;
   PooledSeries series;
-  if (batch)
-    rows = evaluate_run(a.dir, a.params, a.svg_dir, a.jobs, series, Progress::mode_for_stderr(a.quiet));
-  else
-    rows.push_back(evaluate_single(a, series));
+  if (batch) rows = evaluate_run(a.dir, a.params, a.svg_dir, a.jobs, series, Progress::mode_for_stderr(a.quiet));
+  else rows.push_back(evaluate_single(a, series));
   std::vector<BuildingEval> evals;
   for (const RunRow& r : rows) evals.push_back(r.eval);
   const PooledEval pooled = pool_evaluations(evals, series);

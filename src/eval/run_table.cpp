@@ -56,26 +56,29 @@ json moved_json(const RunRow& r) {
 
 json row_json(const RunRow& r) {
   const BuildingEval& e = r.eval;
-  json j = {{"id", e.id},
-            {"status", e.ok() ? "ok" : "failed"},
-            {"error", e.error},
-            {"outcome", r.outcome},
-            {"reason", r.reason},
-            {"facades_moved", moved_json(r)},
-            {"refine_seconds", number_or_null(r.refine_seconds)},
-            {"facade_points", e.facade_points},
-            {"c2m", {{"original", stats_json(e.before)}, {"refined", stats_json(e.ok() ? std::optional(e.after) : std::nullopt)}}},
-            {"delta_d", number_or_null(e.delta_d)},
-            {"watertight", {{"original", e.watertight_before}, {"refined", e.watertight_after}}},
-            {"centroids",
-             {{"mls", point_json(e.c_mls + r.origin)},
-              {"original", point_json(e.c_init + r.origin)},
-              {"refined", e.ok() ? point_json(e.c_ref + r.origin) : json(nullptr)}}}};
+  json j = {
+      {"id", e.id},
+      {"status", e.ok() ? "ok" : "failed"},
+      {"error", e.error},
+      {"outcome", r.outcome},
+      {"reason", r.reason},
+      {"facades_moved", moved_json(r)},
+      {"refine_seconds", number_or_null(r.refine_seconds)},
+      {"facade_points", e.facade_points},
+      {"c2m",
+       {{"original", stats_json(e.before)}, {"refined", stats_json(e.ok() ? std::optional(e.after) : std::nullopt)}}},
+      {"delta_d", number_or_null(e.delta_d)},
+      {"watertight", {{"original", e.watertight_before}, {"refined", e.watertight_after}}},
+      {"centroids",
+       {{"mls", point_json(e.c_mls + r.origin)},
+        {"original", point_json(e.c_init + r.origin)},
+        {"refined", e.ok() ? point_json(e.c_ref + r.origin) : json(nullptr)}}}};
   if (!r.truth_faces_source.empty())
-    j["truth"] = {{"scanned_faces", e.scanned_truth_faces},
-                  {"scanned_faces_from", r.truth_faces_source},
-                  {"facade", {{"original", stats_json(e.truth_facade_before)}, {"refined", stats_json(e.truth_facade_after)}}},
-                  {"roof", {{"original", stats_json(e.truth_roof_before)}, {"refined", stats_json(e.truth_roof_after)}}}};
+    j["truth"] = {
+        {"scanned_faces", e.scanned_truth_faces},
+        {"scanned_faces_from", r.truth_faces_source},
+        {"facade", {{"original", stats_json(e.truth_facade_before)}, {"refined", stats_json(e.truth_facade_after)}}},
+        {"roof", {{"original", stats_json(e.truth_roof_before)}, {"refined", stats_json(e.truth_roof_after)}}}};
   if (!r.refine_outcome.empty()) j["refine_outcome"] = r.refine_outcome;
   if (!r.selection.empty()) j["selection"] = r.selection;
   return j;
@@ -83,22 +86,26 @@ json row_json(const RunRow& r) {
 
 json totals_json(const RunTotals& t) {
   return {{"outcomes", t.outcomes},
-          {"facades_moved", {{"count", t.moved.count}, {"max", number_or_null(t.moved.max)}, {"mean", number_or_null(t.moved.mean)}}},
+          {"facades_moved",
+           {{"count", t.moved.count}, {"max", number_or_null(t.moved.max)}, {"mean", number_or_null(t.moved.mean)}}},
           {"refine_seconds_total", t.refine_seconds}};
 }
 
 json pooled_json(const PooledEval& p) {
-  return {{"buildings", p.buildings},
-          {"failed", p.failed},
-          {"evaluated", p.evaluated},
-          {"pooled_over_points",
-           {{"c2m", {{"original", stats_json(p.before)}, {"refined", stats_json(p.after)}}},
-            {"truth_facade", {{"original", stats_json(p.truth_facade_before)}, {"refined", stats_json(p.truth_facade_after)}}},
-            {"truth_roof", {{"original", stats_json(p.truth_roof_before)}, {"refined", stats_json(p.truth_roof_after)}}}}},
-          {"mean_of_buildings", {{"c2m", {{"original", stats_json(p.mean_before)}, {"refined", stats_json(p.mean_after)}}}}},
-          {"delta_d", {{"mean", p.delta_d_mean}, {"median", p.delta_d_median}}},
-          {"watertight_rate", {{"original", p.watertight_rate_before}, {"refined", p.watertight_rate_after}}},
-          {"truth_buildings", p.truth_buildings}};
+  return {
+      {"buildings", p.buildings},
+      {"failed", p.failed},
+      {"evaluated", p.evaluated},
+      {"pooled_over_points",
+       {{"c2m", {{"original", stats_json(p.before)}, {"refined", stats_json(p.after)}}},
+        {"truth_facade",
+         {{"original", stats_json(p.truth_facade_before)}, {"refined", stats_json(p.truth_facade_after)}}},
+        {"truth_roof", {{"original", stats_json(p.truth_roof_before)}, {"refined", stats_json(p.truth_roof_after)}}}}},
+      {"mean_of_buildings",
+       {{"c2m", {{"original", stats_json(p.mean_before)}, {"refined", stats_json(p.mean_after)}}}}},
+      {"delta_d", {{"mean", p.delta_d_mean}, {"median", p.delta_d_median}}},
+      {"watertight_rate", {{"original", p.watertight_rate_before}, {"refined", p.watertight_rate_after}}},
+      {"truth_buildings", p.truth_buildings}};
 }
 
 std::string csv_field(const std::string& s) {
@@ -200,9 +207,11 @@ std::string table1_text(const PooledEval& p, bool batch) {
 
 std::string totals_text(const RunTotals& t) {
   std::string out;
-  appendf(out, "\noutcomes: refined %zu, kept %zu, failed %zu; facades moved %zu (max %s m, mean %s m); refine %.1f s in all\n",
-          t.outcomes.at("refined"), t.outcomes.at("kept"), t.outcomes.at("failed"), t.moved.count,
-          fmt(t.moved.max).c_str(), fmt(t.moved.mean).c_str(), t.refine_seconds);
+  appendf(
+      out,
+      "\noutcomes: refined %zu, kept %zu, failed %zu; facades moved %zu (max %s m, mean %s m); refine %.1f s in all\n",
+      t.outcomes.at("refined"), t.outcomes.at("kept"), t.outcomes.at("failed"), t.moved.count, fmt(t.moved.max).c_str(),
+      fmt(t.moved.mean).c_str(), t.refine_seconds);
   return out;
 }
 
@@ -272,9 +281,10 @@ BuildingView html_view(const RunRow& r, const Params& params) {
   constexpr std::size_t kFootprintPoints = 1500;  // idem for the top view
   BuildingView v = make_building_view(e.id, b.original, b.refined, facade_points(e, b.cloud), c2m, kViewPoints);
   v.footprint_svg = building_footprint_svg(e, b, kFootprintPoints);
-  v.caption = r.outcome + (r.reason.empty() ? "" : " (" + r.reason + ")") + ", " + std::to_string(r.moved.size()) +
-              " facade(s) moved" +
-              (e.facade_points ? ", C2M RMSE " + fmt(e.before.rmse) + " -> " + (e.ok() ? fmt(e.after.rmse) : "-") + " m" : "");
+  v.caption =
+      r.outcome + (r.reason.empty() ? "" : " (" + r.reason + ")") + ", " + std::to_string(r.moved.size()) +
+      " facade(s) moved" +
+      (e.facade_points ? ", C2M RMSE " + fmt(e.before.rmse) + " -> " + (e.ok() ? fmt(e.after.rmse) : "-") + " m" : "");
   return v;
 }
 

@@ -13,12 +13,12 @@
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
-#include "lodrefine/io/cityjson.h"
+#include "lodrefine/core/refine.h"
 #include "lodrefine/io/citygml.h"
+#include "lodrefine/io/cityjson.h"
 #include "lodrefine/io/cityjson_write.h"
 #include "lodrefine/io/crop.h"
 #include "lodrefine/io/files.h"
-#include "lodrefine/core/refine.h"
 
 namespace lodrefine {
 namespace {
@@ -30,7 +30,6 @@ using json = nlohmann::ordered_json;
 constexpr std::size_t kMaxSequenceHeader = 1 << 20;
 // Buildings in flight per thread of the pool (see in_order_pool).
 constexpr int kItemsPerJob = 16;
-
 
 // The outcome of one building in the three words of the report, with its reason: anything
 // refine_building does not call "refined" is kept (its original geometry stays), and a kept
@@ -46,7 +45,8 @@ CityBuildingOutcome classify(const RefineResult& r) {
   o.reason = r.reason.empty() ? std::string(outcome_name(r.outcome)) : r.reason;
   if (r.trace.judgement && !r.trace.judgement->ok) o.refused_by = r.trace.judgement->check;
   // A crop that only grazes the building (its box's edge): no wall of it faces a scan plane.
-  const bool no_facade = (r.trace.planes && r.trace.planes->empty()) || (r.trace.matching && r.trace.matching->walls.empty());
+  const bool no_facade =
+      (r.trace.planes && r.trace.planes->empty()) || (r.trace.matching && r.trace.matching->walls.empty());
   if (o.outcome == "kept" && no_facade) o.reason = "scan covers no facade of this building";
   if (!r.valid && r.outcome != Outcome::KeptInvalid)
     o.reason += " (not valid: " + r.trace.output_validation.problem + ")";
@@ -65,7 +65,8 @@ CityJsonTransform transform_of(const json& header) {
   CityJsonTransform t;
   const json& j = header.at("transform");
   t.scale = Vec3(j.at("scale")[0].get<double>(), j.at("scale")[1].get<double>(), j.at("scale")[2].get<double>());
-  t.translate = Vec3(j.at("translate")[0].get<double>(), j.at("translate")[1].get<double>(), j.at("translate")[2].get<double>());
+  t.translate =
+      Vec3(j.at("translate")[0].get<double>(), j.at("translate")[1].get<double>(), j.at("translate")[2].get<double>());
   return t;
 }
 
@@ -73,7 +74,7 @@ CityJsonTransform transform_of(const json& header) {
 // crop is its own, refine_building keeps its state per call: CGAL's default random generator
 // and GLPK's environment are thread-local, see ARCHITECTURE.md).
 struct BuildingJob {
-  std::size_t index = 0;  // in the document's buildings
+  std::size_t index = 0;    // in the document's buildings
   bool has_points = false;  // or refused: either way the building gets an outcome
   std::string refused;      // why its crop target was refused (e.g. an absurd extent)
   PointCloud cloud;
@@ -150,8 +151,8 @@ void apply_job(json& doc, const CityJsonTransform& tf, const CityJsonBuilding& b
 // building does not idle the other threads while its successors wait to be given in order
 // (the crops are in memory anyway; what waits is their refined meshes).
 template <class Item>
-void in_order_pool(int jobs, const std::function<std::shared_ptr<Item>()>& take,
-                   const std::function<void(Item&)>& work, const std::function<void(Item&)>& give) {
+void in_order_pool(int jobs, const std::function<std::shared_ptr<Item>()>& take, const std::function<void(Item&)>& work,
+                   const std::function<void(Item&)>& give) {
   if (jobs <= 1) {
     while (auto item = take()) {
       work(*item);
@@ -166,18 +167,14 @@ void in_order_pool(int jobs, const std::function<std::shared_ptr<Item>()>& take,
   arena.execute([&] {
     tbb::parallel_pipeline(
         std::size_t(kItemsPerJob * jobs),
-        tbb::make_filter<void, Ptr>(tbb::filter_mode::serial_in_order,
-                                    [&](tbb::flow_control& fc) {
-                                      Ptr item = take();
-                                      if (!item) fc.stop();
-                                      return item;
-                                    }) &
-            tbb::make_filter<Ptr, Ptr>(tbb::filter_mode::parallel,
-                                       [&](Ptr item) {
-                                         work(*item);
-                                         return item;
-                                       }) &
-            tbb::make_filter<Ptr, void>(tbb::filter_mode::serial_in_order, [&](Ptr item) { give(*item); }));
+        tbb::make_filter<void, Ptr>(tbb::filter_mode::serial_in_order, [&](tbb::flow_control& fc) {
+          Ptr item = take();
+          if (!item) fc.stop();
+          return item;
+        }) & tbb::make_filter<Ptr, Ptr>(tbb::filter_mode::parallel, [&](Ptr item) {
+          work(*item);
+          return item;
+        }) & tbb::make_filter<Ptr, void>(tbb::filter_mode::serial_in_order, [&](Ptr item) { give(*item); }));
   });
 }
 
@@ -352,7 +349,8 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
                                   const std::string& out_path, const Params& params, const CityRefineOptions& options) {
   CityRefineSummary sum;
   sum.input_format = "CityJSONSeq " + header.value("version", std::string("?"));
-  if (!header.contains("transform")) throw InputError(model_path + ": line 1: a CityJSONSeq header needs a \"transform\"");
+  if (!header.contains("transform"))
+    throw InputError(model_path + ": line 1: a CityJSONSeq header needs a \"transform\"");
   // The header checked by the reader (transform shape, scale) before transform_of trusts it.
   read_cityjson_document(feature_document(header, {{"CityObjects", json::object()}, {"vertices", json::array()}}),
                          model_path + ": line 1");
@@ -432,7 +430,8 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
         json feature = parse_feature(job.text, where);
         const CityJsonFile f = read_cityjson_document(feature_document(header, feature), where, options.lod);
         if (upgrade) upgrade_objects(feature["CityObjects"]);
-        refine_document(feature, tf, f.buildings, targets, target_of, job.first, params, 1, options.on_building, job.part, {});
+        refine_document(feature, tf, f.buildings, targets, target_of, job.first, params, 1, options.on_building,
+                        job.part, {});
         job.text = feature.dump(-1, ' ', false, json::error_handler_t::replace) + "\n";
       },
       [&](FeatureJob& job) {
@@ -447,7 +446,8 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
 
 }  // namespace
 
-json cityjson_solid(const Mesh& mesh, const std::string& lod, const Vec3& scale, const Vec3& translate, json& vertices) {
+json cityjson_solid(const Mesh& mesh, const std::string& lod, const Vec3& scale, const Vec3& translate,
+                    json& vertices) {
   const long long base = (long long)vertices.size();
   for (const auto& p : mesh.vertices) {
     json q = json::array();
@@ -494,7 +494,8 @@ CityRefineSummary refine_city(const std::string& model_path, const std::string& 
   } else {
     const std::string text = read_text(model_path);
     doc = parse_city_json(text, model_path);
-    format = "CityJSON " + (doc.contains("version") && doc["version"].is_string() ? doc["version"].get<std::string>() : "?");
+    format =
+        "CityJSON " + (doc.contains("version") && doc["version"].is_string() ? doc["version"].get<std::string>() : "?");
   }
   const CityJsonFile file = read_cityjson_document(doc, model_path, options.lod);
   sum.input_format = format;
@@ -519,8 +520,8 @@ CityRefineSummary refine_city(const std::string& model_path, const std::string& 
     upgrade_objects(doc["CityObjects"]);
   }
   ensure_transform(doc);
-  refine_document(doc, transform_of(doc), file.buildings, targets, target_of, 0, params, options.jobs, options.on_building, sum,
-                  options.progress);
+  refine_document(doc, transform_of(doc), file.buildings, targets, target_of, 0, params, options.jobs,
+                  options.on_building, sum, options.progress);
   sum.seconds_refine = seconds_since(t);
 
   t = Clock::now();

@@ -203,7 +203,8 @@ class Converter {
     for (unsigned i = 0; i < g.getPolygonsCount(); ++i) {
       const auto p = g.getPolygon(i);
       // Rings libcitygml could not read (bad posList) come back empty: no surface.
-      if (!p || !p->exteriorRing() || p->exteriorRing()->getVertices().size() < 3 || !seen.insert(p.get()).second) continue;
+      if (!p || !p->exteriorRing() || p->exteriorRing()->getVertices().size() < 3 || !seen.insert(p.get()).second)
+        continue;
       json surface = json::array({ring(*p->exteriorRing())});
       for (const auto& hole : p->interiorRings())
         if (hole) surface.push_back(ring(*hole));
@@ -217,7 +218,8 @@ class Converter {
     for (const auto& v : r.getVertices()) {
       const Vec3 p(v.x, v.y, v.z);
       if (!p.allFinite() || p.cwiseAbs().maxCoeff() > kMaxCoordinate)
-        throw InputError(path_ + ": a vertex of ring " + (generated_id(r.getId()) ? std::string("(no id)") : r.getId()) +
+        throw InputError(path_ + ": a vertex of ring " +
+                         (generated_id(r.getId()) ? std::string("(no id)") : r.getId()) +
                          " is not finite or beyond 1e9 m");
       const auto q = transform_.quantise(p);
       auto [it, added] = index_.emplace(q, int(vertices_.size()));
@@ -288,7 +290,7 @@ nlohmann::ordered_json citygml_to_cityjson(const std::string& path, std::string*
   if (citygml_version) *citygml_version = version;
 
   citygml::ParserParams params;
-  params.tesselate = false;   // keep polygons as written (rings, not triangles)
+  params.tesselate = false;    // keep polygons as written (rings, not triangles)
   params.keepVertices = true;  // rings keep their vertices after finishing
   const auto logger = std::make_shared<Logger>();
   std::shared_ptr<const citygml::CityModel> model;

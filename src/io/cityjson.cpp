@@ -98,7 +98,8 @@ class Reader {
   }
 
   void read_header(const json& root, CityJsonFile& out) {
-    if (!root.is_object() || member(root, "type") != "CityJSON") fail("not a CityJSON file (no \"type\": \"CityJSON\")");
+    if (!root.is_object() || member(root, "type") != "CityJSON")
+      fail("not a CityJSON file (no \"type\": \"CityJSON\")");
     const json& version = member(root, "version");
     if (version.is_string()) out.version = version.get<std::string>();
     if (root.contains("transform")) {
@@ -219,14 +220,10 @@ class Reader {
   void read_geometry(const json& g, const std::vector<Vec3>& vertices, CityJsonBuilding& b) {
     const std::string type = g["type"].get<std::string>();
     int depth = 0;  // array levels above a surface: 1 MultiSurface, 2 Solid, 3 MultiSolid
-    if (type == "MultiSurface" || type == "CompositeSurface")
-      depth = 1;
-    else if (type == "Solid")
-      depth = 2;
-    else if (type == "MultiSolid" || type == "CompositeSolid")
-      depth = 3;
-    else
-      fail("LoD " + b.lod + " geometry type \"" + one_line(type, 30) + "\" is not a surface or solid type");
+    if (type == "MultiSurface" || type == "CompositeSurface") depth = 1;
+    else if (type == "Solid") depth = 2;
+    else if (type == "MultiSolid" || type == "CompositeSolid") depth = 3;
+    else fail("LoD " + b.lod + " geometry type \"" + one_line(type, 30) + "\" is not a surface or solid type");
     const json& boundaries = member(g, "boundaries");
     if (!boundaries.is_array()) fail(type + " has no \"boundaries\" array");
 
@@ -298,10 +295,12 @@ class Reader {
       const json& jr = surface[r];
       if (!jr.is_array()) fail(type + " boundaries are not nested as the type needs");
       for (const json& ji : jr) {
-        if (!ji.is_number_integer() && !ji.is_number_unsigned()) fail(type + " boundaries are not nested as the type needs");
+        if (!ji.is_number_integer() && !ji.is_number_unsigned())
+          fail(type + " boundaries are not nested as the type needs");
         const long long i = ji.get<long long>();
         if (i < 0 || i >= static_cast<long long>(vertices.size()))
-          fail("vertex index " + std::to_string(i) + " is out of range (" + std::to_string(vertices.size()) + " vertices)");
+          fail("vertex index " + std::to_string(i) + " is out of range (" + std::to_string(vertices.size()) +
+               " vertices)");
         if (r == 0) ring.push_back(int(i));
       }
     }
@@ -359,8 +358,8 @@ class Reader {
     for (int i : ring)
       if (r.empty() || r.back() != i) r.push_back(i);
     while (r.size() > 1 && r.front() == r.back()) r.pop_back();
-    std::vector<int> walk;                      // the open part of the walk: distinct vertices
-    std::unordered_map<int, std::size_t> at;   // vertex -> its position in walk
+    std::vector<int> walk;                    // the open part of the walk: distinct vertices
+    std::unordered_map<int, std::size_t> at;  // vertex -> its position in walk
     for (int v : r) {
       const auto it = at.find(v);
       if (it == at.end()) {
@@ -440,7 +439,8 @@ CityJsonFile parse_cityjson(const std::string& text, const std::string& name, co
   return Reader(name, lod).read(text);
 }
 
-CityJsonFile read_cityjson_document(const nlohmann::ordered_json& doc, const std::string& name, const std::string& lod) {
+CityJsonFile read_cityjson_document(const nlohmann::ordered_json& doc, const std::string& name,
+                                    const std::string& lod) {
   return Reader(name, lod).read_document(doc);
 }
 

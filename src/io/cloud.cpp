@@ -4,9 +4,9 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "lodrefine/io/ply.h"
 #include "lodrefine/io/files.h"
 #include "lodrefine/io/las.h"
+#include "lodrefine/io/ply.h"
 
 namespace lodrefine {
 
@@ -55,7 +55,8 @@ std::string overlap_problem(const Eigen::AlignedBox3d& cloud, const Eigen::Align
                             double margin) {
   if (cloud.isEmpty() || model.isEmpty()) return {};
   const Eigen::AlignedBox2d c(cloud.min().head<2>(), cloud.max().head<2>());
-  const Eigen::AlignedBox2d m(model.min().head<2>() - Vec2::Constant(margin), model.max().head<2>() + Vec2::Constant(margin));
+  const Eigen::AlignedBox2d m(model.min().head<2>() - Vec2::Constant(margin),
+                              model.max().head<2>() + Vec2::Constant(margin));
   if (c.intersects(m)) return {};
   const auto range = [](const Eigen::AlignedBox3d& b) {
     char s[160];

@@ -4,8 +4,8 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -15,8 +15,8 @@
 #include <unordered_map>
 
 #include "lodrefine/core/geometry.h"
-#include "lodrefine/io/files.h"
 #include "lodrefine/core/topology.h"
+#include "lodrefine/io/files.h"
 #include "lodrefine/io/ply.h"
 
 namespace lodrefine {
@@ -158,11 +158,14 @@ std::size_t crop_tile_to_files(const std::string& tile, const std::vector<CropTa
   };
   std::size_t n = 0;
   try {
-    n = for_each_hit(tile, targets, options, nullptr, [&](std::size_t i, const Vec3& p) {
-      held[i].push_back(p);
-      ++counts[i];
-      if (++in_memory > buffer_points) flush_all();
-    }, on_read);
+    n = for_each_hit(
+        tile, targets, options, nullptr,
+        [&](std::size_t i, const Vec3& p) {
+          held[i].push_back(p);
+          ++counts[i];
+          if (++in_memory > buffer_points) flush_all();
+        },
+        on_read);
     for (std::size_t i = 0; i < targets.size(); ++i) {
       PointCloud cloud;
       cloud.points = unspill(spills[i]);

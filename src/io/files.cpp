@@ -124,7 +124,8 @@ void require_regular_file(const std::string& path) {
 }
 
 bool same_file(const std::string& a, const std::string& b) {
-  struct stat sa {}, sb {};
+  struct stat sa {
+  }, sb{};
   const bool has_a = ::stat(a.c_str(), &sa) == 0, has_b = ::stat(b.c_str(), &sb) == 0;
   if (has_a && has_b) return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
   if (has_a != has_b) return false;
@@ -172,9 +173,7 @@ bool is_safe_name(const std::string& name) {
   return true;
 }
 
-std::string safe_name(const std::string& id) {
-  return is_safe_name(id) ? id : hashed_name(id);
-}
+std::string safe_name(const std::string& id) { return is_safe_name(id) ? id : hashed_name(id); }
 
 SafeNames::SafeNames(const std::vector<std::string>& reserved) {
   for (const auto& r : reserved) taken_.insert(lower(r));

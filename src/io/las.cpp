@@ -11,9 +11,9 @@
 #include <fstream>
 #include <optional>
 
+#include "laz.h"
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/io/files.h"
-#include "laz.h"
 #include "text.h"
 
 namespace lodrefine {
@@ -44,7 +44,6 @@ void put_le(std::string& out, T v) {
 Vec3 get_vec(const unsigned char* p, int stride) {
   return {get_le<double>(p), get_le<double>(p + stride), get_le<double>(p + 2 * stride)};
 }
-
 
 // The LASzip VLR's payload, when one of the VLRs between the header and the point data is
 // "laszip encoded" (record 22204): that marks LAZ even when a tool cleared the format bits.
@@ -89,8 +88,9 @@ Parsed parse_header(const std::string& path, std::ifstream& in, std::uint64_t fi
   if (h.version_major != 1 || h.version_minor > 4)
     fail(path, "unsupported LAS version " + std::to_string(h.version_major) + "." + std::to_string(h.version_minor) +
                    " (1.0–1.4 are read)");
-  const std::uint32_t min_header =
-      h.version_minor >= 4 ? kHeaderSize14 : h.version_minor == 3 ? kHeaderSize13 : kHeaderSize12;
+  const std::uint32_t min_header = h.version_minor >= 4   ? kHeaderSize14
+                                   : h.version_minor == 3 ? kHeaderSize13
+                                                          : kHeaderSize12;
   h.header_size = get_le<std::uint16_t>(b + 94);
   h.point_offset = get_le<std::uint32_t>(b + 96);
   const std::uint32_t vlr_count = get_le<std::uint32_t>(b + 100);
@@ -109,7 +109,8 @@ Parsed parse_header(const std::string& path, std::ifstream& in, std::uint64_t fi
                    std::to_string(file_size) + " bytes; truncated?)");
   std::optional<std::string> vlr = laszip_vlr(in, h, vlr_count);
   h.compressed = (b[104] & kCompressedBits) != 0 || vlr.has_value();
-  if (h.compressed && !vlr) fail(path, "compressed point format bits set but no LASzip VLR (\"laszip encoded\", 22204)");
+  if (h.compressed && !vlr)
+    fail(path, "compressed point format bits set but no LASzip VLR (\"laszip encoded\", 22204)");
   if (format_id > 10) fail(path, "unknown point data format " + std::to_string(format_id) + " (0–10 are defined)");
   h.point_format = format_id;
   const std::uint32_t min_record = las_min_record_length(format_id);
@@ -129,7 +130,8 @@ Parsed parse_header(const std::string& path, std::ifstream& in, std::uint64_t fi
   const std::uint64_t data_bytes = file_size - h.point_offset;
   if (!h.compressed && h.point_count > data_bytes / h.record_length)
     fail(path, "header declares " + std::to_string(h.point_count) + " points of " + std::to_string(h.record_length) +
-                   " bytes but the file holds only " + std::to_string(data_bytes) + " bytes of point data (truncated?)");
+                   " bytes but the file holds only " + std::to_string(data_bytes) +
+                   " bytes of point data (truncated?)");
 
   h.scale = get_vec(b + 131, 8);
   h.offset = get_vec(b + 155, 8);
@@ -218,8 +220,9 @@ void write_las(const std::string& path, const PointCloud& cloud, const std::vect
   if (record > 0xffff) throw std::invalid_argument("write_las: record length over 65535");
   if (!classes.empty() && classes.size() != cloud.points.size())
     throw std::invalid_argument("write_las: one class per point");
-  const std::uint32_t header =
-      o.version_minor == 4 ? kHeaderSize14 : o.version_minor == 3 ? kHeaderSize13 : kHeaderSize12;
+  const std::uint32_t header = o.version_minor == 4   ? kHeaderSize14
+                               : o.version_minor == 3 ? kHeaderSize13
+                                                      : kHeaderSize12;
   const std::uint64_t n = cloud.points.size();
   Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();
   if (n > 0) {
@@ -263,7 +266,8 @@ void write_las(const std::string& path, const PointCloud& cloud, const std::vect
     const std::size_t start = out.size();
     for (int a = 0; a < 3; ++a) {
       const double q = std::round((cloud.points[i][a] - o.offset[a]) / o.scale[a]);
-      if (!(std::abs(q) <= 2147483647.0)) throw std::invalid_argument("write_las: coordinate does not fit scale/offset");
+      if (!(std::abs(q) <= 2147483647.0))
+        throw std::invalid_argument("write_las: coordinate does not fit scale/offset");
       put_le<std::int32_t>(out, std::int32_t(q));
     }
     out.append(record - 12, '\0');

@@ -67,8 +67,8 @@ class ChunkTable {
       : layout_(layout) {
     // An entry takes at most a few bytes; the table never needs more than this many.
     const std::uint64_t start = layout.table_offset + 8;
-    const std::uint64_t want = std::min<std::uint64_t>(file_size - std::min(file_size, start),
-                                                       16 * std::uint64_t(layout.chunk_count) + 64);
+    const std::uint64_t want =
+        std::min<std::uint64_t>(file_size - std::min(file_size, start), 16 * std::uint64_t(layout.chunk_count) + 64);
     bytes_.resize(std::size_t(want));
     if (!read_at(in, start, bytes_.data(), bytes_.size())) fail(path, "read error in the LAZ chunk table");
     reader_.emplace(bytes_.data(), bytes_.data() + bytes_.size());
@@ -78,7 +78,8 @@ class ChunkTable {
   std::pair<std::uint32_t, std::uint32_t> next() {
     if (!started_) dec_->init(), started_ = true;
     std::uint32_t count = layout_.chunk_size;
-    if (layout_.chunk_size == kVariableChunks) count = prev_count_ = std::uint32_t(ic_.decode(*dec_, std::int32_t(prev_count_), 0));
+    if (layout_.chunk_size == kVariableChunks)
+      count = prev_count_ = std::uint32_t(ic_.decode(*dec_, std::int32_t(prev_count_), 0));
     prev_bytes_ = std::uint32_t(ic_.decode(*dec_, std::int32_t(prev_bytes_), 1));
     return {count, prev_bytes_};
   }

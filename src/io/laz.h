@@ -29,9 +29,9 @@ struct Item {
 // The parts of the LAZ VLR and chunk table the decoder needs, checked against the file.
 struct Layout {
   std::uint16_t compressor = 0;
-  std::uint32_t chunk_size = 0;      // points per chunk; kVariableChunks: sizes in the table
-  std::vector<Item> items;           // in record order; their sizes add up to the record length
-  std::uint64_t table_offset = 0;    // byte offset of the chunk table header
+  std::uint32_t chunk_size = 0;    // points per chunk; kVariableChunks: sizes in the table
+  std::vector<Item> items;         // in record order; their sizes add up to the record length
+  std::uint64_t table_offset = 0;  // byte offset of the chunk table header
   std::uint32_t chunk_count = 0;
 };
 constexpr std::uint32_t kVariableChunks = 0xffffffffu;

@@ -37,10 +37,10 @@ class ByteReader {
   const unsigned char* end_;
 };
 
-constexpr std::uint32_t kMinLength = 0x01000000u;   // renormalise below this interval length
-constexpr std::uint32_t kBitLengthShift = 13;       // bit models: probabilities of 13 bits
+constexpr std::uint32_t kMinLength = 0x01000000u;  // renormalise below this interval length
+constexpr std::uint32_t kBitLengthShift = 13;      // bit models: probabilities of 13 bits
 constexpr std::uint32_t kBitMaxCount = 1u << 13;
-constexpr std::uint32_t kSymbolLengthShift = 15;    // symbol models: distributions of 15 bits
+constexpr std::uint32_t kSymbolLengthShift = 15;  // symbol models: distributions of 15 bits
 constexpr std::uint32_t kSymbolMaxCount = 1u << 15;
 
 // Adaptive model of one binary decision.

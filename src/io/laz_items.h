@@ -16,8 +16,16 @@ namespace lodrefine::laz {
 
 // Item types of the LASzip VLR.
 enum ItemType : std::uint16_t {
-  kByte = 0, kPoint10 = 6, kGpsTime11 = 7, kRgb12 = 8, kWavePacket13 = 9,
-  kPoint14 = 10, kRgb14 = 11, kRgbNir14 = 12, kWavePacket14 = 13, kByte14 = 14
+  kByte = 0,
+  kPoint10 = 6,
+  kGpsTime11 = 7,
+  kRgb12 = 8,
+  kWavePacket13 = 9,
+  kPoint14 = 10,
+  kRgb14 = 11,
+  kRgbNir14 = 12,
+  kWavePacket14 = 13,
+  kByte14 = 14
 };
 
 // Median of the last five values, kept sorted with LASzip's insertion rule.
@@ -159,7 +167,8 @@ struct RgbModels {
 
 // One colour: which bytes changed (bit 6: green and blue differ from red), then each changed
 // byte as a correction of a prediction from red's change.
-inline std::array<std::uint32_t, 3> decode_rgb(ArithmeticDecoder& dec, RgbModels& m, const std::array<std::uint32_t, 3>& last) {
+inline std::array<std::uint32_t, 3> decode_rgb(ArithmeticDecoder& dec, RgbModels& m,
+                                               const std::array<std::uint32_t, 3>& last) {
   const std::uint32_t sym = dec.symbol(m.byte_used);
   std::array<std::uint32_t, 3> c{};
   const auto clamp8 = [](int v) { return std::uint32_t(std::clamp(v, 0, 255)); };
@@ -189,7 +198,9 @@ inline std::array<std::uint32_t, 3> decode_rgb(ArithmeticDecoder& dec, RgbModels
   return c;
 }
 
-inline std::array<std::uint32_t, 3> get_rgb(const unsigned char* p) { return {get_u16(p), get_u16(p + 2), get_u16(p + 4)}; }
+inline std::array<std::uint32_t, 3> get_rgb(const unsigned char* p) {
+  return {get_u16(p), get_u16(p + 2), get_u16(p + 4)};
+}
 inline void put_rgb(unsigned char* p, const std::array<std::uint32_t, 3>& c) {
   for (int i = 0; i < 3; ++i) put_u16(p + 2 * i, std::uint16_t(c[i]));
 }

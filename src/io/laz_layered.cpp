@@ -116,7 +116,8 @@ class Point14Decoder {
       put_u32(p + 8, std::uint32_t(c.last_z[level]));
     }
     if (layers_[kClass].present())
-      p[16] = (unsigned char)layers_[kClass]->symbol(c.classification[unsigned(r == 1 && r >= n) | (p[16] & 0x1f) << 1]);
+      p[16] =
+          (unsigned char)layers_[kClass]->symbol(c.classification[unsigned(r == 1 && r >= n) | (p[16] & 0x1f) << 1]);
     if (layers_[kFlags].present()) {
       const unsigned merged = (p[15] & 15) | (p[15] >> 6 & 1) << 4 | (p[15] >> 7) << 5;
       const std::uint32_t f = layers_[kFlags]->symbol(c.flags[merged]);
@@ -128,9 +129,11 @@ class Point14Decoder {
       put_u16(p + 12, c.last_intensity[i]);
     }
     if (changed & 8)
-      put_u16(p + 18, std::uint16_t(c.ic_scan_angle.decode(*layers_[kScanAngle], std::int16_t(get_u16(p + 18)), gps_changed)));
+      put_u16(p + 18,
+              std::uint16_t(c.ic_scan_angle.decode(*layers_[kScanAngle], std::int16_t(get_u16(p + 18)), gps_changed)));
     if (layers_[kUserData].present()) p[17] = (unsigned char)layers_[kUserData]->symbol(c.user_data[p[17] / 4]);
-    if (changed & 32) put_u16(p + 20, std::uint16_t(c.ic_point_source.decode(*layers_[kPointSource], get_u16(p + 20), 0)));
+    if (changed & 32)
+      put_u16(p + 20, std::uint16_t(c.ic_point_source.decode(*layers_[kPointSource], get_u16(p + 20), 0)));
     if (gps_changed) c.time.next(*layers_[kGpsTime], p + 22);
     c.gps_changed = gps_changed;
     std::memcpy(out, p, 30);

@@ -12,10 +12,10 @@ namespace {
 // Context tables of POINT10 v2 by (number of returns, return number): 16 contexts for the
 // intensity and x/y medians, 8 levels for the z prediction. Files that number returns from 0
 // or swap the two fields still get distinct contexts.
-constexpr unsigned char kReturnMap[8][8] = {
-    {15, 14, 13, 12, 11, 10, 9, 8}, {14, 0, 1, 3, 6, 10, 10, 9},    {13, 1, 2, 4, 7, 11, 11, 10},
-    {12, 3, 4, 5, 8, 12, 12, 11},   {11, 6, 7, 8, 9, 13, 13, 12},   {10, 10, 11, 12, 13, 14, 14, 13},
-    {9, 10, 11, 12, 13, 14, 15, 14}, {8, 9, 10, 11, 12, 13, 14, 15}};
+constexpr unsigned char kReturnMap[8][8] = {{15, 14, 13, 12, 11, 10, 9, 8},  {14, 0, 1, 3, 6, 10, 10, 9},
+                                            {13, 1, 2, 4, 7, 11, 11, 10},    {12, 3, 4, 5, 8, 12, 12, 11},
+                                            {11, 6, 7, 8, 9, 13, 13, 12},    {10, 10, 11, 12, 13, 14, 14, 13},
+                                            {9, 10, 11, 12, 13, 14, 15, 14}, {8, 9, 10, 11, 12, 13, 14, 15}};
 constexpr unsigned char kReturnLevel[8][8] = {
     {0, 1, 2, 3, 4, 5, 6, 7}, {1, 0, 1, 2, 3, 4, 5, 6}, {2, 1, 0, 1, 2, 3, 4, 5}, {3, 2, 1, 0, 1, 2, 3, 4},
     {4, 3, 2, 1, 0, 1, 2, 3}, {5, 4, 3, 2, 1, 0, 1, 2}, {6, 5, 4, 3, 2, 1, 0, 1}, {7, 6, 5, 4, 3, 2, 1, 0}};
@@ -97,7 +97,8 @@ class BytesDecoder {
     std::copy(out, out + last_.size(), last_.begin());
   }
   void next(ArithmeticDecoder& dec, unsigned char* out) {
-    for (std::size_t i = 0; i < last_.size(); ++i) out[i] = last_[i] = (unsigned char)(last_[i] + dec.symbol(models_[i]));
+    for (std::size_t i = 0; i < last_.size(); ++i)
+      out[i] = last_[i] = (unsigned char)(last_[i] + dec.symbol(models_[i]));
   }
 
  private:

@@ -48,8 +48,8 @@ struct CheckedObj {
   std::vector<int> face_lines;  // line of each `f` with at least one vertex, in file order
   int empty_faces = 0;          // `f` without any vertex (tinyobjloader does not report them)
   std::vector<Vec3> vertices;
-  std::string object;           // the first `o` name, as written (tinyobjloader sees plain blanks)
-  std::string comment_id;       // `# id: X`
+  std::string object;      // the first `o` name, as written (tinyobjloader sees plain blanks)
+  std::string comment_id;  // `# id: X`
 };
 
 // The strict line check. Line by line it refuses what the reader does not accept: binary
@@ -100,8 +100,9 @@ class ObjCheck {
     const std::string_view kw = tok[0];
     if (kw == "v") vertex(tok);
     else if (kw == "f") face(tok);
-    else if (kw == "o") { if (out_.object.empty()) out_.object = trim(line.substr(1)); }
-    else if (kw != "g" && kw != "usemtl" && !ignored(kw)) fail_line("unknown statement " + quote(kw));
+    else if (kw == "o") {
+      if (out_.object.empty()) out_.object = trim(line.substr(1));
+    } else if (kw != "g" && kw != "usemtl" && !ignored(kw)) fail_line("unknown statement " + quote(kw));
   }
 
   // To tinyobjloader every blank is ' ' (it splits at ' ' and '\t' only, and also ends lines at
@@ -112,7 +113,7 @@ class ObjCheck {
   }
 
   static bool ignored(std::string_view kw) {
-    static const std::array<std::string_view, 10> kws = {"vt", "vn", "vp",  "s",  "mtllib",
+    static const std::array<std::string_view, 10> kws = {"vt", "vn", "vp", "s",   "mtllib",
                                                          "l",  "p",  "mg", "lod", "usemap"};
     for (auto k : kws)
       if (kw == k) return true;
@@ -201,7 +202,7 @@ class ObjBuild {
  private:
   void face(const tinyobj::index_t* idx, int n) {
     if (faces_seen_++ >= checked_.face_lines.size()) return;  // a disagreement, reported by finish()
-    if (n < 3) {  // a point or a line is no polygon; counted, not fatal
+    if (n < 3) {                                              // a point or a line is no polygon; counted, not fatal
       ++skipped_;
       return;
     }
@@ -222,18 +223,19 @@ class ObjBuild {
     if (faces_seen_ != checked_.face_lines.size() || vertices_seen_ != checked_.vertices.size())
       throw std::logic_error(path_ + ": tinyobjloader read " + std::to_string(vertices_seen_) + " vertices and " +
                              std::to_string(faces_seen_) + " faces, the line check " +
-                             std::to_string(checked_.vertices.size()) + " and " + std::to_string(checked_.face_lines.size()));
+                             std::to_string(checked_.vertices.size()) + " and " +
+                             std::to_string(checked_.face_lines.size()));
     mesh_.vertices = std::move(checked_.vertices);
     skipped_ += checked_.empty_faces;
     const std::size_t n = mesh_.vertices.size();
     for (std::size_t k = 0; k < mesh_.faces.size(); ++k)
       for (int i : mesh_.faces[k].v)
         if (i < 0 || std::size_t(i) >= n)
-          fail(path_, "line " + std::to_string(kept_lines_[k]) + ": face index " + std::to_string(i + 1) + " out of range (" +
-                          std::to_string(n) + " vertices)");
+          fail(path_, "line " + std::to_string(kept_lines_[k]) + ": face index " + std::to_string(i + 1) +
+                          " out of range (" + std::to_string(n) + " vertices)");
     if (mesh_.faces.empty())
-      fail(path_, skipped_ ? "no faces with 3 or more vertices (" + std::to_string(skipped_) + " skipped)"
-                           : "no faces");
+      fail(path_,
+           skipped_ ? "no faces with 3 or more vertices (" + std::to_string(skipped_) + " skipped)" : "no faces");
     mesh_.id = !checked_.object.empty()       ? checked_.object
                : !checked_.comment_id.empty() ? checked_.comment_id
                                               : std::filesystem::path(path_).stem().string();
@@ -264,10 +266,8 @@ std::string obj_text(const Mesh& mesh, const Vec3& origin, AtomicFile& file) {
     const auto u = static_cast<unsigned char>(c);
     return (u < 0x20 && c != '\t') || u == 0x7f;
   });
-  if (token != mesh.id && one_line_id && trim(mesh.id) == mesh.id)
-    out += "# id: " + mesh.id + "\n";
-  else if (!mesh.id.empty())
-    out += "o " + token + "\n";
+  if (token != mesh.id && one_line_id && trim(mesh.id) == mesh.id) out += "# id: " + mesh.id + "\n";
+  else if (!mesh.id.empty()) out += "o " + token + "\n";
   for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
     const Vec3 p = mesh.vertices[i] + origin;
     if (!p.allFinite()) file.fail("vertex " + std::to_string(i) + " is not finite");

@@ -20,10 +20,22 @@ enum class PlyFormat { Ascii, BinaryLE, BinaryBE };
 
 std::optional<PlyType> ply_type(std::string_view s) {
   static const std::array<std::pair<std::string_view, PlyType>, 16> names = {{
-      {"char", PlyType::I8},    {"int8", PlyType::I8},     {"uchar", PlyType::U8},  {"uint8", PlyType::U8},
-      {"short", PlyType::I16},  {"int16", PlyType::I16},   {"ushort", PlyType::U16}, {"uint16", PlyType::U16},
-      {"int", PlyType::I32},    {"int32", PlyType::I32},   {"uint", PlyType::U32},  {"uint32", PlyType::U32},
-      {"float", PlyType::F32},  {"float32", PlyType::F32}, {"double", PlyType::F64}, {"float64", PlyType::F64},
+      {"char", PlyType::I8},
+      {"int8", PlyType::I8},
+      {"uchar", PlyType::U8},
+      {"uint8", PlyType::U8},
+      {"short", PlyType::I16},
+      {"int16", PlyType::I16},
+      {"ushort", PlyType::U16},
+      {"uint16", PlyType::U16},
+      {"int", PlyType::I32},
+      {"int32", PlyType::I32},
+      {"uint", PlyType::U32},
+      {"uint32", PlyType::U32},
+      {"float", PlyType::F32},
+      {"float32", PlyType::F32},
+      {"double", PlyType::F64},
+      {"float64", PlyType::F64},
   }};
   for (const auto& [name, t] : names)
     if (s == name) return t;
@@ -32,9 +44,13 @@ std::optional<PlyType> ply_type(std::string_view s) {
 
 std::size_t type_size(PlyType t) {
   switch (t) {
-    case PlyType::I8: case PlyType::U8: return 1;
-    case PlyType::I16: case PlyType::U16: return 2;
-    case PlyType::I32: case PlyType::U32: case PlyType::F32: return 4;
+    case PlyType::I8:
+    case PlyType::U8: return 1;
+    case PlyType::I16:
+    case PlyType::U16: return 2;
+    case PlyType::I32:
+    case PlyType::U32:
+    case PlyType::F32: return 4;
     default: return 8;
   }
 }
@@ -305,8 +321,8 @@ class PlyReader {
     std::vector<double> vals(el.props.size());
     for (std::uint64_t r = 0; r < el.count; ++r) {
       if (!record(data, el, vals))
-        fail(path_, "data ends after " + std::to_string(r) + " of " + std::to_string(el.count) +
-                        " vertices (truncated)");
+        fail(path_,
+             "data ends after " + std::to_string(r) + " of " + std::to_string(el.count) + " vertices (truncated)");
       const Vec3 p(vals[xyz_[0]], vals[xyz_[1]], vals[xyz_[2]]);
       if (!p.allFinite()) fail(path_, "vertex " + std::to_string(r) + " has a non-finite coordinate");
       if (p.cwiseAbs().maxCoeff() > kMaxCoordinate)

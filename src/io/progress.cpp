@@ -34,12 +34,19 @@ Progress::Mode Progress::mode_for_stderr(bool quiet) {
 
 Progress::Progress(std::string what, std::string unit, std::uint64_t total, Mode mode, Sink sink, Clock clock,
                    double interval, double redraw)
-    : what_(std::move(what)), unit_(std::move(unit)), total_(total), mode_(mode), sink_(std::move(sink)),
-      clock_(std::move(clock)), interval_(interval), redraw_(redraw) {
-  if (!sink_) sink_ = [](const std::string& s) {
-    std::fputs(s.c_str(), stderr);
-    std::fflush(stderr);
-  };
+    : what_(std::move(what)),
+      unit_(std::move(unit)),
+      total_(total),
+      mode_(mode),
+      sink_(std::move(sink)),
+      clock_(std::move(clock)),
+      interval_(interval),
+      redraw_(redraw) {
+  if (!sink_)
+    sink_ = [](const std::string& s) {
+      std::fputs(s.c_str(), stderr);
+      std::fflush(stderr);
+    };
   if (!clock_) clock_ = steady_seconds;
   start_ = last_print_ = clock_();
 }
@@ -60,8 +67,8 @@ std::string Progress::duration_text(double seconds) {
   return printf_text("%.0f h %02.0f min", double(s / 3600), double(s / 60 % 60));
 }
 
-std::string Progress::format(const std::string& what, const std::string& unit, std::uint64_t done,
-                             std::uint64_t total, double seconds, const std::string& tally) {
+std::string Progress::format(const std::string& what, const std::string& unit, std::uint64_t done, std::uint64_t total,
+                             double seconds, const std::string& tally) {
   std::string s = what + ": " + count_text(double(done));
   if (total > 0) s += "/" + count_text(double(total));
   s += " " + unit;
@@ -95,18 +102,14 @@ void Progress::finish() {
   if (finished_) return;
   finished_ = true;
   if (mode_ == Mode::Off || !printed_) return;
-  if (pending_)
-    print(true);
-  else if (mode_ == Mode::Terminal)
-    sink_("\n");  // the line on screen is already the last one
+  if (pending_) print(true);
+  else if (mode_ == Mode::Terminal) sink_("\n");  // the line on screen is already the last one
 }
 
 void Progress::print(bool last) {
   const std::string line = format(what_, unit_, done_, total_, clock_() - start_, tally_);
-  if (mode_ == Mode::Terminal)
-    sink_("\r" + line + kClearToEnd + (last ? "\n" : ""));
-  else
-    sink_(line + "\n");
+  if (mode_ == Mode::Terminal) sink_("\r" + line + kClearToEnd + (last ? "\n" : ""));
+  else sink_(line + "\n");
   printed_ = true;
   pending_ = false;
 }

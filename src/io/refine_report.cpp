@@ -51,9 +51,14 @@ json selection_json(const ShellSelectionStats& st, const std::string& reason) {
 }  // namespace
 
 json validation_json(const Validation& v) {
-  return {{"watertight", v.watertight()}, {"valid", v.valid()}, {"problem", v.problem},
-          {"boundary_edges", v.boundary_edges}, {"nonmanifold_edges", v.nonmanifold_edges},
-          {"outward", v.outward}, {"volume", v.volume}, {"max_planarity_error", v.max_planarity_error},
+  return {{"watertight", v.watertight()},
+          {"valid", v.valid()},
+          {"problem", v.problem},
+          {"boundary_edges", v.boundary_edges},
+          {"nonmanifold_edges", v.nonmanifold_edges},
+          {"outward", v.outward},
+          {"volume", v.volume},
+          {"max_planarity_error", v.max_planarity_error},
           {"self_intersecting", v.self_intersecting}};
 }
 
@@ -87,17 +92,27 @@ json refine_report(const RefineResult& r) {
   if (t.planes) {
     json planes = json::array();
     for (const auto& p : *t.planes)
-      planes.push_back({{"normal", {p.plane.n.x(), p.plane.n.y(), p.plane.n.z()}}, {"d", p.plane.d},
-                        {"inliers", p.inliers.size()}, {"rms", p.rms}, {"area", p.hull_area}, {"facade", p.facade}});
+      planes.push_back({{"normal", {p.plane.n.x(), p.plane.n.y(), p.plane.n.z()}},
+                        {"d", p.plane.d},
+                        {"inliers", p.inliers.size()},
+                        {"rms", p.rms},
+                        {"area", p.hull_area},
+                        {"facade", p.facade}});
     rep["planes"] = planes;
   }
   if (t.matching) {
     json matches = json::array();
     for (const auto& w : t.matching->walls) {
       const Match& m = w.match;
-      matches.push_back({{"scan_plane", m.scan_plane}, {"surface", m.surface}, {"s_normal", m.s_normal},
-                         {"d_centroid", m.d_centroid}, {"c_bbox", m.c_bbox}, {"s_match", m.s_match},
-                         {"points", m.owned.size()}, {"deviation", w.deviation}, {"faces", w.faces}});
+      matches.push_back({{"scan_plane", m.scan_plane},
+                         {"surface", m.surface},
+                         {"s_normal", m.s_normal},
+                         {"d_centroid", m.d_centroid},
+                         {"c_bbox", m.c_bbox},
+                         {"s_match", m.s_match},
+                         {"points", m.owned.size()},
+                         {"deviation", w.deviation},
+                         {"faces", w.faces}});
     }
     rep["matches"] = matches;
     rep["rejected_matches"] = t.matching->rejected;
@@ -114,19 +129,27 @@ json refine_report(const RefineResult& r) {
     rep["replacements"] = steps;
     json facades = json::array();
     for (const auto& f : t.facades)
-      facades.push_back({{"input_faces", f.input_faces}, {"evidence", f.evidence}, {"max_move", f.max_move},
+      facades.push_back({{"input_faces", f.input_faces},
+                         {"evidence", f.evidence},
+                         {"max_move", f.max_move},
                          {"mean_move", f.mean_move}});
     rep["facades"] = facades;
   }
   if (t.judgement) {
     auto fit = [](const Judgement::Fit& f) {
-      return json{{"points", f.points}, {"better", f.better}, {"worse", f.worse}, {"rms_before", f.rms_before},
+      return json{{"points", f.points},
+                  {"better", f.better},
+                  {"worse", f.worse},
+                  {"rms_before", f.rms_before},
                   {"rms_after", f.rms_after}};
     };
     json walls = json::array();
     for (const auto& w : t.judgement->walls) walls.push_back(fit(w));
-    rep["judgement"] = {{"ok", t.judgement->ok}, {"check", t.judgement->check}, {"detail", t.judgement->detail},
-                        {"building", fit(t.judgement->building)}, {"walls", walls}};
+    rep["judgement"] = {{"ok", t.judgement->ok},
+                        {"check", t.judgement->check},
+                        {"detail", t.judgement->detail},
+                        {"building", fit(t.judgement->building)},
+                        {"walls", walls}};
     if (t.corners_refused) rep["judgement"]["corners_refused"] = *t.corners_refused;
   }
   if (t.selection) rep["selection"] = selection_json(*t.selection, t.selection_reason);

@@ -57,7 +57,8 @@ std::string read_whole_file(const std::string& path) {
 
 std::string one_token(const std::string& name) {
   std::string s;
-  for (char c : name) s += std::isspace(static_cast<unsigned char>(c)) || static_cast<unsigned char>(c) < 0x20 ? '_' : c;
+  for (char c : name)
+    s += std::isspace(static_cast<unsigned char>(c)) || static_cast<unsigned char>(c) < 0x20 ? '_' : c;
   return s;
 }
 

@@ -2,13 +2,13 @@
 // (messages, tokens, numbers). Not a public header: nothing outside src/io/ includes it.
 #pragma once
 #include <charconv>
-#include <cstring>
-#include <type_traits>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "lodrefine/core/types.h"

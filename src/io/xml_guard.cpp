@@ -131,8 +131,7 @@ std::optional<std::string> decode_references(std::string_view run) {
     else if (name == "apos") out += '\'';
     else if (const auto c = name.empty() || name[0] != '#' ? std::nullopt : character_reference(name))
       append_utf8(out, *c);
-    else
-      return std::nullopt;
+    else return std::nullopt;
   }
   return out;
 }
@@ -190,8 +189,9 @@ std::size_t markup_end(std::string_view t, std::size_t i, const std::string& pat
     return e == npos ? t.size() : e + close.size();
   };
   if (starts_with(t, i, "<!"))  // comments and CDATA sections are character data's
-    io_text::fail(path, "the XML has a document type or entity declaration (" + io_text::quote(t.substr(i, 24)) +
-                            "): not accepted, CityGML needs none and its entities could read local files or fetch URLs");
+    io_text::fail(path,
+                  "the XML has a document type or entity declaration (" + io_text::quote(t.substr(i, 24)) +
+                      "): not accepted, CityGML needs none and its entities could read local files or fetch URLs");
   if (starts_with(t, i, "<?")) return past("?>", i + 2);
   char quote = 0;  // a tag: its '>' is the first one outside an attribute value
   for (++i; i < t.size(); ++i) {

@@ -181,5 +181,4 @@ std::vector<std::string> add_defects(Mesh& s, Rng& r) {
   return log;
 }
 
-
 }  // namespace lodrefine::synth

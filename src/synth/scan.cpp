@@ -71,7 +71,6 @@ std::vector<int> choose_street(const Mesh& m, const std::vector<WallInfo>& walls
   return chosen;
 }
 
-
 namespace {
 
 // A wall turned more than 45 degrees from the street is seen obliquely (street-facade types).
@@ -252,7 +251,7 @@ void sample_facade(Scene& sc, const ScanWall& w, double noise, Rng& r) {
         scanner = p + sc.scanner_dist * w.street + r.uniform(kObliqueMin, kObliqueMax) * w.n;
         scanner.z() = sc.z0 + 2.2;
         const Vec3 ray = (scanner - p).normalized();
-        if (r.uniform() > ray.dot(w.n)) continue;  // grazing beams return fewer points
+        if (r.uniform() > ray.dot(w.n)) continue;                              // grazing beams return fewer points
         if (crosses_footprint(sc, p + kClearOfWall * w.n, scanner)) continue;  // the building hides it
       }
       if (occluded(sc, scanner, p)) continue;

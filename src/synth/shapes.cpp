@@ -208,28 +208,17 @@ Spec setback_spec(Rng& r, double z0) {
 
 Spec make_spec(BuildingType t, Rng& r, double z0) {
   switch (t) {
-    case BuildingType::Flat:
-      return flat_spec(r, z0);
-    case BuildingType::Gable:
-      return gable_spec(r, z0, false);
-    case BuildingType::Hip:
-      return gable_spec(r, z0, true);
-    case BuildingType::Shed:
-      return shed_spec(r, z0);
-    case BuildingType::Stepped:
-      return stepped_spec(r, z0);
-    case BuildingType::LShape:
-      return lshape_spec(r, z0);
-    case BuildingType::TShape:
-      return tshape_spec(r, z0);
-    case BuildingType::Polygon:
-      return polygon_spec(r, z0);
-    case BuildingType::Recess:
-      return recess_spec(r, z0);
-    case BuildingType::Bay:
-      return bay_spec(r, z0);
-    case BuildingType::Setback:
-      return setback_spec(r, z0);
+    case BuildingType::Flat: return flat_spec(r, z0);
+    case BuildingType::Gable: return gable_spec(r, z0, false);
+    case BuildingType::Hip: return gable_spec(r, z0, true);
+    case BuildingType::Shed: return shed_spec(r, z0);
+    case BuildingType::Stepped: return stepped_spec(r, z0);
+    case BuildingType::LShape: return lshape_spec(r, z0);
+    case BuildingType::TShape: return tshape_spec(r, z0);
+    case BuildingType::Polygon: return polygon_spec(r, z0);
+    case BuildingType::Recess: return recess_spec(r, z0);
+    case BuildingType::Bay: return bay_spec(r, z0);
+    case BuildingType::Setback: return setback_spec(r, z0);
   }
   throw std::logic_error("synth: unknown building type");
 }

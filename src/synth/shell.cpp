@@ -47,7 +47,6 @@ std::vector<Edge> part_edges(const Spec& s, const Part& p) {
   return e;
 }
 
-
 // Counter-clockwise, not self-intersecting and not a sliver (a bay's part is 1.5 m^2 and up).
 bool valid_footprint(const std::vector<Vec2>& poly) {
   const std::size_t n = poly.size();

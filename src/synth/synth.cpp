@@ -45,10 +45,10 @@ void check_options(const SynthOptions& o) {
 
 // Every building type with its name, in the order `--type all` generates them.
 constexpr std::pair<BuildingType, const char*> kBuildingTypes[] = {
-    {BuildingType::Flat, "flat"},       {BuildingType::Gable, "gable"},   {BuildingType::Hip, "hip"},
-    {BuildingType::Shed, "shed"},       {BuildingType::Stepped, "stepped"}, {BuildingType::LShape, "lshape"},
+    {BuildingType::Flat, "flat"},     {BuildingType::Gable, "gable"},     {BuildingType::Hip, "hip"},
+    {BuildingType::Shed, "shed"},     {BuildingType::Stepped, "stepped"}, {BuildingType::LShape, "lshape"},
     {BuildingType::TShape, "tshape"}, {BuildingType::Polygon, "polygon"}, {BuildingType::Recess, "recess"},
-    {BuildingType::Bay, "bay"},         {BuildingType::Setback, "setback"}};
+    {BuildingType::Bay, "bay"},       {BuildingType::Setback, "setback"}};
 }  // namespace
 
 const char* building_type_name(BuildingType t) {

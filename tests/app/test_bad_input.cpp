@@ -35,13 +35,13 @@
 #include <nlohmann/json.hpp>
 
 #include "lodrefine/core/candidates.h"
-#include "lodrefine/io/files.h"
-#include "lodrefine/io/obj.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/refine.h"
-#include "lodrefine/io/refine_report.h"
 #include "lodrefine/core/selection.h"
 #include "lodrefine/core/validate.h"
+#include "lodrefine/io/files.h"
+#include "lodrefine/io/obj.h"
+#include "lodrefine/io/refine_report.h"
 
 using namespace lodrefine;
 
@@ -92,9 +92,8 @@ struct Quad {
   int v[4];
   const char* group;
 };
-const Quad kQuads[6] = {{{0, 3, 2, 1}, "GroundSurface"}, {{4, 5, 6, 7}, "RoofSurface"},
-                        {{0, 1, 5, 4}, "WallSurface"},   {{1, 2, 6, 5}, "WallSurface"},
-                        {{2, 3, 7, 6}, "WallSurface"},   {{3, 0, 4, 7}, "WallSurface"}};
+const Quad kQuads[6] = {{{0, 3, 2, 1}, "GroundSurface"}, {{4, 5, 6, 7}, "RoofSurface"}, {{0, 1, 5, 4}, "WallSurface"},
+                        {{1, 2, 6, 5}, "WallSurface"},   {{2, 3, 7, 6}, "WallSurface"}, {{3, 0, 4, 7}, "WallSurface"}};
 
 // OBJ text of the listed faces of the box (each face its own 4 vertices).
 std::string box_obj(const std::vector<int>& faces = {0, 1, 2, 3, 4, 5}, const std::string& extra = "") {
@@ -126,10 +125,9 @@ std::vector<Vec3> wall_scan(unsigned seed = 1) {
   return pts;
 }
 
-
 std::string ply_header(const std::string& format, std::uint64_t count, const std::string& type = "double") {
-  return "ply\nformat " + format + " 1.0\ncomment test\nelement vertex " + std::to_string(count) + "\nproperty " + type +
-         " x\nproperty " + type + " y\nproperty " + type + " z\nend_header\n";
+  return "ply\nformat " + format + " 1.0\ncomment test\nelement vertex " + std::to_string(count) + "\nproperty " +
+         type + " x\nproperty " + type + " y\nproperty " + type + " z\nend_header\n";
 }
 
 std::string ply_binary(const std::vector<Vec3>& pts, bool big_endian = false) {
@@ -164,7 +162,8 @@ std::string shell_quote(const std::string& s) {
 CliRun run_cli(const std::string& args, const std::string& dir, double timeout_seconds = 300) {
   const std::string out = dir + "/.stdout", err = dir + "/.stderr";
   const std::string cmd = "timeout -k 5 " + std::to_string(int(std::ceil(timeout_seconds))) + " " +
-                          shell_quote(LODREFINE_BINARY) + " " + args + " >" + shell_quote(out) + " 2>" + shell_quote(err);
+                          shell_quote(LODREFINE_BINARY) + " " + args + " >" + shell_quote(out) + " 2>" +
+                          shell_quote(err);
   const auto t0 = std::chrono::steady_clock::now();
   const int st = std::system(cmd.c_str());
   CliRun r;
@@ -235,7 +234,8 @@ class TablePrinter : public testing::Environment {
   void TearDown() override {
     if (table().size() < 2) return;  // one case per process under ctest: its row is printed already
     std::cout << "\n| input | what lodrefine says | exit code |\n| --- | --- | --- |\n";
-    for (const auto& r : table()) std::cout << "| " << cell(r.input) << " | " << cell(r.says) << " | " << r.exit << " |\n";
+    for (const auto& r : table())
+      std::cout << "| " << cell(r.input) << " | " << cell(r.says) << " | " << r.exit << " |\n";
     std::cout << std::flush;
   }
 };
@@ -245,22 +245,22 @@ const testing::Environment* const kTablePrinter = testing::AddGlobalTestEnvironm
 // Cases
 
 enum class Expect {
-  Error,          // refused with one error line, nothing written
-  Kept,           // exit 0, repaired input written, report outcome "kept" (reason in "reason")
-  KeptInvalid,    // exit 0, the input written as read, report outcome "kept-invalid"
-  Refined,        // exit 0, report outcome "refined"
-  Valid,          // exit 0, valid output, any outcome
-  ErrorOrValid,   // either of the first (refused) or a valid written building
+  Error,         // refused with one error line, nothing written
+  Kept,          // exit 0, repaired input written, report outcome "kept" (reason in "reason")
+  KeptInvalid,   // exit 0, the input written as read, report outcome "kept-invalid"
+  Refined,       // exit 0, report outcome "refined"
+  Valid,         // exit 0, valid output, any outcome
+  ErrorOrValid,  // either of the first (refused) or a valid written building
 };
 
 struct Paths {
   std::string dir, model, cloud, out, report;
-  std::string args;  // extra CLI arguments
+  std::string args;                           // extra CLI arguments
   std::string model_arg, cloud_arg, out_arg;  // override the paths on the command line
 };
 
 struct Case {
-  std::string name;       // the table's "input" column
+  std::string name;  // the table's "input" column
   std::function<void(Paths&)> make;
   Expect expect;
   std::string fragment = {};  // must appear in the error line (Error) or the report's reason (Kept*), if set
@@ -295,15 +295,15 @@ std::vector<Case> cases() {
 
   // --- the good path
   c.push_back({"valid box + wall scan 0.4 m off (binary LE doubles)", both_valid, Expect::Refined});
-  c.push_back({"valid box + same scan as ASCII PLY", [](Paths& p) { cloud_is(p, ply_ascii(wall_scan())); },
-               Expect::Refined});
+  c.push_back(
+      {"valid box + same scan as ASCII PLY", [](Paths& p) { cloud_is(p, ply_ascii(wall_scan())); }, Expect::Refined});
   c.push_back({"valid box + same scan as big-endian PLY", [](Paths& p) { cloud_is(p, ply_binary(wall_scan(), true)); },
                Expect::Refined});
 
   // --- malformed models
   c.push_back({"model: empty file (0 bytes)", [](Paths& p) { model_is(p, ""); }, Expect::Error, "empty"});
-  c.push_back({"model: only comments and blank lines", [](Paths& p) { model_is(p, "# nothing\n\n  \n"); },
-               Expect::Error});
+  c.push_back(
+      {"model: only comments and blank lines", [](Paths& p) { model_is(p, "# nothing\n\n  \n"); }, Expect::Error});
   c.push_back({"model: truncated inside a vertex line",
                [box](Paths& p) { model_is(p, box.substr(0, box.find("v ", box.size() / 2) + 9)); }, Expect::Error});
   c.push_back({"model: truncated after the vertices (faces lost)",
@@ -336,9 +336,10 @@ std::vector<Case> cases() {
                                  " 0\nv " + fmt(d.x()) + " " + fmt(d.y()) + " 0\nf -3 -2 -1\n");
                },
                Expect::Refined});
-  c.push_back({"model: only zero-area faces",
-               [](Paths& p) { model_is(p, "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nf 1 2 3\nf 2 3 4\nf 1 2 4\nf 1 3 4\n"); },
-               Expect::KeptInvalid, "usable faces"});
+  c.push_back(
+      {"model: only zero-area faces",
+       [](Paths& p) { model_is(p, "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nf 1 2 3\nf 2 3 4\nf 1 2 4\nf 1 3 4\n"); },
+       Expect::KeptInvalid, "usable faces"});
   c.push_back({"model: self-intersecting (bow-tie) front wall",
                [](Paths& p) {
                  std::string s = box_obj();
@@ -348,14 +349,29 @@ std::vector<Case> cases() {
                  model_is(p, s);
                },
                Expect::ErrorOrValid});
-  c.push_back({"model: just the 4 walls (no roof, no ground)", [](Paths& p) { model_is(p, box_obj({2, 3, 4, 5})); },
+  c.push_back({"model: just the 4 walls (no roof, no ground)",
+               [](Paths& p) {
+                 model_is(p, box_obj({2, 3, 4, 5}));
+               },
                Expect::ErrorOrValid});
-  c.push_back({"model: just 2 walls", [](Paths& p) { model_is(p, box_obj({2, 3})); }, Expect::KeptInvalid, "not closable"});
+  c.push_back({"model: just 2 walls",
+               [](Paths& p) {
+                 model_is(p, box_obj({2, 3}));
+               },
+               Expect::KeptInvalid, "not closable"});
   c.push_back({"model: a single triangle", [](Paths& p) { model_is(p, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"); },
                Expect::KeptInvalid, "usable faces"});
-  c.push_back({"model: binary garbage", [](Paths& p) { model_is(p, std::string("\x7f" "ELF\x02\x01\x01\0\0\0", 10)); },
+  c.push_back({"model: binary garbage",
+               [](Paths& p) {
+                 model_is(p, std::string("\x7f"
+                                         "ELF\x02\x01\x01\0\0\0",
+                                         10));
+               },
                Expect::Error, "binary"});
-  c.push_back({"model: a PLY file given as the model", [](Paths& p) { model_is(p, ply_ascii({{0, 0, 0}})); },
+  c.push_back({"model: a PLY file given as the model",
+               [](Paths& p) {
+                 model_is(p, ply_ascii({{0, 0, 0}}));
+               },
                Expect::Error});
 
   // --- malformed clouds
@@ -420,11 +436,12 @@ std::vector<Case> cases() {
                  cloud_is(p, s);
                },
                Expect::ErrorOrValid});
-  c.push_back({"cloud: no x property",
-               [](Paths& p) {
-                 cloud_is(p, "ply\nformat ascii 1.0\nelement vertex 1\nproperty float y\nproperty float z\nend_header\n1 2\n");
-               },
-               Expect::Error, "no scalar property x"});
+  c.push_back(
+      {"cloud: no x property",
+       [](Paths& p) {
+         cloud_is(p, "ply\nformat ascii 1.0\nelement vertex 1\nproperty float y\nproperty float z\nend_header\n1 2\n");
+       },
+       Expect::Error, "no scalar property x"});
   c.push_back({"cloud: not a PLY (an OBJ)", [](Paths& p) { cloud_is(p, valid_model()); }, Expect::Error, "not a PLY"});
   c.push_back({"cloud: NaN coordinate (binary)",
                [nan](Paths& p) {
@@ -441,10 +458,10 @@ std::vector<Case> cases() {
                },
                Expect::Error, "non-finite"});
   c.push_back({"cloud: 'nan' in an ASCII PLY",
-               [](Paths& p) { cloud_is(p, ply_header("ascii", 2) + "85001 447000 1\nnan 447000 2\n"); }, Expect::Error});
+               [](Paths& p) { cloud_is(p, ply_header("ascii", 2) + "85001 447000 1\nnan 447000 2\n"); },
+               Expect::Error});
   c.push_back({"cloud: 0 points", [](Paths& p) { cloud_is(p, ply_binary({})); }, Expect::Error, "no points"});
-  c.push_back({"cloud: 1 point", [](Paths& p) { cloud_is(p, ply_binary({kOrigin + Vec3(6, 0, 2)})); },
-               Expect::Kept});
+  c.push_back({"cloud: 1 point", [](Paths& p) { cloud_is(p, ply_binary({kOrigin + Vec3(6, 0, 2)})); }, Expect::Kept});
   c.push_back({"cloud: 10 points on the wall",
                [](Paths& p) {
                  std::vector<Vec3> pts;
@@ -492,8 +509,9 @@ std::vector<Case> cases() {
                Expect::Error, "", 10.0});
   c.push_back({"cloud: header count above 2^64 (overflow)",
                [](Paths& p) {
-                 cloud_is(p, "ply\nformat ascii 1.0\nelement vertex 99999999999999999999999\nproperty float x\n"
-                             "property float y\nproperty float z\nend_header\n1 2 3\n");
+                 cloud_is(p,
+                          "ply\nformat ascii 1.0\nelement vertex 99999999999999999999999\nproperty float x\n"
+                          "property float y\nproperty float z\nend_header\n1 2 3\n");
                },
                Expect::Error, "", 10.0});
 
@@ -555,22 +573,23 @@ std::vector<Case> cases() {
     std::sort(files.begin(), files.end());
     for (const auto& f : files) {
       const std::string t = target;
-      c.push_back({"fuzz regression " + t + "/" + f.filename().string(),
-                   [t, f](Paths& p) {
-                     const std::string bytes = read_text(f.string());
-                     if (t == "fuzz_obj") return model_is(p, bytes);
-                     if (t == "fuzz_ply") return cloud_is(p, bytes);
-                     if (bytes.size() < 3) return both_valid(p);
-                     const std::size_t rest = bytes.size() - 3;
-                     const std::size_t len =
-                         (std::size_t(std::uint8_t(bytes[0])) | std::size_t(std::uint8_t(bytes[1])) << 8) % (rest + 1);
-                     write_text(p.model, bytes.substr(3, len));
-                     write_text(p.cloud, bytes.substr(3 + len));
-                     p.args = "--mip-time-limit 1";
-                     if (bytes[2] & 1)
-                       p.args += " --ransac-min-points 20 --min-plane-area 0.2 --normal-neighbors 6 --ransac-cluster-epsilon 1";
-                   },
-                   Expect::ErrorOrValid, "", 60.0});
+      c.push_back(
+          {"fuzz regression " + t + "/" + f.filename().string(),
+           [t, f](Paths& p) {
+             const std::string bytes = read_text(f.string());
+             if (t == "fuzz_obj") return model_is(p, bytes);
+             if (t == "fuzz_ply") return cloud_is(p, bytes);
+             if (bytes.size() < 3) return both_valid(p);
+             const std::size_t rest = bytes.size() - 3;
+             const std::size_t len =
+                 (std::size_t(std::uint8_t(bytes[0])) | std::size_t(std::uint8_t(bytes[1])) << 8) % (rest + 1);
+             write_text(p.model, bytes.substr(3, len));
+             write_text(p.cloud, bytes.substr(3 + len));
+             p.args = "--mip-time-limit 1";
+             if (bytes[2] & 1)
+               p.args += " --ransac-min-points 20 --min-plane-area 0.2 --normal-neighbors 6 --ransac-cluster-epsilon 1";
+           },
+           Expect::ErrorOrValid, "", 60.0});
     }
   }
 
@@ -608,9 +627,9 @@ TEST_P(BadInput, Contract) {
   const std::string model = p.model_arg.empty() ? p.model : p.model_arg;
   const std::string cloud = p.cloud_arg.empty() ? p.cloud : p.cloud_arg;
   const std::string out = p.out_arg.empty() ? p.out : p.out_arg;
-  const CliRun r = run_cli("refine --model " + shell_quote(model) + " --cloud " + shell_quote(cloud) + " --out " + shell_quote(out) +
-                            " --report " + shell_quote(p.report) + " " + p.args,
-                        p.dir, k.max_seconds);
+  const CliRun r = run_cli("refine --model " + shell_quote(model) + " --cloud " + shell_quote(cloud) + " --out " +
+                               shell_quote(out) + " --report " + shell_quote(p.report) + " " + p.args,
+                           p.dir, k.max_seconds);
   SCOPED_TRACE(k.name + "\nstdout: " + r.out + "\nstderr: " + r.err);
 
   // Never a crash (signal / sanitizer abort) nor a hang.
@@ -658,7 +677,9 @@ TEST_P(BadInput, Contract) {
     EXPECT_TRUE(k.expect == Expect::KeptInvalid || k.expect == Expect::ErrorOrValid) << outcome << ": " << reason;
     EXPECT_EQ(outcome, "kept-invalid");
     EXPECT_FALSE(reason.empty());
-    if (!k.fragment.empty()) { EXPECT_NE(reason.find(k.fragment), std::string::npos) << reason; }
+    if (!k.fragment.empty()) {
+      EXPECT_NE(reason.find(k.fragment), std::string::npos) << reason;
+    }
     EXPECT_EQ(read_obj(out).faces.size(), read_obj(p.model).faces.size()) << "kept-invalid is the input as read";
     return;
   }
@@ -680,7 +701,9 @@ TEST_P(BadInput, Contract) {
   if (k.expect == Expect::Kept) {
     EXPECT_EQ(outcome, "kept") << reason;
     EXPECT_FALSE(report.value("refined", true));
-    if (!k.fragment.empty()) { EXPECT_NE(reason.find(k.fragment), std::string::npos) << reason; }
+    if (!k.fragment.empty()) {
+      EXPECT_NE(reason.find(k.fragment), std::string::npos) << reason;
+    }
   }
 }
 
@@ -707,7 +730,8 @@ TEST(BadInputAtomic, KillAtAnyTimeLeavesNoPartialModel) {
   write_text(model, valid_model());
   write_text(cloud, valid_cloud());
   // First measure a whole run, then kill at fractions of it.
-  const CliRun full = run_cli("refine --model " + shell_quote(model) + " --cloud " + shell_quote(cloud) + " --out " + shell_quote(out), dir);
+  const CliRun full = run_cli(
+      "refine --model " + shell_quote(model) + " --cloud " + shell_quote(cloud) + " --out " + shell_quote(out), dir);
   ASSERT_EQ(full.exit, 0) << full.err;
   const std::string complete = read_text(out);
   std::string says;
@@ -865,7 +889,8 @@ TEST(BadInputSolver, TimeLimitWithoutSolutionIsReported) {
   EXPECT_NE(budget.status_text().find("time limit"), std::string::npos) << budget.status_text();
   EXPECT_LT(budget.seconds, 5.0) << "the budget argument was not honoured";
   add_row("select_faces: 3000-face parity program, 10 ms limit",
-          "ok=" + std::string(r.ok ? "true" : "false") + ", status '" + r.status_text() + "', " + fmt(r.seconds) + " s", 0);
+          "ok=" + std::string(r.ok ? "true" : "false") + ", status '" + r.status_text() + "', " + fmt(r.seconds) + " s",
+          0);
 }
 
 // A real, easy program: the arrangement of a cube's six planes in a larger region (54
@@ -882,8 +907,7 @@ CandidateSet cube_program(std::vector<double>& cost, std::vector<int>& outside) 
   Region region;
   region.half = Vec3::Constant(2.0);
   CandidateSet cs = build_candidates(planes, region);
-  for (const auto& f : cs.faces)
-    cost.push_back(f.centroid.lpNorm<Eigen::Infinity>() <= 1.0 + 1e-9 ? -f.area : f.area);
+  for (const auto& f : cs.faces) cost.push_back(f.centroid.lpNorm<Eigen::Infinity>() <= 1.0 + 1e-9 ? -f.area : f.area);
   outside.assign(cs.edges.size(), 0);
   return cs;
 }
@@ -928,16 +952,16 @@ TEST(BadInputSolver, RefineUnderAStarvedSolverWritesAValidShell) {
   const std::string status = report["selection"].value("status", std::string());
   if (r.refined())
     EXPECT_TRUE(status == "optimal" || status == "feasible" || status == "feasible (time limit)") << status;
-  else
-    EXPECT_EQ(r.reason, "the selection found no valid shell: face selection " + status);
-  add_row("refine_building, mip_time_limit 0.001", std::string("outcome '") + outcome_name(r.outcome) + "', " + status, 0);
+  else EXPECT_EQ(r.reason, "the selection found no valid shell: face selection " + status);
+  add_row("refine_building, mip_time_limit 0.001", std::string("outcome '") + outcome_name(r.outcome) + "', " + status,
+          0);
 
   // And through the CLI: exit 0, a valid shell written, the status in the report.
   write_text(dir + "/c.ply", valid_cloud());
-  const CliRun cli = run_cli("refine --model " + shell_quote(dir + "/m.obj") + " --cloud " + shell_quote(dir + "/c.ply") +
-                              " --out " + shell_quote(dir + "/r.obj") + " --report " + shell_quote(dir + "/r.json") +
-                              " --mip-time-limit 0.001",
-                          dir);
+  const CliRun cli =
+      run_cli("refine --model " + shell_quote(dir + "/m.obj") + " --cloud " + shell_quote(dir + "/c.ply") + " --out " +
+                  shell_quote(dir + "/r.obj") + " --report " + shell_quote(dir + "/r.json") + " --mip-time-limit 0.001",
+              dir);
   EXPECT_EQ(cli.exit, 0) << cli.err;
   EXPECT_EQ(output_problem(dir + "/r.obj"), "");
   const json rep = json::parse(read_text(dir + "/r.json"));
@@ -963,7 +987,8 @@ TEST(BadInputSecurity, NonUtf8NamesAreWrittenWithReplacementCharacters) {
   write_text(run + "/coarse.obj", valid_model());
   write_text(run + "/refined.obj", read_text(dir + "/r.obj"));
   write_text(run + "/cloud.ply", valid_cloud());
-  const CliRun e = run_cli("eval --dir " + shell_quote(dir + "/run") + " --json " + shell_quote(dir + "/e.json") + " --jobs 1", dir);
+  const CliRun e =
+      run_cli("eval --dir " + shell_quote(dir + "/run") + " --json " + shell_quote(dir + "/e.json") + " --jobs 1", dir);
   EXPECT_EQ(e.exit, 0) << e.err;
   EXPECT_EQ(e.err.find("json.exception"), std::string::npos) << e.err;
   EXPECT_NE(read_text(dir + "/e.json").find("b\xEF\xBF\xBD"), std::string::npos);
@@ -972,23 +997,25 @@ TEST(BadInputSecurity, NonUtf8NamesAreWrittenWithReplacementCharacters) {
 TEST(BadInputSecurity, CityFilesRefusedInOneLineNamingTheFile) {
   const std::string dir = temp_dir("city_refusals");
   write_text(dir + "/c.ply", valid_cloud());
-  const std::string xxe = "<?xml version=\"1.0\"?>\n<!DOCTYPE CityModel [<!ENTITY e SYSTEM \"file:///etc/passwd\">]>\n"
-                          "<CityModel xmlns=\"http://www.opengis.net/citygml/2.0\"><gml:name>&e;</gml:name></CityModel>\n";
+  const std::string xxe =
+      "<?xml version=\"1.0\"?>\n<!DOCTYPE CityModel [<!ENTITY e SYSTEM \"file:///etc/passwd\">]>\n"
+      "<CityModel xmlns=\"http://www.opengis.net/citygml/2.0\"><gml:name>&e;</gml:name></CityModel>\n";
   const std::vector<std::pair<std::string, std::string>> files = {
       {"xxe.gml", xxe},
       {"overflow.city.json", R"({"type":"CityJSON","version":"2.0","CityObjects":{},"vertices":[[1e400,0,0]]})"},
       {"scale0.city.json",
        R"({"type":"CityJSON","version":"2.0","transform":{"scale":[1,1,0],"translate":[0,0,0]},"CityObjects":{},"vertices":[]})"},
-      {"header.city.jsonl", R"({"type":"CityJSON","version":"2.0","transform":{"scale":"x"},"CityObjects":{},"vertices":[]})"
-                            "\n{\"type\":\"CityJSONFeature\",\"CityObjects\":{},\"vertices\":[]}\n"},
-      {"deep.city.json", R"({"type":"CityJSON","version":"2.0","CityObjects":{},"vertices":[],"x":)" + std::string(100000, '[') +
-                             std::string(100000, ']') + "}"},
+      {"header.city.jsonl",
+       R"({"type":"CityJSON","version":"2.0","transform":{"scale":"x"},"CityObjects":{},"vertices":[]})"
+       "\n{\"type\":\"CityJSONFeature\",\"CityObjects\":{},\"vertices\":[]}\n"},
+      {"deep.city.json", R"({"type":"CityJSON","version":"2.0","CityObjects":{},"vertices":[],"x":)" +
+                             std::string(100000, '[') + std::string(100000, ']') + "}"},
   };
   for (const auto& [name, text] : files) {
     const std::string model = dir + "/" + name;
     write_text(model, text);
-    const CliRun r = run_cli("refine --model " + shell_quote(model) + " --cloud " + shell_quote(dir + "/c.ply") + " --out " +
-                                 shell_quote(dir + "/out.city.json"),
+    const CliRun r = run_cli("refine --model " + shell_quote(model) + " --cloud " + shell_quote(dir + "/c.ply") +
+                                 " --out " + shell_quote(dir + "/out.city.json"),
                              dir);
     EXPECT_EQ(r.exit, 2) << name << ": " << r.err;
     EXPECT_EQ(lines(r.err).size(), 1u) << r.err;
@@ -1011,16 +1038,21 @@ namespace {
 // A CityJSON 2.0 file: each id a copy of the box (MultiSurface, LoD 2.2); ids in `flat` get a
 // geometry without any usable surface (rings of one repeated vertex).
 std::string box_city(const std::vector<std::string>& ids, const std::vector<std::string>& flat = {}) {
-  json doc = {{"type", "CityJSON"}, {"version", "2.0"},
+  json doc = {{"type", "CityJSON"},
+              {"version", "2.0"},
               {"transform", {{"scale", {0.001, 0.001, 0.001}}, {"translate", {kOrigin.x(), kOrigin.y(), kOrigin.z()}}}},
-              {"CityObjects", json::object()}, {"vertices", json::array()}};
-  for (const Vec3& v : kBox) doc["vertices"].push_back({std::llround(v.x() * 1000), std::llround(v.y() * 1000), std::llround(v.z() * 1000)});
+              {"CityObjects", json::object()},
+              {"vertices", json::array()}};
+  for (const Vec3& v : kBox)
+    doc["vertices"].push_back({std::llround(v.x() * 1000), std::llround(v.y() * 1000), std::llround(v.z() * 1000)});
   json boundaries = json::array(), degenerate = json::array();
-  for (const Quad& q : kQuads) boundaries.push_back({{q.v[0], q.v[1], q.v[2], q.v[3]}}), degenerate.push_back({{0, 0, 0}});
+  for (const Quad& q : kQuads)
+    boundaries.push_back({{q.v[0], q.v[1], q.v[2], q.v[3]}}), degenerate.push_back({{0, 0, 0}});
   for (const auto& id : ids) {
     const bool is_flat = std::find(flat.begin(), flat.end(), id) != flat.end();
-    doc["CityObjects"][id] = {{"type", "Building"},
-                              {"geometry", {{{"type", "MultiSurface"}, {"lod", "2.2"}, {"boundaries", is_flat ? degenerate : boundaries}}}}};
+    doc["CityObjects"][id] = {
+        {"type", "Building"},
+        {"geometry", {{{"type", "MultiSurface"}, {"lod", "2.2"}, {"boundaries", is_flat ? degenerate : boundaries}}}}};
   }
   return doc.dump();
 }
@@ -1092,7 +1124,8 @@ TEST(BadInputFiles, CropRefusesTwoModelsForOneBuilding) {
   fs::remove_all(dir + "/models/A");
   fs::create_directories(dir + "/run/A");
   write_text(dir + "/run/A/cloud.ply", valid_cloud());
-  const CliRun t = run_cli("crop --tile " + dir + "/run/A/cloud.ply --models " + dir + "/models --out " + dir + "/run", dir);
+  const CliRun t =
+      run_cli("crop --tile " + dir + "/run/A/cloud.ply --models " + dir + "/models --out " + dir + "/run", dir);
   expect_one_error_line(t, "the tile would be overwritten");
   EXPECT_EQ(read_text(dir + "/run/A/cloud.ply"), valid_cloud());
   add_row("crop: A.obj and A/coarse.obj; tile inside --out", "refused: two models / tile would be overwritten", r.exit);
@@ -1131,7 +1164,8 @@ TEST(BadInputFiles, ConvertAccountsForEveryBuildingAndNeverOverwrites) {
   expect_one_error_line(again, "already exists");
   EXPECT_EQ(read_text(dir + "/objs/B_1.obj"), "mine\n");
   EXPECT_EQ(files_in(dir + "/objs"), names);
-  add_row("convert: ids `B 1`/`B_1`, shell code, 300 bytes, no surface", "distinct safe names, ids kept, dropped named", r.exit);
+  add_row("convert: ids `B 1`/`B_1`, shell code, 300 bytes, no surface", "distinct safe names, ids kept, dropped named",
+          r.exit);
 }
 
 // An output that is an input (any spelling of it) or the other output is refused before
@@ -1144,9 +1178,9 @@ TEST(BadInputFiles, RefineRefusesOutputsThatAreInputs) {
   write_text(cloud, valid_cloud());
   fs::create_symlink(model, dir + "/link.obj");
   const std::string in = "refine --model " + model + " --cloud " + cloud;
-  for (const std::string& outputs : {" --out " + model, " --out " + dir + "/link.obj", " --out " + dir + "/sub/../model.obj",
-                                     " --out " + dir + "/r.obj --report " + cloud,
-                                     " --out " + dir + "/r.obj --report " + dir + "/sub/../r.obj"}) {
+  for (const std::string& outputs :
+       {" --out " + model, " --out " + dir + "/link.obj", " --out " + dir + "/sub/../model.obj",
+        " --out " + dir + "/r.obj --report " + cloud, " --out " + dir + "/r.obj --report " + dir + "/sub/../r.obj"}) {
     const CliRun r = run_cli(in + outputs, dir);
     expect_one_error_line(r, "--");
     EXPECT_LT(r.seconds, 5.0) << outputs;
@@ -1156,7 +1190,8 @@ TEST(BadInputFiles, RefineRefusesOutputsThatAreInputs) {
   }
   // A city file: --out the model.
   write_text(dir + "/city.json", box_city({"B"}));
-  const CliRun c = run_cli("refine --model " + dir + "/city.json --cloud " + cloud + " --out " + dir + "/city.json", dir);
+  const CliRun c =
+      run_cli("refine --model " + dir + "/city.json --cloud " + cloud + " --out " + dir + "/city.json", dir);
   expect_one_error_line(c, "is the --model file");
   EXPECT_EQ(read_text(dir + "/city.json"), box_city({"B"}));
   add_row("refine: --out/--report = --model/--cloud (links, ../)", "refused before reading", c.exit);
@@ -1169,11 +1204,14 @@ TEST(BadInputFiles, UnwritableOutputFailsFirstAndLeavesNoReport) {
   const std::string model = dir + "/model.obj", cloud = dir + "/cloud.ply";
   write_text(model, valid_model());
   write_text(cloud, valid_cloud());
-  const CliRun r = run_cli("refine --model " + model + " --cloud " + cloud + " --out /proc/self/refined.obj --report " + dir + "/report.json", dir);
+  const CliRun r = run_cli("refine --model " + model + " --cloud " + cloud + " --out /proc/self/refined.obj --report " +
+                               dir + "/report.json",
+                           dir);
   expect_one_error_line(r, "cannot write /proc/self/refined.obj");
   EXPECT_FALSE(fs::exists(dir + "/report.json")) << "the report claims a model that was never written";
   write_text(dir + "/city.json", box_city({"B"}));
-  const CliRun c = run_cli("refine --model " + dir + "/city.json --cloud " + cloud + " --out /proc/self/out.city.json", dir);
+  const CliRun c =
+      run_cli("refine --model " + dir + "/city.json --cloud " + cloud + " --out /proc/self/out.city.json", dir);
   expect_one_error_line(c, "cannot write /proc/self/out.city.json");
   EXPECT_EQ(c.out, "") << "refined before finding the output unwritable";
   EXPECT_TRUE(temp_leftovers(dir).empty());
@@ -1186,8 +1224,9 @@ TEST(BadInputFiles, DevZeroIsRefusedAtOnce) {
   write_text(dir + "/model.obj", valid_model());
   write_text(dir + "/cloud.ply", valid_cloud());
   ASSERT_EQ(::mkfifo((dir + "/fifo").c_str(), 0600), 0);
-  for (const std::string& args : {"--model /dev/zero --cloud " + dir + "/cloud.ply", "--model " + dir + "/model.obj --cloud /dev/zero",
-                                  "--model " + dir + "/fifo --cloud " + dir + "/cloud.ply"}) {
+  for (const std::string& args :
+       {"--model /dev/zero --cloud " + dir + "/cloud.ply", "--model " + dir + "/model.obj --cloud /dev/zero",
+        "--model " + dir + "/fifo --cloud " + dir + "/cloud.ply"}) {
     const CliRun r = run_cli("refine " + args + " --out " + dir + "/r.obj", dir, 60);
     expect_one_error_line(r, "not a regular file");
     EXPECT_LT(r.seconds, 5.0) << args;
@@ -1205,8 +1244,8 @@ TEST(BadInputFiles, FailedWriteLeavesNoHalfRunFolder) {
   write_text(dir + "/city.json", box_city({"a", "b", "c"}));
   // SIGXFSZ ignored: a write beyond 64 KB fails with EFBIG, as on a full disk.
   auto limited = [&](const std::string& args) {
-    return std::system(("cd " + shell_quote(dir) + " && sh -c \"trap '' XFSZ; ulimit -f 64; exec " + shell_quote(LODREFINE_BINARY) +
-                        " " + args + "\" > /dev/null 2> err.txt")
+    return std::system(("cd " + shell_quote(dir) + " && sh -c \"trap '' XFSZ; ulimit -f 64; exec " +
+                        shell_quote(LODREFINE_BINARY) + " " + args + "\" > /dev/null 2> err.txt")
                            .c_str());
   };
   EXPECT_NE(limited("crop --tile tile.ply --models models --out run"), 0);

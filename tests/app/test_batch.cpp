@@ -104,7 +104,8 @@ TEST_F(Batch, SummaryFollowsAFailureAndARemovedBuilding) {
   EXPECT_EQ(summary["pooled"]["buildings"], 4);
   EXPECT_EQ(summary["pooled"]["failed"], 1);
   const std::string csv = read_text(run / "summary.csv");
-  EXPECT_NE(csv.find(reason.substr(0, reason.size() - 1)), std::string::npos) << "csv lacks the FAILED reason:\n" << csv;
+  EXPECT_NE(csv.find(reason.substr(0, reason.size() - 1)), std::string::npos) << "csv lacks the FAILED reason:\n"
+                                                                              << csv;
   EXPECT_EQ(csv.find("refined model missing"), std::string::npos) << csv;
   EXPECT_TRUE(rerun(run).empty()) << "a recorded failure is not retried until FAILED is removed";
 
@@ -124,7 +125,8 @@ TEST_F(Batch, SecondConcurrentRunIsRefusedWithOneLine) {
   std::ofstream(slow) << "#!/bin/sh\nsleep 1\nexec '" << kBinary << "' \"$@\"\n";
   fs::permissions(slow, fs::perms::owner_all);
   const pid_t first = spawn_group(batch_command(run, "LODREFINE=" + shell_quoted(slow)) + " > /dev/null 2>&1");
-  for (int i = 0; i < 200 && !fs::exists(run / ".batch.pid"); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  for (int i = 0; i < 200 && !fs::exists(run / ".batch.pid"); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
   ASSERT_TRUE(fs::exists(run / ".batch.pid"));
   const fs::path err = run.parent_path() / (run.filename().string() + "_second.err");
   const int second = shell(batch_command(run) + " > /dev/null 2> " + shell_quoted(err));
@@ -184,9 +186,12 @@ TEST_F(Batch, TileTableWorstFirstWithOutcomesAndMovedFacades) {
     std::size_t moved = 0;
     double max_move = 0.0;
     if (outcome == "refined")
-      for (const auto& f : report["facades"]) ++moved, max_move = std::max(max_move, std::abs(f["max_move"].get<double>()));
+      for (const auto& f : report["facades"])
+        ++moved, max_move = std::max(max_move, std::abs(f["max_move"].get<double>()));
     EXPECT_EQ(row["facades_moved"]["count"], moved) << id;
-    if (moved) { EXPECT_NEAR(row["facades_moved"]["max"].get<double>(), max_move, 1e-9) << id; }
+    if (moved) {
+      EXPECT_NEAR(row["facades_moved"]["max"].get<double>(), max_move, 1e-9) << id;
+    }
     for (const auto& f : row["facades_moved"]["facades"]) EXPECT_FALSE(f["surface"].is_null()) << id;
     EXPECT_GT(row["refine_seconds"].get<double>(), 0.0);
     moved_total += moved;
@@ -216,10 +221,12 @@ TEST_F(Batch, TileTableWorstFirstWithOutcomesAndMovedFacades) {
     report["facades"] = facades;
     std::ofstream(run / id / "report.json") << report.dump(2);
   };
-  edit_report(a, "refined", {{{"input_faces", {7}}, {"evidence", "scan"}, {"max_move", 0.5}, {"mean_move", 0.5}},
-                             {{"input_faces", {8}}, {"evidence", "corner"}, {"max_move", -0.25}, {"mean_move", 0.1}}});
-  edit_report(b, "refined", {{{"input_faces", {3, 4}}, {"evidence", "scan"}, {"max_move", 0.6}, {"mean_move", 0.4}},
-                             {{"surface", "wall-8"}, {"displacement", 0.9}}});
+  edit_report(a, "refined",
+              {{{"input_faces", {7}}, {"evidence", "scan"}, {"max_move", 0.5}, {"mean_move", 0.5}},
+               {{"input_faces", {8}}, {"evidence", "corner"}, {"max_move", -0.25}, {"mean_move", 0.1}}});
+  edit_report(b, "refined",
+              {{{"input_faces", {3, 4}}, {"evidence", "scan"}, {"max_move", 0.6}, {"mean_move", 0.4}},
+               {{"surface", "wall-8"}, {"displacement", 0.9}}});
   edit_report(c, "kept", {{{"input_faces", {1}}, {"evidence", "scan"}, {"max_move", 0.9}, {"mean_move", 0.9}}});
   EXPECT_TRUE(rerun(run).empty());
   const json updated = json::parse(read_text(run / "summary.json"));
@@ -262,9 +269,11 @@ std::vector<std::string> pwned(const fs::path& dir) {
 
 // A CityJSON 2.0 file holding the given models (polygon soups) under the given ids.
 std::string city_json(const std::vector<lodrefine::Mesh>& models, const std::vector<std::string>& ids) {
-  json doc = {{"type", "CityJSON"}, {"version", "2.0"},
+  json doc = {{"type", "CityJSON"},
+              {"version", "2.0"},
               {"transform", {{"scale", {0.001, 0.001, 0.001}}, {"translate", {0.0, 0.0, 0.0}}}},
-              {"CityObjects", json::object()}, {"vertices", json::array()}};
+              {"CityObjects", json::object()},
+              {"vertices", json::array()}};
   for (std::size_t b = 0; b < models.size(); ++b) {
     const std::size_t first = doc["vertices"].size();
     for (const auto& v : models[b].vertices)
@@ -275,8 +284,8 @@ std::string city_json(const std::vector<lodrefine::Mesh>& models, const std::vec
       for (int i : f.v) ring.push_back(first + std::size_t(i));
       boundaries.push_back({ring});
     }
-    doc["CityObjects"][ids[b]] = {{"type", "Building"},
-                                  {"geometry", {{{"type", "MultiSurface"}, {"lod", "2.2"}, {"boundaries", boundaries}}}}};
+    doc["CityObjects"][ids[b]] = {
+        {"type", "Building"}, {"geometry", {{{"type", "MultiSurface"}, {"lod", "2.2"}, {"boundaries", boundaries}}}}};
   }
   return doc.dump();
 }
@@ -288,16 +297,22 @@ std::string city_json(const std::vector<lodrefine::Mesh>& models, const std::vec
 TEST(BatchIds, HostileIdsThroughConvertCropAndDispatchersRunNothing) {
   const fs::path base = fresh_dir("batch ids");
   const std::string in_base = "cd " + shell_quoted(base) + " && ";
-  ASSERT_EQ(shell(in_base + shell_quoted(kBinary) + " synth --tile tile.ply --count 4 --points 3000 --out synth > /dev/null"), 0);
+  ASSERT_EQ(
+      shell(in_base + shell_quoted(kBinary) + " synth --tile tile.ply --count 4 --points 3000 --out synth > /dev/null"),
+      0);
   std::vector<lodrefine::Mesh> models;
-  for (const auto& e : fs::directory_iterator(base / "synth")) models.push_back(lodrefine::read_obj((e.path() / "coarse.obj").string()));
+  for (const auto& e : fs::directory_iterator(base / "synth"))
+    models.push_back(lodrefine::read_obj((e.path() / "coarse.obj").string()));
   ASSERT_EQ(models.size(), kHostileIds.size());
   std::ofstream(base / "city.json") << city_json(models, kHostileIds);
 
   const fs::path run = base / "my run";
   const fs::path log = base / "log.txt";
-  ASSERT_EQ(shell(in_base + shell_quoted(kBinary) + " convert --cityjson city.json --out-dir objs > log.txt 2>&1"), 0) << read_text(log);
-  ASSERT_EQ(shell(in_base + shell_quoted(kBinary) + " crop --tile tile.ply --models objs --out 'my run' > log.txt 2>&1"), 0) << read_text(log);
+  ASSERT_EQ(shell(in_base + shell_quoted(kBinary) + " convert --cityjson city.json --out-dir objs > log.txt 2>&1"), 0)
+      << read_text(log);
+  ASSERT_EQ(
+      shell(in_base + shell_quoted(kBinary) + " crop --tile tile.ply --models objs --out 'my run' > log.txt 2>&1"), 0)
+      << read_text(log);
   ASSERT_EQ(shell(in_base + batch_command(run) + " > log.txt 2>&1"), 0) << read_text(log);
   EXPECT_TRUE(pwned(base).empty()) << pwned(base).front();
 
@@ -307,7 +322,8 @@ TEST(BatchIds, HostileIdsThroughConvertCropAndDispatchersRunNothing) {
       if (!fs::exists(e.path() / "coarse.obj")) continue;
       EXPECT_TRUE(lodrefine::is_safe_name(e.path().filename().string())) << e.path();
       EXPECT_TRUE(fs::exists(e.path() / "refined.obj")) << e.path() << ": " << read_text(e.path() / "FAILED");
-      if (fs::exists(e.path() / "report.json")) ids.insert(json::parse(read_text(e.path() / "report.json"))["id"].get<std::string>());
+      if (fs::exists(e.path() / "report.json"))
+        ids.insert(json::parse(read_text(e.path() / "report.json"))["id"].get<std::string>());
     }
     EXPECT_EQ(ids, std::set<std::string>(kHostileIds.begin(), kHostileIds.end())) << "the reports hold the real ids";
     EXPECT_EQ(json::parse(read_text(r / "summary.json"))["pooled"]["buildings"], 4);
@@ -315,7 +331,9 @@ TEST(BatchIds, HostileIdsThroughConvertCropAndDispatchersRunNothing) {
   expect_all_refined(run);
 
   if (shell("command -v parallel > /dev/null") == 0) {
-    ASSERT_EQ(shell("make -s -f " + shell_quoted(kSource / "scripts" / "batch.mk") + " RUN=" + shell_quoted(run) + " clean-results"), 0);
+    ASSERT_EQ(shell("make -s -f " + shell_quoted(kSource / "scripts" / "batch.mk") + " RUN=" + shell_quoted(run) +
+                    " clean-results"),
+              0);
     ASSERT_EQ(shell(in_base + "LODREFINE=" + shell_quoted(kBinary) + " HOME=" + shell_quoted(base) + " " +
                     shell_quoted(kSource / "scripts" / "parallel_batch.sh") + " " + shell_quoted(run) +
                     " --sshlogin : -j2 > log.txt 2>&1"),
@@ -340,14 +358,16 @@ TEST(BatchIds, UnsafeFolderNamesAreRefusedBeforeAnythingRuns) {
     fs::copy_file(good / "coarse.obj", bad / "coarse.obj");
     fs::copy_file(good / "cloud.ply", bad / "cloud.ply");
     const fs::path err = base / "err.txt";
-    EXPECT_EQ(shell("cd " + shell_quoted(base) + " && " + batch_command(run) + " > /dev/null 2> " + shell_quoted(err)), 2) << name;
+    EXPECT_EQ(shell("cd " + shell_quoted(base) + " && " + batch_command(run) + " > /dev/null 2> " + shell_quoted(err)),
+              2)
+        << name;
     const std::string message = read_text(err);
     EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
     EXPECT_NE(message.find("is not a safe name"), std::string::npos) << message;
     if (shell("command -v parallel > /dev/null") == 0) {
-      EXPECT_NE(shell("cd " + shell_quoted(base) + " && LODREFINE=" + shell_quoted(kBinary) + " HOME=" + shell_quoted(base) +
-                      " " + shell_quoted(kSource / "scripts" / "parallel_batch.sh") + " " + shell_quoted(run) +
-                      " --sshlogin : > /dev/null 2>&1"),
+      EXPECT_NE(shell("cd " + shell_quoted(base) + " && LODREFINE=" + shell_quoted(kBinary) +
+                      " HOME=" + shell_quoted(base) + " " + shell_quoted(kSource / "scripts" / "parallel_batch.sh") +
+                      " " + shell_quoted(run) + " --sshlogin : > /dev/null 2>&1"),
                 0)
           << name;
     }

@@ -9,13 +9,13 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "lodrefine/eval/eval.h"
 #include "lodrefine/core/geometry.h"
+#include "lodrefine/core/params.h"
+#include "lodrefine/core/refine.h"
+#include "lodrefine/core/validate.h"
+#include "lodrefine/eval/eval.h"
 #include "lodrefine/io/obj.h"
 #include "lodrefine/io/ply.h"
-#include "lodrefine/core/refine.h"
-#include "lodrefine/core/params.h"
-#include "lodrefine/core/validate.h"
 
 using namespace lodrefine;
 

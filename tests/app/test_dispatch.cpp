@@ -121,7 +121,8 @@ TEST_F(Dispatch, SlurmJobArrayEqualsLocalBatch) {
   EXPECT_NE(read_text(log).find("4 buildings in 3 tasks"), std::string::npos) << read_text(log);
   expect_same_as_local(run);
   std::size_t task_logs = 0;
-  for (const auto& e : fs::directory_iterator(run / ".slurm")) task_logs += e.path().filename().string().find('_') != std::string::npos;
+  for (const auto& e : fs::directory_iterator(run / ".slurm"))
+    task_logs += e.path().filename().string().find('_') != std::string::npos;
   EXPECT_EQ(task_logs, 4u) << "3 array tasks + the summary job";
   if (!HasFailure()) fs::remove_all(run), fs::remove(log), stop.remove = true;
 }

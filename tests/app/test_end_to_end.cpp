@@ -5,12 +5,12 @@
 #include <algorithm>
 #include <cmath>
 
-#include "lodrefine/eval/eval.h"
 #include "lodrefine/core/geometry.h"
-#include "lodrefine/core/refine.h"
-#include "lodrefine/synth/synth.h"
 #include "lodrefine/core/params.h"
+#include "lodrefine/core/refine.h"
 #include "lodrefine/core/validate.h"
+#include "lodrefine/eval/eval.h"
+#include "lodrefine/synth/synth.h"
 
 using namespace lodrefine;
 

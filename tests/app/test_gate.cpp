@@ -30,10 +30,12 @@ EvalRun eval(const fs::path& run, const std::string& args) {
 // it failed; an "error: ..." line when it is not well-formed.
 std::string junit_summary(const fs::path& xml) {
   const fs::path out = xml.string() + ".txt";
-  shell("python3 -c \"import sys, xml.etree.ElementTree as E\ntry:\n r = E.parse(sys.argv[1]).getroot()\nexcept Exception as e:\n"
-        " print('error:', e); sys.exit()\nc = r.findall('.//testcase')\nprint(len(c), len(r.findall('.//failure')))\n"
-        "for t in c: print(ascii(t.get('name')), 'FAILED' if t.find('failure') is not None else 'passed')\" " +
-        shell_quoted(xml) + " > " + shell_quoted(out) + " 2>&1");
+  shell(
+      "python3 -c \"import sys, xml.etree.ElementTree as E\ntry:\n r = E.parse(sys.argv[1]).getroot()\nexcept "
+      "Exception as e:\n"
+      " print('error:', e); sys.exit()\nc = r.findall('.//testcase')\nprint(len(c), len(r.findall('.//failure')))\n"
+      "for t in c: print(ascii(t.get('name')), 'FAILED' if t.find('failure') is not None else 'passed')\" " +
+      shell_quoted(xml) + " > " + shell_quoted(out) + " 2>&1");
   return read_text(out);
 }
 
@@ -83,9 +85,10 @@ TEST(EvalGate, BaselineThenAModelMovedFailsWithItsLine) {
   EXPECT_GT(b.at("buildings")[0].at("c2m_rmse").get<double>(), 0.0);
 
   // The same run: nothing worse, every test case passes.
-  std::ofstream(dir / "gates.json") << R"({"_comment": "samples", "max_failed_buildings": 0, "min_watertight_rate": 1})";
+  std::ofstream(dir / "gates.json")
+      << R"({"_comment": "samples", "max_failed_buildings": 0, "min_watertight_rate": 1})";
   const EvalRun same = eval(run, "--baseline " + shell_quoted(dir / "base.json") + " --gates " +
-                                 shell_quoted(dir / "gates.json") + " --junit " + shell_quoted(dir / "same.xml"));
+                                     shell_quoted(dir / "gates.json") + " --junit " + shell_quoted(dir / "same.xml"));
   EXPECT_EQ(same.exit, 0) << same.out << same.err;
   EXPECT_NE(same.out.find("gate: 4 building(s), 0 new, 3 pooled check(s): passed"), std::string::npos) << same.out;
   const std::string pass = junit_summary(dir / "same.xml");
@@ -97,11 +100,13 @@ TEST(EvalGate, BaselineThenAModelMovedFailsWithItsLine) {
 
   // One refined model moved 0.3 m: its C2M grows; exit 1, one line naming it, a JUnit failure.
   move_obj(run / refined[0] / "refined.obj", 0.3);
-  const EvalRun moved = eval(run, "--baseline " + shell_quoted(dir / "base.json") + " --junit " + shell_quoted(dir / "moved.xml"));
+  const EvalRun moved =
+      eval(run, "--baseline " + shell_quoted(dir / "base.json") + " --junit " + shell_quoted(dir / "moved.xml"));
   EXPECT_EQ(moved.exit, 1) << moved.out << moved.err;
   std::smatch m;
-  ASSERT_TRUE(std::regex_search(moved.out, m, std::regex("regression: " + refined[0] +
-                                                         ": c2m_rmse (\\d+\\.\\d+) m -> (\\d+\\.\\d+) m \\(worse by")))
+  ASSERT_TRUE(std::regex_search(
+      moved.out, m,
+      std::regex("regression: " + refined[0] + ": c2m_rmse (\\d+\\.\\d+) m -> (\\d+\\.\\d+) m \\(worse by")))
       << moved.out;
   EXPECT_LT(std::stod(m[1]), 0.05);
   EXPECT_GT(std::stod(m[2]), 0.15);
@@ -125,7 +130,8 @@ TEST(EvalGate, BaselineThenAModelMovedFailsWithItsLine) {
   std::ofstream(dir / "bad.json") << R"({"max_c2m": 0.1})";
   const EvalRun bad = eval(run, "--gates " + shell_quoted(dir / "bad.json"));
   EXPECT_EQ(bad.exit, 2);
-  EXPECT_EQ(bad.err.rfind("lodrefine: error: " + (dir / "bad.json").string() + ": unknown gate 'max_c2m' (known: ", 0), 0u)
+  EXPECT_EQ(bad.err.rfind("lodrefine: error: " + (dir / "bad.json").string() + ": unknown gate 'max_c2m' (known: ", 0),
+            0u)
       << bad.err;
   EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1);
   if (!HasFailure()) fs::remove_all(dir);

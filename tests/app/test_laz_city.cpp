@@ -45,7 +45,8 @@ TEST(LazCity, Ahn3LazCropsAndRefinesLikeItsLas) {
   ASSERT_FALSE(read_las_header(las).compressed);
 
   // crop: one cloud per LoD1 building, the same bytes from either tile.
-  auto r = cli_fixtures::run_cli("convert --cityjson '" + city.string() + "' --lod 1 --out-dir '" + dir + "/models'", dir);
+  auto r =
+      cli_fixtures::run_cli("convert --cityjson '" + city.string() + "' --lod 1 --out-dir '" + dir + "/models'", dir);
   ASSERT_EQ(r.exit, 0) << r.err;
   for (const char* kind : {"laz", "las"}) {
     r = cli_fixtures::run_cli("crop --tile '" + std::string(std::strcmp(kind, "laz") == 0 ? laz : las) +
@@ -56,7 +57,8 @@ TEST(LazCity, Ahn3LazCropsAndRefinesLikeItsLas) {
   }
   std::size_t clouds = 0, nonempty = 0;
   for (const auto& e : fs::directory_iterator(dir + "/run_laz")) {
-    const fs::path from_laz = e.path() / "cloud.ply", from_las = fs::path(dir) / "run_las" / e.path().filename() / "cloud.ply";
+    const fs::path from_laz = e.path() / "cloud.ply",
+                   from_las = fs::path(dir) / "run_las" / e.path().filename() / "cloud.ply";
     ASSERT_TRUE(fs::exists(from_las)) << from_las;
     const std::string a = cli_fixtures::slurp(from_laz.string());
     EXPECT_EQ(a, cli_fixtures::slurp(from_las.string())) << e.path().filename();
@@ -70,8 +72,8 @@ TEST(LazCity, Ahn3LazCropsAndRefinesLikeItsLas) {
   const std::string model = fs::directory_iterator(dir + "/models")->path().string();
   for (const char* kind : {"laz", "las"}) {
     r = cli_fixtures::run_cli("eval --original '" + model + "' --refined '" + model + "' --cloud '" +
-                                  std::string(std::strcmp(kind, "laz") == 0 ? laz : las) +
-                                  "' --classes 9 --json '" + dir + "/eval_" + kind + ".json'",
+                                  std::string(std::strcmp(kind, "laz") == 0 ? laz : las) + "' --classes 9 --json '" +
+                                  dir + "/eval_" + kind + ".json'",
                               dir);
     ASSERT_EQ(r.exit, 0) << r.err;
   }

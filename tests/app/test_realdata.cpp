@@ -17,16 +17,15 @@
 #include <map>
 #include <random>
 
-#include "lodrefine/io/cityjson.h"
-#include "lodrefine/io/files.h"
-#include "lodrefine/core/geometry.h"
-#include "lodrefine/io/obj.h"
-#include "lodrefine/io/ply.h"
-#include "lodrefine/io/files.h"
 #include "lodrefine/core/distance.h"
+#include "lodrefine/core/geometry.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/core/repair.h"
 #include "lodrefine/core/validate.h"
+#include "lodrefine/io/cityjson.h"
+#include "lodrefine/io/files.h"
+#include "lodrefine/io/obj.h"
+#include "lodrefine/io/ply.h"
 #include "support/realdata.h"
 
 using namespace lodrefine;
@@ -46,18 +45,18 @@ struct Row {
   int planes = 0, candidates = 0, mip_vars = 0, mip_rows = 0;
   double seconds = 0;
   std::string outcome;
-  double rms = NAN;        // scan points to the refined wall (m)
-  int roof_moved = 0;      // far roof vertices of the refined model not in the unrefined one
+  double rms = NAN;    // scan points to the refined wall (m)
+  int roof_moved = 0;  // far roof vertices of the refined model not in the unrefined one
   std::vector<std::string> failures;
 };
 
-constexpr double kMove = 0.30;         // the wall's true position: this far outward (m)
-constexpr double kSpacing = 0.05;      // scan grid (m)
-constexpr double kNoise = 0.01;        // range noise sigma (m)
-constexpr double kCover = 0.70;        // scanned share of the wall's height
-constexpr double kMinWall = 2.0;       // shorter walls are not tried (m; scan planes need >= 1 m^2)
-constexpr double kMaxRms = 0.03;       // allowed RMS of the scan to the refined wall (m)
-constexpr double kRoofFar = 2.0;       // roof vertices farther than this from the wall stay (m)
+constexpr double kMove = 0.30;     // the wall's true position: this far outward (m)
+constexpr double kSpacing = 0.05;  // scan grid (m)
+constexpr double kNoise = 0.01;    // range noise sigma (m)
+constexpr double kCover = 0.70;    // scanned share of the wall's height
+constexpr double kMinWall = 2.0;   // shorter walls are not tried (m; scan planes need >= 1 m^2)
+constexpr double kMaxRms = 0.03;   // allowed RMS of the scan to the refined wall (m)
+constexpr double kRoofFar = 2.0;   // roof vertices farther than this from the wall stay (m)
 constexpr double kRoofTolerance = 0.01;
 
 // Buildings known to fail, with the diagnosed reason (still run and printed, not asserted).
@@ -266,7 +265,8 @@ Row run_building(const Mesh& soup) {
   const Validation val = validate_mesh(refined, 0.01);
   if (!r.valid || !val.valid())
     row.failures.push_back("invalid result: " + (val.problem.empty() ? std::string("r.valid false") : val.problem));
-  if (!r.refined()) row.failures.push_back(std::string("not refined: ") + outcome_name(r.outcome) + " (" + r.reason + ")");
+  if (!r.refined())
+    row.failures.push_back(std::string("not refined: ") + outcome_name(r.outcome) + " (" + r.reason + ")");
 
   // Scan facade points to the nearest refined face parallel to the wall (within 5 degrees).
   std::vector<std::vector<Vec3>> parallel;
@@ -403,7 +403,7 @@ namespace {
 struct Merged {
   Mesh soup, before;  // georeferenced input; its repaired, merged model in the local frame
   Vec3 origin;
-  int wall = -1;      // the longest wall of `before`
+  int wall = -1;  // the longest wall of `before`
 };
 
 // Points on `poly` (outward plane `pl`) moved `offset` along its normal, over the lower
@@ -516,12 +516,9 @@ Mesh with_semantics(Mesh m) {
     const Vec3 n = newell_normal(poly).normalized();
     double zmax = -1e300;
     for (const auto& p : poly) zmax = std::max(zmax, p.z());
-    if (std::abs(n.z()) < 0.05)
-      f.sem = Semantic::Wall;
-    else if (n.z() < -0.95 && zmax < zmin + 0.1)
-      f.sem = Semantic::Ground;
-    else
-      f.sem = Semantic::Roof;
+    if (std::abs(n.z()) < 0.05) f.sem = Semantic::Wall;
+    else if (n.z() < -0.95 && zmax < zmin + 0.1) f.sem = Semantic::Ground;
+    else f.sem = Semantic::Roof;
   }
   return m;
 }

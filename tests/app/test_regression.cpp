@@ -36,8 +36,9 @@ TEST(Regression, SampleBatchStaysWithinThresholds) {
   const double c2m_before = points.at("c2m").at("original").at("rmse").get<double>();
   const double facade = points.at("truth_facade").at("refined").at("rmse").get<double>();
   const double roof = points.at("truth_roof").at("refined").at("rmse").get<double>();
-  std::printf("samples %d: watertight %.0f %%, C2M RMSE %.4f -> %.4f m, truth facade RMSE %.4f m, truth roof RMSE %.4f m\n",
-              samples, 100 * watertight, c2m_before, c2m, facade, roof);
+  std::printf(
+      "samples %d: watertight %.0f %%, C2M RMSE %.4f -> %.4f m, truth facade RMSE %.4f m, truth roof RMSE %.4f m\n",
+      samples, 100 * watertight, c2m_before, c2m, facade, roof);
   EXPECT_LE(pooled.at("failed").get<int>(), t.at("max_failed_buildings").get<int>());
   EXPECT_GE(watertight, t.at("min_watertight_rate").get<double>());
   EXPECT_LE(c2m, t.at("max_c2m_rmse_refined").get<double>());

@@ -42,8 +42,7 @@ double rms(const std::vector<double>& d) {
 // Every edge used by exactly two faces, once in each direction (core/topology's edge map).
 int edges_not_used_twice(const Mesh& m) {
   int bad = 0;
-  for (const auto& [e, uses] : edge_uses(m.faces))
-    bad += uses.size() != 2 || uses[0].forward == uses[1].forward;
+  for (const auto& [e, uses] : edge_uses(m.faces)) bad += uses.size() != 2 || uses[0].forward == uses[1].forward;
   return bad;
 }
 
@@ -61,7 +60,8 @@ Figures expect_selection_decided(const Mesh& coarse, const Mesh& truth, const Po
   EXPECT_TRUE(r.valid);
   if (!r.valid) return fig;
   const Vec3 o = local_origin(truth);
-  const Mesh refined = translated(r.mesh, -o), local_truth = translated(truth, -o), local_coarse = translated(coarse, -o);
+  const Mesh refined = translated(r.mesh, -o), local_truth = translated(truth, -o),
+             local_coarse = translated(coarse, -o);
   const Validation v = validate_mesh(refined, Params{}.planarity_tolerance);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_EQ(v.boundary_edges, 0);
@@ -77,7 +77,8 @@ Figures expect_selection_decided(const Mesh& coarse, const Mesh& truth, const Po
   const auto samples = sample_faces(local_truth, scanned, 0.25);
   fig.before = rms(cloud_to_mesh(local_coarse, samples)), fig.after = rms(cloud_to_mesh(refined, samples));
   fig.refined = r.refined();
-  if (figures) EXPECT_LE(fig.after, fig.before + kNotWorse) << "truth facade RMSE " << fig.before << " -> " << fig.after;
+  if (figures)
+    EXPECT_LE(fig.after, fig.before + kNotWorse) << "truth facade RMSE " << fig.before << " -> " << fig.after;
   if (!r.refined()) return fig;
 
   EXPECT_TRUE(r.trace.selection.has_value());
@@ -100,7 +101,8 @@ TEST(SelectionDecides, EverySample) {
   for (const auto& dir : fs::directory_iterator(samples)) {
     if (!fs::exists(dir.path() / "truth.obj")) continue;
     SCOPED_TRACE(dir.path().filename().string());
-    expect_selection_decided(read_obj((dir.path() / "coarse.obj").string()), read_obj((dir.path() / "truth.obj").string()),
+    expect_selection_decided(read_obj((dir.path() / "coarse.obj").string()),
+                             read_obj((dir.path() / "truth.obj").string()),
                              read_cloud((dir.path() / "cloud.ply").string()));
     ++n;
   }
@@ -154,8 +156,7 @@ TEST_P(SelectionAddsFaces, RefinedOntoTheTruth) {
     if (known_short)
       std::printf("KNOWN SHORT %s: %s %.3f -> %.3f m%s\n", b.id.c_str(), fig.refined ? "refined" : "kept", fig.before,
                   fig.after, on_truth ? " (now reaches the truth: remove it from kKnownShort)" : "");
-    else
-      EXPECT_TRUE(fig.refined) << "truth facade RMSE " << fig.before;
+    else EXPECT_TRUE(fig.refined) << "truth facade RMSE " << fig.before;
   }
   EXPECT_GE(reached, int(kStreetSeeds - kKnownShort.at(GetParam()).size()));
 }

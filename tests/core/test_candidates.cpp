@@ -18,7 +18,8 @@ TEST(Candidates, BoxArrangementHasNinePiecesPerPlane) {
   double total = 0.0;
   for (const auto& f : cs.faces) total += f.area;
   // Sections: planes x=const are (8+2*1.8)x(6+2*1.6) ... compare with the region's cross-sections.
-  const double expect = 2 * (2 * region.half.y() * 2 * region.half.z()) + 2 * (2 * region.half.x() * 2 * region.half.z()) +
+  const double expect = 2 * (2 * region.half.y() * 2 * region.half.z()) +
+                        2 * (2 * region.half.x() * 2 * region.half.z()) +
                         2 * (2 * region.half.x() * 2 * region.half.y());
   EXPECT_NEAR(total, expect, 1e-6);
   // Interior edges (not on the region boundary) are shared by exactly 4 faces (2 planes x 2 sides).
@@ -48,7 +49,8 @@ TEST(Candidates, LiveOnASurfaceMeshOneComponentPerPlane) {
   ASSERT_TRUE(CGAL::is_valid_polygon_mesh(cs.mesh));
   const auto support = cs.mesh.property_map<CandidateMesh::Face_index, int>("f:support");
   ASSERT_TRUE(support.second);
-  for (int f = 0; f < int(cs.faces.size()); ++f) EXPECT_EQ(support.first[CandidateMesh::Face_index(f)], cs.faces[f].plane);
+  for (int f = 0; f < int(cs.faces.size()); ++f)
+    EXPECT_EQ(support.first[CandidateMesh::Face_index(f)], cs.faces[f].plane);
   int shared = 0;
   for (auto e : cs.mesh.edges()) {
     const auto h = cs.mesh.halfedge(e);

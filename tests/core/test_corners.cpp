@@ -17,7 +17,8 @@ Mesh box() {
   soup.id = "box";
   const Vec3 c[8] = {{0, 0, 0}, {12, 0, 0}, {12, 8, 0}, {0, 8, 0}, {0, 0, 6}, {12, 0, 6}, {12, 8, 6}, {0, 8, 6}};
   const int quads[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
-  const Semantic sem[6] = {Semantic::Ground, Semantic::Roof, Semantic::Wall, Semantic::Wall, Semantic::Wall, Semantic::Wall};
+  const Semantic sem[6] = {Semantic::Ground, Semantic::Roof, Semantic::Wall,
+                           Semantic::Wall,   Semantic::Wall, Semantic::Wall};
   for (int f = 0; f < 6; ++f) {
     Face face;
     face.sem = sem[f];

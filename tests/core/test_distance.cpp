@@ -39,14 +39,14 @@ void expect_nearest(const Mesh& mesh, const std::vector<Probe>& probes, double t
 
 TEST(CloudToMesh, UnitCubeFaceEdgeVertexAndInside) {
   const std::vector<Vec3> pts = {
-      {0.5, 0.5, 1.3},  // above the roof
-      {0.5, 0.5, 0.8},  // inside, nearest the roof
-      {0.5, 0.5, 0.5},  // centre: all six faces tie
-      {1.2, 0.5, 1.2},  // nearest an edge
-      {1.2, 1.2, 1.2},  // nearest a vertex
-      {-0.3, 0.5, 0.1}, // outside a wall
-      {0.9, 0.5, 0.9},  // inside, equidistant to two faces
-      {1.0, 0.3, 0.7},  // on the surface
+      {0.5, 0.5, 1.3},   // above the roof
+      {0.5, 0.5, 0.8},   // inside, nearest the roof
+      {0.5, 0.5, 0.5},   // centre: all six faces tie
+      {1.2, 0.5, 1.2},   // nearest an edge
+      {1.2, 1.2, 1.2},   // nearest a vertex
+      {-0.3, 0.5, 0.1},  // outside a wall
+      {0.9, 0.5, 0.9},   // inside, equidistant to two faces
+      {1.0, 0.3, 0.7},   // on the surface
   };
   const std::vector<double> want = {0.3, -0.2, -0.5, std::sqrt(0.08), std::sqrt(0.12), 0.3, -0.1, 0.0};
   const auto got = cloud_to_mesh(unit_cube(), pts);

@@ -79,14 +79,17 @@ TEST(Judge, AWallMovedOntoABaysPlaneIsRefused) {
   EXPECT_NE(j.detail.find("RMS"), std::string::npos) << j.detail;
   EXPECT_GT(j.building.rms_after, j.building.rms_before);
   // Onto the facade's own plane it is better.
-  const Judgement k = judge_refinement(coarse, box({0, 0, 0}, {12, 8, 6}), {front_wall(-0.2, 0.0)}, cloud, MatchConfig{}, PlaneConfig{});
+  const Judgement k = judge_refinement(coarse, box({0, 0, 0}, {12, 8, 6}), {front_wall(-0.2, 0.0)}, cloud,
+                                       MatchConfig{}, PlaneConfig{});
   EXPECT_TRUE(k.ok) << k.check << ": " << k.detail;
   // A bay twice as wide: no plane of the model's wall fits better than where it is.
   PointCloud wide;
   scan_front(wide, 0.0, 0.0, 4.0, 1);
   scan_front(wide, -0.5, 4.0, 8.0, 2);
   scan_front(wide, 0.0, 8.0, 12.0, 3);
-  EXPECT_FALSE(judge_refinement(coarse, box({0, 0, 0}, {12, 8, 6}), {front_wall(-0.2, 0.0)}, wide, MatchConfig{}, PlaneConfig{}).ok);
+  EXPECT_FALSE(
+      judge_refinement(coarse, box({0, 0, 0}, {12, 8, 6}), {front_wall(-0.2, 0.0)}, wide, MatchConfig{}, PlaneConfig{})
+          .ok);
 }
 
 // The right side wall (x = 12) moves in by 0.7 m while only the front is scanned: the points do
@@ -104,7 +107,8 @@ TEST(Judge, AnUnscannedWallMovesOnlyOnCornerEvidence) {
   EXPECT_EQ(j.check, "wall");
   EXPECT_NE(j.detail.find("no corner evidence"), std::string::npos) << j.detail;
   side.corner = true;
-  EXPECT_EQ(judge_refinement(coarse, refined, {side}, cloud, MatchConfig{}, PlaneConfig{}).check, "gain");  // nothing shows it
+  EXPECT_EQ(judge_refinement(coarse, refined, {side}, cloud, MatchConfig{}, PlaneConfig{}).check,
+            "gain");  // nothing shows it
   // The return onto the side wall where the facade ends (corners.h): now the scan shows it.
   add_grid(cloud, wall_patch({11.3, 0.05, 0}, kY, 0.6, 1.0, 5.5), 0.05);
   const Judgement k = judge_refinement(coarse, refined, {side}, cloud, MatchConfig{}, PlaneConfig{});

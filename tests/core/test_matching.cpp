@@ -96,7 +96,8 @@ TEST(ModelSurfaces, BoxGivesSixOutwardSurfacesWithTheirSemantics) {
   const auto ss = model_surfaces(building());
   ASSERT_EQ(ss.size(), 6u);
   const Vec3 normals[6] = {-Vec3::UnitZ(), Vec3::UnitZ(), -Vec3::UnitY(), Vec3::UnitX(), Vec3::UnitY(), -Vec3::UnitX()};
-  const Semantic sems[6] = {Semantic::Ground, Semantic::Roof, Semantic::Wall, Semantic::Wall, Semantic::Wall, Semantic::Wall};
+  const Semantic sems[6] = {Semantic::Ground, Semantic::Roof, Semantic::Wall,
+                            Semantic::Wall,   Semantic::Wall, Semantic::Wall};
   const double areas[6] = {96, 96, 72, 48, 72, 48};
   const Vec3 centroids[6] = {{6, 4, 0}, {6, 4, 6}, {6, 0, 3}, {12, 4, 3}, {6, 8, 3}, {0, 4, 3}};
   for (int k = 0; k < 6; ++k) {
@@ -186,7 +187,8 @@ TEST(Matching, NonFacadePlanesAreNeverMatched) {
 TEST(Matching, DetectedPlanesOfTwoScannedWallsMatchTheirWalls) {
   Scene s(building());
   const auto front = add_grid(s.cloud, wall_patch({0, -0.4, 0}, Vec3::UnitX(), 12.4, 0.0, 5.0), kStep, 0.01, 1);
-  const auto right = add_grid(s.cloud, {{12.4, 0, 0}, Vec3::UnitY(), Vec3::UnitZ(), -0.3, 8.0, 0.0, 5.0}, kStep, 0.01, 2);
+  const auto right =
+      add_grid(s.cloud, {{12.4, 0, 0}, Vec3::UnitY(), Vec3::UnitZ(), -0.3, 8.0, 0.0, 5.0}, kStep, 0.01, 2);
   add_grid(s.cloud, {{0, 0, 0}, Vec3::UnitX(), Vec3::UnitY(), 0.0, 12.4, -3.0, -0.5}, kStep, 0.01, 3);
   s.planes = detect_planes(s.cloud, Params{});
   ASSERT_EQ(s.planes.size(), 3u);
@@ -313,7 +315,7 @@ TEST(Matching, PlaneSpanningTwoCollinearWallsIsSharedByOwnership) {
   EXPECT_EQ(count_if_x(s.cloud, a->owned, [](double x) { return x > 12.5; }), 0);
   EXPECT_EQ(count_if_x(s.cloud, b->owned, [](double x) { return x < 11.5; }), 0);
   EXPECT_EQ(count_if_x(s.cloud, a->owned, [](double x) { return x < 11.5; }), columns(11.4) * kRows);  // 0.05 ... 11.45
-  EXPECT_EQ(count_if_x(s.cloud, b->owned, [](double x) { return x > 12.5; }), columns(7.4) * kRows);   // 12.55 ... 19.95
+  EXPECT_EQ(count_if_x(s.cloud, b->owned, [](double x) { return x > 12.5; }), columns(7.4) * kRows);  // 12.55 ... 19.95
 }
 
 // A setback: the front is y = 0 for x in [0, 6] and y = 1.5 for x in [6, 12]. The front's scan

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <random>
 
-#include "lodrefine/core/refine.h"
 #include "lodrefine/core/params.h"
+#include "lodrefine/core/refine.h"
 #include "lodrefine/core/validate.h"
 #include "support/mesh_fixtures.h"
 #include "support/scan_fixtures.h"
@@ -119,7 +119,6 @@ TEST(Refine, NoScanFallsBackToTheRepairedOriginal) {
   EXPECT_EQ(r.reason, "no planes found in the cloud near the model");
   EXPECT_EQ(r.mesh.faces.size(), 6u);
 }
-
 
 // Three terraced houses A [0,12], B [12,24], C [24,36]: the tile holds the street from x = -0.6
 // (a neighbour's facade left of A) to x = 24.6 (0.6 m of C). A is correct; B's front is 0.5 m

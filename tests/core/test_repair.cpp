@@ -60,10 +60,10 @@ void expect_valid_solid(const Mesh& m, double volume) {
 
 TEST(Repair, CubeSoupWithExportDefectsBecomesClosedSolid) {
   auto faces = box({0, 0, 0}, {1, 1, 1});
-  faces.erase(faces.begin() + 1);                       // ground missing
-  faces[1].first = reversed(faces[1].first);            // front wall flipped
-  faces[2].first.insert(faces[2].first.begin() + 1, faces[2].first[1]);  // repeated corner
-  faces.push_back({reversed(faces[3].first), Semantic::Wall});           // back wall again, reversed
+  faces.erase(faces.begin() + 1);                                            // ground missing
+  faces[1].first = reversed(faces[1].first);                                 // front wall flipped
+  faces[2].first.insert(faces[2].first.begin() + 1, faces[2].first[1]);      // repeated corner
+  faces.push_back({reversed(faces[3].first), Semantic::Wall});               // back wall again, reversed
   faces.push_back({{{0, 0, 1}, {0, 0, 1.001}, {1, 0, 1}}, Semantic::Roof});  // degenerate sliver
   Mesh in = soup(faces);
   std::mt19937 rng(7);
@@ -122,8 +122,8 @@ TEST(Repair, InvertedLShapedPrismWithoutGroundIsOrientedAndClosed) {
   Polygon roof;
   for (std::size_t i = 0; i < foot.size(); ++i) {
     const Vec2 &a = foot[i], &b = foot[(i + 1) % foot.size()];
-    faces.push_back({reversed({{a.x(), a.y(), 0}, {b.x(), b.y(), 0}, {b.x(), b.y(), 3}, {a.x(), a.y(), 3}}),
-                     Semantic::Wall});
+    faces.push_back(
+        {reversed({{a.x(), a.y(), 0}, {b.x(), b.y(), 0}, {b.x(), b.y(), 3}, {a.x(), a.y(), 3}}), Semantic::Wall});
     roof.push_back({a.x(), a.y(), 3});
   }
   faces.push_back({reversed(roof), Semantic::Roof});  // every face inward, as some exporters do
@@ -219,8 +219,8 @@ TEST(Repair, MergeJoinsCoplanarTilesButKeepsARingAroundAHoleApart) {
     faces.erase(faces.begin());
     for (double x = 0; x < 3; ++x)
       for (double y = 0; y < 3; ++y)
-        faces.push_back({{{x, y, 1}, {x + 1, y, 1}, {x + 1, y + 1, 1}, {x, y + 1, 1}},
-                         x == 1 && y == 1 ? centre : Semantic::Roof});
+        faces.push_back(
+            {{{x, y, 1}, {x + 1, y, 1}, {x + 1, y + 1, 1}, {x, y + 1, 1}}, x == 1 && y == 1 ? centre : Semantic::Roof});
     RepairReport r;
     const Mesh m = repair_model(soup(faces), 0.01, &r);
     EXPECT_EQ(r.split_t_junctions, 8);  // two tile corners on each wall's top edge

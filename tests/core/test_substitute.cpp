@@ -3,9 +3,9 @@
 #include <gtest/gtest.h>
 
 #include "lodrefine/core/matching.h"
+#include "lodrefine/core/params.h"
 #include "lodrefine/core/repair.h"
 #include "lodrefine/core/substitute.h"
-#include "lodrefine/core/params.h"
 #include "lodrefine/core/validate.h"
 #include "support/mesh_fixtures.h"
 

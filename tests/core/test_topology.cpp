@@ -69,15 +69,15 @@ TEST(Topology, InsideSegmentParameterAndDistance) {
 
 TEST(Topology, VerticesOnSegmentOrderAndExclusions) {
   const std::vector<Vec3> V = {
-      {0, 0, 0},     // 0: a
-      {4, 0, 0},     // 1: b
-      {3, 0, 0},     // 2: t = 0.75
-      {1, 0, 0},     // 3: t = 0.25
-      {2, 0.1, 0},   // 4: t = 0.5, 0.1 off
-      {2, 0, 0},     // 5: t = 0.5, on the line (tie with 4: index order)
-      {2, 1, 0},     // 6: too far off
-      {0, 0, 0},     // 7: a's position under another index: t = 0
-      {5, 0, 0},     // 8: beyond b
+      {0, 0, 0},    // 0: a
+      {4, 0, 0},    // 1: b
+      {3, 0, 0},    // 2: t = 0.75
+      {1, 0, 0},    // 3: t = 0.25
+      {2, 0.1, 0},  // 4: t = 0.5, 0.1 off
+      {2, 0, 0},    // 5: t = 0.5, on the line (tie with 4: index order)
+      {2, 1, 0},    // 6: too far off
+      {0, 0, 0},    // 7: a's position under another index: t = 0
+      {5, 0, 0},    // 8: beyond b
   };
   const SegmentRule rule{0.2};
   EXPECT_EQ(vertices_on_segment(V, 0, 1, rule), (std::vector<int>{3, 4, 5, 2}));
@@ -104,9 +104,9 @@ TEST(Topology, GridKeysAndHash) {
 TEST(Topology, GridVisitsTheNeighbouringCellsOnly) {
   PointGrid grid(1.0);
   grid.insert(Vec3(0.5, 0.5, 0.5), 0);
-  grid.insert(Vec3(1.5, 0.5, 0.5), 1);    // next cell in x
+  grid.insert(Vec3(1.5, 0.5, 0.5), 1);     // next cell in x
   grid.insert(Vec3(-0.5, -0.5, -0.5), 2);  // diagonal neighbour
-  grid.insert(Vec3(2.5, 0.5, 0.5), 3);    // two cells away
+  grid.insert(Vec3(2.5, 0.5, 0.5), 3);     // two cells away
   grid.insert(Vec3(0.25, 0.25, 0.25), 4);  // same cell as 0, inserted later
   std::vector<int> seen;
   EXPECT_FALSE(grid.visit_near(Vec3(0.9, 0.1, 0.1), [&](int id) {
@@ -125,13 +125,13 @@ TEST(Topology, GridVisitsTheNeighbouringCellsOnly) {
 TEST(Topology, WelderAcrossCellBoundaries) {
   PointWelder w(0.25);  // cells of 1.0
   EXPECT_EQ(w.add(Vec3(0.875, 0, 0)), 0);
-  EXPECT_EQ(w.add(Vec3(1.125, 0, 0)), 0);          // next cell in x, exactly 0.25 away: welded
-  EXPECT_EQ(w.add(Vec3(1.1875, 0.0625, 0)), 1);    // 0.319 away: a new point
-  EXPECT_EQ(w.add(Vec3(-0.0625, 0, 0)), 2);        // cell -1, 0.94 from point 0
-  EXPECT_EQ(w.add(Vec3(0.0625, 0, 0)), 2);         // cell 0, 0.125 from point 2 in cell -1
-  EXPECT_EQ(w.add(Vec3(0.0625, 0, 0.3125)), 3);    // 0.337 from point 2: outside
-  EXPECT_EQ(w.add(Vec3(0, 0, -0.1875)), 2);        // cell (0, 0, -1), 0.198 from point 2 in (-1, 0, 0)
-  EXPECT_EQ(w.add(Vec3(0.0625, 0, -0.25)), 4);     // 0.280 from point 2: outside
+  EXPECT_EQ(w.add(Vec3(1.125, 0, 0)), 0);        // next cell in x, exactly 0.25 away: welded
+  EXPECT_EQ(w.add(Vec3(1.1875, 0.0625, 0)), 1);  // 0.319 away: a new point
+  EXPECT_EQ(w.add(Vec3(-0.0625, 0, 0)), 2);      // cell -1, 0.94 from point 0
+  EXPECT_EQ(w.add(Vec3(0.0625, 0, 0)), 2);       // cell 0, 0.125 from point 2 in cell -1
+  EXPECT_EQ(w.add(Vec3(0.0625, 0, 0.3125)), 3);  // 0.337 from point 2: outside
+  EXPECT_EQ(w.add(Vec3(0, 0, -0.1875)), 2);      // cell (0, 0, -1), 0.198 from point 2 in (-1, 0, 0)
+  EXPECT_EQ(w.add(Vec3(0.0625, 0, -0.25)), 4);   // 0.280 from point 2: outside
   ASSERT_EQ(w.points().size(), 5u);
   EXPECT_EQ(w.points()[0], Vec3(0.875, 0, 0));  // a cluster keeps its first point
   EXPECT_EQ(w.points()[2], Vec3(-0.0625, 0, 0));
@@ -155,7 +155,7 @@ TEST(Topology, EdgeUsesForwardFlags) {
   EXPECT_EQ(e12[0].face, 0);
   EXPECT_TRUE(e12[0].forward);  // 1 -> 2
   EXPECT_EQ(e12[1].face, 1);
-  EXPECT_FALSE(e12[1].forward);  // 2 -> 1
+  EXPECT_FALSE(e12[1].forward);              // 2 -> 1
   EXPECT_FALSE(uses.at({0, 2})[0].forward);  // face 0 closes 2 -> 0
   const auto& e13 = uses.at({1, 3});
   ASSERT_EQ(e13.size(), 2u);

@@ -4,8 +4,8 @@
 #include <map>
 
 #include "lodrefine/core/geometry.h"
-#include "lodrefine/core/topology.h"
 #include "lodrefine/core/params.h"
+#include "lodrefine/core/topology.h"
 #include "lodrefine/core/validate.h"
 
 using namespace lodrefine;

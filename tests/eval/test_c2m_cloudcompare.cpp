@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 
+#include <unistd.h>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -11,10 +12,9 @@
 #include <fstream>
 #include <random>
 #include <sstream>
-#include <unistd.h>
 
-#include "lodrefine/eval/eval.h"
 #include "lodrefine/core/geometry.h"
+#include "lodrefine/eval/eval.h"
 #include "support/mesh_fixtures.h"
 
 using namespace lodrefine;
@@ -41,7 +41,8 @@ void write_triangle_obj(const std::string& path, const Triangles& tris) {
   out.precision(17);
   for (const auto& t : tris)
     for (const auto& v : t) out << "v " << v.x() << ' ' << v.y() << ' ' << v.z() << '\n';
-  for (std::size_t i = 0; i < tris.size(); ++i) out << "f " << 3 * i + 1 << ' ' << 3 * i + 2 << ' ' << 3 * i + 3 << '\n';
+  for (std::size_t i = 0; i < tris.size(); ++i)
+    out << "f " << 3 * i + 1 << ' ' << 3 * i + 2 << ' ' << 3 * i + 3 << '\n';
 }
 
 void write_ascii_ply(const std::string& path, const std::vector<Vec3>& pts) {

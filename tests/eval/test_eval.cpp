@@ -41,9 +41,9 @@ TEST(EvalStats, KnownVectors) {
   EXPECT_NEAR(b.mean, 0.1, 1e-12);
   EXPECT_NEAR(b.rmse, std::sqrt(0.075), 1e-12);
   EXPECT_NEAR(b.mae, 0.25, 1e-12);
-  EXPECT_NEAR(b.std, std::sqrt(0.065), 1e-12);     // population std: rmse² = mean² + std²
+  EXPECT_NEAR(b.std, std::sqrt(0.065), 1e-12);  // population std: rmse² = mean² + std²
   EXPECT_NEAR(b.median, 0.15, 1e-12);
-  EXPECT_NEAR(b.p95, 0.3 + 0.85 * 0.1, 1e-12);     // of |d| = {0.1, 0.2, 0.3, 0.4}
+  EXPECT_NEAR(b.p95, 0.3 + 0.85 * 0.1, 1e-12);  // of |d| = {0.1, 0.2, 0.3, 0.4}
 
   EXPECT_EQ(summarize_distances({}).count, 0u);
   EXPECT_EQ(summarize_distances({}).rmse, 0.0);

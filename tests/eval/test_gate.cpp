@@ -49,7 +49,8 @@ std::string parse_with_python(const std::string& xml) {
   const std::string cmd =
       "python3 -c \"import sys, xml.etree.ElementTree as E; r = E.parse(sys.argv[1]).getroot(); "
       "c = r.findall('.//testcase'); print(len(c), len(r.findall('.//failure'))); "
-      "[print(ascii(t.get('name')), t.find('failure') is not None) for t in c]\" '" + path + "' 2>&1";
+      "[print(ascii(t.get('name')), t.find('failure') is not None) for t in c]\" '" +
+      path + "' 2>&1";
   std::string out;
   if (FILE* p = popen(cmd.c_str(), "r")) {
     char buf[4096];
@@ -92,13 +93,13 @@ TEST(Gate, IdsThatAreNotUtf8MatchTheBaselineTheyWrote) {
 TEST(Gate, EachRegressionNamesBuildingFigureAndValues) {
   const RunFigures base = sample_run();
   RunFigures run = sample_run();
-  run.buildings[0].c2m_rmse = 0.301;               // a: moved by 0.3 m
-  run.buildings[2].outcome = "kept";               // c: refined -> kept
+  run.buildings[0].c2m_rmse = 0.301;  // a: moved by 0.3 m
+  run.buildings[2].outcome = "kept";  // c: refined -> kept
   run.buildings[2].reason = "no facade matched";
-  run.buildings[2].c2m_rmse = 0.5;                 // not compared again: the outcome says it
-  run.buildings[1].c2m_rmse = 0.034;               // b: worse by 4 mm, within the tolerance
+  run.buildings[2].c2m_rmse = 0.5;                          // not compared again: the outcome says it
+  run.buildings[1].c2m_rmse = 0.034;                        // b: worse by 4 mm, within the tolerance
   run.buildings.push_back(building("d", "refined", 0.01));  // new: listed, not failed
-  run.buildings.erase(run.buildings.begin() + 1);  // b gone
+  run.buildings.erase(run.buildings.begin() + 1);           // b gone
   const GateVerdict v = check_run(run, &base, nullptr, 0.005);
   const auto t = texts(v);
   ASSERT_EQ(t.size(), 3u) << ::testing::PrintToString(t);
@@ -139,7 +140,8 @@ TEST(Gate, LostMeasuresWatertightnessAndPooledFiguresFail) {
 TEST(Gate, GatesBreachedPooledAndPerBuilding) {
   const Gates g = read_gates(R"({"_comment": "x", "max_c2m_rmse_refined": 0.02, "min_watertight_rate": 1,
       "max_failed_buildings": 0, "max_building_c2m_rmse_refined": 0.025, "max_truth_roof_rmse_refined": 0.05,
-      "max_c2m_rmse_ratio": 0.5})", "gates.json");
+      "max_c2m_rmse_ratio": 0.5})",
+                             "gates.json");
   ASSERT_EQ(g.size(), 6u);
   const GateVerdict v = check_run(sample_run(), nullptr, &g, 0.005);
   const auto t = texts(v);
@@ -173,9 +175,9 @@ TEST(Gate, BadGateAndBaselineFilesAreOneLineErrors) {
   EXPECT_THROW(read_baseline(R"({"format": "lodrefine-baseline", "version": 2})", "b"), InputError);
   EXPECT_THROW(read_baseline(R"({"format": "lodrefine-baseline", "version": 1, "pooled": {"failed": "x"}})", "b"),
                InputError);
-  EXPECT_THROW(read_baseline(R"({"format": "lodrefine-baseline", "version": 1, "buildings": [{"id": "a"}, {"id": "a"}]})",
-                             "b"),
-               InputError);
+  EXPECT_THROW(
+      read_baseline(R"({"format": "lodrefine-baseline", "version": 1, "buildings": [{"id": "a"}, {"id": "a"}]})", "b"),
+      InputError);
 }
 
 TEST(Gate, XmlEscapeKeepsOnlyWhatXml10Allows) {
@@ -183,12 +185,12 @@ TEST(Gate, XmlEscapeKeepsOnlyWhatXml10Allows) {
   EXPECT_EQ(xml_escape("a\tb\nc\r"), "a&#9;b&#10;c&#13;");
   const std::string fffd = "\xEF\xBF\xBD";
   EXPECT_EQ(xml_escape(std::string("x\x01y\0z", 5)), "x" + fffd + "y" + fffd + "z");
-  EXPECT_EQ(xml_escape("caf\xC3\xA9 \xE2\x80\xA8"), "caf\xC3\xA9 \xE2\x80\xA8");   // UTF-8 kept
-  EXPECT_EQ(xml_escape("\xFF\xC3"), fffd + fffd);                                   // not UTF-8
-  EXPECT_EQ(xml_escape("\xC0\xAF"), fffd + fffd);                                   // overlong "/"
-  EXPECT_EQ(xml_escape("\xED\xA0\x80"), fffd + fffd + fffd);                        // a surrogate
-  EXPECT_EQ(xml_escape("\xEF\xBF\xBE"), fffd);                                      // U+FFFE
-  EXPECT_EQ(xml_escape("\xF0\x9F\x8F\xA0"), "\xF0\x9F\x8F\xA0");                    // beyond the BMP
+  EXPECT_EQ(xml_escape("caf\xC3\xA9 \xE2\x80\xA8"), "caf\xC3\xA9 \xE2\x80\xA8");  // UTF-8 kept
+  EXPECT_EQ(xml_escape("\xFF\xC3"), fffd + fffd);                                 // not UTF-8
+  EXPECT_EQ(xml_escape("\xC0\xAF"), fffd + fffd);                                 // overlong "/"
+  EXPECT_EQ(xml_escape("\xED\xA0\x80"), fffd + fffd + fffd);                      // a surrogate
+  EXPECT_EQ(xml_escape("\xEF\xBF\xBE"), fffd);                                    // U+FFFE
+  EXPECT_EQ(xml_escape("\xF0\x9F\x8F\xA0"), "\xF0\x9F\x8F\xA0");                  // beyond the BMP
 }
 
 TEST(Gate, JunitHasOneTestcasePerBuildingAndParsesWithHostileIds) {
@@ -203,7 +205,8 @@ TEST(Gate, JunitHasOneTestcasePerBuildingAndParsesWithHostileIds) {
   const std::string xml = junit_xml(v, "samples");
   EXPECT_EQ(xml.find("<script>"), std::string::npos);
   EXPECT_EQ(xml.find('\x01'), std::string::npos);
-  EXPECT_NE(xml.find("<failure message=\"&lt;/testcase&gt;&lt;script&gt;alert(&quot;x&quot;)"), std::string::npos) << xml;
+  EXPECT_NE(xml.find("<failure message=\"&lt;/testcase&gt;&lt;script&gt;alert(&quot;x&quot;)"), std::string::npos)
+      << xml;
   EXPECT_NE(xml.find("<system-out>new building: not in the baseline</system-out>"), std::string::npos);
   const std::string parsed = parse_with_python(xml);
   if (parsed.find("No module") != std::string::npos || parsed.find("not found") != std::string::npos)

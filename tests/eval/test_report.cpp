@@ -20,7 +20,8 @@ TEST(Report, PageLoadsWithoutErrorsAndTheScreenshotShowsTheModel) {
   std::string broken;
   for (const auto& e : fs::directory_iterator(run)) broken = std::max(broken, e.path().filename().string());
   std::ofstream(run / broken / "cloud.ply") << "ply\nformat ascii 1.0\nelement vertex 5\nend_header\n1 2\n";
-  ASSERT_EQ(shell(batch_command(run) + " > " + shell_quoted(run / "batch.log") + " 2>&1"), 0) << read_text(run / "batch.log");
+  ASSERT_EQ(shell(batch_command(run) + " > " + shell_quoted(run / "batch.log") + " 2>&1"), 0)
+      << read_text(run / "batch.log");
   const std::string html = read_text(run / "report.html");
   ASSERT_FALSE(html.empty());
   // Self-contained: nothing fetched from anywhere.

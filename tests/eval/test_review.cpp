@@ -156,7 +156,8 @@ TEST(Review, DelfshavenRefinePageRendersEveryRefinedBuilding) {
   EXPECT_EQ(d.root.find("data-errors"), std::string::npos) << d.root;
   EXPECT_EQ(d.root.find("data-pwned"), std::string::npos) << "the hostile id ran";
   EXPECT_NE(d.root.find("data-rendered=\"" + std::to_string(refined.size()) + "\""), std::string::npos)
-      << d.root << "\n" << d.log;
+      << d.root << "\n"
+      << d.log;
   for (const std::string& line : d.console_errors) ADD_FAILURE() << line;
 
   // Every refined building's canvas, in one screenshot tall enough for all of them.
@@ -190,14 +191,17 @@ TEST(Review, HtmlNeedsACityFileAndAWritableFolder) {
   const std::string sample = (kSource / "data" / "samples" / "synth_gable_0001").string();
   const std::string refine = kBinary + " refine --model " + shell_quoted(sample + "/coarse.obj") + " --cloud " +
                              shell_quoted(sample + "/cloud.ply") + " --out " + shell_quoted(dir / "r.obj");
-  EXPECT_EQ(shell(refine + " --html " + shell_quoted(dir / "r.html") + " > /dev/null 2> " + shell_quoted(dir / "err")), 2);
-  EXPECT_NE(read_text(dir / "err").find("lodrefine: error: " + (dir / "r.html").string() +
-                                        ": --html is the review page of a city refine"),
-            std::string::npos)
+  EXPECT_EQ(shell(refine + " --html " + shell_quoted(dir / "r.html") + " > /dev/null 2> " + shell_quoted(dir / "err")),
+            2);
+  EXPECT_NE(
+      read_text(dir / "err")
+          .find("lodrefine: error: " + (dir / "r.html").string() + ": --html is the review page of a city refine"),
+      std::string::npos)
       << read_text(dir / "err");
   EXPECT_FALSE(fs::exists(dir / "r.obj"));
-  EXPECT_EQ(shell(refine + " --html " + shell_quoted(dir / "no" / "r.html") + " > /dev/null 2> " + shell_quoted(dir / "err")),
-            2);
+  EXPECT_EQ(
+      shell(refine + " --html " + shell_quoted(dir / "no" / "r.html") + " > /dev/null 2> " + shell_quoted(dir / "err")),
+      2);
   EXPECT_NE(read_text(dir / "err").find("output directory"), std::string::npos) << read_text(dir / "err");
   if (!HasFailure()) fs::remove_all(dir);
 }

@@ -55,8 +55,8 @@ TEST(RunTable, MovedSummaryCountMaxMean) {
 }
 
 TEST(RunTable, WorstFirstFailedThenLeakyThenLargestRmseThenId) {
-  std::vector<RunRow> rows = {row("good", 0.4, 0.01, true), row("leaky", 0.4, 0.001, false),
-                              row("bad", 0.4, 0.30, true),  failed_row("gone"),
+  std::vector<RunRow> rows = {row("good", 0.4, 0.01, true),     row("leaky", 0.4, 0.001, false),
+                              row("bad", 0.4, 0.30, true),      failed_row("gone"),
                               row("unmeasured", 0, 0, true, 0), row("also-bad", 0.4, 0.30, true)};
   EXPECT_EQ(ids(worst_first(rows)),
             (std::vector<std::string>{"gone", "leaky", "also-bad", "bad", "good", "unmeasured"}));
@@ -75,8 +75,9 @@ TEST(RunTable, TotalsCountOutcomesMovesAndSeconds) {
   EXPECT_EQ(t.moved.count, 2u);
   EXPECT_DOUBLE_EQ(t.moved.max, 0.4);
   EXPECT_DOUBLE_EQ(t.refine_seconds, 2.5);  // the failed building recorded none (NaN)
-  EXPECT_EQ(totals_text(t),
-            "\noutcomes: refined 1, kept 1, failed 1; facades moved 2 (max 0.400 m, mean 0.300 m); refine 2.5 s in all\n");
+  EXPECT_EQ(
+      totals_text(t),
+      "\noutcomes: refined 1, kept 1, failed 1; facades moved 2 (max 0.400 m, mean 0.300 m); refine 2.5 s in all\n");
 }
 
 TEST(RunTable, Table1LinesWithDashesForWhatWasNotMeasured) {

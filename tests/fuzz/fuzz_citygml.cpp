@@ -33,15 +33,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   static const std::string path = fuzz::temp_file("in.gml");
   write_secret();
   fuzz::write_bytes(path, data, size);
-  const bool input_has_secret = std::string(reinterpret_cast<const char*>(data), size).find(kSecret) != std::string::npos;
+  const bool input_has_secret =
+      std::string(reinterpret_cast<const char*>(data), size).find(kSecret) != std::string::npos;
   try {
     const CityJsonFile f = read_citygml(path);
     std::set<std::string> ids;
     for (const auto& b : f.buildings) {
       FUZZ_CHECK(!b.mesh.faces.empty(), "building %s without faces", b.mesh.id.c_str());
       FUZZ_CHECK(ids.insert(b.mesh.id).second, "two buildings with id %s", b.mesh.id.c_str());
-      FUZZ_CHECK(input_has_secret || b.attributes.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)
-                                             .find(kSecret) == std::string::npos,
+      FUZZ_CHECK(input_has_secret ||
+                     b.attributes.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).find(kSecret) ==
+                         std::string::npos,
                  "a local file's content reached the attributes of %s", b.mesh.id.c_str());
       FUZZ_CHECK(b.mesh.id.find("genID_") == std::string::npos, "generated id written: %s", b.mesh.id.c_str());
       for (const auto& face : b.mesh.faces) {

@@ -30,21 +30,21 @@ inline void write_bytes(const std::string& path, const std::uint8_t* data, std::
 }
 
 // A broken invariant is a finding: abort so libFuzzer saves the input.
-#define FUZZ_CHECK(cond, ...)                                             \
-  do {                                                                    \
-    if (!(cond)) {                                                        \
-      std::fprintf(stderr, "FUZZ_CHECK failed: %s: ", #cond);             \
-      std::fprintf(stderr, __VA_ARGS__);                                  \
-      std::fprintf(stderr, "\n");                                         \
-      std::abort();                                                       \
-    }                                                                     \
+#define FUZZ_CHECK(cond, ...)                                 \
+  do {                                                        \
+    if (!(cond)) {                                            \
+      std::fprintf(stderr, "FUZZ_CHECK failed: %s: ", #cond); \
+      std::fprintf(stderr, __VA_ARGS__);                      \
+      std::fprintf(stderr, "\n");                             \
+      std::abort();                                           \
+    }                                                         \
   } while (0)
 
 // InputError messages must be one line and name the file (apps/main.cpp prints them as is).
 inline void check_message(const char* what, const std::string& path) {
   const std::string msg = what;
-  FUZZ_CHECK(msg.find('\n') == std::string::npos && msg.find('\r') == std::string::npos,
-             "multi-line InputError: %s", what);
+  FUZZ_CHECK(msg.find('\n') == std::string::npos && msg.find('\r') == std::string::npos, "multi-line InputError: %s",
+             what);
   FUZZ_CHECK(msg.rfind(path, 0) == 0, "InputError does not start with the path: %s", what);
   FUZZ_CHECK(msg.size() < 1024, "InputError longer than 1 KiB (%zu chars)", msg.size());
 }

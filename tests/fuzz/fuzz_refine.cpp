@@ -10,9 +10,9 @@
 #include <string>
 
 #include "fuzz_common.h"
+#include "lodrefine/core/refine.h"
 #include "lodrefine/io/obj.h"
 #include "lodrefine/io/ply.h"
-#include "lodrefine/core/refine.h"
 #include "lodrefine/io/refine_report.h"
 
 using namespace lodrefine;
@@ -59,7 +59,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                  outcome_name(r.outcome));
   FUZZ_CHECK(!r.reason.empty(), "outcome '%s' without a reason", outcome_name(r.outcome));
   FUZZ_CHECK(!r.refined() || r.valid, "refined but not valid");
-  FUZZ_CHECK(refine_report(r).value("outcome", std::string()) == outcome_name(r.outcome), "report disagrees on the outcome");
+  FUZZ_CHECK(refine_report(r).value("outcome", std::string()) == outcome_name(r.outcome),
+             "report disagrees on the outcome");
   if (r.valid) {
     FUZZ_CHECK(!r.mesh.faces.empty(), "valid result without faces");
     for (const auto& v : r.mesh.vertices) FUZZ_CHECK(v.allFinite(), "non-finite vertex in a valid result");

@@ -9,24 +9,24 @@
 #include "support/scan_fixtures.h"
 
 #include <chrono>
-#include <functional>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <random>
 
-#include "lodrefine/io/cityfile.h"
-#include "lodrefine/io/cityjson.h"
-#include "lodrefine/io/citygml.h"
 #include "lodrefine/core/geometry.h"
-#include "lodrefine/io/obj.h"
-#include "lodrefine/io/ply.h"
+#include "lodrefine/core/params.h"
+#include "lodrefine/core/refine.h"
+#include "lodrefine/core/validate.h"
+#include "lodrefine/io/cityfile.h"
+#include "lodrefine/io/citygml.h"
+#include "lodrefine/io/cityjson.h"
 #include "lodrefine/io/files.h"
 #include "lodrefine/io/las.h"
-#include "lodrefine/core/refine.h"
+#include "lodrefine/io/obj.h"
+#include "lodrefine/io/ply.h"
 #include "lodrefine/synth/synth.h"
-#include "lodrefine/core/params.h"
-#include "lodrefine/core/validate.h"
 
 using namespace lodrefine;
 
@@ -91,10 +91,13 @@ std::string geometry_problem(const Mesh& soup) {
 // A CityJSON 2.0 document of generated buildings: the coarse soup as an LoD 2.2 MultiSurface
 // with semantics, plus an LoD 1 block and attributes, so the test sees both kept exactly.
 json synth_city(const std::vector<SynthBuilding>& bs, const Vec3& translate) {
-  json doc = {{"type", "CityJSON"}, {"version", "2.0"},
-              {"transform", {{"scale", {0.001, 0.001, 0.001}}, {"translate", {translate.x(), translate.y(), translate.z()}}}},
-              {"metadata", {{"referenceSystem", "https://www.opengis.net/def/crs/EPSG/0/7415"}, {"title", "synth"}}},
-              {"CityObjects", json::object()}, {"vertices", json::array()}};
+  json doc = {
+      {"type", "CityJSON"},
+      {"version", "2.0"},
+      {"transform", {{"scale", {0.001, 0.001, 0.001}}, {"translate", {translate.x(), translate.y(), translate.z()}}}},
+      {"metadata", {{"referenceSystem", "https://www.opengis.net/def/crs/EPSG/0/7415"}, {"title", "synth"}}},
+      {"CityObjects", json::object()},
+      {"vertices", json::array()}};
   for (const auto& b : bs) {
     json boundaries = json::array(), values = json::array();
     for (const Face& f : b.coarse.faces) {
@@ -108,9 +111,12 @@ json synth_city(const std::vector<SynthBuilding>& bs, const Vec3& translate) {
       values.push_back(f.sem == Semantic::Wall ? 0 : f.sem == Semantic::Roof ? 1 : f.sem == Semantic::Ground ? 2 : -1);
       if (values.back() == -1) values.back() = nullptr;
     }
-    json lod2 = {{"type", "MultiSurface"}, {"lod", "2.2"}, {"boundaries", boundaries},
-                 {"semantics", {{"surfaces", {{{"type", "WallSurface"}}, {{"type", "RoofSurface"}}, {{"type", "GroundSurface"}}}},
-                                {"values", values}}}};
+    json lod2 = {{"type", "MultiSurface"},
+                 {"lod", "2.2"},
+                 {"boundaries", boundaries},
+                 {"semantics",
+                  {{"surfaces", {{{"type", "WallSurface"}}, {{"type", "RoofSurface"}}, {{"type", "GroundSurface"}}}},
+                   {"values", values}}}};
     json lod1 = {{"type", "MultiSurface"}, {"lod", "1"}, {"boundaries", json::array({boundaries[0]})}};
     doc["CityObjects"][b.id] = {{"type", "Building"},
                                 {"attributes", {{"yearOfConstruction", 1931}, {"function", "residential"}}},
@@ -138,7 +144,8 @@ void check_city_output(const json& in, const std::string& out_path, const CityRe
     const auto it = outcome.find(id);
     if (it != outcome.end()) {
       EXPECT_EQ(o["attributes"]["lodrefine_outcome"], it->second) << id;
-      for (const char* k : {"lodrefine_outcome", "lodrefine_reason", "lodrefine_facades_moved"}) o["attributes"].erase(k);
+      for (const char* k : {"lodrefine_outcome", "lodrefine_reason", "lodrefine_facades_moved"})
+        o["attributes"].erase(k);
       if (o["attributes"].empty() && !obj.contains("attributes")) o.erase("attributes");
     }
     if (it != outcome.end() && it->second == "refined") {
@@ -169,15 +176,18 @@ void check_city_output(const json& in, const std::string& out_path, const CityRe
     EXPECT_EQ(b.geometry_type, "Solid") << b.mesh.id;
     EXPECT_EQ(geometry_problem(b.mesh), "") << b.mesh.id;
     int walls = 0, roofs = 0, grounds = 0;
-    for (const Face& f : b.mesh.faces) walls += f.sem == Semantic::Wall, roofs += f.sem == Semantic::Roof, grounds += f.sem == Semantic::Ground;
+    for (const Face& f : b.mesh.faces)
+      walls += f.sem == Semantic::Wall, roofs += f.sem == Semantic::Roof, grounds += f.sem == Semantic::Ground;
     EXPECT_GE(walls, 4) << b.mesh.id;
     EXPECT_GE(roofs, 1) << b.mesh.id;
     EXPECT_GE(grounds, 1) << b.mesh.id;
   }
   const std::string verdict = schema_verdict(out_path);
-  if (!verdict.empty()) { EXPECT_EQ(verdict, "valid"); }
-  std::printf("  %s: %d building(s): %d refined, %d kept, %d kept-invalid, %d untouched; schema: %s\n", out_path.c_str(),
-              s.buildings, s.refined, s.kept, s.kept_invalid, s.untouched,
+  if (!verdict.empty()) {
+    EXPECT_EQ(verdict, "valid");
+  }
+  std::printf("  %s: %d building(s): %d refined, %d kept, %d kept-invalid, %d untouched; schema: %s\n",
+              out_path.c_str(), s.buildings, s.refined, s.kept, s.kept_invalid, s.untouched,
               verdict.empty() ? "not checked (validator or schemas absent)" : verdict.c_str());
 }
 
@@ -191,7 +201,8 @@ std::vector<SynthBuilding> synth_street(const std::vector<BuildingType>& types, 
   for (std::size_t k = 0; k < types.size(); ++k) {
     so.origin = Vec3(93000.0 + 80.0 * double(k), 436000.0, 0.0);
     bs.push_back(make_building(types[k], first_seed + k, so));
-    if (k < scanned) cloud.points.insert(cloud.points.end(), bs.back().cloud.points.begin(), bs.back().cloud.points.end());
+    if (k < scanned)
+      cloud.points.insert(cloud.points.end(), bs.back().cloud.points.begin(), bs.back().cloud.points.end());
   }
   return bs;
 }
@@ -214,7 +225,9 @@ TEST(CityFile, GeneratedCityRefinedIntoCityJson2) {
   EXPECT_GE(s.refined, 2);
   EXPECT_EQ(s.cloud_points, cloud.points.size());
   for (const auto& o : s.outcomes)
-    if (o.outcome == "refined") { EXPECT_GE(o.facades_moved, 1) << o.id; }
+    if (o.outcome == "refined") {
+      EXPECT_GE(o.facades_moved, 1) << o.id;
+    }
   check_city_output(in, dir + "/out.city.json", s);
   // The refined LoD 2.2 geometry replaced in place; the LoD 1 geometry before it kept.
   const json out = load(dir + "/out.city.json");
@@ -228,7 +241,8 @@ TEST(CityFile, GeneratedCityRefinedIntoCityJson2) {
   // --building picks one; the others are untouched.
   CityRefineOptions one;
   one.building = bs[1].id;
-  const CityRefineSummary s1 = refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/one.city.json", Params{}, one);
+  const CityRefineSummary s1 =
+      refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/one.city.json", Params{}, one);
   ASSERT_EQ(s1.outcomes.size(), 1u);
   EXPECT_EQ(s1.outcomes[0].id, bs[1].id);
   EXPECT_EQ(s1.untouched, 3);
@@ -285,10 +299,12 @@ TEST(CityFile, ErrorsAndBuildingsThatCannotBeRefined) {
   // A second building of two triangles: no repair can close it, so refine_building throws.
   json& v = in["vertices"];
   const std::size_t n = v.size();
-  for (const auto& q : {json{5000, 5000, 0}, json{6000, 5000, 0}, json{5000, 6000, 0}, json{5000, 5000, 1000}}) v.push_back(q);
-  in["CityObjects"]["broken"] = {{"type", "Building"},
-                                 {"geometry", {{{"type", "MultiSurface"}, {"lod", "2"},
-                                                {"boundaries", {{{n, n + 1, n + 2}}, {{n, n + 1, n + 3}}}}}}}};
+  for (const auto& q : {json{5000, 5000, 0}, json{6000, 5000, 0}, json{5000, 6000, 0}, json{5000, 5000, 1000}})
+    v.push_back(q);
+  in["CityObjects"]["broken"] = {
+      {"type", "Building"},
+      {"geometry",
+       {{{"type", "MultiSurface"}, {"lod", "2"}, {"boundaries", {{{n, n + 1, n + 2}}, {{n, n + 1, n + 3}}}}}}}};
   write_file_atomic(dir + "/city.json", in.dump());
   PointCloud cloud = bs[0].cloud;
   for (int i = 0; i < 500; ++i) cloud.points.push_back(Vec3(93005.0 + 0.002 * i, 436005.5, 0.5));
@@ -311,15 +327,17 @@ TEST(CityFile, ErrorsAndBuildingsThatCannotBeRefined) {
   write_ply(dir + "/far.ply", far);
   expect_error("refine --model " + dir + "/city.json --cloud " + dir + "/far.ply --out " + dir + "/x.city.json",
                "does not overlap the city model x 92");
-  expect_error("refine --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir + "/x.city.json --building nope",
+  expect_error("refine --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir +
+                   "/x.city.json --building nope",
                "no building 'nope'");
-  expect_error("refine --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir + "/x.city.json --lod 3",
-               "no Building/BuildingPart with an LoD 3 geometry");
+  expect_error(
+      "refine --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir + "/x.city.json --lod 3",
+      "no Building/BuildingPart with an LoD 3 geometry");
   EXPECT_FALSE(fs::exists(dir + "/x.city.json"));
   // --lod 1 picks the LoD 1 blocks (one face each: kept-invalid, kept exactly).
-  const Cli lod1 = run_cli("refine --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir +
-                               "/lod1.city.json --lod 1",
-                           dir);
+  const Cli lod1 = run_cli(
+      "refine --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir + "/lod1.city.json --lod 1",
+      dir);
   EXPECT_EQ(lod1.exit, 0) << lod1.err;
   EXPECT_NE(lod1.out.find("0 refined"), std::string::npos) << lod1.out;
 }
@@ -361,7 +379,8 @@ TEST(CityFile, RotterdamDelfshaven) {
   CityRefineSummary s;
   s.buildings = rep["buildings"], s.refined = rep["refined"], s.kept = rep["kept"];
   s.kept_invalid = rep["kept_invalid"], s.untouched = rep["untouched"];
-  for (const auto& o : rep["outcomes"]) s.outcomes.push_back({o["id"], o["outcome"], o["reason"], o["facades_moved"], {}});
+  for (const auto& o : rep["outcomes"])
+    s.outcomes.push_back({o["id"], o["outcome"], o["reason"], o["facades_moved"], {}});
   EXPECT_EQ(s.buildings, 853);
   EXPECT_GE(s.refined, 1);
   check_city_output(load(path.string()), dir + "/rotterdam.city.json", s);
@@ -405,13 +424,17 @@ TEST(CityFile, CityJsonSeqStreamedThrough) {
   lines.push_back(header);
   for (const auto& b : bs) {
     json one = synth_city({b}, Vec3(93000, 436000, 0));
-    lines.push_back({{"type", "CityJSONFeature"}, {"id", b.id}, {"CityObjects", one["CityObjects"]}, {"vertices", one["vertices"]}});
+    lines.push_back({{"type", "CityJSONFeature"},
+                     {"id", b.id},
+                     {"CityObjects", one["CityObjects"]},
+                     {"vertices", one["vertices"]}});
   }
   std::string text;
   for (const auto& l : lines) text += l.dump() + "\n";
   write_file_atomic(dir + "/city.city.jsonl", text);
   write_ply(dir + "/cloud.ply", cloud);
-  const CityRefineSummary s = refine_city(dir + "/city.city.jsonl", dir + "/cloud.ply", dir + "/out.city.jsonl", Params{}, {});
+  const CityRefineSummary s =
+      refine_city(dir + "/city.city.jsonl", dir + "/cloud.ply", dir + "/out.city.jsonl", Params{}, {});
   EXPECT_EQ(s.input_format, "CityJSONSeq 2.0");
   EXPECT_EQ(s.buildings, 3);
   EXPECT_EQ(s.untouched, 1);
@@ -427,14 +450,20 @@ TEST(CityFile, CityJsonSeqStreamedThrough) {
   ASSERT_EQ(back.buildings.size(), 3u);
   for (const auto& o : s.outcomes)
     for (const auto& b : back.buildings)
-      if (b.mesh.id == o.id && o.outcome == "refined") { EXPECT_EQ(geometry_problem(b.mesh), "") << b.mesh.id; }
+      if (b.mesh.id == o.id && o.outcome == "refined") {
+        EXPECT_EQ(geometry_problem(b.mesh), "") << b.mesh.id;
+      }
   const fs::path schemas = shared_dir() / "schemas" / "cityjson-2.0.2";
   if (fs::exists(schemas) && fs::exists("/usr/bin/python3")) {
-    const int st = std::system(("/usr/bin/python3 " + std::string(LODREFINE_SOURCE_DIR) + "/scripts/validate_cityjson.py " +
-                                schemas.string() + " " + dir + "/out.city.jsonl --seq >" + dir + "/v.txt 2>&1").c_str());
+    const int st =
+        std::system(("/usr/bin/python3 " + std::string(LODREFINE_SOURCE_DIR) + "/scripts/validate_cityjson.py " +
+                     schemas.string() + " " + dir + "/out.city.jsonl --seq >" + dir + "/v.txt 2>&1")
+                        .c_str());
     std::ifstream v(dir + "/v.txt");
     const std::string verdict((std::istreambuf_iterator<char>(v)), {});
-    if (!(WIFEXITED(st) && WEXITSTATUS(st) == 2)) { EXPECT_EQ(verdict, "valid\n"); }
+    if (!(WIFEXITED(st) && WEXITSTATUS(st) == 2)) {
+      EXPECT_EQ(verdict, "valid\n");
+    }
   }
 }
 
@@ -459,7 +488,9 @@ TEST(CityFile, CityJson1xUpgradedTo2) {
   EXPECT_EQ(out["metadata"]["pointOfContact"]["address"]["addressLine"], "Julianalaan 134, Delft");
   for (const auto& [id, obj] : out["CityObjects"].items()) EXPECT_EQ(obj["geometry"][1]["lod"], "2.2") << id;
   const std::string verdict = schema_verdict(dir + "/out.city.json");
-  if (!verdict.empty()) { EXPECT_EQ(verdict, "valid"); }
+  if (!verdict.empty()) {
+    EXPECT_EQ(verdict, "valid");
+  }
 }
 
 TEST(CityFile, LodPicksTheGeometryToRefine) {
@@ -483,7 +514,9 @@ TEST(CityFile, LodPicksTheGeometryToRefine) {
     const Mesh& m = f.buildings[0].mesh;
     double largest = 0;
     std::size_t big = 0;
-    const auto vertical = [&](std::size_t k) { return std::abs(newell_normal(face_points(m, m.faces[k])).normalized().z()) < 0.1; };
+    const auto vertical = [&](std::size_t k) {
+      return std::abs(newell_normal(face_points(m, m.faces[k])).normalized().z()) < 0.1;
+    };
     for (std::size_t k = 0; k < m.faces.size(); ++k)
       if (vertical(k) && polygon_area(face_points(m, m.faces[k])) > largest)
         largest = polygon_area(face_points(m, m.faces[k])), big = k;
@@ -504,7 +537,8 @@ TEST(CityFile, LodPicksTheGeometryToRefine) {
     }
     std::printf("  --lod %s: %s (%s)\n", lod.c_str(), s.outcomes[0].outcome.c_str(), s.outcomes[0].reason.c_str());
     // convert --lod writes that LoD's faces.
-    const Cli c = run_cli("convert --cityjson " + path.string() + " --lod " + lod + " --out-dir " + dir + "/obj_" + lod, dir);
+    const Cli c =
+        run_cli("convert --cityjson " + path.string() + " --lod " + lod + " --out-dir " + dir + "/obj_" + lod, dir);
     ASSERT_EQ(c.exit, 0) << c.err;
     EXPECT_EQ(read_obj(dir + "/obj_" + lod + "/" + id + ".obj").faces.size(), m.faces.size()) << lod;
   }
@@ -529,9 +563,11 @@ TEST(CityFile, LasTileWithClassesThroughTheCli) {
   lo.version_minor = 4, lo.point_format = 6, lo.scale = Vec3::Constant(1e-4), lo.offset = Vec3(93000, 436000, 0);
   write_las(dir + "/tile.las", tile, classes, lo);
   const Cli ply = run_cli("refine --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir +
-                              "/a.city.json --report " + dir + "/a.json", dir);
+                              "/a.city.json --report " + dir + "/a.json",
+                          dir);
   const Cli las = run_cli("refine --model " + dir + "/city.json --cloud " + dir + "/tile.las --classes 6 --out " + dir +
-                              "/b.city.json --report " + dir + "/b.json", dir);
+                              "/b.city.json --report " + dir + "/b.json",
+                          dir);
   ASSERT_EQ(ply.exit, 0) << ply.err;
   ASSERT_EQ(las.exit, 0) << las.err;
   const json a = load(dir + "/a.json"), b = load(dir + "/b.json");
@@ -550,17 +586,21 @@ TEST(CityFile, LasTileWithClassesThroughTheCli) {
 TEST(CityFile, JobsWriteTheSameBytesAsOneAtATime) {
   const std::string dir = test_dir();
   PointCloud cloud;
-  const std::vector<SynthBuilding> bs = synth_street(
-      {BuildingType::Gable, BuildingType::LShape, BuildingType::Flat, BuildingType::Hip, BuildingType::Shed,
-       BuildingType::Stepped, BuildingType::TShape},
-      41, 5000, 6, cloud);
+  const std::vector<SynthBuilding> bs =
+      synth_street({BuildingType::Gable, BuildingType::LShape, BuildingType::Flat, BuildingType::Hip,
+                    BuildingType::Shed, BuildingType::Stepped, BuildingType::TShape},
+                   41, 5000, 6, cloud);
   const json in = synth_city(bs, Vec3(93000, 436000, 0));
   write_file_atomic(dir + "/city.json", in.dump());
   std::string seq = synth_city({}, Vec3(93000, 436000, 0)).dump() + "\n";
   for (const auto& b : bs) {
     json one = synth_city({b}, Vec3(93000, 436000, 0));
-    seq += json({{"type", "CityJSONFeature"}, {"id", b.id}, {"CityObjects", one["CityObjects"]}, {"vertices", one["vertices"]}})
-               .dump() + "\n";
+    seq += json({{"type", "CityJSONFeature"},
+                 {"id", b.id},
+                 {"CityObjects", one["CityObjects"]},
+                 {"vertices", one["vertices"]}})
+               .dump() +
+           "\n";
   }
   write_file_atomic(dir + "/city.city.jsonl", seq);
   write_ply(dir + "/cloud.ply", cloud);
@@ -601,15 +641,17 @@ TEST(CityFile, ProgressLineOnATerminalOnly) {
       synth_street({BuildingType::Gable, BuildingType::LShape, BuildingType::Hip}, 61, 6000, 3, cloud);
   write_file_atomic(dir + "/city.json", synth_city(bs, Vec3(93000, 436000, 0)).dump());
   write_ply(dir + "/cloud.ply", cloud);
-  const std::string args = "refine --jobs 2 --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir + "/o.city.json";
+  const std::string args =
+      "refine --jobs 2 --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir + "/o.city.json";
   const Cli plain = run_cli(args, dir);
   ASSERT_EQ(plain.exit, 0) << plain.err;
   EXPECT_EQ(plain.err, "") << "a short run into a file prints no progress";
   EXPECT_NE(plain.out.find("3 building(s)"), std::string::npos) << plain.out;
   auto on_terminal = [&](const std::string& extra) {
     const std::string log = dir + "/tty.log";
-    const int st = std::system(("script -qec '" + std::string(LODREFINE_BINARY) + " " + args + extra + "' /dev/null > " +
-                                log + " 2>&1").c_str());
+    const int st = std::system(
+        ("script -qec '" + std::string(LODREFINE_BINARY) + " " + args + extra + "' /dev/null > " + log + " 2>&1")
+            .c_str());
     EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0);
     std::ifstream in(log, std::ios::binary);
     return std::string(std::istreambuf_iterator<char>(in), {});
@@ -630,11 +672,12 @@ TEST(CityFile, ProgressLineOnATerminalOnly) {
 TEST(CityFileSecurity, FlatAndStrayBuildingsAreKeptInvalidTheRunGoesOn) {
   const std::string dir = test_dir();
   PointCloud cloud;
-  std::vector<SynthBuilding> bs = synth_street({BuildingType::Gable, BuildingType::Hip, BuildingType::Gable}, 1, 6000, 3, cloud);
+  std::vector<SynthBuilding> bs =
+      synth_street({BuildingType::Gable, BuildingType::Hip, BuildingType::Gable}, 1, 6000, 3, cloud);
   double ground = 1e9;
   for (const auto& p : bs[1].coarse.vertices) ground = std::min(ground, p.z());
   for (auto& p : bs[1].coarse.vertices) p.z() = ground;  // the roof lowered onto the ground
-  bs[2].coarse.vertices[0] += Vec3(1e6, 0, 0);          // one stray vertex 1000 km away
+  bs[2].coarse.vertices[0] += Vec3(1e6, 0, 0);           // one stray vertex 1000 km away
   const json in = synth_city(bs, Vec3(93000, 436000, 0));
   write_file_atomic(dir + "/city.json", in.dump());
   write_ply(dir + "/cloud.ply", cloud);
@@ -643,7 +686,8 @@ TEST(CityFileSecurity, FlatAndStrayBuildingsAreKeptInvalidTheRunGoesOn) {
   EXPECT_NE(s.outcomes[0].outcome, "kept-invalid") << s.outcomes[0].reason;
   EXPECT_EQ(s.outcomes[1].outcome, "kept-invalid");
   EXPECT_EQ(s.outcomes[2].outcome, "kept-invalid");
-  EXPECT_NE(s.outcomes[2].reason.find("spans 1000 km, more than a building can"), std::string::npos) << s.outcomes[2].reason;
+  EXPECT_NE(s.outcomes[2].reason.find("spans 1000 km, more than a building can"), std::string::npos)
+      << s.outcomes[2].reason;
   EXPECT_EQ(s.outcomes[2].points, 0u);
   check_city_output(in, dir + "/out.city.json", s);
 }

@@ -21,7 +21,8 @@ namespace {
 
 std::string write_temp(const std::string& name, const std::string& text) {
   const auto* info = testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir = fs::path(testing::TempDir()) / ("lodrefine_citygml_" + std::to_string(::getpid())) / info->name();
+  const fs::path dir =
+      fs::path(testing::TempDir()) / ("lodrefine_citygml_" + std::to_string(::getpid())) / info->name();
   fs::create_directories(dir);
   std::ofstream((dir / name).string()) << text;
   return (dir / name).string();
@@ -45,8 +46,8 @@ std::string polygon(const std::vector<Vec3>& ring, const std::string& id) {
 // The six faces of a box (outward), walls first, then roof, then ground.
 std::vector<std::vector<Vec3>> box_faces(const Vec3& o, double w, double d, double h) {
   const Vec3 a = o, b = o + Vec3(w, 0, 0), c = o + Vec3(w, d, 0), e = o + Vec3(0, d, 0), z(0, 0, h);
-  return {{a, b, b + z, a + z}, {b, c, c + z, b + z}, {c, e, e + z, c + z}, {e, a, a + z, e + z},
-          {a + z, b + z, c + z, e + z}, {a, e, c, b}};
+  return {{a, b, b + z, a + z}, {b, c, c + z, b + z},         {c, e, e + z, c + z},
+          {e, a, a + z, e + z}, {a + z, b + z, c + z, e + z}, {a, e, c, b}};
 }
 
 const char* kHeader = R"(<?xml version="1.0" encoding="UTF-8"?>
@@ -66,16 +67,20 @@ std::string sample_citygml() {
        "<gen:stringAttribute name=\"street\"><gen:value>Hauptstr.</gen:value></gen:stringAttribute>";
   const char* kinds[] = {"WallSurface", "WallSurface", "WallSurface", "WallSurface", "RoofSurface", "GroundSurface"};
   for (int k = 0; k < 6; ++k)
-    s += std::string("<bldg:boundedBy><bldg:") + kinds[k] + "><bldg:lod2MultiSurface><gml:MultiSurface><gml:surfaceMember>" +
+    s += std::string("<bldg:boundedBy><bldg:") + kinds[k] +
+         "><bldg:lod2MultiSurface><gml:MultiSurface><gml:surfaceMember>" +
          polygon(f1[std::size_t(k)], k % 2 ? "" : "poly" + std::to_string(k)) +
          "</gml:surfaceMember></gml:MultiSurface></bldg:lod2MultiSurface></bldg:" + kinds[k] + "></bldg:boundedBy>";
   s += "</bldg:Building></cityObjectMember>";
   const auto f2 = box_faces(o + Vec3(30, 0, 0), 6, 6, 9);
-  s += "<cityObjectMember><bldg:Building gml:id=\"solid\"><bldg:lod2Solid><gml:Solid><gml:exterior><gml:CompositeSurface>";
+  s += "<cityObjectMember><bldg:Building "
+       "gml:id=\"solid\"><bldg:lod2Solid><gml:Solid><gml:exterior><gml:CompositeSurface>";
   for (const auto& f : f2) s += "<gml:surfaceMember>" + polygon(f, "") + "</gml:surfaceMember>";
   s += "</gml:CompositeSurface></gml:exterior></gml:Solid></bldg:lod2Solid></bldg:Building></cityObjectMember>";
-  s += "<cityObjectMember><bldg:Building gml:id=\"lod1\"><bldg:lod1Solid><gml:Solid><gml:exterior><gml:CompositeSurface>";
-  for (const auto& f : box_faces(o + Vec3(60, 0, 0), 5, 5, 5)) s += "<gml:surfaceMember>" + polygon(f, "") + "</gml:surfaceMember>";
+  s += "<cityObjectMember><bldg:Building "
+       "gml:id=\"lod1\"><bldg:lod1Solid><gml:Solid><gml:exterior><gml:CompositeSurface>";
+  for (const auto& f : box_faces(o + Vec3(60, 0, 0), 5, 5, 5))
+    s += "<gml:surfaceMember>" + polygon(f, "") + "</gml:surfaceMember>";
   s += "</gml:CompositeSurface></gml:exterior></gml:Solid></bldg:lod1Solid></bldg:Building></cityObjectMember>";
   return s + "</CityModel>\n";
 }
@@ -100,7 +105,8 @@ TEST(CityGml, BoundarySurfacesSolidsIdsAttributesCrs) {
   EXPECT_EQ(t.mesh.id, "thematic");
   EXPECT_EQ(t.type, "Building");
   ASSERT_EQ(t.mesh.faces.size(), 6u);
-  EXPECT_EQ(semantics(t.mesh), (std::map<Semantic, int>{{Semantic::Wall, 4}, {Semantic::Roof, 1}, {Semantic::Ground, 1}}));
+  EXPECT_EQ(semantics(t.mesh),
+            (std::map<Semantic, int>{{Semantic::Wall, 4}, {Semantic::Roof, 1}, {Semantic::Ground, 1}}));
   EXPECT_EQ(t.attributes.value("height", 0.0), 6.0);
   EXPECT_EQ(t.attributes.value("street", std::string()), "Hauptstr.");
   // Coordinates exact to 0.1 mm (the CityJSON transform of the conversion) at UTM magnitudes.
@@ -121,8 +127,10 @@ TEST(CityGml, BoundarySurfacesSolidsIdsAttributesCrs) {
 TEST(CityGml, CrsNamesBecomeCityJsonUrls) {
   const std::string url = "https://www.opengis.net/def/crs/EPSG/0/";
   const std::vector<std::pair<std::string, std::string>> names = {
-      {"urn:ogc:def:crs:EPSG::28992", url + "28992"},      {"EPSG:25832", url + "25832"},
-      {"urn:ogc:def:crs:EPSG:6.12:31467", url + "31467"}, {"http://www.opengis.net/def/crs/EPSG/0/7415", url + "7415"},
+      {"urn:ogc:def:crs:EPSG::28992", url + "28992"},
+      {"EPSG:25832", url + "25832"},
+      {"urn:ogc:def:crs:EPSG:6.12:31467", url + "31467"},
+      {"http://www.opengis.net/def/crs/EPSG/0/7415", url + "7415"},
       {"local", "local"}};
   for (const auto& [name, expected] : names) EXPECT_EQ(crs_url(name), expected) << name;
 }
@@ -178,7 +186,8 @@ TEST(CityGml, CoordinatesFarApart) {
   std::string s = kHeader;
   s += "<cityObjectMember><bldg:Building gml:id=\"far\"><bldg:lod2MultiSurface><gml:MultiSurface><gml:surfaceMember>" +
        polygon({{-9e8, 0, 0}, {9e8, 0, 0}, {9e8, 5e8, 0}}, "") +
-       "</gml:surfaceMember></gml:MultiSurface></bldg:lod2MultiSurface></bldg:Building></cityObjectMember></CityModel>\n";
+       "</gml:surfaceMember></gml:MultiSurface></bldg:lod2MultiSurface></bldg:Building></cityObjectMember></"
+       "CityModel>\n";
   const CityJsonFile f = read_citygml(write_temp("far.gml", s));
   ASSERT_EQ(f.buildings.size(), 1u);
   ASSERT_EQ(f.buildings[0].mesh.faces.size(), 1u);
@@ -196,7 +205,8 @@ std::string building_with_attribute(const std::string& value, const std::string&
   s.replace(s.find("xmlns:gml"), 0, root_attributes + " ");
   s += "<cityObjectMember><bldg:Building gml:id=\"b\"><gen:stringAttribute name=\"name\"><gen:value>" + value +
        "</gen:value></gen:stringAttribute><bldg:lod2MultiSurface><gml:MultiSurface>";
-  for (const auto& f : box_faces(Vec3(10, 20, 0), 4, 5, 3)) s += "<gml:surfaceMember>" + polygon(f, "") + "</gml:surfaceMember>";
+  for (const auto& f : box_faces(Vec3(10, 20, 0), 4, 5, 3))
+    s += "<gml:surfaceMember>" + polygon(f, "") + "</gml:surfaceMember>";
   return s + "</gml:MultiSurface></bldg:lod2MultiSurface></bldg:Building></cityObjectMember></CityModel>\n";
 }
 
@@ -263,7 +273,8 @@ TEST(CityGmlSecurity, EntitiesAndDtdsAreRefusedBeforeParsing) {
   std::string utf16;
   for (char c : building_with_attribute("x")) utf16 += c, utf16 += '\0';
   EXPECT_NE(refusal(write_temp("utf16.gml", utf16)).find("UTF-16 or UTF-32 is not read"), std::string::npos);
-  EXPECT_NE(refusal(write_temp("utf16bom.gml", "\xFF\xFE" + utf16)).find("not a CityGML file (no XML)"), std::string::npos);
+  EXPECT_NE(refusal(write_temp("utf16bom.gml", "\xFF\xFE" + utf16)).find("not a CityGML file (no XML)"),
+            std::string::npos);
   std::string ebcdic = building_with_attribute("x");
   ebcdic.replace(ebcdic.find("UTF-8"), 5, "IBM037");
   EXPECT_NE(refusal(write_temp("ebcdic.gml", ebcdic)).find("encoding 'ibm037' is not read"), std::string::npos);
@@ -288,13 +299,15 @@ TEST(CityGmlSecurity, BillionLaughsIsRefusedAtOnce) {
 // xsi:schemaLocation, not an XInclude. A socket on 127.0.0.1 sees no connection.
 TEST(CityGmlSecurity, NothingIsFetched) {
   const Listener server;
-  const std::string dtd = write_temp("dtd.gml", building_with_attribute("x", "<!DOCTYPE CityModel SYSTEM \"" + server.url("a.dtd") + "\">\n"));
+  const std::string dtd = write_temp(
+      "dtd.gml", building_with_attribute("x", "<!DOCTYPE CityModel SYSTEM \"" + server.url("a.dtd") + "\">\n"));
   EXPECT_NE(refusal(dtd).find("document type"), std::string::npos);
   const std::string schema = write_temp(
       "schema.gml", building_with_attribute("x<xi:include href=\"" + server.url("inc.xml") + "\"/>", "",
                                             "xmlns:xsi=\"http://www.w3.org/2001/XMLSchema-instance\" "
                                             "xmlns:xi=\"http://www.w3.org/2001/XInclude\" xsi:schemaLocation=\""
-                                            "http://www.opengis.net/citygml/2.0 " + server.url("CityGML.xsd") + "\""));
+                                            "http://www.opengis.net/citygml/2.0 " +
+                                                server.url("CityGML.xsd") + "\""));
   const CityJsonFile f = read_citygml(schema);
   ASSERT_EQ(f.buildings.size(), 1u);
   EXPECT_EQ(f.buildings[0].mesh.faces.size(), 6u);
@@ -304,10 +317,14 @@ TEST(CityGmlSecurity, NothingIsFetched) {
 // Issue 15, item 8: libcitygml kept only the text after the last reference ("& Sons").
 TEST(CityGmlSecurity, ReferencesInTextComeThroughWhole) {
   const std::vector<std::pair<std::string, std::string>> cases = {
-      {"Bakery &amp; Sons", "Bakery & Sons"},     {"caf&#233; 1", "caf\xC3\xA9 1"},
-      {"caf\xC3\xA9 2", "caf\xC3\xA9 2"},          {"&lt;a&gt; &quot;b&quot; &apos;c&apos;", "<a> \"b\" 'c'"},
-      {"x&#x26;y&#38;z &#x1F600;", "x&y&z \xF0\x9F\x98\x80"}, {"a <![CDATA[&amp;]]> b", "a &amp; b"},
-      {"a <!-- c --> b", "a  b"}, {"\n  <![CDATA[x]]>\n", "\n  x\n"},
+      {"Bakery &amp; Sons", "Bakery & Sons"},
+      {"caf&#233; 1", "caf\xC3\xA9 1"},
+      {"caf\xC3\xA9 2", "caf\xC3\xA9 2"},
+      {"&lt;a&gt; &quot;b&quot; &apos;c&apos;", "<a> \"b\" 'c'"},
+      {"x&#x26;y&#38;z &#x1F600;", "x&y&z \xF0\x9F\x98\x80"},
+      {"a <![CDATA[&amp;]]> b", "a &amp; b"},
+      {"a <!-- c --> b", "a  b"},
+      {"\n  <![CDATA[x]]>\n", "\n  x\n"},
       {"plain", "plain"}};
   for (const auto& [xml, expected] : cases) {
     const CityJsonFile f = read_citygml(write_temp("text.gml", building_with_attribute(xml)));
@@ -333,7 +350,8 @@ TEST(CityGmlSecurity, EveryBuildingKeepsItsOwnId) {
   for (const std::string id : {"dup", "dup", "building-1", "", "dup~2"}) {
     s += "<cityObjectMember><bldg:Building" + (id.empty() ? std::string() : " gml:id=\"" + id + "\"") +
          "><bldg:lod2MultiSurface><gml:MultiSurface>";
-    for (const auto& f : box_faces(Vec3(20.0 * n++, 0, 0), 4, 5, 3)) s += "<gml:surfaceMember>" + polygon(f, "") + "</gml:surfaceMember>";
+    for (const auto& f : box_faces(Vec3(20.0 * n++, 0, 0), 4, 5, 3))
+      s += "<gml:surfaceMember>" + polygon(f, "") + "</gml:surfaceMember>";
     s += "</gml:MultiSurface></bldg:lod2MultiSurface></bldg:Building></cityObjectMember>";
   }
   const CityJsonFile f = read_citygml(write_temp("dup.gml", s + "</CityModel>\n"));

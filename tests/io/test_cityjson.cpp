@@ -25,8 +25,7 @@ namespace fs = std::filesystem;
 namespace {
 
 // A unit cube [0,1]^3 (in transformed units) as one Solid shell; faces: ground, roof, 4 walls.
-const char* kCubeBoundaries =
-    R"([[[[0,3,2,1]],[[4,5,6,7]],[[0,1,5,4]],[[1,2,6,5]],[[2,3,7,6]],[[3,0,4,7]]]])";
+const char* kCubeBoundaries = R"([[[[0,3,2,1]],[[4,5,6,7]],[[0,1,5,4]],[[1,2,6,5]],[[2,3,7,6]],[[3,0,4,7]]]])";
 const char* kCubeVertices =
     R"([[0,0,0],[1000,0,0],[1000,1000,0],[0,1000,0],[0,0,1000],[1000,0,1000],[1000,1000,1000],[0,1000,1000]])";
 
@@ -62,7 +61,7 @@ TEST(CityJson, ReadsHighestLod2SolidWithTransformAndSemantics) {
   EXPECT_EQ(b.geometry_type, "Solid");
   ASSERT_EQ(b.mesh.faces.size(), 6u);
   EXPECT_EQ(b.mesh.vertices.size(), 24u);  // polygon soup: every face its own vertices
-  const Semantic expect[6] = {Semantic::Ground, Semantic::Roof, Semantic::Wall,
+  const Semantic expect[6] = {Semantic::Ground, Semantic::Roof,  Semantic::Wall,
                               Semantic::Wall,   Semantic::Other, Semantic::Wall};
   for (int i = 0; i < 6; ++i) {
     EXPECT_EQ(b.mesh.faces[i].sem, expect[i]) << i;
@@ -125,9 +124,11 @@ TEST(CityJson, RejectsMalformedInputWithOneLineMessages) {
       {R"({"type":"FeatureCollection"})", "not a CityJSON file"},
       {R"({"type":"CityJSON","CityObjects":{}})", "no \"vertices\""},
       {R"({"type":"CityJSON","vertices":[]})", "no \"CityObjects\""},
-      {cube_document("2.0", R"("A":{"type":"Building","geometry":[{"type":"Solid","lod":"2","boundaries":[[[[0,1,99]]]]}]})"),
+      {cube_document("2.0",
+                     R"("A":{"type":"Building","geometry":[{"type":"Solid","lod":"2","boundaries":[[[[0,1,99]]]]}]})"),
        "vertex index 99 is out of range"},
-      {cube_document("2.0", R"("A":{"type":"Building","geometry":[{"type":"Solid","lod":"2","boundaries":[[0,1,2]]}]})"),
+      {cube_document("2.0",
+                     R"("A":{"type":"Building","geometry":[{"type":"Solid","lod":"2","boundaries":[[0,1,2]]}]})"),
        "not nested"},
       {cube_document("2.0", R"("A":{"type":"Building","geometry":[{"type":"Solid","lod":"2","boundaries":)" +
                                 std::string(kCubeBoundaries) +
@@ -144,7 +145,8 @@ TEST(CityJson, RejectsMalformedInputWithOneLineMessages) {
       {R"({"type":"CityJSON","version":"2.0","CityObjects":{},"vertices":[]})"
        "\n{\"type\":\"CityJSONFeature\",\"CityObjects\":{},\"vertices\":[]}\n{\"type\":\"CityJSON\"}\n",
        "line 3: expected a CityJSONFeature"},
-      {cube_document("2.0", R"("A":{"type":"Building","geometry":[)" + ok_solid + R"(]},"B":{"type":"Building","geometry":{}})"),
+      {cube_document(
+           "2.0", R"("A":{"type":"Building","geometry":[)" + ok_solid + R"(]},"B":{"type":"Building","geometry":{}})"),
        "object B: \"geometry\" is not an array"},
   };
   for (const auto& [text, expect] : bad) {
@@ -245,7 +247,8 @@ TEST(CityJsonWrite, QuantiseRoundsToTheNearestStep) {
   t.scale = Vec3::Constant(kCityGmlResolution);
   for (const Vec3& p : {Vec3(85123.45678, 447987.65432, 3.21098), Vec3(93512.00004, 436001.99996, -4.5)}) {
     const auto q = t.quantise(p);
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(double(q[k]) * t.scale[k] + t.translate[k], p[k], 0.5 * kCityGmlResolution + 1e-9);
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(double(q[k]) * t.scale[k] + t.translate[k], p[k], 0.5 * kCityGmlResolution + 1e-9);
   }
 }
 
@@ -268,10 +271,13 @@ TEST(CityJsonSecurity, DeepNestingOverflowsAndDuplicatesAreOneLine) {
   const std::string deep = std::string(100000, '[') + std::string(100000, ']');
   const std::vector<std::pair<std::string, std::string>> bad = {
       // 100k-deep attribute: the writer's recursion overflowed the stack.
-      {cube_document("2.0", ok + R"(,"attributes":{"x":)" + deep + "}}"), "bad.json: JSON nested deeper than 256 levels"},
-      {cube_document("2.0", ok + "}").replace(1, 0, R"("deep":)" + deep + ","), "bad.json: JSON nested deeper than 256"},
+      {cube_document("2.0", ok + R"(,"attributes":{"x":)" + deep + "}}"),
+       "bad.json: JSON nested deeper than 256 levels"},
+      {cube_document("2.0", ok + "}").replace(1, 0, R"("deep":)" + deep + ","),
+       "bad.json: JSON nested deeper than 256"},
       // 1e400: out_of_range.406, raw and without the file name.
-      {cube_document("2.0", ok + R"(,"attributes":{"x":1e400}})"), "bad.json: not valid JSON: number overflow parsing '1e400'"},
+      {cube_document("2.0", ok + R"(,"attributes":{"x":1e400}})"),
+       "bad.json: not valid JSON: number overflow parsing '1e400'"},
       // A zero scale collapses every vertex.
       {R"({"type":"CityJSON","transform":{"scale":[0.001,0.001,0],"translate":[0,0,0]},"CityObjects":{},"vertices":[]})",
        "bad.json: transform.scale has a zero or negative factor"},
@@ -287,9 +293,10 @@ TEST(CityJsonSecurity, DeepNestingOverflowsAndDuplicatesAreOneLine) {
     EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
   }
   // A CityJSONSeq line names its line; keys repeated elsewhere (attributes) are JSON's business.
-  const std::string seq = R"({"type":"CityJSON","version":"2.0","transform":{"scale":[1,1,1],"translate":[0,0,0]},"CityObjects":{},"vertices":[]})"
-                          "\n{\"type\":\"CityJSONFeature\",\"CityObjects\":{\"A\":{\"type\":\"Building\",\"attributes\":{\"x\":" +
-                          deep + "}}},\"vertices\":[]}\n";
+  const std::string seq =
+      R"({"type":"CityJSON","version":"2.0","transform":{"scale":[1,1,1],"translate":[0,0,0]},"CityObjects":{},"vertices":[]})"
+      "\n{\"type\":\"CityJSONFeature\",\"CityObjects\":{\"A\":{\"type\":\"Building\",\"attributes\":{\"x\":" +
+      deep + "}}},\"vertices\":[]}\n";
   EXPECT_EQ(refusal_of(seq).rfind("bad.json: line 2: JSON nested deeper than 256 levels", 0), 0u) << refusal_of(seq);
   EXPECT_EQ(parse_cityjson(cube_document("2.0", ok + R"(,"attributes":{"k":1,"k":2}})")).buildings.size(), 1u);
 }
@@ -305,7 +312,8 @@ TEST(CityJsonSecurity, RingPinchedThousandsOfTimesSplitsInLinearTime) {
     ring += (k ? ",0," : "0,") + std::to_string(2 * k + 1) + "," + std::to_string(2 * k + 2);
   }
   const std::string doc = R"({"type":"CityJSON","version":"2.0","CityObjects":{"P":{"type":"Building","geometry":[)"
-                          R"({"type":"MultiSurface","lod":"2","boundaries":[[)" + ring + R"(]]]}]}},"vertices":)" + vertices + "]}";
+                          R"({"type":"MultiSurface","lod":"2","boundaries":[[)" +
+                          ring + R"(]]]}]}},"vertices":)" + vertices + "]}";
   const auto t0 = std::chrono::steady_clock::now();
   const CityJsonFile f = parse_cityjson(doc);
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2.0);

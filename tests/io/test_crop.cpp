@@ -9,8 +9,8 @@
 #include <functional>
 #include <stdexcept>
 
-#include "lodrefine/io/crop.h"
 #include "lodrefine/core/geometry.h"
+#include "lodrefine/io/crop.h"
 #include "lodrefine/io/ply.h"
 #include "lodrefine/synth/synth.h"
 
@@ -67,11 +67,13 @@ TEST(Crop, BoundedMemoryCropWritesTheSameClouds) {
   std::vector<CropTarget> in_memory = targets;
   crop_tile(path, in_memory);
   std::vector<std::string> outs;
-  for (std::size_t i = 0; i < targets.size(); ++i) outs.push_back((dir / ("crop" + std::to_string(i) + ".ply")).string());
+  for (std::size_t i = 0; i < targets.size(); ++i)
+    outs.push_back((dir / ("crop" + std::to_string(i) + ".ply")).string());
   // Links planted at the spill files' old, predictable names are not followed (issue 15).
   const auto victim = dir / "victim.txt";
   { std::ofstream(victim) << "precious\n"; }
-  for (const auto& out : outs) std::filesystem::create_symlink(victim, out + ".spill.tmp." + std::to_string(::getpid()));
+  for (const auto& out : outs)
+    std::filesystem::create_symlink(victim, out + ".spill.tmp." + std::to_string(::getpid()));
   std::vector<std::size_t> counts;
   EXPECT_EQ(crop_tile_to_files(path, targets, outs, 7, counts), tile.points.size());
   EXPECT_EQ(std::filesystem::file_size(victim), 9u);
@@ -82,7 +84,8 @@ TEST(Crop, BoundedMemoryCropWritesTheSameClouds) {
     const PointCloud c = read_ply(outs[i]);
     EXPECT_EQ(counts[i], in_memory[i].cloud.points.size());
     ASSERT_EQ(c.points.size(), in_memory[i].cloud.points.size());
-    for (std::size_t k = 0; k < c.points.size(); ++k) ASSERT_EQ(c.points[k], in_memory[i].cloud.points[k]) << i << " " << k;
+    for (std::size_t k = 0; k < c.points.size(); ++k)
+      ASSERT_EQ(c.points[k], in_memory[i].cloud.points[k]) << i << " " << k;
     total += counts[i];
   }
   EXPECT_GT(total, tile.points.size()) << "the boxes overlap: some points belong to two crops";
@@ -138,7 +141,8 @@ TEST(Crop, HugeBoxAmongSmallOnesKeepsTheGridSmall) {
   targets.push_back(huge);
   tile.points.push_back(Vec3(-9e5, 9e5, 50.0));    // the huge box's alone
   tile.points.push_back(Vec3(5e6, 447000.0, 10));  // nobody's
-  const auto path = std::filesystem::temp_directory_path() / ("lodrefine_crop_huge_" + std::to_string(::getpid()) + ".ply");
+  const auto path =
+      std::filesystem::temp_directory_path() / ("lodrefine_crop_huge_" + std::to_string(::getpid()) + ".ply");
   write_ply(path.string(), tile);
   EXPECT_TRUE(runs_within(std::size_t(200) << 20, [&] {
     std::vector<CropTarget> copy = targets;

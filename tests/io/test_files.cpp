@@ -22,9 +22,7 @@ using namespace lodrefine;
 using namespace lodrefine::fixtures;
 namespace fs = std::filesystem;
 
-namespace {
-
-}  // namespace
+namespace {}  // namespace
 
 TEST(IoWrite, MissingDirectoryGivesOneLineErrorAndNoFile) {
   const std::string dir = temp_path("no_such_dir");
@@ -69,7 +67,9 @@ TEST(IoWrite, AtomicWriteReplacesAndLeavesNoTempOnFailure) {
 namespace {
 
 bool only_safe_chars(const std::string& s) {
-  return std::all_of(s.begin(), s.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-'; });
+  return std::all_of(s.begin(), s.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-';
+  });
 }
 
 std::string lower(std::string s) {
@@ -82,9 +82,9 @@ std::string lower(std::string s) {
 TEST(SafeName, KeepsSafeIdsAndHashesTheRest) {
   EXPECT_EQ(safe_name("NL.IMBAG.Pand.0503100000031927-0"), "NL.IMBAG.Pand.0503100000031927-0");
   EXPECT_EQ(safe_name("bldg_0001"), "bldg_0001");
-  for (const std::string& id : std::vector<std::string>{"$(touch PWNED)", "a';touch PWNED;'", "x;touch PWNED", "{10A31B7E-8FC2}", "..", ".", "",
-                               "-rf", ".hidden", "a/b c\\d:e\n", "caf\xc3\xa9", std::string(300, 'x'),
-                               std::string("nul\0byte", 8)}) {
+  for (const std::string& id : std::vector<std::string>{
+           "$(touch PWNED)", "a';touch PWNED;'", "x;touch PWNED", "{10A31B7E-8FC2}", "..", ".", "", "-rf", ".hidden",
+           "a/b c\\d:e\n", "caf\xc3\xa9", std::string(300, 'x'), std::string("nul\0byte", 8)}) {
     const std::string name = safe_name(id);
     EXPECT_NE(name, id);
     EXPECT_TRUE(is_safe_name(name)) << name;
@@ -96,7 +96,7 @@ TEST(SafeName, KeepsSafeIdsAndHashesTheRest) {
     EXPECT_EQ(safe_name(name), name) << "not idempotent: convert's names would change in crop";
   }
   EXPECT_EQ(safe_name("a b").substr(0, 5), "a_b--");  // readable where it can be
-  EXPECT_NE(safe_name("a b"), safe_name("a:b"));       // the hash tells them apart
+  EXPECT_NE(safe_name("a b"), safe_name("a:b"));      // the hash tells them apart
   EXPECT_EQ(safe_name(std::string(100, 'y')), std::string(100, 'y'));
   EXPECT_NE(safe_name(std::string(101, 'y')), std::string(101, 'y'));
   EXPECT_FALSE(is_safe_name("a b"));
@@ -107,9 +107,20 @@ TEST(SafeName, KeepsSafeIdsAndHashesTheRest) {
 
 TEST(SafeName, SafeNamesAreDistinctAlsoIgnoringCase) {
   // Ids that the old per-character mapping (or a case-folding file system) merged into one name.
-  const std::vector<std::string> ids = {"a b", "a_b", "a:b", "a/b", "A_B", "A", "a", "a", "plots", "PLOTS",
-                                        std::string(120, 'z') + "1", std::string(120, 'z') + "2",
-                                        safe_name("a b"), "a_b--ffffffffffff"};
+  const std::vector<std::string> ids = {"a b",
+                                        "a_b",
+                                        "a:b",
+                                        "a/b",
+                                        "A_B",
+                                        "A",
+                                        "a",
+                                        "a",
+                                        "plots",
+                                        "PLOTS",
+                                        std::string(120, 'z') + "1",
+                                        std::string(120, 'z') + "2",
+                                        safe_name("a b"),
+                                        "a_b--ffffffffffff"};
   SafeNames names({"plots"});
   std::set<std::string> seen;
   std::vector<std::string> given;

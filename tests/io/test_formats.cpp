@@ -9,9 +9,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lodrefine/io/las.h"
 #include "lodrefine/io/obj.h"
 #include "lodrefine/io/ply.h"
-#include "lodrefine/io/las.h"
 #include "lodrefine/synth/synth.h"
 
 using namespace lodrefine;
@@ -33,7 +33,8 @@ void expect_error(const Cli& r, const std::string& fault) {
   EXPECT_NE(r.err.find(fault), std::string::npos) << r.err;
 }
 
-const char* kLod1CityJson = R"({"type":"CityJSON","version":"2.0","transform":{"scale":[0.001,0.001,0.001],"translate":[0,0,0]},
+const char* kLod1CityJson =
+    R"({"type":"CityJSON","version":"2.0","transform":{"scale":[0.001,0.001,0.001],"translate":[0,0,0]},
 "CityObjects":{"b1":{"type":"Building","geometry":[{"type":"Solid","lod":"1.2","boundaries":[[[[0,1,2,3]],[[4,5,6,7]]]]}]}},
 "vertices":[[0,0,0],[1000,0,0],[1000,1000,0],[0,1000,0],[0,0,3000],[1000,0,3000],[1000,1000,3000],[0,1000,3000]]})";
 
@@ -45,21 +46,28 @@ TEST(Formats, WrongKindOfFileSaysWhatItIs) {
   write_obj(dir + "/m.obj", b.coarse);
   write_ply(dir + "/c.ply", b.cloud);
   write_las(dir + "/c.las", b.cloud, {}, LasWriteOptions{});
-  std::ofstream(dir + "/city.gml") << "<?xml version=\"1.0\"?>\n<CityModel xmlns=\"http://www.opengis.net/citygml/2.0\"/>\n";
+  std::ofstream(dir + "/city.gml")
+      << "<?xml version=\"1.0\"?>\n<CityModel xmlns=\"http://www.opengis.net/citygml/2.0\"/>\n";
   std::ofstream(dir + "/lod1.city.json") << kLod1CityJson;
   std::ofstream(dir + "/other.json") << "{\"type\": \"FeatureCollection\", \"features\": []}";
   const std::string out = " --out " + dir + "/r.obj";
-  expect_error(run_cli("eval --original " + dir + "/city.gml --refined " + dir + "/m.obj --cloud " + dir + "/c.ply", dir),
-               "city.gml: not an OBJ model: the file is XML (a CityGML model?)");
+  expect_error(
+      run_cli("eval --original " + dir + "/city.gml --refined " + dir + "/m.obj --cloud " + dir + "/c.ply", dir),
+      "city.gml: not an OBJ model: the file is XML (a CityGML model?)");
   // A city file as the model is the city workflow; one without LoD 2 buildings is an error.
-  expect_error(run_cli("refine --model " + dir + "/city.gml --cloud " + dir + "/c.ply --out " + dir + "/r.city.json", dir),
-               "city.gml: no Building/BuildingPart with an LoD 2.x geometry");
-  expect_error(run_cli("refine --model " + dir + "/lod1.city.json --cloud " + dir + "/c.ply --out " + dir + "/r.city.json", dir),
-               "lod1.city.json: no Building/BuildingPart with an LoD 2.x geometry (1 building object(s) without one); nothing to refine");
-  expect_error(run_cli("refine --model " + dir + "/lod1.city.json --cloud " + dir + "/c.ply --out " + dir + "/r.obj", dir),
-               "r.obj: a city file in gives a CityJSON city file out; name it e.g. refined.city.json");
-  expect_error(run_cli("refine --model " + dir + "/other.json --cloud " + dir + "/c.ply --out " + dir + "/r.city.json", dir),
-               "other.json: not a CityJSON file (no \"type\": \"CityJSON\")");
+  expect_error(
+      run_cli("refine --model " + dir + "/city.gml --cloud " + dir + "/c.ply --out " + dir + "/r.city.json", dir),
+      "city.gml: no Building/BuildingPart with an LoD 2.x geometry");
+  expect_error(
+      run_cli("refine --model " + dir + "/lod1.city.json --cloud " + dir + "/c.ply --out " + dir + "/r.city.json", dir),
+      "lod1.city.json: no Building/BuildingPart with an LoD 2.x geometry (1 building object(s) without one); nothing "
+      "to refine");
+  expect_error(
+      run_cli("refine --model " + dir + "/lod1.city.json --cloud " + dir + "/c.ply --out " + dir + "/r.obj", dir),
+      "r.obj: a city file in gives a CityJSON city file out; name it e.g. refined.city.json");
+  expect_error(
+      run_cli("refine --model " + dir + "/other.json --cloud " + dir + "/c.ply --out " + dir + "/r.city.json", dir),
+      "other.json: not a CityJSON file (no \"type\": \"CityJSON\")");
   expect_error(run_cli("refine --model " + dir + "/c.ply --cloud " + dir + "/m.obj" + out, dir),
                "c.ply: not an OBJ model: the file is a PLY point cloud");
   expect_error(run_cli("refine --model " + dir + "/c.las --cloud " + dir + "/c.ply" + out, dir),
@@ -87,8 +95,8 @@ TEST(Formats, CloudOfAnotherTileIsCalledOut) {
   PointCloud far = b.cloud;
   for (auto& p : far.points) p.x() += 10000.0;  // e.g. the neighbouring tile, or another false easting
   write_ply(dir + "/far.ply", far);
-  const Cli r = run_cli("refine --model " + dir + "/m.obj --cloud " + dir + "/far.ply --out " + dir + "/r.obj --report " +
-                            dir + "/r.json",
+  const Cli r = run_cli("refine --model " + dir + "/m.obj --cloud " + dir + "/far.ply --out " + dir +
+                            "/r.obj --report " + dir + "/r.json",
                         dir);
   EXPECT_EQ(r.exit, 0) << r.err;  // the building still gets its (repaired) original
   EXPECT_EQ(r.err, "");           // stderr is only for the error line of a failed run

@@ -7,16 +7,16 @@
 
 #include <algorithm>
 #include <cstring>
-#include <limits>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <tuple>
 
 #include "lodrefine/io/cloud.h"
+#include "lodrefine/io/las.h"
 #include "lodrefine/io/obj.h"
 #include "lodrefine/io/ply.h"
-#include "lodrefine/io/las.h"
 #include "lodrefine/synth/synth.h"
 
 using namespace lodrefine;
@@ -30,11 +30,11 @@ using fixtures::write_bytes;
 
 std::string read_bytes(const std::string& path) { return cli_fixtures::slurp(path); }
 
-
 // Georeferenced points on a millimetre grid (the LAS scale), so they read back exactly.
 PointCloud sample_points() {
   PointCloud c;
-  for (int i = 0; i < 50; ++i) c.points.push_back(Vec3(85123.456 + 0.125 * i, 447987.654 - 0.25 * i, 1.234 + 0.001 * i));
+  for (int i = 0; i < 50; ++i)
+    c.points.push_back(Vec3(85123.456 + 0.125 * i, 447987.654 - 0.25 * i, 1.234 + 0.001 * i));
   return c;
 }
 
@@ -72,7 +72,8 @@ TEST(Las, EveryFormatAndVersionReadsBackExactly) {
     for (int format = 0; format <= 10; ++format) {
       if (format >= 6 && minor < 4) continue;  // formats 6–10 are LAS 1.4
       for (std::uint32_t extra : {0u, 7u}) {   // extra bytes after the format's fields are skipped
-        SCOPED_TRACE("LAS 1." + std::to_string(minor) + " format " + std::to_string(format) + " +" + std::to_string(extra));
+        SCOPED_TRACE("LAS 1." + std::to_string(minor) + " format " + std::to_string(format) + " +" +
+                     std::to_string(extra));
         LasWriteOptions o = opts(minor, format);
         o.record_length = las_min_record_length(format) + extra;
         const std::string path = temp_path("f.las");
@@ -88,7 +89,8 @@ TEST(Las, EveryFormatAndVersionReadsBackExactly) {
         const PointCloud back = read_cloud(path);
         ASSERT_EQ(back.points.size(), pts.points.size());
         double worst = 0;
-        for (std::size_t i = 0; i < pts.points.size(); ++i) worst = std::max(worst, (back.points[i] - pts.points[i]).norm());
+        for (std::size_t i = 0; i < pts.points.size(); ++i)
+          worst = std::max(worst, (back.points[i] - pts.points[i]).norm());
         EXPECT_LT(worst, 1e-9);  // integer millimetres · 0.001 + offset, in double
         const PointCloud walls = read_cloud(path, {{6}});
         EXPECT_EQ(walls.points.size(), 17u);  // i % 3 == 0 of 50
@@ -113,7 +115,8 @@ TEST(Las, ClassificationWidthFollowsTheFormat) {
   write_las(p1, pts, sample_classes(pts.points.size(), 8), opts(2, 1));
   std::string bytes = read_bytes(p1);
   const std::size_t off = 227, rec = 28;
-  for (std::size_t i = 0; i < pts.points.size(); ++i) bytes[off + i * rec + 15] = char(bytes[off + i * rec + 15] | 0xE0);
+  for (std::size_t i = 0; i < pts.points.size(); ++i)
+    bytes[off + i * rec + 15] = char(bytes[off + i * rec + 15] | 0xE0);
   write_bytes("f1.las", bytes);
   EXPECT_EQ(read_cloud(p1, {{8}}).points.size(), 16u);
 }
@@ -180,15 +183,19 @@ TEST(Las, LyingAndTruncatedHeadersAreOneClearError) {
   expect_error("LASF", "LAS header truncated");
   // One field of a valid header changed: (file, edit, expected fault).
   const std::vector<std::tuple<const std::string*, std::function<void(std::string&)>, std::string>> lies = {
-      {&good, [](std::string& b) { poke<std::uint16_t>(b, 105, 19); }, "point record length 19 is below the 28 bytes of point format 1"},
+      {&good, [](std::string& b) { poke<std::uint16_t>(b, 105, 19); },
+       "point record length 19 is below the 28 bytes of point format 1"},
       {&good, [](std::string& b) { b[104] = 11; }, "unknown point data format 11"},
       {&good, [](std::string& b) { poke<std::uint32_t>(b, 96, 100); }, "point data offset 100 lies inside the header"},
-      {&good, [](std::string& b) { poke<std::uint32_t>(b, 96, 1u << 30); }, "point data offset 1073741824 is beyond the end of the file"},
+      {&good, [](std::string& b) { poke<std::uint32_t>(b, 96, 1u << 30); },
+       "point data offset 1073741824 is beyond the end of the file"},
       {&good, [](std::string& b) { poke<std::uint16_t>(b, 94, 100); }, "header size 100 is below the 227 bytes"},
-      {&good14, [](std::string& b) { poke<std::uint16_t>(b, 94, 227); }, "header size 227 is below the 375 bytes of LAS 1.4"},
+      {&good14, [](std::string& b) { poke<std::uint16_t>(b, 94, 227); },
+       "header size 227 is below the 375 bytes of LAS 1.4"},
       {&good, [](std::string& b) { b[24] = 2; }, "unsupported LAS version 2.2"},
       {&good, [](std::string& b) { poke<double>(b, 131, 0.0); }, "scale factor of x is zero or not finite"},
-      {&good, [](std::string& b) { poke<double>(b, 171, std::numeric_limits<double>::quiet_NaN()); }, "offset of z is not finite"},
+      {&good, [](std::string& b) { poke<double>(b, 171, std::numeric_limits<double>::quiet_NaN()); },
+       "offset of z is not finite"},
       {&good, [](std::string& b) { poke<double>(b, 139, 1e6); }, "has a coordinate beyond 1e9 m"},  // y = Y · 1e6 m
   };
   for (const auto& [base, edit, fault] : lies) {
@@ -249,7 +256,8 @@ TEST(Las, RefineCropAndEvalTakeLasWithClasses) {
   lo.offset = (b.coarse.vertices[0] / 1000).array().floor() * 1000;
   write_las(dir + "/c.las", mixed, classes, lo);
 
-  const Cli ply = run_cli("refine --model " + dir + "/m.obj --cloud " + dir + "/c.ply --out " + dir + "/r_ply.obj", dir);
+  const Cli ply =
+      run_cli("refine --model " + dir + "/m.obj --cloud " + dir + "/c.ply --out " + dir + "/r_ply.obj", dir);
   const Cli las = run_cli("refine --model " + dir + "/m.obj --cloud " + dir + "/c.las --classes 1 --out " + dir +
                               "/r_las.obj --report " + dir + "/r.json",
                           dir);
@@ -261,7 +269,8 @@ TEST(Las, RefineCropAndEvalTakeLasWithClasses) {
   ASSERT_EQ(a.faces.size(), c.faces.size());
   for (std::size_t i = 0; i < a.vertices.size(); ++i) EXPECT_LT((a.vertices[i] - c.vertices[i]).norm(), 2e-3);
 
-  const Cli none = run_cli("refine --model " + dir + "/m.obj --cloud " + dir + "/c.las --classes 2,3 --out " + dir + "/n.obj", dir);
+  const Cli none =
+      run_cli("refine --model " + dir + "/m.obj --cloud " + dir + "/c.las --classes 2,3 --out " + dir + "/n.obj", dir);
   EXPECT_EQ(none.exit, 2);
   EXPECT_NE(none.err.find("the cloud has no points of classes 2,3 (of " + std::to_string(mixed.points.size()) + ")"),
             std::string::npos)
@@ -269,7 +278,8 @@ TEST(Las, RefineCropAndEvalTakeLasWithClasses) {
 
   fs::create_directories(dir + "/models");
   write_obj(dir + "/models/" + b.id + ".obj", b.coarse);
-  const Cli crop = run_cli("crop --tile " + dir + "/c.las --classes 1 --models " + dir + "/models --out " + dir + "/run", dir);
+  const Cli crop =
+      run_cli("crop --tile " + dir + "/c.las --classes 1 --models " + dir + "/models --out " + dir + "/run", dir);
   ASSERT_EQ(crop.exit, 0) << crop.err;
   EXPECT_NE(crop.out.find(std::to_string(b.cloud.points.size()) + " tile points"), std::string::npos) << crop.out;
   const PointCloud cut = read_cloud(dir + "/run/" + b.id + "/cloud.ply");

@@ -154,7 +154,8 @@ TEST(Laz, LyingHeadersAndTruncatedChunksAreOneLine) {
 
   const std::vector<std::pair<std::function<void(std::string&)>, std::string>> lies = {
       // point count beyond what the chunks hold (5 chunks of 50,000 points)
-      {[](std::string& b) { poke<std::uint32_t>(b, 107, 250001); }, "header declares 250001 points but the LAZ chunks hold only 250000"},
+      {[](std::string& b) { poke<std::uint32_t>(b, 107, 250001); },
+       "header declares 250001 points but the LAZ chunks hold only 250000"},
       {[](std::string& b) { poke<std::uint32_t>(b, 107, 0xffffffffu); }, "header declares 4294967295 points"},
       // chunk table offset outside the file, inside the header, or -1 with a bad tail
       {[&](std::string& b) { poke<std::uint64_t>(b, point_offset, b.size() + 10); }, "LAZ chunk table offset"},
@@ -263,7 +264,9 @@ TEST(Laz, EveryTruncationAndByteFlipIsOneLineOrTheSamePoints) {
       try {
         const LasHeader h = read_las_header(path);
         const std::string got = records(path);
-        if (truncated) { EXPECT_EQ(got, want) << seed << ": truncated at " << bytes.size(); }
+        if (truncated) {
+          EXPECT_EQ(got, want) << seed << ": truncated at " << bytes.size();
+        }
         EXPECT_EQ(got.size(), h.point_count * h.record_length);
       } catch (const InputError& e) {
         const std::string msg = e.what();
@@ -296,7 +299,8 @@ TEST(Laz, SampleFolderEqualsLazPerf) {
     if (e.path().extension() != ".laz") continue;
     const std::string dump = temp_path("sample.ref");
     fs::remove(dump);
-    const std::string cmd = "node '" + script + "' '" + modules + "' '" + e.path().string() + "' '" + dump + "' 2>/dev/null";
+    const std::string cmd =
+        "node '" + script + "' '" + modules + "' '" + e.path().string() + "' '" + dump + "' 2>/dev/null";
     const bool reference = std::system(cmd.c_str()) == 0 && fs::exists(dump) && fs::file_size(dump) > 0;
     try {
       const std::string ours = records(e.path().string());

@@ -43,7 +43,6 @@ const char* kCubeTopObj =
     "usemtl RoofSurface_mat\n"
     "f 1//1 2//2 6//3\n";
 
-
 }  // namespace
 
 TEST(IoObj, GeoreferencedRoundTripKeepsTenthOfMillimetre) {
@@ -83,9 +82,9 @@ TEST(IoObj, GroupsAndMaterialsGiveSemanticsAndIdComesFromO) {
   EXPECT_EQ(m.faces[0].sem, Semantic::Roof);
   EXPECT_EQ(m.faces[1].sem, Semantic::Wall);
   EXPECT_EQ(m.faces[1].v, (std::vector<int>{4, 5, 1, 0}));
-  EXPECT_EQ(m.faces[2].sem, Semantic::Ground);  // group wins over an unknown material
+  EXPECT_EQ(m.faces[2].sem, Semantic::Ground);           // group wins over an unknown material
   EXPECT_EQ(m.faces[2].v, (std::vector<int>{5, 4, 3}));  // negative indices are relative
-  EXPECT_EQ(m.faces[3].sem, Semantic::Roof);  // unknown group: the material decides
+  EXPECT_EQ(m.faces[3].sem, Semantic::Roof);             // unknown group: the material decides
   EXPECT_EQ(m.faces[3].source, 3);
 }
 

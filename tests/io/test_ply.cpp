@@ -78,7 +78,8 @@ TEST(IoPly, BinaryIntegerCoordinatesExtraPropertiesAndFaceElement) {
     put<std::uint8_t>(s, 3, be), put<std::int32_t>(s, 0, be), put<std::int32_t>(s, 1, be), put<std::int32_t>(s, 0, be);
     put<std::uint16_t>(s, 7, be);
     put<std::uint8_t>(s, 0, be), put<std::uint16_t>(s, 9, be);
-    put<std::int16_t>(s, -300, be), put<std::int8_t>(s, 5, be), put<std::uint32_t>(s, 900000000u, be);  // beyond int16, within the 1e9 m limit
+    put<std::int16_t>(s, -300, be), put<std::int8_t>(s, 5, be),
+        put<std::uint32_t>(s, 900000000u, be);  // beyond int16, within the 1e9 m limit
     put<std::int8_t>(s, -5, be), put<double>(s, 1.0, be);
     put<std::int16_t>(s, 12, be), put<std::int8_t>(s, 0, be), put<std::uint32_t>(s, 1, be);
     put<std::int8_t>(s, 127, be), put<double>(s, 2.0, be);
@@ -96,7 +97,10 @@ TEST(IoPly, StreamYieldsTheSamePointsAsRead) {
   write_ply(path, cloud, Vec3(85000, 447000, 0));
   const PointCloud r = read_ply(path);
   std::size_t n = 0, mismatches = 0;
-  stream_ply(path, [&](const Vec3& p) { mismatches += n >= r.points.size() || p != r.points[n]; ++n; });
+  stream_ply(path, [&](const Vec3& p) {
+    mismatches += n >= r.points.size() || p != r.points[n];
+    ++n;
+  });
   EXPECT_EQ(n, cloud.points.size());
   EXPECT_EQ(mismatches, 0u);
   ASSERT_EQ(r.points.size(), cloud.points.size());
@@ -141,24 +145,29 @@ TEST(IoPly, MalformedInputsThrowOneLineInputErrors) {
   std::string lie2 = good;
   lie2.replace(lie2.find("vertex 3"), 8, "vertex 4");
   expect_ply_error(lie2, "more data than the file holds");
-  expect_ply_error("ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
-                   "end_header\n1 2 3\n4 5\n  \n\n  \n",
-                   "data ends after 1 of 2 vertices");
-  expect_ply_error("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
-                   "end_header\n1 nan 3\n",
-                   "non-finite");
-  expect_ply_error("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
-                   "end_header\n1 2 3abc\n",
-                   "bad ASCII value '3abc'");
-  expect_ply_error("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
-                   "end_header\n1 +-2 3\n",
-                   "bad ASCII value '+-2'");
+  expect_ply_error(
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
+      "end_header\n1 2 3\n4 5\n  \n\n  \n",
+      "data ends after 1 of 2 vertices");
+  expect_ply_error(
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+      "end_header\n1 nan 3\n",
+      "non-finite");
+  expect_ply_error(
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+      "end_header\n1 2 3abc\n",
+      "bad ASCII value '3abc'");
+  expect_ply_error(
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+      "end_header\n1 +-2 3\n",
+      "bad ASCII value '+-2'");
   std::string inf = good;
   const double bad = std::numeric_limits<double>::infinity();
   std::memcpy(&inf[inf.size() - 8], &bad, 8);
   expect_ply_error(inf, "vertex 2 has a non-finite coordinate");
   // A face element before the vertices whose lists run past the end of the file.
-  expect_ply_error("ply\nformat binary_little_endian 1.0\nelement face 1\nproperty list uchar int vi\n"
-                   "element vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n\x03\x01",
-                   "data ends inside element 'face'");
+  expect_ply_error(
+      "ply\nformat binary_little_endian 1.0\nelement face 1\nproperty list uchar int vi\n"
+      "element vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n\x03\x01",
+      "data ends inside element 'face'");
 }

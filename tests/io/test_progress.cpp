@@ -15,8 +15,9 @@ struct Rig {
   double now = 100.0;
   std::vector<std::string> out;
   Progress make(Progress::Mode mode, std::uint64_t total) {
-    return Progress("refine", "buildings", total, mode, [this](const std::string& s) { out.push_back(s); },
-                    [this] { return now; }, 10.0, 0.2);
+    return Progress(
+        "refine", "buildings", total, mode, [this](const std::string& s) { out.push_back(s); }, [this] { return now; },
+        10.0, 0.2);
   }
 };
 

@@ -37,8 +37,9 @@ TEST(RefineReport, RefinedBuildingHasEveryStage) {
   EXPECT_EQ(j["outcome"], "refined");
   EXPECT_EQ(j["refined"], true);
   EXPECT_EQ(j["origin"], nlohmann::json({85000.0, 447000.0, 0.0}));
-  for (const char* key : {"repair", "input_validation", "output_validation", "cloud", "planes", "matches",
-                          "rejected_matches", "q_model", "substitution", "replacements", "facades", "judgement", "selection"})
+  for (const char* key :
+       {"repair", "input_validation", "output_validation", "cloud", "planes", "matches", "rejected_matches", "q_model",
+        "substitution", "replacements", "facades", "judgement", "selection"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["cloud"]["points"], s.scan.points.size());
   ASSERT_EQ(j["matches"].size(), 1u);
@@ -53,7 +54,8 @@ TEST(RefineReport, RefinedBuildingHasEveryStage) {
   EXPECT_EQ(j["judgement"]["check"], "");
   EXPECT_LT(j["judgement"]["building"]["rms_after"].get<double>(), 0.05);
   EXPECT_GT(j["judgement"]["building"]["rms_before"].get<double>(), 0.3);
-  EXPECT_GT(j["judgement"]["building"]["better"].get<std::size_t>(), j["judgement"]["building"]["worse"].get<std::size_t>());
+  EXPECT_GT(j["judgement"]["building"]["better"].get<std::size_t>(),
+            j["judgement"]["building"]["worse"].get<std::size_t>());
   ASSERT_EQ(j["judgement"]["walls"].size(), 1u);
   EXPECT_EQ(j["output_validation"]["valid"], true);
   EXPECT_EQ(j["faces"], r.trace.faces);
@@ -82,7 +84,8 @@ TEST(RefineReport, ABuildingStoppedAtRepairHasOnlyWhatItReached) {
   EXPECT_EQ(j["outcome"], "kept-invalid");
   EXPECT_EQ(j["reason"], r.reason);
   EXPECT_FALSE(r.reason.empty());
-  for (const char* key : {"repair", "cloud", "planes", "matches", "substitution", "replacements", "judgement", "selection"})
+  for (const char* key :
+       {"repair", "cloud", "planes", "matches", "substitution", "replacements", "judgement", "selection"})
     EXPECT_FALSE(j.contains(key)) << key;
   EXPECT_EQ(j["seconds"].size(), 2u);  // repair, total
   EXPECT_EQ(j["faces"], 2u);

@@ -68,8 +68,8 @@ inline void copy_run(const fs::path& from, const fs::path& to) {
 
 // The batch Makefile over `run` (extra make arguments appended).
 inline std::string batch_command(const fs::path& run, const std::string& extra = "") {
-  return "make -s -f " + shell_quoted(kSource / "scripts" / "batch.mk") + " RUN=" + shell_quoted(run) + " LODREFINE=" +
-         shell_quoted(kBinary) + " -j2 " + extra;
+  return "make -s -f " + shell_quoted(kSource / "scripts" / "batch.mk") + " RUN=" + shell_quoted(run) +
+         " LODREFINE=" + shell_quoted(kBinary) + " -j2 " + extra;
 }
 
 // The report without timings (the only part of a refine that differs between runs): every
@@ -109,7 +109,7 @@ inline std::map<std::string, std::string> outcome_files(const fs::path& run) {
 struct TileRun {
   fs::path inputs, done;
   std::map<std::string, std::string> outputs;  // outcome_files(done)
-  double seconds = 0.0;                         // the batch's wall time
+  double seconds = 0.0;                        // the batch's wall time
 };
 
 inline TileRun tile_and_batch(const std::string& name, int buildings) {

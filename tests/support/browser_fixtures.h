@@ -27,7 +27,8 @@ inline bool chromium_available() { return std::system("command -v chromium > /de
 inline std::string chromium(const fs::path& profile, int height) {
   return "timeout 120 chromium --headless --no-sandbox --disable-gpu-sandbox --enable-unsafe-swiftshader "
          "--use-angle=swiftshader --hide-scrollbars --force-device-scale-factor=1 --virtual-time-budget=20000 "
-         "--user-data-dir=" + quoted(profile) + " --window-size=1400," + std::to_string(height) + " ";
+         "--user-data-dir=" +
+         quoted(profile) + " --window-size=1400," + std::to_string(height) + " ";
 }
 
 // An 8-bit RGB/RGBA, non-interlaced PNG (what Chromium writes) as RGB rows.
@@ -37,7 +38,9 @@ struct Image {
   const std::array<int, 3>& at(int x, int y) const { return rgb[std::size_t(y) * std::size_t(width) + std::size_t(x)]; }
 };
 
-inline std::uint32_t be32(const unsigned char* p) { return (std::uint32_t(p[0]) << 24) | (p[1] << 16) | (p[2] << 8) | p[3]; }
+inline std::uint32_t be32(const unsigned char* p) {
+  return (std::uint32_t(p[0]) << 24) | (p[1] << 16) | (p[2] << 8) | p[3];
+}
 
 inline Image decode_png(const std::string& file) {
   Image img;
@@ -61,7 +64,8 @@ inline Image decode_png(const std::string& file) {
   const std::size_t stride = std::size_t(img.width) * std::size_t(channels);
   std::vector<unsigned char> raw((stride + 1) * std::size_t(img.height));
   uLongf raw_len = raw.size();
-  if (channels == 0 || uncompress(raw.data(), &raw_len, reinterpret_cast<const Bytef*>(idat.data()), idat.size()) != Z_OK)
+  if (channels == 0 ||
+      uncompress(raw.data(), &raw_len, reinterpret_cast<const Bytef*>(idat.data()), idat.size()) != Z_OK)
     return {};
   std::vector<unsigned char> prev(stride, 0), cur(stride);
   for (int y = 0; y < img.height; ++y) {
@@ -107,8 +111,8 @@ inline std::string file_text(const fs::path& path) {
 
 inline PageDump dump_page(const fs::path& html, const fs::path& dir) {
   PageDump d;
-  const int st = std::system((chromium(dir / "profile", 900) + "--enable-logging=stderr --v=0 --dump-dom " + quoted(html) +
-                              " > " + quoted(dir / "dom.html") + " 2> " + quoted(dir / "chromium.log"))
+  const int st = std::system((chromium(dir / "profile", 900) + "--enable-logging=stderr --v=0 --dump-dom " +
+                              quoted(html) + " > " + quoted(dir / "dom.html") + " 2> " + quoted(dir / "chromium.log"))
                                  .c_str());
   d.exit = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
   d.page = file_text(dir / "dom.html");
@@ -137,7 +141,8 @@ inline CanvasShares canvas_shares(const Image& img, int x0, int y0, int w, int h
       drawn += std::max({255 - p[0], 255 - p[1], 255 - p[2]}) > 30;
       orange += p[0] > 150 && p[1] > 60 && p[1] < 170 && p[2] < 90;
     }
-  return {double(drawn) / double(std::max<std::size_t>(1, total)), double(orange) / double(std::max<std::size_t>(1, total))};
+  return {double(drawn) / double(std::max<std::size_t>(1, total)),
+          double(orange) / double(std::max<std::size_t>(1, total))};
 }
 
 }  // namespace lodrefine::browser_fixtures

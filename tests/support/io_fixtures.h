@@ -17,7 +17,8 @@ namespace lodrefine::fixtures {
 // A fresh per-test path under the GoogleTest temp dir.
 inline std::string temp_path(const std::string& name) {
   const auto* info = testing::UnitTest::GetInstance()->current_test_info();
-  const std::filesystem::path dir = std::filesystem::path(testing::TempDir()) / ("lodrefine_io_" + std::to_string(::getpid())) / info->name();
+  const std::filesystem::path dir =
+      std::filesystem::path(testing::TempDir()) / ("lodrefine_io_" + std::to_string(::getpid())) / info->name();
   std::filesystem::create_directories(dir);
   return (dir / name).string();
 }

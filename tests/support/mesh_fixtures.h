@@ -37,17 +37,20 @@ inline Mesh box(const Vec3& lo, const Vec3& hi) {
 inline Mesh needle() {
   Mesh m;
   m.vertices = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, {0, 0, 10}};
-  m.faces = {{{0, 3, 2, 1}, Semantic::Ground}, {{0, 1, 4}, Semantic::Wall}, {{1, 2, 4}, Semantic::Wall},
-             {{2, 3, 4}, Semantic::Wall},      {{3, 0, 4}, Semantic::Wall}};
+  m.faces = {{{0, 3, 2, 1}, Semantic::Ground},
+             {{0, 1, 4}, Semantic::Wall},
+             {{1, 2, 4}, Semantic::Wall},
+             {{2, 3, 4}, Semantic::Wall},
+             {{3, 0, 4}, Semantic::Wall}};
   return m;
 }
 
 // 10 × 8 m house, eaves at 6 m, ridge at 9 m along x.
 inline Mesh gable_house() {
   Mesh m;
-  m.vertices = {{0, 0, 0}, {10, 0, 0}, {10, 8, 0}, {0, 8, 0}, {0, 0, 6},
-                {10, 0, 6}, {10, 8, 6}, {0, 8, 6}, {0, 4, 9}, {10, 4, 9}};
-  m.faces = {{{0, 3, 2, 1}, Semantic::Ground}, {{0, 1, 5, 4}, Semantic::Wall},    {{2, 3, 7, 6}, Semantic::Wall},
+  m.vertices = {{0, 0, 0},  {10, 0, 0}, {10, 8, 0}, {0, 8, 0}, {0, 0, 6},
+                {10, 0, 6}, {10, 8, 6}, {0, 8, 6},  {0, 4, 9}, {10, 4, 9}};
+  m.faces = {{{0, 3, 2, 1}, Semantic::Ground},  {{0, 1, 5, 4}, Semantic::Wall},    {{2, 3, 7, 6}, Semantic::Wall},
              {{1, 2, 6, 9, 5}, Semantic::Wall}, {{3, 0, 4, 8, 7}, Semantic::Wall}, {{4, 5, 9, 8}, Semantic::Roof},
              {{6, 7, 8, 9}, Semantic::Roof}};
   return m;

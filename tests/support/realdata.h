@@ -14,6 +14,6 @@ inline std::filesystem::path realdata_dir() {
 }  // namespace lodrefine::fixtures
 
 // Declares `data_path` = realdata_dir() / rel, or skips the test when it does not exist.
-#define REQUIRE_REALDATA(rel)                                                   \
+#define REQUIRE_REALDATA(rel)                                                          \
   const std::filesystem::path data_path = lodrefine::fixtures::realdata_dir() / (rel); \
   if (!std::filesystem::exists(data_path)) GTEST_SKIP() << "real data not found: " << data_path.string()

@@ -20,12 +20,15 @@ constexpr double kRunWallOffset = 0.4;  // m the scanned front wall lies in fron
 // A refine report of the current version: `outcome`, its reason and one moved facade (input
 // faces {2}, max_move -kRunWallOffset) when refined.
 inline nlohmann::json run_report(const std::string& outcome, const std::string& reason = "") {
-  nlohmann::json r = {{"report_version", 1}, {"outcome", outcome}, {"reason", reason},
-                      {"seconds", {{"total", 1.25}}}, {"selection", {{"status", "optimal"}}}};
+  nlohmann::json r = {{"report_version", 1},
+                      {"outcome", outcome},
+                      {"reason", reason},
+                      {"seconds", {{"total", 1.25}}},
+                      {"selection", {{"status", "optimal"}}}};
   r["facades"] = nlohmann::json::array();
   if (outcome == "refined")
-    r["facades"].push_back({{"input_faces", {2}}, {"evidence", "scan"}, {"max_move", -kRunWallOffset},
-                            {"mean_move", kRunWallOffset}});
+    r["facades"].push_back(
+        {{"input_faces", {2}}, {"evidence", "scan"}, {"max_move", -kRunWallOffset}, {"mean_move", kRunWallOffset}});
   return r;
 }
 
@@ -42,8 +45,7 @@ inline void write_run_building(const std::filesystem::path& run, const std::stri
   for (auto& p : scan.points) p += kRunOrigin;
   write_ply((d / "cloud.ply").string(), scan);
   if (refined)
-    write_obj((d / "refined.obj").string(),
-              translated(box(Vec3(0, -kRunWallOffset, 0), Vec3(12, 8, 6)), kRunOrigin));
+    write_obj((d / "refined.obj").string(), translated(box(Vec3(0, -kRunWallOffset, 0), Vec3(12, 8, 6)), kRunOrigin));
   if (!report.is_null()) std::ofstream(d / "report.json") << report.dump(2);
 }
 

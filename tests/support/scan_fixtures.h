@@ -68,7 +68,8 @@ inline void sample_face(const std::vector<Vec3>& poly, double offset, double ste
   const Vec3 base = pl.project(Vec3::Zero());
   for (double a = u0 + step / 2; a < u1; a += step)
     for (double b = v0 + step / 2; b < v1; b += step)
-      if (point_in_polygon_2d(Vec2(a, b), p2)) out.points.push_back(base + a * u + b * v + (offset + noise(rng)) * pl.n);
+      if (point_in_polygon_2d(Vec2(a, b), p2))
+        out.points.push_back(base + a * u + b * v + (offset + noise(rng)) * pl.n);
 }
 
 // A terraced street: one facade plane y = 0 running from x = x0 to x1 (the houses' fronts are

@@ -9,8 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "lodrefine/core/geometry.h"
-#include "lodrefine/synth/synth.h"
 #include "lodrefine/core/validate.h"
+#include "lodrefine/synth/synth.h"
 
 using namespace lodrefine;
 
@@ -126,9 +126,15 @@ TEST_P(SynthAll, TruthIsClosedPlanarOutwardAndGeoreferenced) {
       walls += f.sem == Semantic::Wall;
       roofs += f.sem == Semantic::Roof;
       grounds += f.sem == Semantic::Ground;
-      if (f.sem == Semantic::Wall) { EXPECT_LT(std::abs(n.z()), 1e-6); }
-      if (f.sem == Semantic::Roof) { EXPECT_GT(n.z(), 0.3); }
-      if (f.sem == Semantic::Ground) { EXPECT_LT(n.z(), -1 + 1e-9); }
+      if (f.sem == Semantic::Wall) {
+        EXPECT_LT(std::abs(n.z()), 1e-6);
+      }
+      if (f.sem == Semantic::Roof) {
+        EXPECT_GT(n.z(), 0.3);
+      }
+      if (f.sem == Semantic::Ground) {
+        EXPECT_LT(n.z(), -1 + 1e-9);
+      }
     }
     EXPECT_GE(walls, 3);
     EXPECT_GE(roofs, 1);
@@ -189,8 +195,7 @@ TEST_P(SynthAll, CoarseKeepsRoofPlanesAndMovesOnlyChosenWalls) {
         double len = 0;
         for (const auto& a : wp)
           for (const auto& bb : wp) len = std::max(len, (a - bb).head<2>().norm());
-        const double bound =
-            std::abs(m.offset) + (len / 2 + 2) * std::tan(radians(std::abs(m.rotation_deg))) + 0.01;
+        const double bound = std::abs(m.offset) + (len / 2 + 2) * std::tan(radians(std::abs(m.rotation_deg))) + 0.01;
         near |= std::abs(pl.distance(q)) <= bound;
       }
       EXPECT_TRUE(near) << "coarse vertex " << q.transpose() << " moved away from the truth far from a moved wall";

@@ -40,7 +40,7 @@ using CandidateMesh = CGAL::Surface_mesh<CGAL::Simple_cartesian<double>::Point_3
 
 // What the program needs of candidate f (face f of CandidateSet::mesh): its plane and size.
 struct Candidate {
-  int plane = -1;          // index into CandidateSet::planes
+  int plane = -1;  // index into CandidateSet::planes
   double area = 0.0;
   Vec3 centroid = Vec3::Zero();
 };
@@ -65,7 +65,7 @@ struct CandidateSet {
   CandidateMesh mesh;
   std::vector<Candidate> faces;
   std::vector<CandidateEdge> edges;
-  std::vector<int> corners(int f) const;     // indices into `vertices`, CCW
+  std::vector<int> corners(int f) const;  // indices into `vertices`, CCW
   std::vector<Vec3> polygon(int f) const;
 };
 

@@ -14,12 +14,12 @@ struct ModelReference {
 };
 
 struct CloudReference {
-  std::vector<Vec3> points;   // the inliers of a matched scan plane
+  std::vector<Vec3> points;  // the inliers of a matched scan plane
 };
 
 struct Confidence {
-  double value = 0.0;   // best projected-overlap ratio, 0..1
-  int model_ref = -1;   // which reference gave it (-1: none)
+  double value = 0.0;  // best projected-overlap ratio, 0..1
+  int model_ref = -1;  // which reference gave it (-1: none)
   int cloud_ref = -1;
 };
 

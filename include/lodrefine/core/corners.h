@@ -22,9 +22,9 @@
 namespace lodrefine {
 
 struct ScannedWall {
-  int surface = -1;    // model surface
+  int surface = -1;  // model surface
   int scan_plane = -1;
-  Plane plane;         // the scan plane oriented like the wall
+  Plane plane;  // the scan plane oriented like the wall
 };
 
 struct CornerMove {

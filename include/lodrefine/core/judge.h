@@ -25,18 +25,18 @@ constexpr double kGroundBand = 0.3;  // m above the model's lowest vertex
 struct JudgedWall {
   std::vector<std::vector<Vec3>> polygons;  // its faces before the move
   Plane from, to;                           // its plane before and after (oriented outwards)
-  bool corner = false;  // moved on corner evidence (the scan shows its corner, not its face)
+  bool corner = false;                      // moved on corner evidence (the scan shows its corner, not its face)
 };
 
 struct Judgement {
   struct Fit {
-    std::size_t points = 0;              // judged points
-    std::size_t better = 0, worse = 0;   // closer / farther by more than PlaneConfig::ransac_epsilon
+    std::size_t points = 0;                    // judged points
+    std::size_t better = 0, worse = 0;         // closer / farther by more than PlaneConfig::ransac_epsilon
     double rms_before = 0.0, rms_after = 0.0;  // of the capped distances
   };
   bool ok = true;
-  std::string check;   // the check that refused: "building", "wall" or "gain"; empty when ok
-  std::string detail;  // one line with the figures of the refusal; empty when ok
+  std::string check;       // the check that refused: "building", "wall" or "gain"; empty when ok
+  std::string detail;      // one line with the figures of the refusal; empty when ok
   Fit building;            // every judged point
   std::vector<Fit> walls;  // per JudgedWall, its region
 };
@@ -55,8 +55,8 @@ struct Judgement {
 //   its windows, is no refinement).
 // The building is judged first, then each wall, then the gain. Refuses (never throws) when a
 // mesh has no face.
-constexpr double kRmsSlack = 0.001;      // m
-constexpr double kWallRmsSlack = 0.01;   // m
+constexpr double kRmsSlack = 0.001;     // m
+constexpr double kWallRmsSlack = 0.01;  // m
 constexpr double kWorseShare = 0.25;
 constexpr int kMinGain = 50;
 constexpr double kMinRmsGain = 0.001;  // m

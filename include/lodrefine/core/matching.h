@@ -34,15 +34,15 @@ std::vector<ModelSurface> model_surfaces(const Mesh& mesh, double angle_deg = kS
 double surface_deviation(const Mesh& mesh, const ModelSurface& surface, const Plane& plane);
 
 struct Match {
-  int scan_plane = -1;   // index into the scan planes
-  int surface = -1;      // index into the model surfaces
+  int scan_plane = -1;  // index into the scan planes
+  int surface = -1;     // index into the model surfaces
   double s_normal = 0, d_centroid = 0, c_bbox = 0, s_match = 0;
   std::vector<int> owned;  // the scan points in front of the wall that belong to it
 };
 
 struct MatchResult {
-  std::vector<Match> matches;   // the accepted one-to-one matches (one scan plane per surface)
-  double q_model = 0.0;         // sum of S_match
+  std::vector<Match> matches;  // the accepted one-to-one matches (one scan plane per surface)
+  double q_model = 0.0;        // sum of S_match
   // One line per match turned down after a wall was found in reach of the plane (coverage,
   // facing, a corner conflict), and why; a plane no wall is near (match_distance,
   // match_angle_deg) has no candidate and no line.
@@ -57,9 +57,8 @@ struct MatchResult {
 // plane with most points, walls facing away from the one the plane fits best are dropped, and
 // so are matches whose corner with an adjacent matched facade lies over corner_gap beyond that
 // facade's points. S_match = w_normal |S_normal| + w_coverage IoU.
-MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
-                           const PointCloud& cloud, const std::vector<ScanPlane>& planes,
-                           const MatchConfig& config);
+MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& surfaces, const PointCloud& cloud,
+                           const std::vector<ScanPlane>& planes, const MatchConfig& config);
 
 // The inliers of each matched scan plane that lie in front of its wall, grown by `margin` (a
 // plane may run on along a flush neighbouring facade, whose points are not this building's);

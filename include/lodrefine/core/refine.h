@@ -54,7 +54,7 @@ struct RefineTrace {
     bool ok = false;
     std::string reason;  // when !ok
   };
-  struct FacadeMove {  // a moved wall, described on the mesh it was moved on
+  struct FacadeMove {           // a moved wall, described on the mesh it was moved on
     std::set<int> input_faces;  // Face::source of its faces
     std::string evidence;       // "scan" or "corner"
     double max_move = 0.0, mean_move = 0.0;
@@ -62,12 +62,12 @@ struct RefineTrace {
   };
 
   std::string id;
-  Vec3 origin = Vec3::Zero();  // of the local frame
+  Vec3 origin = Vec3::Zero();                           // of the local frame
   std::vector<std::pair<std::string, double>> seconds;  // per stage, then "total"
   std::optional<RepairReport> repair;
   std::optional<Validation> input_validation;
   Validation output_validation;
-  std::size_t faces = 0;  // of the output
+  std::size_t faces = 0;                                     // of the output
   std::optional<std::pair<std::size_t, std::size_t>> cloud;  // points, points near the model
   std::optional<std::vector<ScanPlane>> planes;
   std::optional<Matching> matching;

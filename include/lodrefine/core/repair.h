@@ -14,11 +14,11 @@ struct RepairReport {
   int welded_vertices = 0;           // vertex count removed by welding
   int removed_degenerate_faces = 0;  // < 3 distinct vertices or ~zero area
   int removed_duplicate_faces = 0;
-  int split_t_junctions = 0;         // vertices inserted into edges that passed through them
-  int flipped_faces = 0;             // faces reversed to make the orientation consistent/outward
-  int filled_holes = 0;              // boundary loops closed with a new face (missing ground ...)
-  int split_warped_faces = 0;        // faces split by split_warped_faces
-  bool closed = false;               // closed 2-manifold after repair
+  int split_t_junctions = 0;   // vertices inserted into edges that passed through them
+  int flipped_faces = 0;       // faces reversed to make the orientation consistent/outward
+  int filled_holes = 0;        // boundary loops closed with a new face (missing ground ...)
+  int split_warped_faces = 0;  // faces split by split_warped_faces
+  bool closed = false;         // closed 2-manifold after repair
   std::vector<std::string> notes;
 };
 

@@ -13,15 +13,15 @@ struct CandidateSet;  // candidates.h (its Surface_mesh stays out of the headers
 
 // What GLPK made of the program (glp_intopt's return code with glp_mip_status).
 enum class SolveStatus {
-  NotRun,               // nothing solved yet
-  NoCandidates,         // an empty program (GLPK aborts on one; never handed to it)
+  NotRun,        // nothing solved yet
+  NoCandidates,  // an empty program (GLPK aborts on one; never handed to it)
   Optimal,
-  Feasible,             // stopped at the gap
-  FeasibleTimeLimit,    // a selection, not proven optimal
+  Feasible,           // stopped at the gap
+  FeasibleTimeLimit,  // a selection, not proven optimal
   Infeasible,
   TimeLimitNoSolution,
   NoDualFeasible,
-  SolverFailure,        // any other glp_intopt return code (SelectionResult::glpk_code)
+  SolverFailure,  // any other glp_intopt return code (SelectionResult::glpk_code)
 };
 // "optimal", "feasible (time limit)", "infeasible", "time limit (no solution)", ...
 std::string status_name(SolveStatus status, int glpk_code = 0);
@@ -31,12 +31,12 @@ struct SelectionResult {
   std::vector<char> selected;  // per candidate
   std::vector<int> column;     // per candidate: its GLPK column (1-based), 0 when fixed
   SolveStatus status = SolveStatus::NotRun;
-  int glpk_code = 0;           // glp_intopt's return code
+  int glpk_code = 0;  // glp_intopt's return code
   std::string status_text() const { return status_name(status, glpk_code); }
   int variables = 0, constraints = 0, nonzeros = 0;
-  int fixed = 0;               // candidates fixed before solving (constants, not columns)
-  double objective = 0.0;      // of the free columns (fixed faces' costs are constants)
-  double gap = 0.0;            // relative MIP gap when the search ended (0: proven optimal)
+  int fixed = 0;           // candidates fixed before solving (constants, not columns)
+  double objective = 0.0;  // of the free columns (fixed faces' costs are constants)
+  double gap = 0.0;        // relative MIP gap when the search ended (0: proven optimal)
   double seconds = 0.0;
   // The starting selection (SelectionProgram::warm): handed to GLPK's heuristic callback, and
   // whether GLPK accepted it as an incumbent (not needed: the search ended before asking).

@@ -14,7 +14,7 @@ using Vec2 = Eigen::Vector2d;
 
 // CityGML thematic surface of a face; Other for groups we do not recognise.
 enum class Semantic { Wall, Roof, Ground, Other };
-const char* semantic_name(Semantic s);       // "WallSurface", "RoofSurface", ...
+const char* semantic_name(Semantic s);                  // "WallSurface", "RoofSurface", ...
 Semantic semantic_from_name(const std::string& group);  // case-insensitive substring match
 
 // One planar polygon of a building, vertices indexing Mesh::vertices (counter-clockwise seen

@@ -8,8 +8,8 @@
 namespace lodrefine {
 
 struct Validation {
-  int boundary_edges = 0;      // edges with one incident face
-  int nonmanifold_edges = 0;   // edges with > 2 incident faces
+  int boundary_edges = 0;     // edges with one incident face
+  int nonmanifold_edges = 0;  // edges with > 2 incident faces
   int nonmanifold_vertices = 0;
   int inconsistent_edges = 0;  // both faces traverse the edge the same way
   bool outward = false;        // signed volume > 0
@@ -17,7 +17,7 @@ struct Validation {
   double max_planarity_error = 0.0;  // max vertex distance from its face's plane (m)
   bool self_intersecting = false;
   int components = 0;
-  std::string problem;         // first problem found, one line; empty when valid
+  std::string problem;  // first problem found, one line; empty when valid
 
   bool watertight() const { return boundary_edges == 0 && nonmanifold_edges == 0 && nonmanifold_vertices == 0; }
   bool valid() const { return problem.empty(); }
@@ -28,8 +28,8 @@ struct Validation {
 // parameter table holds it), one component, no self-intersections (CGAL PMP on the triangulated
 // faces). Expects shared vertices. `single_component` false accepts a building of several closed
 // shells (a multi-part export).
-Validation validate_mesh(const Mesh& mesh, double planarity_tolerance,
-                         bool check_self_intersections = true, bool single_component = true);
+Validation validate_mesh(const Mesh& mesh, double planarity_tolerance, bool check_self_intersections = true,
+                         bool single_component = true);
 
 // Enclosed volume of `faces` (all indices valid), positive when they point outward; exact for
 // closed meshes of planar faces.

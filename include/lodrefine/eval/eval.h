@@ -49,8 +49,8 @@ std::vector<int> scanned_walls(const Mesh& truth, const std::vector<Vec3>& point
 struct BuildingEval {
   std::string id;
   std::size_t facade_points = 0;
-  DistanceStats before, after;          // C2M of the facade points to original / refined
-  double delta_d = 0.0;                 // centroid offset reduction (m); NaN without facade points
+  DistanceStats before, after;  // C2M of the facade points to original / refined
+  double delta_d = 0.0;         // centroid offset reduction (m); NaN without facade points
   bool watertight_before = false, watertight_after = false;
   // With a truth model: points sampled on the truth's scanned walls / roofs vs each model.
   std::optional<DistanceStats> truth_facade_before, truth_facade_after;
@@ -60,11 +60,11 @@ struct BuildingEval {
   // the building counts as not watertight after refinement.
   std::string error;
   // Raw data for pooling and plots.
-  std::vector<int> facade_index;                 // indices into the cloud
-  std::vector<double> c2m_before, c2m_after;     // per facade point, same order
+  std::vector<int> facade_index;                                    // indices into the cloud
+  std::vector<double> c2m_before, c2m_after;                        // per facade point, same order
   std::vector<double> truth_facade_d_before, truth_facade_d_after;  // unsigned, per sample
   std::vector<double> truth_roof_d_before, truth_roof_d_after;
-  std::vector<int> scanned_truth_faces;          // the truth walls sampled
+  std::vector<int> scanned_truth_faces;  // the truth walls sampled
   Vec3 c_mls = Vec3::Zero(), c_init = Vec3::Zero(), c_ref = Vec3::Zero();
   bool ok() const { return error.empty(); }
 };
@@ -72,19 +72,18 @@ struct BuildingEval {
 // All inputs in the same frame (use a local one for georeferenced data). The facade points are
 // select_facade_points() of the ORIGINAL model, so both models are measured on the same points.
 // A refined mesh without faces marks the building failed (see BuildingEval::error).
-BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const PointCloud& cloud,
-                               const Mesh* truth, const Params& params);
+BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const PointCloud& cloud, const Mesh* truth,
+                               const Params& params);
 // As above; `scanned_truth_faces` (indices into truth->faces, e.g. from the generator's
 // meta.json) replaces the detection of scanned walls when given.
-BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const PointCloud& cloud,
-                               const Mesh* truth, const Params& params,
-                               const std::vector<int>* scanned_truth_faces);
+BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const PointCloud& cloud, const Mesh* truth,
+                               const Params& params, const std::vector<int>* scanned_truth_faces);
 
 // Figures over a whole run.
 struct PooledEval {
   std::size_t buildings = 0, failed = 0, evaluated = 0;  // evaluated: ok and with facade points
-  DistanceStats before, after;            // over all facade points of all evaluated buildings
-  DistanceStats mean_before, mean_after;  // each field averaged over evaluated buildings
+  DistanceStats before, after;                           // over all facade points of all evaluated buildings
+  DistanceStats mean_before, mean_after;                 // each field averaged over evaluated buildings
   double delta_d_mean = 0.0, delta_d_median = 0.0;
   double watertight_rate_before = 0.0, watertight_rate_after = 0.0;  // over all buildings (0..1)
   std::size_t truth_buildings = 0;

@@ -15,9 +15,9 @@ namespace lodrefine {
 // was not measured (no facade points, no truth, a failed building).
 struct BuildingFigures {
   std::string id;
-  std::string outcome;  // "refined", "kept", "kept-invalid" or "failed" (best to worst)
-  std::string reason;   // why kept / failed (informative only)
-  std::optional<double> c2m_rmse, c2m_mae;                   // facade points to the refined model
+  std::string outcome;                      // "refined", "kept", "kept-invalid" or "failed" (best to worst)
+  std::string reason;                       // why kept / failed (informative only)
+  std::optional<double> c2m_rmse, c2m_mae;  // facade points to the refined model
   std::optional<double> truth_facade_rmse, truth_roof_rmse;  // truth samples to the refined model
   bool watertight = false;                                   // the refined model
   std::size_t facades_moved = 0;
@@ -63,10 +63,10 @@ struct GateLine {
 };
 
 struct GateVerdict {
-  std::vector<std::string> buildings;       // every building of the run, then the missing ones, sorted
-  std::vector<std::string> new_buildings;   // in the run, not in the baseline (listed, never failed)
-  std::vector<std::string> pooled_checks;   // "baseline" (with a baseline) and each gate that is not per building
-  std::vector<GateLine> failures;           // regressions and breaches, in check order
+  std::vector<std::string> buildings;      // every building of the run, then the missing ones, sorted
+  std::vector<std::string> new_buildings;  // in the run, not in the baseline (listed, never failed)
+  std::vector<std::string> pooled_checks;  // "baseline" (with a baseline) and each gate that is not per building
+  std::vector<GateLine> failures;          // regressions and breaches, in check order
   bool failed() const { return !failures.empty(); }
 };
 

@@ -12,8 +12,8 @@ namespace lodrefine {
 // Overlaid histograms of signed C2M distances (m) of the original (blue) and refined (orange)
 // model, as percent of points per bin. `range` clips the x axis to ±range (0: the 99th
 // percentile of |d| over both series, at least 0.1 m); the share beyond it is in the legend.
-std::string svg_histogram(const std::vector<double>& before, const std::vector<double>& after,
-                          const std::string& title, double range = 0.0, int bins = 60);
+std::string svg_histogram(const std::vector<double>& before, const std::vector<double>& after, const std::string& title,
+                          double range = 0.0, int bins = 60);
 // The same from pooled histograms (a run's distances, not held): bars, range and the share
 // beyond it to within the histogram's 0.1 mm bins.
 std::string svg_histogram(const DistanceHistogram& before, const DistanceHistogram& after, const std::string& title,
@@ -21,8 +21,7 @@ std::string svg_histogram(const DistanceHistogram& before, const DistanceHistogr
 
 // Tukey boxplots of signed C2M distances: box Q1–Q3, red median line, whiskers at the farthest
 // value within 1.5 IQR of the box, mean as a cross; outliers are counted, not drawn.
-std::string svg_boxplot(const std::vector<double>& before, const std::vector<double>& after,
-                        const std::string& title);
+std::string svg_boxplot(const std::vector<double>& before, const std::vector<double>& after, const std::string& title);
 // The same from pooled histograms: quartiles, whiskers and the outlier count to one bin.
 std::string svg_boxplot(const DistanceHistogram& before, const DistanceHistogram& after, const std::string& title);
 

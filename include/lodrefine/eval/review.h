@@ -16,19 +16,20 @@ namespace lodrefine {
 
 struct CityReviewBuilding {
   std::string id;
-  std::string outcome;  // "refined", "kept", "kept-invalid" or "untouched" (no cloud points)
-  std::string reason;   // why kept
+  std::string outcome;     // "refined", "kept", "kept-invalid" or "untouched" (no cloud points)
+  std::string reason;      // why kept
   std::size_t points = 0;  // cloud points in its crop
   std::size_t facades_moved = 0;
   double moved_max = std::nan(""), moved_mean = std::nan("");  // facade displacement (m), NaN if none moved
-  std::optional<double> fit_before, fit_after;  // RMS distance of the scan points near the building, as the judge measured them (m)
-  std::vector<std::vector<Vec2>> outline;       // XY rings in the district frame (review_outline())
-  std::optional<BuildingView> view;             // refined buildings (review_view())
+  std::optional<double> fit_before,
+      fit_after;  // RMS distance of the scan points near the building, as the judge measured them (m)
+  std::vector<std::vector<Vec2>> outline;  // XY rings in the district frame (review_outline())
+  std::optional<BuildingView> view;        // refined buildings (review_view())
 };
 
 struct CityReview {
   std::string title;
-  std::string summary;                       // preformatted: counts, the checks that refused, times
+  std::string summary;                        // preformatted: counts, the checks that refused, times
   std::vector<CityReviewBuilding> buildings;  // every building of the file, any order
 };
 

@@ -4,13 +4,12 @@
 //
 // The cloud is read once: one streaming pass cuts a crop per building (lodrefine crop's box),
 // then each building is refined on its crop, `jobs` buildings at once (memory: the crops, not
-// the cloud); results are written in file order. A refined building's chosen LoD geometry is replaced by a Solid with semantics
-// (WallSurface / RoofSurface / GroundSurface from the refined mesh's faces); its other LoDs,
-// attributes and id stay. Every other building, attribute, LoD, the metadata and the transform
-// are kept as read (new vertices are appended, so existing indices hold). Each building the
-// cloud reaches gets the attributes lodrefine_outcome ("refined" / "kept" / "kept-invalid"),
-// lodrefine_reason and lodrefine_facades_moved; buildings without cloud points are untouched.
-// CityGML input is converted first (citygml_to_cityjson) and written as CityJSON 2.0.
+// the cloud); results are written in file order. A refined building's chosen LoD geometry is replaced by a Solid with
+// semantics (WallSurface / RoofSurface / GroundSurface from the refined mesh's faces); its other LoDs, attributes and
+// id stay. Every other building, attribute, LoD, the metadata and the transform are kept as read (new vertices are
+// appended, so existing indices hold). Each building the cloud reaches gets the attributes lodrefine_outcome ("refined"
+// / "kept" / "kept-invalid"), lodrefine_reason and lodrefine_facades_moved; buildings without cloud points are
+// untouched. CityGML input is converted first (citygml_to_cityjson) and written as CityJSON 2.0.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -20,8 +19,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "lodrefine/io/cloud.h"
 #include "lodrefine/core/params.h"
+#include "lodrefine/io/cloud.h"
 
 namespace lodrefine {
 
@@ -38,9 +37,9 @@ using CityBuildingHook = std::function<void(const Mesh& model, const CityBuildin
 struct CityRefineSummary;
 
 struct CityRefineOptions {
-  std::string building;  // refine only this CityObject id ("" = every building the cloud covers)
-  std::string lod;       // the LoD geometry to refine, e.g. "2.2" ("" = the highest 2.x)
-  CloudOptions cloud;    // LAS class filter
+  std::string building;      // refine only this CityObject id ("" = every building the cloud covers)
+  std::string lod;           // the LoD geometry to refine, e.g. "2.2" ("" = the highest 2.x)
+  CloudOptions cloud;        // LAS class filter
   double crop_expand = 0.1;  // crop box growth, relative and absolute (as lodrefine crop)
   double crop_margin = 3.0;
   CityBuildingHook on_building;  // optional
@@ -64,14 +63,14 @@ struct CityBuildingOutcome {
 };
 
 struct CityRefineSummary {
-  std::string input_format;   // "CityJSON 2.0", "CityJSONSeq 2.0", "CityGML 2.0"
-  int buildings = 0;          // LoD 2 buildings / building parts in the file
+  std::string input_format;  // "CityJSON 2.0", "CityJSONSeq 2.0", "CityGML 2.0"
+  int buildings = 0;         // LoD 2 buildings / building parts in the file
   int refined = 0, kept = 0, kept_invalid = 0;
-  int untouched = 0;          // no cloud point in their box: written exactly as read
-  std::map<std::string, int> refused;  // kept because this never-worse check refused the refinement
-  int objects_without_lod = 0;  // Building/BuildingPart objects without the LoD asked for
-  std::uint64_t cloud_points = 0;  // points read (after the class filter)
-  std::uint64_t cropped_points = 0;  // points held in the crops after the cloud pass (the memory that grows)
+  int untouched = 0;                          // no cloud point in their box: written exactly as read
+  std::map<std::string, int> refused;         // kept because this never-worse check refused the refinement
+  int objects_without_lod = 0;                // Building/BuildingPart objects without the LoD asked for
+  std::uint64_t cloud_points = 0;             // points read (after the class filter)
+  std::uint64_t cropped_points = 0;           // points held in the crops after the cloud pass (the memory that grows)
   std::vector<CityBuildingOutcome> outcomes;  // the buildings the cloud reached, in file order
   double seconds_read = 0.0, seconds_crop = 0.0, seconds_refine = 0.0, seconds_write = 0.0;
 };

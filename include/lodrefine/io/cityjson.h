@@ -34,15 +34,15 @@ struct CityJsonBuilding {
 
 struct CityJsonFile {
   std::string format = "CityJSON";  // or "CityGML"
-  std::string version;        // "1.0", "1.1", "2.0"
-  bool sequence = false;      // read as CityJSONSeq
-  std::string crs;            // metadata.referenceSystem, empty when absent
-  Vec3 scale = Vec3::Ones();  // transform (identity when the file has none)
+  std::string version;              // "1.0", "1.1", "2.0"
+  bool sequence = false;            // read as CityJSONSeq
+  std::string crs;                  // metadata.referenceSystem, empty when absent
+  Vec3 scale = Vec3::Ones();        // transform (identity when the file has none)
   Vec3 translate = Vec3::Zero();
-  std::vector<CityJsonBuilding> buildings;  // in file order (object order within a feature)
-  int objects_without_lod2 = 0;             // Building/BuildingPart objects with no LoD 2.x geometry
+  std::vector<CityJsonBuilding> buildings;    // in file order (object order within a feature)
+  int objects_without_lod2 = 0;               // Building/BuildingPart objects with no LoD 2.x geometry
   std::vector<std::string> ids_without_lod2;  // their ids, in file order (every building by name)
-  std::vector<std::string> notes;           // one line per thing worth knowing (holes dropped ...)
+  std::vector<std::string> notes;             // one line per thing worth knowing (holes dropped ...)
 };
 
 // Reads a CityJSON file or a CityJSONSeq stream (recognised by its content: a first line that
@@ -54,10 +54,12 @@ struct CityJsonFile {
 CityJsonFile read_cityjson(const std::string& path, const std::string& lod = "");
 
 // Same, from text in memory; `name` is used in error messages.
-CityJsonFile parse_cityjson(const std::string& text, const std::string& name = "<cityjson>", const std::string& lod = "");
+CityJsonFile parse_cityjson(const std::string& text, const std::string& name = "<cityjson>",
+                            const std::string& lod = "");
 
 // Same, from a parsed CityJSON object (not a sequence).
-CityJsonFile read_cityjson_document(const nlohmann::ordered_json& doc, const std::string& name, const std::string& lod = "");
+CityJsonFile read_cityjson_document(const nlohmann::ordered_json& doc, const std::string& name,
+                                    const std::string& lod = "");
 
 // JSON nesting accepted in a city file: CityJSON needs about ten levels (a MultiSolid's
 // boundaries are five deep); deeper nesting would overflow the stack when copied or written.

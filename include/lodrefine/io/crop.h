@@ -3,16 +3,16 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/io/cloud.h"
 #include "lodrefine/core/types.h"
+#include "lodrefine/io/cloud.h"
 
 namespace lodrefine {
 
 struct CropTarget {
   std::string id;
-  Vec3 lo, hi;        // expanded bounding box (georeferenced); lo > hi: an empty box, no point
+  Vec3 lo, hi;          // expanded bounding box (georeferenced); lo > hi: an empty box, no point
   std::string refused;  // why this building is not cropped (empty: it is)
-  PointCloud cloud;   // filled by crop_tile
+  PointCloud cloud;     // filled by crop_tile
 };
 
 // A model wider than this (m, in x or y) is no building: a stray vertex, or a wrong unit. Its

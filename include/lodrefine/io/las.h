@@ -15,14 +15,14 @@ namespace lodrefine {
 // The public header block fields the reader uses, validated against the file.
 struct LasHeader {
   int version_major = 1, version_minor = 2;
-  int point_format = 0;            // 0..10
-  std::uint32_t record_length = 0; // bytes per point record (>= the format's minimum; extra bytes are skipped)
+  int point_format = 0;             // 0..10
+  std::uint32_t record_length = 0;  // bytes per point record (>= the format's minimum; extra bytes are skipped)
   std::uint32_t header_size = 0;
   std::uint64_t point_offset = 0;  // byte offset of the first point record
   std::uint64_t point_count = 0;   // LAS 1.4: the 64-bit count; before: the 32-bit legacy count
   Vec3 scale = Vec3::Ones(), offset = Vec3::Zero();
   Vec3 min = Vec3::Zero(), max = Vec3::Zero();  // bounding box as declared by the writer
-  bool compressed = false;         // LAZ: point format bit 7 or 6, or a "laszip encoded" VLR
+  bool compressed = false;                      // LAZ: point format bit 7 or 6, or a "laszip encoded" VLR
 };
 
 // Smallest record length of point data format 0..10 (ASPRS LAS 1.4 R15, Tables 7–17).
@@ -44,9 +44,9 @@ std::uint64_t stream_las_records(const std::string& path,
                                  const std::function<void(const LasHeader&, const unsigned char*)>& on_record);
 
 // Streams the points (x = X·scale + offset, in double) in file order, reading the file in
-// chunks (LAZ: one compressed chunk at a time). `classes` (empty: every point) keeps only points whose classification is listed:
-// formats 0–5 carry a 5-bit class (bits 0–4 of byte 15), formats 6–10 a full byte (byte 16).
-// Returns the number of points passed on. Rejects coordinates beyond 1e9 m (kMaxCoordinate).
+// chunks (LAZ: one compressed chunk at a time). `classes` (empty: every point) keeps only points whose classification
+// is listed: formats 0–5 carry a 5-bit class (bits 0–4 of byte 15), formats 6–10 a full byte (byte 16). Returns the
+// number of points passed on. Rejects coordinates beyond 1e9 m (kMaxCoordinate).
 std::uint64_t stream_las(const std::string& path, const std::vector<int>& classes,
                          const std::function<void(const Vec3&)>& on_point);
 

@@ -34,8 +34,8 @@ class Progress {
 
   // "what: done/total unit (p %), rate/s, ETA t, tally" for `seconds` since the start (rate and
   // ETA from the first second on).
-  static std::string format(const std::string& what, const std::string& unit, std::uint64_t done,
-                            std::uint64_t total, double seconds, const std::string& tally);
+  static std::string format(const std::string& what, const std::string& unit, std::uint64_t done, std::uint64_t total,
+                            double seconds, const std::string& tally);
   // 7 -> "7", 12345 -> "12.3 k", 16600000 -> "16.6 M": counts that stay readable.
   static std::string count_text(double n);
   // 42 -> "42 s", 605 -> "10 min 05 s", 7300 -> "2 h 01 min".

@@ -14,22 +14,22 @@ namespace lodrefine {
 // recess (back wall and two returns), a bay (front and two sides) or a facade line stepping back
 // part-way, which the coarse model generalises to one plain front line.
 enum class BuildingType { Flat, Gable, Hip, Shed, Stepped, LShape, TShape, Polygon, Recess, Bay, Setback };
-const char* building_type_name(BuildingType t);          // "flat", "gable", ...
-BuildingType building_type_from_name(const std::string&); // throws InputError
+const char* building_type_name(BuildingType t);            // "flat", "gable", ...
+BuildingType building_type_from_name(const std::string&);  // throws InputError
 std::vector<BuildingType> all_building_types();
 // Recess, Bay, Setback: the coarse model lacks faces of the truth's street facade.
 bool street_facade_type(BuildingType t);
 
 struct SynthOptions {
-  double max_shift = 0.8;        // facade offset, uniform in [min_shift, max_shift] with random sign (m);
-  double min_shift = 0.2;        // the street types' generalised front: [min_shift/2, 0.75 max_shift], no rotation
-  double max_rotation_deg = 3.0; // facade rotation about a vertical axis
-  double global_shift = 0.03;    // whole coarse model shifted by up to this (m)
-  int scanned_facades = 0;       // 0: random 1..3 (street types: the street walls, ignoring this)
-  double noise = 0.01;           // MLS range noise sigma (m)
-  int target_points = 30000;     // points on scanned facades, before nuisances
-  bool defects = true;           // missing ground / mm gaps / flipped face / duplicate face
-  bool nuisances = true;         // windows, recesses, occlusion holes, trees, cars, ground, neighbours
+  double max_shift = 0.8;         // facade offset, uniform in [min_shift, max_shift] with random sign (m);
+  double min_shift = 0.2;         // the street types' generalised front: [min_shift/2, 0.75 max_shift], no rotation
+  double max_rotation_deg = 3.0;  // facade rotation about a vertical axis
+  double global_shift = 0.03;     // whole coarse model shifted by up to this (m)
+  int scanned_facades = 0;        // 0: random 1..3 (street types: the street walls, ignoring this)
+  double noise = 0.01;            // MLS range noise sigma (m)
+  int target_points = 30000;      // points on scanned facades, before nuisances
+  bool defects = true;            // missing ground / mm gaps / flipped face / duplicate face
+  bool nuisances = true;          // windows, recesses, occlusion holes, trees, cars, ground, neighbours
   Vec3 origin{85000.0, 447000.0, 0.0};  // georeferenced offset (RD New-like by default)
 };
 
@@ -49,15 +49,16 @@ struct SynthBuilding {
   Vec3 frame_origin = Vec3::Zero();  // georeferenced origin of the building's own frame
   double frame_rotation_deg = 0.0;   // rotation of the building's own frame about z
   std::vector<MovedWall> moved_walls;
-  Vec3 coarse_shift = Vec3::Zero();  // global shift applied to the whole coarse model
-  std::vector<std::string> defects;  // export defects of the coarse soup, e.g. "reversed_face:7"
-  double point_spacing = 0.0;        // facade sampling grid step (m)
-  Mesh truth;    // closed, oriented, shared vertices, georeferenced
-  Mesh coarse;   // polygon soup as exported from CityGML (defects included), georeferenced
-  PointCloud cloud;                // georeferenced MLS crop
+  Vec3 coarse_shift = Vec3::Zero();      // global shift applied to the whole coarse model
+  std::vector<std::string> defects;      // export defects of the coarse soup, e.g. "reversed_face:7"
+  double point_spacing = 0.0;            // facade sampling grid step (m)
+  Mesh truth;                            // closed, oriented, shared vertices, georeferenced
+  Mesh coarse;                           // polygon soup as exported from CityGML (defects included), georeferenced
+  PointCloud cloud;                      // georeferenced MLS crop
   std::vector<int> scanned_truth_faces;  // indices into truth.faces of the scanned walls (street types:
                                          // every street wall, returns and bay sides seen obliquely)
-  std::vector<int> point_label;    // per cloud point: truth face index for facade points, -1 window recess, -2 clutter, -3 ground, -4 neighbour
+  std::vector<int> point_label;  // per cloud point: truth face index for facade points, -1 window recess, -2 clutter,
+                                 // -3 ground, -4 neighbour
 };
 
 // Deterministic for (type, seed, options).

@@ -16,7 +16,7 @@ int main(int argc, char** argv) {
   if (argc != 2) return 2;
   Mesh box;
   box.vertices = {{0, 0, 0}, {2, 0, 0}, {2, 3, 0}, {0, 3, 0}, {0, 0, 4}, {2, 0, 4}, {2, 3, 4}, {0, 3, 4}};
-  box.faces = {{{0, 3, 2, 1}, Semantic::Ground}, {{4, 5, 6, 7}, Semantic::Roof},  {{0, 1, 5, 4}, Semantic::Wall},
+  box.faces = {{{0, 3, 2, 1}, Semantic::Ground}, {{4, 5, 6, 7}, Semantic::Roof}, {{0, 1, 5, 4}, Semantic::Wall},
                {{1, 2, 6, 5}, Semantic::Wall},   {{2, 3, 7, 6}, Semantic::Wall}, {{3, 0, 4, 7}, Semantic::Wall}};
   write_obj(argv[1], box);
   const Mesh back = read_obj(argv[1]);
