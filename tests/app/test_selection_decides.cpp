@@ -77,8 +77,9 @@ Figures expect_selection_decided(const Mesh& coarse, const Mesh& truth, const Po
   const auto samples = sample_faces(local_truth, scanned, 0.25);
   fig.before = rms(cloud_to_mesh(local_coarse, samples)), fig.after = rms(cloud_to_mesh(refined, samples));
   fig.refined = r.refined();
-  if (figures)
+  if (figures) {
     EXPECT_LE(fig.after, fig.before + kNotWorse) << "truth facade RMSE " << fig.before << " -> " << fig.after;
+  }
   if (!r.refined()) return fig;
 
   EXPECT_TRUE(r.trace.selection.has_value());
@@ -89,7 +90,9 @@ Figures expect_selection_decided(const Mesh& coarse, const Mesh& truth, const Po
       << sel.selection.status_text();
   EXPECT_GT(sel.faces_from_selection, 0);
   EXPECT_EQ(sel.faces_from_selection, int(r.mesh.faces.size()));
-  if (figures) EXPECT_LT(fig.after, kOnTruth) << "truth facade RMSE " << fig.before << " -> " << fig.after;
+  if (figures) {
+    EXPECT_LT(fig.after, kOnTruth) << "truth facade RMSE " << fig.before << " -> " << fig.after;
+  }
   return fig;
 }
 

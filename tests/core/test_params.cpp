@@ -86,7 +86,9 @@ TEST(Params, ForEachFieldVisitsEveryRowWithItsValue) {
       EXPECT_STREQ(field.stage, "match");
       value = 3.0;  // the field is the config's member
     }
-    if (std::string(field.name) == "seed") EXPECT_EQ(double(value), 7.0);
+    if (std::string(field.name) == "seed") {
+      EXPECT_EQ(double(value), 7.0);
+    }
     ++n;
   });
   EXPECT_EQ(n, param_table().size());
