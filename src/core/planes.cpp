@@ -11,7 +11,9 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <tuple>
+#include <unordered_map>
 
 // City files refine buildings on several threads: CGAL's default random generator must then be
 // thread-local, which it is only with CGAL_HAS_THREADS.
@@ -109,17 +111,17 @@ std::vector<ScanPlane> merge_coplanar(std::vector<ScanPlane> planes, const std::
   return planes;
 }
 
-}  // namespace
+// The fewest points a cloud needs before detection is tried.
+std::size_t min_cloud_points(const Params& prm) {
+  return std::size_t(std::max(prm.ransac_min_points, prm.normal_neighbors + 1));
+}
 
-std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm) {
-  std::vector<ScanPlane> result;
-  const std::size_t n = cloud.points.size();
-  if (n < std::size_t(std::max(prm.ransac_min_points, prm.normal_neighbors + 1))) return result;
-
-  // Exact duplicates carry no shape and make RANSAC's octree loop forever (a cloud of one
-  // repeated point hangs it): detect on distinct points, and only with a real extent.
-  std::vector<int> order(n);
-  for (std::size_t i = 0; i < n; ++i) order[i] = int(i);
+// Exact duplicates carry no shape and make RANSAC's octree loop forever (a cloud of one repeated
+// point hangs it). The cloud's distinct points in file order (which keeps runs reproducible), or
+// none when they are too few or span too little to hold a plane.
+std::vector<int> distinct_points(const PointCloud& cloud, const Params& prm) {
+  std::vector<int> order(cloud.points.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = int(i);
   auto less = [&](int a, int b) {
     const auto &p = cloud.points[a], &q = cloud.points[b];
     return std::tie(p.x(), p.y(), p.z()) < std::tie(q.x(), q.y(), q.z());
@@ -127,32 +129,71 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm)
   std::sort(order.begin(), order.end(), less);
   order.erase(std::unique(order.begin(), order.end(), [&](int a, int b) { return cloud.points[a] == cloud.points[b]; }),
               order.end());
-  if (order.size() < std::size_t(std::max(prm.ransac_min_points, prm.normal_neighbors + 1))) return result;
-  const Eigen::AlignedBox3d box = bounding_box(cloud.points, order);
-  const Vec3 lo = box.min(), hi = box.max();
-  if ((hi - lo).norm() < kMinExtentEpsilons * prm.ransac_epsilon) return result;
-  std::sort(order.begin(), order.end());  // file order: keeps runs reproducible as before
-  // Detection runs on one point per voxel (its cost grows with the points, not the facade
-  // area); every point of a voxel whose representative a plane took, and that lies within
-  // epsilon of that plane, is the plane's inlier.
-  const double voxel = prm.detect_voxel;
-  auto key = [&](const Vec3& p) -> std::uint64_t {
-    if (voxel <= 0) return 0;
-    const Vec3 q = (p - lo) / voxel;
-    return (std::uint64_t(q.x()) << (2 * kVoxelKeyBits)) | (std::uint64_t(q.y()) << kVoxelKeyBits) | std::uint64_t(q.z());
-  };
-  std::vector<int> reps;  // indices into the cloud
-  std::unordered_map<std::uint64_t, int> voxel_rep;
-  if (voxel > 0 && ((hi - lo) / voxel).maxCoeff() < double(1 << kVoxelKeyBits)) {
-    for (int i : order)
-      if (voxel_rep.emplace(key(cloud.points[i]), int(reps.size())).second) reps.push_back(i);
-  } else {
-    reps = order;
+  if (order.size() < min_cloud_points(prm)) return {};
+  if (bounding_box(cloud.points, order).diagonal().norm() < kMinExtentEpsilons * prm.ransac_epsilon) return {};
+  std::sort(order.begin(), order.end());
+  return order;
+}
+
+// One representative point per voxel: detection's cost grows with the points, not with the
+// facade area, so a dense scan is thinned to the voxel size before detection.
+struct Thinning {
+  Vec3 lo = Vec3::Zero();
+  double size = 0.0;                                 // voxel edge (m); 0: no thinning
+  std::vector<int> reps;                             // cloud indices, one per occupied voxel
+  std::unordered_map<std::uint64_t, int> voxel_rep;  // voxel key -> position in reps
+
+  bool thinned() const { return size > 0.0; }
+  Eigen::Array3i cell(const Vec3& p) const { return ((p - lo) / size).array().floor().cast<int>(); }
+  static std::uint64_t key(const Eigen::Array3i& c) {
+    return (std::uint64_t(c.x()) << (2 * kVoxelKeyBits)) | (std::uint64_t(c.y()) << kVoxelKeyBits) | std::uint64_t(c.z());
   }
-  if (reps.size() < std::size_t(std::max(prm.ransac_min_points, prm.normal_neighbors + 1))) return result;
+  // The position in reps of the voxel at `c`, or -1 (none there, or outside the grid).
+  int rep_at(const Eigen::Array3i& c) const {
+    if ((c < 0).any() || (c >= (1 << kVoxelKeyBits)).any()) return -1;
+    const auto it = voxel_rep.find(key(c));
+    return it == voxel_rep.end() ? -1 : it->second;
+  }
+};
+
+// The first distinct point of each voxel of `prm.detect_voxel` (all of them when it is 0 or the
+// grid would not fit the key).
+Thinning thin_to_voxels(const PointCloud& cloud, const std::vector<int>& order, const Params& prm) {
+  Thinning t;
+  const Eigen::AlignedBox3d box = bounding_box(cloud.points, order);
+  const double voxel = prm.detect_voxel;
+  if (voxel <= 0 || (box.diagonal() / voxel).maxCoeff() >= double((1 << kVoxelKeyBits) - 1)) {
+    t.reps = order;
+    return t;
+  }
+  t.lo = box.min();
+  t.size = voxel;
+  for (int i : order)
+    if (t.voxel_rep.emplace(Thinning::key(t.cell(cloud.points[i])), int(t.reps.size())).second) t.reps.push_back(i);
+  return t;
+}
+
+// The least inliers of a plane in the thinned cloud: ransac_min_points scaled by the share of
+// points kept, so RANSAC's work per point stays that of the full cloud. Planes with fewer than
+// ransac_min_points points after the take-back are dropped.
+std::size_t detection_min_points(const Thinning& t, std::size_t distinct, const Params& prm) {
+  const double kept = double(t.reps.size()) / double(distinct);
+  return std::max(std::size_t(prm.normal_neighbors) + 1, std::size_t(double(prm.ransac_min_points) * kept));
+}
+
+// Representatives of neighbouring voxels can lie up to two voxels apart: the thinned cloud's
+// inliers are connected at that distance or ransac_cluster_epsilon, whichever is larger.
+double detection_cluster_epsilon(const Thinning& t, const Params& prm) {
+  return std::max(prm.ransac_cluster_epsilon, 2.0 * t.size);
+}
+
+// Efficient RANSAC on the representatives with their PCA normals: each shape's inliers as cloud
+// indices, in CGAL's order of detection.
+std::vector<std::vector<int>> ransac_shapes(const PointCloud& cloud, const Thinning& t, std::size_t distinct,
+                                            const Params& prm) {
   PointList pts;
-  pts.reserve(reps.size());
-  for (int i : reps) {
+  pts.reserve(t.reps.size());
+  for (int i : t.reps) {
     const auto& p = cloud.points[i];
     pts.emplace_back(Point(p.x(), p.y(), p.z()), Vector(0, 0, 0), i);
   }
@@ -167,48 +208,86 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm)
   ransac.add_shape_factory<RansacPlane>();
   Ransac::Parameters rp;
   rp.probability = prm.ransac_probability;
-  // min_points counts points of the full cloud: scaled to the voxel representatives.
-  rp.min_points = std::max<std::size_t>(std::size_t(prm.normal_neighbors) + 1,
-                                        std::size_t(double(prm.ransac_min_points) * double(reps.size()) / double(order.size())));
+  rp.min_points = detection_min_points(t, distinct, prm);
   rp.epsilon = prm.ransac_epsilon;
-  rp.cluster_epsilon = prm.ransac_cluster_epsilon;
+  rp.cluster_epsilon = detection_cluster_epsilon(t, prm);
   rp.normal_threshold = std::cos(radians(prm.ransac_normal_deg));
   ransac.detect(rp);
 
-  // Efficient RANSAC reorders `pts`: a representative is found by its cloud index, not by k.
-  std::unordered_map<int, int> rep_position;
-  if (!voxel_rep.empty())
-    for (int r = 0; r < int(reps.size()); ++r) rep_position.emplace(reps[r], r);
-  std::vector<int> rep_shape(reps.size(), -1);
-  int shape_id = 0;
-  std::vector<std::vector<int>> shape_inliers;
+  // Efficient RANSAC reorders `pts` ("the data in the input is reordered by detect()"): a point
+  // is known by the cloud index it carries, not by its position.
+  std::vector<std::vector<int>> shapes;
   for (const auto& shape : ransac.shapes()) {
     std::vector<int> inl;
-    for (std::size_t k : shape->indices_of_assigned_points()) {
-      inl.push_back(std::get<2>(pts[k]));
-      if (!voxel_rep.empty()) rep_shape[rep_position.at(std::get<2>(pts[k]))] = shape_id;
-    }
-    shape_inliers.push_back(std::move(inl));
-    ++shape_id;
+    for (std::size_t k : shape->indices_of_assigned_points()) inl.push_back(std::get<2>(pts[k]));
+    shapes.push_back(std::move(inl));
   }
-  if (!voxel_rep.empty()) {
-    // Back to the full cloud: each shape takes the points of its voxels near its plane.
-    std::vector<Plane> fitted;
-    for (const auto& inl : shape_inliers) {
-      std::vector<Vec3> q;
-      for (int i : inl) q.push_back(cloud.points[i]);
-      fitted.push_back(q.size() >= 3 ? fit_plane(q) : Plane());
-    }
-    for (auto& inl : shape_inliers) inl.clear();
-    for (int i = 0; i < int(n); ++i) {
-      const auto it = voxel_rep.find(key(cloud.points[i]));
-      if (it == voxel_rep.end()) continue;
-      const int sh = rep_shape[it->second];
-      if (sh >= 0 && std::abs(fitted[sh].distance(cloud.points[i])) <= prm.ransac_epsilon) shape_inliers[sh].push_back(i);
-    }
+  return shapes;
+}
+
+// For each representative, the shapes that own a representative in its voxel or one of the 26
+// around it: the shapes its voxel's points may go back to, in ascending order.
+std::vector<std::vector<int>> shapes_near_voxels(const PointCloud& cloud, const Thinning& t,
+                                                 const std::vector<std::vector<int>>& shapes) {
+  std::vector<int> rep_shape(t.reps.size(), -1);
+  for (int s = 0; s < int(shapes.size()); ++s)
+    for (int i : shapes[s]) rep_shape[t.rep_at(t.cell(cloud.points[i]))] = s;
+  std::vector<std::vector<int>> near(t.reps.size());
+  for (int r = 0; r < int(t.reps.size()); ++r) {
+    const Eigen::Array3i c = t.cell(cloud.points[t.reps[r]]);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const int q = t.rep_at(c + Eigen::Array3i(dx, dy, dz));
+          if (q >= 0 && rep_shape[q] >= 0) near[r].push_back(rep_shape[q]);
+        }
+    std::sort(near[r].begin(), near[r].end());
+    near[r].erase(std::unique(near[r].begin(), near[r].end()), near[r].end());
   }
-  for (auto& inl : shape_inliers) {
-    if (inl.size() < 3) continue;
+  return near;
+}
+
+// Back to the full cloud: every point (copies too) goes to the nearest plane, within
+// ransac_epsilon, among the shapes of its own and the neighbouring voxels. The neighbours
+// bring back the points of voxels whose representative RANSAC left out (a noisy one, one
+// with a skewed normal at an edge), so a plane's support and evidence stay complete.
+std::vector<std::vector<int>> take_back(const PointCloud& cloud, const Thinning& t,
+                                        const std::vector<std::vector<int>>& shapes, const Params& prm) {
+  std::vector<Plane> fitted;
+  for (const auto& inl : shapes) {
+    std::vector<Vec3> q;
+    for (int i : inl) q.push_back(cloud.points[i]);
+    fitted.push_back(fit_plane(q));
+  }
+  const auto near = shapes_near_voxels(cloud, t, shapes);
+  std::vector<std::vector<int>> full(shapes.size());
+  for (int i = 0; i < int(cloud.points.size()); ++i) {
+    const int r = t.rep_at(t.cell(cloud.points[i]));
+    if (r < 0) continue;
+    int best = -1;
+    double best_d = prm.ransac_epsilon;
+    for (int s : near[r]) {
+      const double d = std::abs(fitted[s].distance(cloud.points[i]));
+      if (d < best_d || (d == best_d && best < 0)) best = s, best_d = d;
+    }
+    if (best >= 0) full[best].push_back(i);
+  }
+  return full;
+}
+
+}  // namespace
+
+std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const Params& prm) {
+  std::vector<ScanPlane> result;
+  if (cloud.points.size() < min_cloud_points(prm)) return result;
+  const std::vector<int> order = distinct_points(cloud, prm);
+  if (order.empty()) return result;
+  const Thinning thinning = thin_to_voxels(cloud, order, prm);
+  if (thinning.reps.size() < std::size_t(prm.normal_neighbors) + 1) return result;
+  std::vector<std::vector<int>> shapes = ransac_shapes(cloud, thinning, order.size(), prm);
+  if (thinning.thinned()) shapes = take_back(cloud, thinning, shapes, prm);
+  for (auto& inl : shapes) {
+    if (inl.size() < std::max<std::size_t>(3, std::size_t(prm.ransac_min_points))) continue;
     ScanPlane sp = describe(cloud.points, std::move(inl), prm);
     if (sp.hull_area >= prm.min_plane_area) result.push_back(std::move(sp));
   }
