@@ -187,7 +187,7 @@ TEST(Planes, VoxelDetectionTakesBackEveryPointOfItsPlanes) {
 
 // A voxel's representative is its first point: when that one is off the plane (a point on a
 // window sill, a pedestrian), RANSAC leaves it out, and its voxel's points on the plane come back
-// through the plane's neighbouring voxels. With the representative's own voxel only, 160 of the
+// through the plane's neighbouring voxels. With the representative's own voxel only, 165 of the
 // wall's 2501 points (the 40 voxels with such a representative) were lost.
 TEST(Planes, VoxelTakeBackRecoversVoxelsWhoseRepresentativeIsOffThePlane) {
   PointCloud cloud;
