@@ -183,8 +183,8 @@ std::size_t detection_min_points(const Thinning& t, std::size_t distinct, const 
   return std::max(std::size_t(prm.normal_neighbors) + 1, std::size_t(double(prm.ransac_min_points) * kept));
 }
 
-// Representatives of neighbouring voxels can lie up to two voxels apart: the thinned cloud's
-// inliers are connected at that distance or ransac_cluster_epsilon, whichever is larger.
+// Representatives of neighbouring voxels on a plane lie about a voxel diagonal apart: the thinned
+// cloud's inliers are connected at that distance or ransac_cluster_epsilon, whichever is larger.
 double detection_cluster_epsilon(const Thinning& t, const Params& prm) {
   return std::max(prm.ransac_cluster_epsilon, std::sqrt(2.0) * t.size);
 }
@@ -192,7 +192,7 @@ double detection_cluster_epsilon(const Thinning& t, const Params& prm) {
 // The representatives' normals from their k nearest points of the full cloud (the distinct
 // points `order`): the same neighbourhoods as without thinning. Normals of the thinned cloud
 // itself span several voxels and blur at a corner, where RANSAC then found a diagonal plane
-// through the two walls' edges (topo dev tile, TOPO0014 at 0.1 m: 151 points, normal 22° off).
+// through the two walls' edges (topo dev tile, TOPO0014 at 0.1 m: 151 points, 25° off the front wall).
 void estimate_normals_in_full_cloud(PointList& pts, const PointCloud& cloud, const std::vector<int>& order, int k) {
   using KnnTraits = CGAL::Search_traits_3<Kernel>;
   using Knn = CGAL::Orthogonal_k_neighbor_search<KnnTraits>;
