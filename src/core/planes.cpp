@@ -252,52 +252,28 @@ std::vector<std::vector<int>> ransac_shapes(const PointCloud& cloud, const Thinn
   return shapes;
 }
 
-// For each representative, the shapes that own a representative in its voxel or one of the 26
-// around it: the shapes its voxel's points may go back to, in ascending order.
-std::vector<std::vector<int>> shapes_near_voxels(const PointCloud& cloud, const Thinning& t,
-                                                 const std::vector<std::vector<int>>& shapes) {
-  std::vector<int> rep_shape(t.reps.size(), -1);
-  for (int s = 0; s < int(shapes.size()); ++s)
-    for (int i : shapes[s]) rep_shape[t.rep_at(t.cell(cloud.points[i]))] = s;
-  std::vector<std::vector<int>> near(t.reps.size());
-  for (int r = 0; r < int(t.reps.size()); ++r) {
-    const Eigen::Array3i c = t.cell(cloud.points[t.reps[r]]);
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          const int q = t.rep_at(c + Eigen::Array3i(dx, dy, dz));
-          if (q >= 0 && rep_shape[q] >= 0) near[r].push_back(rep_shape[q]);
-        }
-    std::sort(near[r].begin(), near[r].end());
-    near[r].erase(std::unique(near[r].begin(), near[r].end()), near[r].end());
-  }
-  return near;
-}
-
-// Back to the full cloud: every point (copies too) goes to the nearest plane, within
-// ransac_epsilon, among the shapes of its own and the neighbouring voxels. The neighbours
-// bring back the points of voxels whose representative RANSAC left out (a noisy one, one
-// with a skewed normal at an edge), so a plane's support and evidence stay complete.
+// Back to the full cloud: every point (copies too) of a voxel whose representative a shape
+// took goes to that shape when it lies within ransac_epsilon of the shape's plane (fitted on
+// its representatives). Only the representative's own voxel: taking back from the neighbouring
+// voxels too made supports larger than full detection's, and the selection then kept three
+// topo dev tile buildings from their notch and bay walls (truth facade RMSE 0.084 -> 0.38 m).
 std::vector<std::vector<int>> take_back(const PointCloud& cloud, const Thinning& t,
                                         const std::vector<std::vector<int>>& shapes, const Params& prm) {
+  std::vector<int> rep_shape(t.reps.size(), -1);
   std::vector<Plane> fitted;
-  for (const auto& inl : shapes) {
+  for (int s = 0; s < int(shapes.size()); ++s) {
     std::vector<Vec3> q;
-    for (int i : inl) q.push_back(cloud.points[i]);
+    for (int i : shapes[s]) {
+      q.push_back(cloud.points[i]);
+      rep_shape[t.rep_at(t.cell(cloud.points[i]))] = s;
+    }
     fitted.push_back(fit_plane(q));
   }
-  const auto near = shapes_near_voxels(cloud, t, shapes);
   std::vector<std::vector<int>> full(shapes.size());
   for (int i = 0; i < int(cloud.points.size()); ++i) {
     const int r = t.rep_at(t.cell(cloud.points[i]));
-    if (r < 0) continue;
-    int best = -1;
-    double best_d = prm.ransac_epsilon;
-    for (int s : near[r]) {
-      const double d = std::abs(fitted[s].distance(cloud.points[i]));
-      if (d < best_d || (d == best_d && best < 0)) best = s, best_d = d;
-    }
-    if (best >= 0) full[best].push_back(i);
+    const int s = r < 0 ? -1 : rep_shape[r];
+    if (s >= 0 && std::abs(fitted[s].distance(cloud.points[i])) <= prm.ransac_epsilon) full[s].push_back(i);
   }
   return full;
 }

@@ -185,31 +185,6 @@ TEST(Planes, VoxelDetectionTakesBackEveryPointOfItsPlanes) {
   }
 }
 
-// A voxel's representative is its first point: when that one is off the plane (a point on a
-// window sill, a pedestrian), RANSAC leaves it out, and its voxel's points on the plane come back
-// through the plane's neighbouring voxels. With the representative's own voxel only, 165 of the
-// wall's 2501 points (the 40 voxels with such a representative) were lost.
-TEST(Planes, VoxelTakeBackRecoversVoxelsWhoseRepresentativeIsOffThePlane) {
-  PointCloud cloud;
-  const double voxel = 0.2;
-  std::vector<int> off;
-  for (int i = 1; i < 29; i += 3)
-    for (int j = 1; j < 19; j += 5) {
-      off.push_back(int(cloud.points.size()));
-      cloud.points.emplace_back(voxel * i + 0.05, -0.12, voxel * j + 0.05);  // 12 cm in front
-    }
-  ASSERT_EQ(off.size(), 40u);
-  const Truth wall = add_patch(cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 6.0, 0.0, 4.0), 1);
-  Params prm;
-  prm.detect_voxel = voxel;
-  const auto planes = detect_planes(cloud, prm);
-  ASSERT_EQ(planes.size(), 1u);
-  expect_same_plane(planes[0], wall.plane);
-  EXPECT_GE(count_of(planes[0].inliers, wall.points), std::size_t(0.995 * double(wall.points.size())));
-  EXPECT_EQ(count_of(planes[0].inliers, off), 0u);
-  EXPECT_NEAR(planes[0].rms, kNoise, 0.0015);
-}
-
 // A plane the thinned detection finds with fewer than ransac_min_points points of the full cloud
 // is dropped, as full detection would never have found it. Two walls, 10 000 and 120 points: the
 // small one's representatives pass the scaled minimum, its points do not pass the real one.
