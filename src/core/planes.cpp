@@ -102,7 +102,8 @@ std::vector<ScanPlane> merge_coplanar(std::vector<ScanPlane> planes, const std::
     for (std::size_t i = 0; i < planes.size() && !merged; ++i)
       for (std::size_t j = i + 1; j < planes.size() && !merged; ++j) {
         if (unoriented_angle_deg(planes[i].plane.n, planes[j].plane.n) > kMergeAngleDeg) continue;
-        if (mean_distance(planes[j], planes[i].plane) > tol || mean_distance(planes[i], planes[j].plane) > tol) continue;
+        if (mean_distance(planes[j], planes[i].plane) > tol || mean_distance(planes[i], planes[j].plane) > tol)
+          continue;
         std::vector<int> inl = planes[i].inliers;
         inl.insert(inl.end(), planes[j].inliers.begin(), planes[j].inliers.end());
         planes[i] = describe(all, std::move(inl), prm);
@@ -148,7 +149,8 @@ struct Thinning {
   bool thinned() const { return size > 0.0; }
   Eigen::Array3i cell(const Vec3& p) const { return ((p - lo) / size).array().floor().cast<int>(); }
   static std::uint64_t key(const Eigen::Array3i& c) {
-    return (std::uint64_t(c.x()) << (2 * kVoxelKeyBits)) | (std::uint64_t(c.y()) << kVoxelKeyBits) | std::uint64_t(c.z());
+    return (std::uint64_t(c.x()) << (2 * kVoxelKeyBits)) | (std::uint64_t(c.y()) << kVoxelKeyBits) |
+           std::uint64_t(c.z());
   }
   // The position in reps of the voxel at `c`, or -1 (none there, or outside the grid).
   int rep_at(const Eigen::Array3i& c) const {
@@ -221,11 +223,10 @@ std::vector<std::vector<int>> ransac_shapes(const PointCloud& cloud, const Thinn
     const auto& p = cloud.points[i];
     pts.emplace_back(Point(p.x(), p.y(), p.z()), Vector(0, 0, 0), i);
   }
-  if (t.thinned())
-    estimate_normals_in_full_cloud(pts, cloud, order, prm.normal_neighbors);
+  if (t.thinned()) estimate_normals_in_full_cloud(pts, cloud, order, prm.normal_neighbors);
   else
-    CGAL::pca_estimate_normals<CGAL::Sequential_tag>(
-        pts, prm.normal_neighbors, CGAL::parameters::point_map(PointMap()).normal_map(NormalMap()));
+    CGAL::pca_estimate_normals<CGAL::Sequential_tag>(pts, prm.normal_neighbors,
+                                                     CGAL::parameters::point_map(PointMap()).normal_map(NormalMap()));
 
   // Efficient RANSAC draws from CGAL's default generator: seed it for reproducible runs. The
   // generator is thread-local (CGAL_HAS_THREADS), so buildings refined at once do not share it.

@@ -29,8 +29,7 @@ struct Truth {
 };
 
 Truth add_patch(PointCloud& cloud, const Patch& p, unsigned seed) {
-  return {Plane::through(p.origin, p.normal()), add_grid(cloud, p, kStep, kNoise, seed),
-          (p.s1 - p.s0) * (p.t1 - p.t0)};
+  return {Plane::through(p.origin, p.normal()), add_grid(cloud, p, kStep, kNoise, seed), (p.s1 - p.s0) * (p.t1 - p.t0)};
 }
 
 // The corner of a building seen from the street: front wall y = 0 (x from 0 to 5.9), side wall
