@@ -184,6 +184,24 @@ TEST(Planes, VoxelDetectionTakesBackEveryPointOfItsPlanes) {
   }
 }
 
+// A plane the thinned detection finds with fewer than ransac_min_points points of the full cloud
+// is dropped, as full detection would never have found it. Two walls, 10 000 and 120 points: the
+// small one's representatives pass the scaled minimum, its points do not pass the real one.
+TEST(Planes, VoxelDetectionKeepsTheMinimumOfPointsOfTheFullCloud) {
+  PointCloud cloud;
+  const Truth big = add_patch(cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 9.9, 0.0, 9.9), 1);
+  PointCloud sparse;  // 12 × 10 points, 0.3 m apart: 3.3 × 2.7 m, one point per voxel
+  const auto small = add_grid(sparse, {{20, 0, 0}, Vec3::UnitY(), Vec3::UnitZ(), 0.0, 3.3, 0.0, 2.7}, 0.3, kNoise, 2);
+  for (int i : small) cloud.points.push_back(sparse.points[i]);
+  Params prm;
+  prm.detect_voxel = 0.2;
+  const auto planes = detect_planes(cloud, prm);
+  ASSERT_EQ(planes.size(), 1u);
+  expect_same_plane(planes[0], big.plane);
+  prm.ransac_min_points = 100;  // now the small wall has enough points of its own
+  EXPECT_EQ(detect_planes(cloud, prm).size(), 2u);
+}
+
 // facade_max_tilt_deg (10°) decides the facade flag; vertical_snap_deg (1.5°) the refit.
 TEST(Planes, FacadeFlagAndVerticalSnapFollowTheTilt) {
   PointCloud cloud;
