@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <set>
 
 namespace lodrefine {
@@ -145,16 +146,12 @@ bool ends_in_the_open(const EndStrips& e) {
          e.facade_past <= kStrayPoints;
 }
 
-}  // namespace
-
-std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
-                                     const std::vector<ScannedWall>& scanned, const PointCloud& cloud,
-                                     const std::vector<ScanPlane>& planes, const MatchConfig& prm,
-                                     const PlaneConfig& detection) {
+// Surfaces adjacent across an edge: (wall, neighbour) -> the edges they share.
+using Adjacency = std::map<std::pair<int, int>, std::vector<std::pair<int, int>>>;
+Adjacency adjacent_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& surfaces) {
   std::vector<int> face_surface(mesh.faces.size(), -1);
   for (int s = 0; s < int(surfaces.size()); ++s)
     for (int f : surfaces[s].faces) face_surface[f] = s;
-  // Surfaces adjacent across an edge, with the shared edges.
   std::map<std::pair<int, int>, std::vector<int>> edge_surfaces;
   for (int f = 0; f < int(mesh.faces.size()); ++f) {
     const auto& v = mesh.faces[f].v;
@@ -163,97 +160,112 @@ std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSu
       edge_surfaces[{std::min(a, b), std::max(a, b)}].push_back(face_surface[f]);
     }
   }
-  std::map<std::pair<int, int>, std::vector<std::pair<int, int>>> shared;  // (wall, neighbour) -> edges
+  Adjacency shared;
   for (const auto& [e, ss] : edge_surfaces)
     if (ss.size() == 2 && ss[0] != ss[1]) {
       shared[{ss[0], ss[1]}].push_back(e);
       shared[{ss[1], ss[0]}].push_back(e);
     }
-  std::set<int> is_scanned;
-  for (const auto& w : scanned) is_scanned.insert(w.surface);
+  return shared;
+}
 
-  std::map<int, std::vector<CornerMove>> evidence;  // per adjacent wall
-  for (const auto& w : scanned) {
-    const ModelSurface& ws = surfaces[w.surface];
-    const auto [u, v] = w.plane.basis();  // u horizontal
-    const Vec3 o = w.plane.project(ws.centroid);
-    double u0 = 1e300, u1 = -1e300, z0 = 1e300, z1 = -1e300;
-    for (int f : ws.faces)
-      for (int vi : mesh.faces[f].v) {
-        const Vec3& p = mesh.vertices[vi];
-        u0 = std::min(u0, (p - o).dot(u));
-        u1 = std::max(u1, (p - o).dot(u));
-        z0 = std::min(z0, p.z());
-        z1 = std::max(z1, p.z());
-      }
-    const double u_mid = 0.5 * (u0 + u1);
-    const bool facade_displaced = mean_offset(mesh, ws, w.plane) >= kMisplacedFacade;
-    // The scan plane's points over the wall's height, along the facade.
-    std::vector<double> pu, pz;
-    for (int i : planes[w.scan_plane].inliers) {
-      const Vec3& p = cloud.points[i];
-      if (p.z() < z0 || p.z() > z1) continue;
-      pu.push_back((p - o).dot(u) - u_mid);
-      pz.push_back(p.z());
+// A scanned wall seen along its facade: a horizontal axis u from o, the wall's extent on it
+// (centred at u_mid) and in height, and the scan plane's points over the wall's height as
+// positions along u (from u_mid) and heights.
+struct FacadeScan {
+  Vec3 o, u;
+  double u_mid = 0.0, z0 = 1e300, z1 = -1e300;
+  std::vector<double> pu, pz;
+  bool displaced = false;  // the scan moves the wall by kMisplacedFacade or more
+};
+
+FacadeScan facade_scan(const Mesh& mesh, const ModelSurface& ws, const ScannedWall& w, const PointCloud& cloud,
+                       const std::vector<ScanPlane>& planes) {
+  FacadeScan f;
+  f.u = w.plane.basis().first;  // horizontal
+  f.o = w.plane.project(ws.centroid);
+  double u0 = 1e300, u1 = -1e300;
+  for (int fi : ws.faces)
+    for (int vi : mesh.faces[fi].v) {
+      const Vec3& p = mesh.vertices[vi];
+      u0 = std::min(u0, (p - f.o).dot(f.u));
+      u1 = std::max(u1, (p - f.o).dot(f.u));
+      f.z0 = std::min(f.z0, p.z());
+      f.z1 = std::max(f.z1, p.z());
     }
-    if (pu.empty()) continue;
-    for (const auto& [key, edges] : shared) {
-      if (key.first != w.surface) continue;
-      const int a = key.second;
-      const ModelSurface& as = surfaces[a];
-      if (as.sem != Semantic::Wall || is_scanned.count(a)) continue;
-      if (std::abs(as.plane.n.dot(ws.plane.n)) > kMaxCornerCos) continue;
-      // The corner on the scanned plane, at mid height of the shared edge.
-      double zc = 0.0;
-      for (const auto& [i, j] : edges) zc += 0.5 * (mesh.vertices[i].z() + mesh.vertices[j].z());
-      zc /= double(edges.size());
-      const auto c = meet(w.plane, as.plane, Plane(Vec3::UnitZ(), -zc));
-      if (!c) continue;
-      const double uc = (*c - o).dot(u) - u_mid;
-      const double s = uc >= 0 ? 1.0 : -1.0;
-      std::vector<double> t(pu.size());
-      for (std::size_t k = 0; k < pu.size(); ++k) t[k] = s * pu[k];
-      const double end = run_end(t);
-      if (end < 0) continue;
-      const double gap = end - s * uc;  // > 0: the scan runs past the corner
-      if (std::abs(gap) <= kCornerTolerance || std::abs(gap) > prm.match_distance) continue;
-      // Points of this plane again past the end, short of the corner: the run ended at a gap
-      // in the facade (a recessed entrance), not at the building's edge.
-      int beyond = 0;
-      for (double x : t) beyond += x > end + kRunGap && x <= s * uc + prm.match_distance;
-      if (beyond > kStrayPoints) continue;
-      // The scan must show the corner itself: a return onto the side wall where the facade's
-      // points end. A scan that just stops (tile edge, occlusion shadow, the vehicle turning)
-      // or a neighbour's facade that runs on shows no return, and moves nothing.
-      const Plane moved(as.plane.n, as.plane.d - as.plane.n.dot(s * gap * u));
-      if (!shows_return(cloud, w.plane, moved, side_of(mesh, as, w.plane), z0, z1, detection) &&
-          !(facade_displaced &&
-            ends_in_the_open(end_strips(cloud, w.plane, o, u, s, end + s * u_mid, z0, z1, detection))))
-        continue;
-      // The same end in every height band that has points.
-      double lo = 1e300, hi = -1e300;
-      int bands = 0;
-      for (int b = 0; b < kBands; ++b) {
-        const double za = z0 + (z1 - z0) * b / kBands, zb = z0 + (z1 - z0) * (b + 1) / kBands;
-        std::vector<double> tb;
-        for (std::size_t k = 0; k < pu.size(); ++k)
-          if (pz[k] >= za && pz[k] < zb) tb.push_back(t[k]);
-        const double eb = run_end(tb);
-        if (eb < 0) continue;
-        ++bands;
-        lo = std::min(lo, eb);
-        hi = std::max(hi, eb);
-      }
-      if (bands < kBands - 1 || hi - lo > kEndSpread) continue;
-      CornerMove cm;
-      cm.move.surface = a;
-      cm.move.plane = moved;
-      cm.scanned_surface = w.surface;
-      cm.shift = gap;
-      evidence[a].push_back(cm);
-    }
+  f.u_mid = 0.5 * (u0 + u1);
+  f.displaced = mean_offset(mesh, ws, w.plane) >= kMisplacedFacade;
+  for (int i : planes[w.scan_plane].inliers) {
+    const Vec3& p = cloud.points[i];
+    if (p.z() < f.z0 || p.z() > f.z1) continue;
+    f.pu.push_back((p - f.o).dot(f.u) - f.u_mid);
+    f.pz.push_back(p.z());
   }
-  // A wall between two scanned facades must get the same answer from both.
+  return f;
+}
+
+// Whether the facade's points (positions t towards the corner) end at the same place, within
+// kEndSpread, in all but one of the height bands: a vertical building edge, not an occluder.
+bool same_end_over_the_height(const FacadeScan& f, const std::vector<double>& t) {
+  double lo = 1e300, hi = -1e300;
+  int bands = 0;
+  for (int b = 0; b < kBands; ++b) {
+    const double za = f.z0 + (f.z1 - f.z0) * b / kBands, zb = f.z0 + (f.z1 - f.z0) * (b + 1) / kBands;
+    std::vector<double> tb;
+    for (std::size_t k = 0; k < f.pu.size(); ++k)
+      if (f.pz[k] >= za && f.pz[k] < zb) tb.push_back(t[k]);
+    const double eb = run_end(tb);
+    if (eb < 0) continue;
+    ++bands;
+    lo = std::min(lo, eb);
+    hi = std::max(hi, eb);
+  }
+  return bands >= kBands - 1 && hi - lo <= kEndSpread;
+}
+
+// The move of the unscanned neighbour `a` (sharing `edges` with the scanned wall) to where the
+// facade's points end, when the scan shows that corner.
+std::optional<CornerMove> corner_at(const Mesh& mesh, const FacadeScan& f, const ScannedWall& w, int a,
+                                    const ModelSurface& as, const std::vector<std::pair<int, int>>& edges,
+                                    const PointCloud& cloud, const MatchConfig& prm, const PlaneConfig& detection) {
+  // The corner on the scanned plane, at mid height of the shared edge.
+  double zc = 0.0;
+  for (const auto& [i, j] : edges) zc += 0.5 * (mesh.vertices[i].z() + mesh.vertices[j].z());
+  zc /= double(edges.size());
+  const auto c = meet(w.plane, as.plane, Plane(Vec3::UnitZ(), -zc));
+  if (!c) return std::nullopt;
+  const double uc = (*c - f.o).dot(f.u) - f.u_mid;
+  const double s = uc >= 0 ? 1.0 : -1.0;
+  std::vector<double> t(f.pu.size());
+  for (std::size_t k = 0; k < f.pu.size(); ++k) t[k] = s * f.pu[k];
+  const double end = run_end(t);
+  if (end < 0) return std::nullopt;
+  const double gap = end - s * uc;  // > 0: the scan runs past the corner
+  if (std::abs(gap) <= kCornerTolerance || std::abs(gap) > prm.match_distance) return std::nullopt;
+  // Points of this plane again past the end, short of the corner: the run ended at a gap in the
+  // facade (a recessed entrance), not at the building's edge.
+  int beyond = 0;
+  for (double x : t) beyond += x > end + kRunGap && x <= s * uc + prm.match_distance;
+  if (beyond > kStrayPoints) return std::nullopt;
+  // The scan must show the corner itself (corners.h): a return onto the side wall where the
+  // facade's points end, or an open end on a facade the scan found misplaced.
+  const Plane moved(as.plane.n, as.plane.d - as.plane.n.dot(s * gap * f.u));
+  if (!shows_return(cloud, w.plane, moved, side_of(mesh, as, w.plane), f.z0, f.z1, detection) &&
+      !(f.displaced &&
+        ends_in_the_open(end_strips(cloud, w.plane, f.o, f.u, s, end + s * f.u_mid, f.z0, f.z1, detection))))
+    return std::nullopt;
+  if (!same_end_over_the_height(f, t)) return std::nullopt;
+  CornerMove cm;
+  cm.move.surface = a;
+  cm.move.plane = moved;
+  cm.scanned_surface = w.surface;
+  cm.shift = gap;
+  return cm;
+}
+
+// A wall between two scanned facades must get the same answer from both (within kEndSpread);
+// it moves to their mean.
+std::vector<CornerMove> agreed_moves(const std::map<int, std::vector<CornerMove>>& evidence) {
   std::vector<CornerMove> out;
   for (const auto& [a, list] : evidence) {
     double lo = 1e300, hi = -1e300, sum = 0.0;
@@ -268,6 +280,32 @@ std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSu
     out.push_back(cm);
   }
   return out;
+}
+
+}  // namespace
+
+std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
+                                     const std::vector<ScannedWall>& scanned, const PointCloud& cloud,
+                                     const std::vector<ScanPlane>& planes, const MatchConfig& prm,
+                                     const PlaneConfig& detection) {
+  const Adjacency shared = adjacent_surfaces(mesh, surfaces);
+  std::set<int> is_scanned;
+  for (const auto& w : scanned) is_scanned.insert(w.surface);
+  std::map<int, std::vector<CornerMove>> evidence;  // per adjacent wall
+  for (const auto& w : scanned) {
+    const ModelSurface& ws = surfaces[w.surface];
+    const FacadeScan f = facade_scan(mesh, ws, w, cloud, planes);
+    if (f.pu.empty()) continue;
+    for (const auto& [key, edges] : shared) {
+      if (key.first != w.surface) continue;
+      const int a = key.second;
+      const ModelSurface& as = surfaces[a];
+      if (as.sem != Semantic::Wall || is_scanned.count(a)) continue;
+      if (std::abs(as.plane.n.dot(ws.plane.n)) > kMaxCornerCos) continue;
+      if (auto cm = corner_at(mesh, f, w, a, as, edges, cloud, prm, detection)) evidence[a].push_back(*cm);
+    }
+  }
+  return agreed_moves(evidence);
 }
 
 }  // namespace lodrefine

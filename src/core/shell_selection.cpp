@@ -13,15 +13,14 @@
 #include "lodrefine/core/repair.h"
 #include "lodrefine/core/topology.h"
 #include "lodrefine/core/validate.h"
+#include "shell_supports.h"
 
 namespace lodrefine {
 namespace {
 
-// Occupancy grid cell (m): several MLS points wide, a fraction of a window.
-constexpr double kCell = 0.25;
-// The region reaches this far (m) beyond the building and its scan evidence, so that no face of
-// a building touches its boundary.
-constexpr double kRegionMargin = 1.0;
+using detail::kCell;
+using detail::near_vertical;
+using detail::Supports;
 // A parallel scanned facade at most this far (m) from a model face (in front or behind) says the
 // facade is there, not on the model face: the scan saw past it, or it lies inside the building.
 constexpr double kSeeThrough = 3.0;
@@ -76,179 +75,6 @@ double share(const std::vector<Vec2>& poly, const CellSet& cells) {
   for (const auto& p : poly) c += p;
   c /= double(poly.size());
   return cells.count(cell_key((long long)std::floor(c.x() / kCell), (long long)std::floor(c.y() / kCell))) ? 1.0 : 0.0;
-}
-
-// The supporting planes: the starting shell's, then the scan's facades that none of them carries.
-struct Supports {
-  std::vector<SupportPlane> planes;
-  int start_planes = 0;
-  std::vector<int> face_plane;            // start face -> supporting plane
-  std::vector<std::vector<Vec3>> points;  // per supporting plane: its scan points
-  int added = 0;
-};
-
-// A plane whose normal is within this of horizontal is a wall's (deg): the contradiction and the
-// represented-facade tests apply to walls only.
-constexpr double kVerticalTiltDeg = 10.0;
-bool near_vertical(const Plane& pl) { return std::abs(pl.n.z()) < std::sin(radians(kVerticalTiltDeg)); }
-
-void add_start_planes(const Mesh& start, Supports& s) {
-  const auto surfaces = model_surfaces(start);
-  std::vector<int> order(surfaces.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = int(i);
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return surfaces[a].area > surfaces[b].area; });
-  s.face_plane.assign(start.faces.size(), -1);
-  for (int si : order) {
-    const ModelSurface& surf = surfaces[si];
-    int k = -1;
-    for (int j = 0; j < int(s.planes.size()) && k < 0; ++j) {
-      if (unoriented_angle_deg(s.planes[j].plane.n, surf.plane.n) > kSurfaceAngleDeg) continue;
-      double worst = 0.0;
-      for (int f : surf.faces)
-        for (int v : start.faces[f].v) worst = std::max(worst, std::abs(s.planes[j].plane.distance(start.vertices[v])));
-      if (worst <= kSurfaceDistance) k = j;
-    }
-    if (k < 0) {
-      k = int(s.planes.size());
-      s.planes.push_back({surf.plane, surf.sem, false, si});
-    }
-    for (int f : surf.faces) s.face_plane[f] = k;
-  }
-  s.start_planes = int(s.planes.size());
-  s.points.assign(s.planes.size(), {});
-}
-
-// The scan's facade planes near the footprint: each one's points within match_distance +
-// bbox_margin of the start's box (in the plane's own horizontal frame), when at least ransac_min_points, go to the
-// supporting plane of the start that they lie on, else to a new one.
-void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& scan, const Params& prm,
-                     Supports& s) {
-  const double reach = prm.match_distance + prm.bbox_margin;  // a wall off by up to match_distance, plus a bay
-  for (int i = 0; i < int(scan.size()); ++i) {
-    const ScanPlane& sp = scan[i];
-    if (!sp.facade) continue;
-    Vec3 n(sp.plane.n.x(), sp.plane.n.y(), 0.0);
-    if (n.norm() < 1e-9) continue;
-    n.normalize();
-    const Vec3 u(-n.y(), n.x(), 0.0);
-    Eigen::AlignedBox3d box;  // the start in (u, n, z)
-    for (const auto& p : start.vertices) box.extend(Vec3(u.dot(p), n.dot(p), p.z()));
-    std::vector<Vec3> near;
-    for (int idx : sp.inliers) {
-      const Vec3& p = cloud.points[idx];
-      const Vec3 q(u.dot(p), n.dot(p), p.z());
-      if ((q - box.min()).minCoeff() >= -reach && (box.max() - q).minCoeff() >= -reach) near.push_back(p);
-    }
-    if (int(near.size()) < prm.ransac_min_points) continue;
-    auto mean_distance = [&](const Plane& pl) {
-      double sum = 0.0;
-      for (const auto& p : near) sum += std::abs(pl.distance(p));
-      return sum / double(near.size());
-    };
-    int k = -1;
-    double best = prm.merge_distance;
-    for (int j = 0; j < int(s.planes.size()); ++j) {
-      if (!near_vertical(s.planes[j].plane) ||
-          unoriented_angle_deg(s.planes[j].plane.n, sp.plane.n) > prm.merge_angle_deg)
-        continue;
-      const double d = mean_distance(s.planes[j].plane);
-      if (d <= best) best = d, k = j;
-    }
-    if (k < 0) {
-      k = int(s.planes.size());
-      s.planes.push_back({sp.plane, Semantic::Wall, true, i});
-      s.points.emplace_back();
-      ++s.added;
-    }
-    s.points[k].insert(s.points[k].end(), near.begin(), near.end());
-  }
-}
-
-// Where a scanned facade's points run along its horizontal direction `u` (positions along u;
-// gaps shorter than kRunGap are bridged: a window column still has wall above and below).
-struct Run {
-  double a, b;
-};
-constexpr double kRunGap = 2 * kCell;  // m
-std::vector<Run> runs_along(const std::vector<Vec3>& pts, const Vec3& u) {
-  std::vector<double> t;
-  for (const auto& p : pts) t.push_back(u.dot(p));
-  std::sort(t.begin(), t.end());
-  std::vector<Run> out;
-  for (double x : t) {
-    if (out.empty() || x - out.back().b > kRunGap) out.push_back({x, x});
-    else out.back().b = x;
-  }
-  return out;
-}
-
-// A facade line that steps, a recess or a bay needs the wall across the step, which the scan
-// often misses (seen edge-on, or in the shadow of the feature). Where the points of a facade
-// plane the start does not carry end inside the footprint, a vertical plane across that end is
-// a hypothesis, and one at each nearby end of a parallel scanned facade's points (the other side
-// of the step, where the points usually end more sharply). The selection takes such a wall only
-// where it closes what the scan shows.
-// Ends within kSideClear (m) of the footprint's ends are the building's own corners; other ends
-// within kStepReach (m) belong to the same step; a plane within kSameStep (m) of the end is there
-// already.
-constexpr double kSideClear = 0.3, kStepReach = 1.0, kSameStep = 0.1;
-void add_step_walls(const Mesh& start, const Params& prm, Supports& s) {
-  const int existing = int(s.planes.size());
-  for (int j = s.start_planes; j < existing; ++j) {
-    const Plane& pj = s.planes[j].plane;
-    if (!s.planes[j].from_scan || s.points[j].empty() || !near_vertical(pj)) continue;
-    const Vec3 u = Vec3(-pj.n.y(), pj.n.x(), 0.0).normalized();
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const auto& p : start.vertices) lo = std::min(lo, u.dot(p)), hi = std::max(hi, u.dot(p));
-    std::vector<double> ends;
-    for (const auto& r : runs_along(s.points[j], u)) ends.insert(ends.end(), {r.a, r.b});
-    std::vector<double> positions;
-    for (double e : ends) {
-      if (e < lo + kSideClear || e > hi - kSideClear) continue;
-      positions.push_back(e);
-      for (int k = 0; k < existing; ++k) {
-        if (k == j || s.points[k].empty() || unoriented_angle_deg(s.planes[k].plane.n, pj.n) > prm.merge_angle_deg)
-          continue;
-        for (const auto& r : runs_along(s.points[k], u))
-          for (double f : {r.a, r.b})
-            if (std::abs(f - e) <= kStepReach && f > lo + kSideClear && f < hi - kSideClear) positions.push_back(f);
-      }
-    }
-    Vec3 c = Vec3::Zero();
-    for (const auto& p : s.points[j]) c += p;
-    c /= double(s.points[j].size());
-    for (double t : positions) {
-      const Vec3 x = c + (t - u.dot(c)) * u;
-      bool there = false;
-      for (const auto& sp : s.planes)
-        there = there || (near_vertical(sp.plane) && unoriented_angle_deg(sp.plane.n, u) <= prm.merge_angle_deg &&
-                          std::abs(sp.plane.distance(x)) <= kSameStep);
-      if (there) continue;
-      s.planes.push_back({Plane::through(x, u), Semantic::Wall, true, -1});
-      s.points.emplace_back();
-    }
-  }
-}
-
-// The region: the start and the scan evidence, in the axes of the start's largest wall.
-Region building_region(const Mesh& start, const Supports& s) {
-  Vec3 n = Vec3::UnitY();
-  for (const auto& sp : s.planes)  // the start's planes come in decreasing area: the first wall
-    if (!sp.from_scan && near_vertical(sp.plane)) {
-      n = Vec3(sp.plane.n.x(), sp.plane.n.y(), 0.0).normalized();
-      break;
-    }
-  Region r;
-  r.axes.col(0) = Vec3(-n.y(), n.x(), 0.0);
-  r.axes.col(1) = n;
-  r.axes.col(2) = Vec3::UnitZ();
-  Eigen::AlignedBox3d box;
-  for (const auto& p : start.vertices) box.extend(r.axes.transpose() * p);
-  for (const auto& pts : s.points)
-    for (const auto& p : pts) box.extend(r.axes.transpose() * p);
-  r.center = r.axes * box.center();
-  r.half = 0.5 * box.sizes() + Vec3::Constant(kRegionMargin);
-  return r;
 }
 
 // What the program knows of each candidate.
@@ -548,10 +374,10 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   ShellSelection out;
   auto& st = out.stats;
   Supports s;
-  add_start_planes(start, s);
-  add_scan_planes(start, cloud, planes, prm, s);
+  detail::add_start_planes(start, s);
+  detail::add_scan_planes(start, cloud, planes, prm, s);
   const int before_steps = int(s.planes.size());
-  add_step_walls(start, prm, s);
+  detail::add_step_walls(start, prm, s);
   st.step_walls = int(s.planes.size()) - before_steps;
   st.supporting_planes = int(s.planes.size());
   st.scan_planes_added = s.added;
@@ -561,7 +387,7 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   // incumbent, and what no evidence reaches is fixed to it; without one everything is free.
   // Candidates fixed unselected that way (no support's evidence reaches them, the starting shell
   // has none there) are pruned: the program over the others is the same.
-  const CandidateSet all = build_candidates(s.planes, building_region(start, s));
+  const CandidateSet all = build_candidates(s.planes, detail::building_region(start, s));
   const CandidateData all_d = describe_candidates(all, start, s, prm);
   const std::vector<char> all_warm = mended_start(all, all_d.in_start, prm);
   std::vector<char> keep(all.faces.size(), 1);

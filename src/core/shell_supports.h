@@ -1,0 +1,45 @@
+// The supporting planes of a building's arrangement (stage 4, shell_selection.h): the starting
+// shell's planes, the scan's facades none of them carries, and the hypothesised walls across the
+// steps of a facade line; and the region the arrangement covers. Internal to shell_selection.
+#pragma once
+#include <vector>
+
+#include "lodrefine/core/candidates.h"
+#include "lodrefine/core/geometry.h"
+#include "lodrefine/core/params.h"
+#include "lodrefine/core/planes.h"
+#include "lodrefine/core/types.h"
+
+namespace lodrefine::detail {
+
+// Occupancy grid cell (m): several MLS points wide, a fraction of a window.
+constexpr double kCell = 0.25;
+
+// The supporting planes: the starting shell's, then the scan's facades that none of them carries.
+struct Supports {
+  std::vector<SupportPlane> planes;
+  int start_planes = 0;
+  std::vector<int> face_plane;            // start face -> supporting plane
+  std::vector<std::vector<Vec3>> points;  // per supporting plane: its scan points
+  int added = 0;
+};
+
+// A plane whose normal is within this of horizontal is a wall's (deg): the contradiction and the
+// represented-facade tests apply to walls only.
+constexpr double kVerticalTiltDeg = 10.0;
+inline bool near_vertical(const Plane& pl) { return std::abs(pl.n.z()) < std::sin(radians(kVerticalTiltDeg)); }
+
+// The start's planes, one per set of its surfaces within kSurfaceAngleDeg / kSurfaceDistance
+// (matching.h), largest first.
+void add_start_planes(const Mesh& start, Supports& s);
+// The scan's facade planes near the footprint (within match_distance + bbox_margin), each on the
+// supporting plane it lies on, else a new one; ransac_min_points such points at least.
+void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& scan, const Params& prm,
+                     Supports& s);
+// Hypothesised walls across where a scanned facade's points end inside the footprint.
+void add_step_walls(const Mesh& start, const Params& prm, Supports& s);
+// The region: the start and the scan evidence, in the axes of the start's largest wall, grown by
+// a margin.
+Region building_region(const Mesh& start, const Supports& s);
+
+}  // namespace lodrefine::detail
