@@ -74,12 +74,18 @@ double side_of(const Mesh& mesh, const ModelSurface& wall, const Plane& facade) 
   return sum >= 0 ? 1.0 : -1.0;
 }
 
+// A point within this of a scan plane lies on it: the plane's noise band, at least the corner
+// tolerance.
+double on_plane_band(const PlaneConfig& prm) {
+  return std::max(kCornerTolerance, kOffPlaneEpsilons * prm.ransac_epsilon);
+}
+
 // Whether points lie on the side wall's new plane `moved`, off the facade plane on the wall's
 // `side`, over the upper part of the facade's height [z0, z1] (ground and clutter below do not
 // count): the return the scanner saw where the facade turns the corner.
 bool shows_return(const PointCloud& cloud, const Plane& facade, const Plane& moved, double side, double z0, double z1,
                   const PlaneConfig& prm) {
-  const double on_plane = std::max(kCornerTolerance, kOffPlaneEpsilons * prm.ransac_epsilon);
+  const double on_plane = on_plane_band(prm);
   const double za = z0 + kLowBand * (z1 - z0);
   const double off = kOffPlaneEpsilons * prm.ransac_epsilon;
   int count = 0;
@@ -101,15 +107,6 @@ bool shows_return(const PointCloud& cloud, const Plane& facade, const Plane& mov
          far - near >= kMinReturnDepth;
 }
 
-// The mean distance of a wall's vertices to a plane.
-double mean_offset(const Mesh& mesh, const ModelSurface& wall, const Plane& plane) {
-  double sum = 0.0;
-  int n = 0;
-  for (int f : wall.faces)
-    for (int v : mesh.faces[f].v) sum += std::abs(plane.distance(mesh.vertices[v])), ++n;
-  return n ? sum / n : 0.0;
-}
-
 // Points in the strips just past and just before a facade's end (t: position along the facade
 // towards the corner, measured from the wall's middle).
 struct EndStrips {
@@ -121,14 +118,15 @@ struct EndStrips {
 EndStrips end_strips(const PointCloud& cloud, const Plane& facade, const Vec3& o, const Vec3& u, double s, double end,
                      double z0, double z1, const PlaneConfig& prm) {
   const double za = z0 + kLowBand * (z1 - z0);
-  const double on_plane = std::max(kCornerTolerance, kOffPlaneEpsilons * prm.ransac_epsilon);
+  const double on_plane = on_plane_band(prm);
   EndStrips e;
   for (const auto& p : cloud.points) {
     const double t = s * (p - o).dot(u) - end;
     const bool past = t > kCornerTolerance && t <= kStrip, before = t < -kCornerTolerance && t >= -kStrip;
     if (!past && !before) continue;
     const double d = facade.distance(p);  // outwards: the street side
-    const bool in_front = d > kStreetNear && d<kStreetFar, high = p.z()> za && p.z() < z1;
+    const bool in_front = d > kStreetNear && d < kStreetFar;
+    const bool high = p.z() > za && p.z() < z1;
     if (in_front && p.z() < z0 + kGroundBand) ++(past ? e.street_past : e.street_before);
     if (in_front && high && past) ++e.front_past;
     if (std::abs(d) <= on_plane && high) ++(past ? e.facade_past : e.facade_before);
@@ -194,7 +192,7 @@ FacadeScan facade_scan(const Mesh& mesh, const ModelSurface& ws, const ScannedWa
       f.z1 = std::max(f.z1, p.z());
     }
   f.u_mid = 0.5 * (u0 + u1);
-  f.displaced = mean_offset(mesh, ws, w.plane) >= kMisplacedFacade;
+  f.displaced = surface_mean_deviation(mesh, ws, w.plane) >= kMisplacedFacade;
   for (int i : planes[w.scan_plane].inliers) {
     const Vec3& p = cloud.points[i];
     if (p.z() < f.z0 || p.z() > f.z1) continue;

@@ -373,6 +373,14 @@ double surface_deviation(const Mesh& mesh, const ModelSurface& s, const Plane& p
   return d;
 }
 
+double surface_mean_deviation(const Mesh& mesh, const ModelSurface& s, const Plane& pl) {
+  double sum = 0.0;
+  int n = 0;
+  for (int f : s.faces)
+    for (int v : mesh.faces[f].v) sum += std::abs(pl.distance(mesh.vertices[v])), ++n;
+  return n > 0 ? sum / n : 0.0;
+}
+
 std::vector<int> points_in_front(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
                                  const std::vector<ScanPlane>& planes, const MatchResult& matched,
                                  const PointCloud& cloud, double margin) {

@@ -37,14 +37,11 @@ PointCloud cloud_near(const Mesh& local_model, const PointCloud& cloud, const Ve
 RefineTrace::FacadeMove describe_move(const Mesh& mesh, const std::vector<ModelSurface>& surfaces, const WallMove& move,
                                       const char* evidence) {
   const ModelSurface& s = surfaces[move.surface];
-  double mean = 0.0, n = 0.0;
-  for (int f : s.faces)
-    for (int v : mesh.faces[f].v) mean += std::abs(move.plane.distance(mesh.vertices[v])), n += 1.0;
   RefineTrace::FacadeMove d;
   for (int f : s.faces) d.input_faces.insert(mesh.faces[f].source);
   d.evidence = evidence;
   d.max_move = surface_deviation(mesh, s, move.plane);
-  d.mean_move = n > 0 ? mean / n : 0.0;
+  d.mean_move = surface_mean_deviation(mesh, s, move.plane);
   for (int f : s.faces) d.wall.polygons.push_back(face_points(mesh, mesh.faces[f]));
   d.wall.from = s.plane;
   d.wall.to = move.plane;

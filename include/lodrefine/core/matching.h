@@ -32,6 +32,8 @@ std::vector<ModelSurface> model_surfaces(const Mesh& mesh, double angle_deg = kS
 
 // Largest distance of a surface's vertices from `plane` (how far the wall moves onto it).
 double surface_deviation(const Mesh& mesh, const ModelSurface& surface, const Plane& plane);
+// Mean distance of a surface's vertices from `plane` (0 for a surface without vertices).
+double surface_mean_deviation(const Mesh& mesh, const ModelSurface& surface, const Plane& plane);
 
 struct Match {
   int scan_plane = -1;  // index into the scan planes
