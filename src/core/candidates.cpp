@@ -21,6 +21,9 @@ constexpr double kVertexWeld = 1e-6;
 // A vertex splits another face's edge when within kVertexWeld of it and farther than this share
 // of the edge from either end (nearer, it is that end).
 constexpr double kEdgeEndShare = 1e-9;
+// A vertex inside an edge of a face on plane P lies within kVertexWeld of that edge, hence of
+// P up to the rounding of the plane meets: 100x the weld is a wide margin for that rounding.
+constexpr double kPlaneReach = 100 * kVertexWeld;
 
 }  // namespace
 
@@ -244,6 +247,15 @@ void build_fans(CandidateSet& cs, const std::vector<std::vector<int>>& corners) 
   for (auto& [first, e] : fans) cs.edges.push_back(std::move(e));
 }
 
+// Per support plane, the vertices within kPlaneReach of it, by index.
+std::vector<std::vector<int>> vertices_on_planes(const std::vector<Vec3>& V, const std::vector<SupportPlane>& planes) {
+  std::vector<std::vector<int>> on(planes.size());
+  for (int w = 0; w < int(V.size()); ++w)
+    for (std::size_t i = 0; i < planes.size(); ++i)
+      if (std::abs(planes[i].plane.distance(V[w])) <= kPlaneReach) on[i].push_back(w);
+  return on;
+}
+
 }  // namespace
 
 CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Region& region, double min_area) {
@@ -290,13 +302,18 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
   cs.vertices = welder.points();
 
   // Where a vertex of one face lies inside another face's edge (several planes meeting at a
-  // point along the line), split that edge so that adjacency is exact.
-  for (auto& v : corners) {
+  // point along the line), split that edge so that adjacency is exact. Such a vertex lies on the
+  // face's plane, so only that plane's vertices are tried: trying every vertex for every edge
+  // took minutes on a large building (thousands of faces).
+  const auto on_plane = vertices_on_planes(cs.vertices, planes);
+  for (std::size_t f = 0; f < corners.size(); ++f) {
+    auto& v = corners[f];
     std::vector<int> out;
     for (std::size_t k = 0; k < v.size(); ++k) {
       const int a = v[k], b = v[(k + 1) % v.size()];
       out.push_back(a);
-      for (int x : vertices_on_segment(cs.vertices, a, b, SegmentRule{kVertexWeld, false, kEdgeEndShare}))
+      for (int x : vertices_on_segment(cs.vertices, a, b, SegmentRule{kVertexWeld, false, kEdgeEndShare},
+                                       &on_plane[cs.faces[f].plane]))
         out.push_back(x);
     }
     v = out;
