@@ -89,7 +89,7 @@ class ChunkTable {
   std::vector<unsigned char> bytes_;
   std::optional<ByteReader> reader_;
   std::optional<ArithmeticDecoder> dec_;
-  IntegerDecoder ic_{32, 2};
+  IntegerCoder ic_{32, 2};
   bool started_ = false;
   std::uint32_t prev_count_ = 0, prev_bytes_ = 0;
 };
