@@ -9,7 +9,8 @@
 // POINT14, RGB14, RGBNIR14 and BYTE14 in version 3, i.e. formats 6–8 with extra bytes; chunk
 // tables of fixed and variable chunk sizes. Refused with one line naming what is missing:
 // waveform packets (formats 4, 5, 9, 10), item version 1 (LASzip 1.x), the unchunked
-// compressor 1.
+// compressor 1. The encoder (laz_write.cpp, the chunk encoders in laz_items.h) writes what this
+// decoder reads, on the same models.
 #pragma once
 #include <array>
 #include <cstdint>

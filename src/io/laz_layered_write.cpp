@@ -140,7 +140,8 @@ class Rgb14Encoder {
     if (!nir_) return;
     std::uint32_t& kept = state_.current_last().nir;  // as the decoder keeps it
     const std::uint32_t nir = get_u16(item + 6);
-    const std::uint32_t sym = std::uint32_t((nir & 0xff) != (last.nir & 0xff)) | std::uint32_t((nir >> 8) != (last.nir >> 8)) << 1;
+    const std::uint32_t sym =
+        std::uint32_t((nir & 0xff) != (last.nir & 0xff)) | std::uint32_t((nir >> 8) != (last.nir >> 8)) << 1;
     ArithmeticEncoder& enc = layers_[1].enc;
     NirModels& m = state_.models().nir;
     enc.symbol(m.byte_used, sym);

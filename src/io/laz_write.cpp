@@ -98,7 +98,8 @@ LasRecordWriter::LasRecordWriter(std::string path, const LasRecordFormat& format
   if (compressed && chunk_size == 0) throw std::invalid_argument("LasRecordWriter: chunk size 0");
   record_length_ = std::max(format.record_length, las_min_record_length(f));
   if (record_length_ > 0xffff) throw std::invalid_argument("LasRecordWriter: record length over 65535");
-  for (int a = 0; a < 3; ++a) lo_[a] = std::numeric_limits<std::int32_t>::max(), hi_[a] = std::numeric_limits<std::int32_t>::min();
+  for (int a = 0; a < 3; ++a)
+    lo_[a] = std::numeric_limits<std::int32_t>::max(), hi_[a] = std::numeric_limits<std::int32_t>::min();
   if (compressed) {
     chunks_ = std::make_unique<Chunks>();
     chunks_->items = items_for(f, record_length_);

@@ -31,8 +31,7 @@ struct LasRecordFormat {
 // format, version or record length it cannot write, std::runtime_error when the file cannot.
 class LasRecordWriter {
  public:
-  LasRecordWriter(std::string path, const LasRecordFormat& format, bool compressed,
-                  std::uint32_t chunk_size = 50000);
+  LasRecordWriter(std::string path, const LasRecordFormat& format, bool compressed, std::uint32_t chunk_size = 50000);
   ~LasRecordWriter();
   LasRecordWriter(const LasRecordWriter&) = delete;
   LasRecordWriter& operator=(const LasRecordWriter&) = delete;
