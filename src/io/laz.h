@@ -4,11 +4,11 @@
 // calls it for files whose header or VLRs say "compressed".
 //
 // Supported: the "laszip encoded" VLR (user id "laszip encoded", record 22204); compressor 2
-// (chunked, pointwise) with items POINT10, GPSTIME11, RGB12 and BYTE in version 2, i.e. point
-// formats 0–3 with any extra bytes; compressor 3 (chunked, layered: LASzip for LAS 1.4) with
-// POINT14, RGB14, RGBNIR14 and BYTE14 in version 3, i.e. formats 6–8 with extra bytes; chunk
-// tables of fixed and variable chunk sizes. Refused with one line naming what is missing:
-// waveform packets (formats 4, 5, 9, 10), item version 1 (LASzip 1.x), the unchunked
+// (chunked, pointwise) with items POINT10, GPSTIME11, RGB12 and BYTE in version 2 and
+// WAVEPACKET13 in version 1, i.e. point formats 0–5 with any extra bytes; compressor 3 (chunked,
+// layered: LASzip for LAS 1.4) with POINT14, RGB14, RGBNIR14, WAVEPACKET14 and BYTE14 in version
+// 3, i.e. formats 6–10 with extra bytes; chunk tables of fixed and variable chunk sizes. Refused
+// with one line naming what is missing: other item versions (LASzip 1.x), the unchunked
 // compressor 1. The encoder (laz_write.cpp, the chunk encoders in laz_items.h) writes what this
 // decoder reads, on the same models.
 #pragma once

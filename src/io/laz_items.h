@@ -300,6 +300,65 @@ inline std::uint32_t encode_rgb(ArithmeticEncoder& enc, RgbModels& m, const std:
   return sym;
 }
 
+// WAVEPACKET13 v1 and the WAVEPACKET14 v3 layer (29 bytes: descriptor index, the 64-bit byte
+// offset, packet size, return point and x/y/z as float bits): the index, then how the offset
+// follows the last (same, right after the last packet, a 32-bit difference, raw), then each
+// 32-bit field predicted by the last one's. One set per scanner channel in v3.
+struct WavePacketModels {
+  SymbolModel packet_index{256};
+  std::array<SymbolModel, 4> offset_diff{SymbolModel(4), SymbolModel(4), SymbolModel(4), SymbolModel(4)};
+  IntegerCoder ic_offset_diff{32}, ic_packet_size{32}, ic_return_point{32}, ic_xyz{32, 3};
+  std::int32_t last_diff = 0;
+  std::uint32_t last_sym = 0;
+};
+constexpr std::size_t kWavePacketSize = 29;
+
+inline void decode_wavepacket(ArithmeticDecoder& dec, WavePacketModels& m, const unsigned char* last,
+                              unsigned char* out) {
+  out[0] = (unsigned char)dec.symbol(m.packet_index);
+  const std::uint64_t last_offset = get_u64(last + 1);
+  m.last_sym = dec.symbol(m.offset_diff[m.last_sym]);
+  std::uint64_t offset = last_offset;
+  if (m.last_sym == 1) {
+    offset += get_u32(last + 9);
+  } else if (m.last_sym == 2) {
+    m.last_diff = m.ic_offset_diff.decode(dec, m.last_diff, 0);
+    offset += std::uint64_t(std::int64_t(m.last_diff));
+  } else if (m.last_sym == 3) {
+    const std::uint64_t low = dec.u32();
+    offset = std::uint64_t(dec.u32()) << 32 | low;
+  }
+  for (int i = 0; i < 8; ++i) out[1 + i] = (unsigned char)(offset >> (8 * i));
+  put_u32(out + 9, std::uint32_t(m.ic_packet_size.decode(dec, std::int32_t(get_u32(last + 9)), 0)));
+  put_u32(out + 13, std::uint32_t(m.ic_return_point.decode(dec, std::int32_t(get_u32(last + 13)), 0)));
+  for (std::uint32_t k = 0; k < 3; ++k)
+    put_u32(out + 17 + 4 * k, std::uint32_t(m.ic_xyz.decode(dec, std::int32_t(get_u32(last + 17 + 4 * k)), k)));
+}
+
+inline void encode_wavepacket(ArithmeticEncoder& enc, WavePacketModels& m, const unsigned char* last,
+                              const unsigned char* item) {
+  enc.symbol(m.packet_index, item[0]);
+  const std::uint64_t offset = get_u64(item + 1), last_offset = get_u64(last + 1);
+  const auto diff = std::int64_t(offset - last_offset);
+  const std::uint32_t sym = offset == last_offset                       ? 0
+                            : offset == last_offset + get_u32(last + 9) ? 1
+                            : diff == std::int64_t(std::int32_t(diff))  ? 2
+                                                                        : 3;
+  enc.symbol(m.offset_diff[m.last_sym], sym);
+  m.last_sym = sym;
+  if (sym == 2) {
+    m.ic_offset_diff.encode(enc, m.last_diff, std::int32_t(diff), 0);
+    m.last_diff = std::int32_t(diff);
+  } else if (sym == 3) {
+    enc.u32(std::uint32_t(offset));
+    enc.u32(std::uint32_t(offset >> 32));
+  }
+  const auto field = [](const unsigned char* p, std::size_t at) { return std::int32_t(get_u32(p + at)); };
+  m.ic_packet_size.encode(enc, field(last, 9), field(item, 9), 0);
+  m.ic_return_point.encode(enc, field(last, 13), field(item, 13), 0);
+  for (std::uint32_t k = 0; k < 3; ++k) m.ic_xyz.encode(enc, field(last, 17 + 4 * k), field(item, 17 + 4 * k), k);
+}
+
 inline std::array<std::uint32_t, 3> get_rgb(const unsigned char* p) {
   return {get_u16(p), get_u16(p + 2), get_u16(p + 4)};
 }

@@ -148,6 +148,31 @@ class Rgb14Decoder {
   std::array<Layer, 2> layers_;
 };
 
+// WAVEPACKET14 (formats 9 and 10): the waveform packet descriptor in its own layer.
+class WavePacket14Decoder {
+ public:
+  void first(ByteReader& in, unsigned char* out, int channel) {
+    in.bytes(out, kWavePacketSize);
+    Last last;
+    std::memcpy(last.data(), out, kWavePacketSize);
+    state_.first(channel, last, make());
+  }
+  Layer& layer() { return layer_; }
+  void next(unsigned char* out, int channel) {
+    Last& last = state_.select(channel, make);
+    if (layer_.present()) decode_wavepacket(*layer_, state_.models(), last.data(), out);
+    else std::memcpy(out, last.data(), kWavePacketSize);
+    std::memcpy(last.data(), out, kWavePacketSize);
+  }
+
+ private:
+  using Last = std::array<unsigned char, kWavePacketSize>;
+  static std::unique_ptr<WavePacketModels> make() { return std::make_unique<WavePacketModels>(); }
+
+  ChannelState<Last, WavePacketModels> state_;
+  Layer layer_;
+};
+
 // BYTE14: each extra byte its own layer, a difference to its last value.
 class Byte14Decoder {
  public:
@@ -182,6 +207,7 @@ class LayeredChunk {
   LayeredChunk(const std::vector<Item>& items, ByteReader& in) : in_(in) {
     for (const Item& it : items) {
       if (it.type == kRgb14 || it.type == kRgbNir14) rgb_.emplace(it.type == kRgbNir14), rgb_size_ = it.size;
+      else if (it.type == kWavePacket14) wave_.emplace(), wave_size_ = it.size;
       else if (it.type == kByte14) bytes_.emplace(it.size);
     }
   }
@@ -190,7 +216,8 @@ class LayeredChunk {
     point_.next(out);
     const int ch = point_.item_context();
     if (rgb_) rgb_->next(out + 30, ch);
-    if (bytes_) bytes_->next(out + 30 + rgb_size_, ch);
+    if (wave_) wave_->next(out + 30 + rgb_size_, ch);
+    if (bytes_) bytes_->next(out + 30 + rgb_size_ + wave_size_, ch);
   }
 
  private:
@@ -200,7 +227,8 @@ class LayeredChunk {
     point_.first(in_, out);
     const int ch = point_.item_context();
     if (rgb_) rgb_->first(in_, out + 30, ch);
-    if (bytes_) bytes_->first(in_, out + 30 + rgb_size_, ch);
+    if (wave_) wave_->first(in_, out + 30 + rgb_size_, ch);
+    if (bytes_) bytes_->first(in_, out + 30 + rgb_size_ + wave_size_, ch);
     unsigned char b[4];
     in_.bytes(b, 4);  // the chunk's point count: the chunk table's is used
     std::vector<std::pair<Layer*, std::uint32_t>> sizes;
@@ -209,6 +237,7 @@ class LayeredChunk {
       sizes.push_back({&rgb_->layers()[0], read_u32()});
       if (rgb_size_ == 8) sizes.push_back({&rgb_->layers()[1], read_u32()});
     }
+    if (wave_) sizes.push_back({&wave_->layer(), read_u32()});
     if (bytes_)
       for (Layer& l : bytes_->layers()) sizes.push_back({&l, read_u32()});
     for (auto& [layer, size] : sizes) {
@@ -229,8 +258,9 @@ class LayeredChunk {
   bool first_ = true;
   Point14Decoder point_;
   std::optional<Rgb14Decoder> rgb_;
+  std::optional<WavePacket14Decoder> wave_;
   std::optional<Byte14Decoder> bytes_;
-  std::size_t rgb_size_ = 0;
+  std::size_t rgb_size_ = 0, wave_size_ = 0;
 };
 
 }  // namespace

@@ -1,4 +1,4 @@
-// LAZ compressor 3 encoder (chunked, layered: point formats 6-8): the inverse of
+// LAZ compressor 3 encoder (chunked, layered: point formats 6-10): the inverse of
 // laz_layered.cpp, on the same per-channel state (laz_layered.h). Per chunk: the first record
 // raw, the point count, every layer's byte size, then the layers. A layer whose values never
 // change in the chunk is left out (size 0), as LASzip's writer does: the decoder then keeps
@@ -159,6 +159,29 @@ class Rgb14Encoder {
   std::array<OutLayer, 2> layers_;
 };
 
+// WAVEPACKET14: the waveform packet descriptor (the inverse of WavePacket14Decoder).
+class WavePacket14Encoder {
+ public:
+  OutLayer& layer() { return layer_; }
+  void first(const unsigned char* item, int channel) {
+    Last last;
+    std::memcpy(last.data(), item, kWavePacketSize);
+    state_.first(channel, last, make());
+  }
+  void encode(const unsigned char* item, int channel) {
+    Last& last = state_.select(channel, make);
+    encode_wavepacket(layer_.enc, state_.models(), last.data(), item);
+    std::memcpy(last.data(), item, kWavePacketSize);
+  }
+
+ private:
+  using Last = std::array<unsigned char, kWavePacketSize>;
+  static std::unique_ptr<WavePacketModels> make() { return std::make_unique<WavePacketModels>(); }
+
+  ChannelState<Last, WavePacketModels> state_;
+  OutLayer layer_;
+};
+
 // BYTE14: each extra byte a difference to its last value, in its own layer.
 class Byte14Encoder {
  public:
@@ -194,6 +217,7 @@ class LayeredChunkEncoder : public ChunkEncoder {
   LayeredChunkEncoder(const std::vector<Item>& items, std::size_t record_length) : record_length_(record_length) {
     for (const Item& it : items) {
       if (it.type == kRgb14 || it.type == kRgbNir14) rgb_.emplace(it.type == kRgbNir14), rgb_size_ = it.size;
+      else if (it.type == kWavePacket14) wave_.emplace(), wave_size_ = it.size;
       else if (it.type == kByte14) bytes_.emplace(it.size);
     }
   }
@@ -204,12 +228,14 @@ class LayeredChunkEncoder : public ChunkEncoder {
       point_.first(record);
       const int ch = (record[15] >> 4) & 3;
       if (rgb_) rgb_->first(record + 30, ch);
-      if (bytes_) bytes_->first(record + 30 + rgb_size_, ch);
+      if (wave_) wave_->first(record + 30 + rgb_size_, ch);
+      if (bytes_) bytes_->first(record + 30 + rgb_size_ + wave_size_, ch);
       return;
     }
     const int ch = point_.encode(record);
     if (rgb_) rgb_->encode(record + 30, ch);
-    if (bytes_) bytes_->encode(record + 30 + rgb_size_, ch);
+    if (wave_) wave_->encode(record + 30 + rgb_size_, ch);
+    if (bytes_) bytes_->encode(record + 30 + rgb_size_ + wave_size_, ch);
   }
   // The first record, the count, the layer sizes, the layers (the XY layer always: it carries
   // every point's change mask).
@@ -220,9 +246,11 @@ class LayeredChunkEncoder : public ChunkEncoder {
       layers.push_back(&rgb_->layer(0));
       if (rgb_size_ == 8) layers.push_back(&rgb_->layer(1));
     }
+    if (wave_) layers.push_back(&wave_->layer());
     if (bytes_)
       for (std::size_t i = 0; i < bytes_->size(); ++i) layers.push_back(&bytes_->layer(i));
     point_.layer(kXY).changed = true;
+    if (wave_) wave_->layer().changed = true;  // always written: the decoder then never guesses
     std::vector<unsigned char> out = std::move(first_);
     append_u32(out, count_);
     for (OutLayer* l : layers) {
@@ -244,8 +272,9 @@ class LayeredChunkEncoder : public ChunkEncoder {
   std::vector<unsigned char> first_;
   Point14Encoder point_;
   std::optional<Rgb14Encoder> rgb_;
+  std::optional<WavePacket14Encoder> wave_;
   std::optional<Byte14Encoder> bytes_;
-  std::size_t rgb_size_ = 0;
+  std::size_t rgb_size_ = 0, wave_size_ = 0;
 };
 
 }  // namespace

@@ -1,6 +1,6 @@
-// LAZ compressor 2 (chunked, pointwise; point formats 0-3): the version-2 item coders of
-// POINT10, RGB12 and BYTE (one state and set of models each, decoded from or encoded into), and
-// one chunk's decoding and encoding (laz_items.h).
+// LAZ compressor 2 (chunked, pointwise; point formats 0-5): the version-2 item coders of
+// POINT10, GPSTIME11, RGB12 and BYTE and WAVEPACKET13 v1 (one state and set of models each, decoded from or encoded
+// into), and one chunk's decoding and encoding (laz_items.h).
 #include <array>
 #include <cstring>
 #include <optional>
@@ -133,6 +133,24 @@ class RgbCoder {
   RgbModels models_;
 };
 
+// WAVEPACKET13 v1 (formats 4 and 5: the waveform packet descriptor of the point).
+class WavePacket13Coder {
+ public:
+  void start(const unsigned char* first) { std::memcpy(last_, first, kWavePacketSize); }
+  void next(ArithmeticDecoder& dec, unsigned char* out) {
+    decode_wavepacket(dec, models_, last_, out);
+    std::memcpy(last_, out, kWavePacketSize);
+  }
+  void encode(ArithmeticEncoder& enc, const unsigned char* item) {
+    encode_wavepacket(enc, models_, last_, item);
+    std::memcpy(last_, item, kWavePacketSize);
+  }
+
+ private:
+  unsigned char last_[kWavePacketSize] = {};
+  WavePacketModels models_;
+};
+
 // BYTE v2 (extra bytes): each byte as a difference to its previous value, one model per byte.
 class BytesCoder {
  public:
@@ -162,6 +180,7 @@ class PointwiseItems {
       if (it.type == kPoint10) point_.emplace();
       else if (it.type == kGpsTime11) time_.emplace();
       else if (it.type == kRgb12) rgb_.emplace();
+      else if (it.type == kWavePacket13) wave_.emplace();
       else bytes_.emplace(it.size);
     }
   }
@@ -174,6 +193,7 @@ class PointwiseItems {
         case kPoint10: f(*point_, at, it.size); break;
         case kGpsTime11: f(*time_, at, it.size); break;
         case kRgb12: f(*rgb_, at, it.size); break;
+        case kWavePacket13: f(*wave_, at, it.size); break;
         default: f(*bytes_, at, it.size);
       }
       at += it.size;
@@ -185,6 +205,7 @@ class PointwiseItems {
   std::optional<Point10Coder> point_;
   std::optional<GpsTime11Coder> time_;
   std::optional<RgbCoder> rgb_;
+  std::optional<WavePacket13Coder> wave_;
   std::optional<BytesCoder> bytes_;
 };
 

@@ -24,12 +24,14 @@ std::vector<laz::Item> items_for(int format, std::uint32_t record_length) {
   if (format >= 6) {
     items.push_back({kPoint14, 30, 3});
     if (format == 7) items.push_back({kRgb14, 6, 3});
-    if (format == 8) items.push_back({kRgbNir14, 8, 3});
+    if (format == 8 || format == 10) items.push_back({kRgbNir14, 8, 3});
+    if (format == 9 || format == 10) items.push_back({kWavePacket14, 29, 3});
     if (extra > 0) items.push_back({kByte14, std::uint16_t(extra), 3});
   } else {
     items.push_back({kPoint10, 20, 2});
-    if (format == 1 || format == 3) items.push_back({kGpsTime11, 8, 2});
-    if (format == 2 || format == 3) items.push_back({kRgb12, 6, 2});
+    if (format == 1 || format >= 3) items.push_back({kGpsTime11, 8, 2});
+    if (format == 2 || format == 3 || format == 5) items.push_back({kRgb12, 6, 2});
+    if (format == 4 || format == 5) items.push_back({kWavePacket13, 29, 1});
     if (extra > 0) items.push_back({kByte, std::uint16_t(extra), 2});
   }
   return items;
@@ -93,8 +95,6 @@ LasRecordWriter::LasRecordWriter(std::string path, const LasRecordFormat& format
   if (f < 0 || f > 10) throw std::invalid_argument("LasRecordWriter: point format 0–10");
   if (format.version_minor < 2 || format.version_minor > 4 || (f >= 6 && format.version_minor < 4))
     throw std::invalid_argument("LasRecordWriter: LAS 1.2–1.4, and 1.4 for point formats 6–10");
-  if (compressed && !(f <= 3 || (f >= 6 && f <= 8)))
-    throw std::invalid_argument("LasRecordWriter: LAZ of point formats 0–3 and 6–8 only");
   if (compressed && chunk_size == 0) throw std::invalid_argument("LasRecordWriter: chunk size 0");
   record_length_ = std::max(format.record_length, las_min_record_length(f));
   if (record_length_ > 0xffff) throw std::invalid_argument("LasRecordWriter: record length over 65535");

@@ -170,7 +170,7 @@ TEST(Laz, LyingHeadersAndTruncatedChunksAreOneLine) {
       {[&](std::string& b) { poke<std::uint16_t>(b, vlr, 1); }, "LASzip compressor 1 is not supported"},
       {[&](std::string& b) { poke<std::uint32_t>(b, vlr + 12, 0); }, "LASzip chunk size 0"},
       {[&](std::string& b) { poke<std::uint16_t>(b, vlr + 34 + 4, 1); }, "LASzip item version 1"},
-      {[&](std::string& b) { poke<std::uint16_t>(b, vlr + 34, 9); }, "waveform packets"},
+      {[&](std::string& b) { poke<std::uint16_t>(b, vlr + 34, 9); }, "LASzip item type 9 does not fit point format 1"},
       {[&](std::string& b) { poke<std::uint16_t>(b, vlr + 34 + 6, 8); }, "does not fit point format 1"},
       {[&](std::string& b) { poke<std::uint16_t>(b, vlr + 32, 60000); }, "item list does not fit"},
       {[](std::string& b) { b[104] = char(0x80); }, "LASzip item type 7 does not fit point format 0"},

@@ -1,9 +1,9 @@
 // Writing LAS point records as LAZ (LASzip-compressed; our own encoder, src/io/laz_write.cpp and
 // the *_write parts of src/io/laz_*.cpp, the inverse of the decoder stream_las_records uses) or
-// as plain LAS. LAZ is LASzip's chunked format as LASzip and laz-perf write it: point formats
-// 0–3 with compressor 2 (POINT10, GPSTIME11, RGB12 and BYTE items in version 2), formats 6–8
-// with compressor 3 (the layered POINT14, RGB14, RGBNIR14 and BYTE14 in version 3), extra bytes
-// in either, fixed-size chunks and a chunk table at the end.
+// as plain LAS. LAZ is LASzip's chunked format as LASzip writes it: point formats 0–5 with
+// compressor 2 (POINT10, GPSTIME11, RGB12 and BYTE items in version 2, WAVEPACKET13 in version
+// 1), formats 6–10 with compressor 3 (the layered POINT14, RGB14, RGBNIR14, WAVEPACKET14 and
+// BYTE14 in version 3), extra bytes in either, fixed-size chunks and a chunk table at the end.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -17,7 +17,7 @@ namespace lodrefine {
 // What the written header declares.
 struct LasRecordFormat {
   int version_minor = 2;            // 2..4 (formats 6–10 need 4)
-  int point_format = 0;             // LAZ: 0–3, 6–8; LAS: 0–10
+  int point_format = 0;             // 0–10
   std::uint32_t record_length = 0;  // bytes per record; 0: the format's minimum (more: extra bytes)
   Vec3 scale = Vec3::Constant(0.001), offset = Vec3::Zero();
 };
