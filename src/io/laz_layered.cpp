@@ -120,6 +120,7 @@ class Rgb14Decoder {
     state_.first(channel, {get_rgb(out), nir_ ? get_u16(out + 6) : 0u}, make());
   }
   std::array<Layer, 2>& layers() { return layers_; }
+  bool nir() const { return nir_; }
   void next(unsigned char* out, int channel) {
     Last& last = state_.select(channel, make);
     if (layers_[0].present()) last.rgb = decode_rgb(*layers_[0], state_.models().rgb, last.rgb);
@@ -149,27 +150,21 @@ class Rgb14Decoder {
 };
 
 // WAVEPACKET14 (formats 9 and 10): the waveform packet descriptor in its own layer.
-class WavePacket14Decoder {
+class WavePacket14Decoder : WavePacket14State {
  public:
   void first(ByteReader& in, unsigned char* out, int channel) {
     in.bytes(out, kWavePacketSize);
-    Last last;
-    std::memcpy(last.data(), out, kWavePacketSize);
-    state_.first(channel, last, make());
+    start(out, channel);
   }
   Layer& layer() { return layer_; }
   void next(unsigned char* out, int channel) {
-    Last& last = state_.select(channel, make);
+    Last& last = select(channel);
     if (layer_.present()) decode_wavepacket(*layer_, state_.models(), last.data(), out);
     else std::memcpy(out, last.data(), kWavePacketSize);
     std::memcpy(last.data(), out, kWavePacketSize);
   }
 
  private:
-  using Last = std::array<unsigned char, kWavePacketSize>;
-  static std::unique_ptr<WavePacketModels> make() { return std::make_unique<WavePacketModels>(); }
-
-  ChannelState<Last, WavePacketModels> state_;
   Layer layer_;
 };
 
@@ -204,20 +199,12 @@ class Byte14Decoder {
 // One chunk of a layered (compressor 3) file.
 class LayeredChunk {
  public:
-  LayeredChunk(const std::vector<Item>& items, ByteReader& in) : in_(in) {
-    for (const Item& it : items) {
-      if (it.type == kRgb14 || it.type == kRgbNir14) rgb_.emplace(it.type == kRgbNir14), rgb_size_ = it.size;
-      else if (it.type == kWavePacket14) wave_.emplace(), wave_size_ = it.size;
-      else if (it.type == kByte14) bytes_.emplace(it.size);
-    }
-  }
+  LayeredChunk(const std::vector<Item>& items, ByteReader& in) : in_(in), items_(items) {}
   void decode(unsigned char* out) {
     if (first_) return decode_first(out);
     point_.next(out);
     const int ch = point_.item_context();
-    if (rgb_) rgb_->next(out + 30, ch);
-    if (wave_) wave_->next(out + 30 + rgb_size_, ch);
-    if (bytes_) bytes_->next(out + 30 + rgb_size_ + wave_size_, ch);
+    items_.each([&](auto& item, std::size_t at) { item.next(out + at, ch); });
   }
 
  private:
@@ -226,20 +213,18 @@ class LayeredChunk {
     first_ = false;
     point_.first(in_, out);
     const int ch = point_.item_context();
-    if (rgb_) rgb_->first(in_, out + 30, ch);
-    if (wave_) wave_->first(in_, out + 30 + rgb_size_, ch);
-    if (bytes_) bytes_->first(in_, out + 30 + rgb_size_ + wave_size_, ch);
+    items_.each([&](auto& item, std::size_t at) { item.first(in_, out + at, ch); });
     unsigned char b[4];
     in_.bytes(b, 4);  // the chunk's point count: the chunk table's is used
     std::vector<std::pair<Layer*, std::uint32_t>> sizes;
     for (Layer& l : point_.layers()) sizes.push_back({&l, read_u32()});
-    if (rgb_) {
-      sizes.push_back({&rgb_->layers()[0], read_u32()});
-      if (rgb_size_ == 8) sizes.push_back({&rgb_->layers()[1], read_u32()});
+    if (auto& rgb = items_.rgb) {
+      sizes.push_back({&rgb->layers()[0], read_u32()});
+      if (rgb->nir()) sizes.push_back({&rgb->layers()[1], read_u32()});
     }
-    if (wave_) sizes.push_back({&wave_->layer(), read_u32()});
-    if (bytes_)
-      for (Layer& l : bytes_->layers()) sizes.push_back({&l, read_u32()});
+    if (items_.wave) sizes.push_back({&items_.wave->layer(), read_u32()});
+    if (items_.bytes)
+      for (Layer& l : items_.bytes->layers()) sizes.push_back({&l, read_u32()});
     for (auto& [layer, size] : sizes) {
       if (size == 0) continue;
       const unsigned char* start = in_.take(size);
@@ -257,10 +242,7 @@ class LayeredChunk {
   ByteReader& in_;
   bool first_ = true;
   Point14Decoder point_;
-  std::optional<Rgb14Decoder> rgb_;
-  std::optional<WavePacket14Decoder> wave_;
-  std::optional<Byte14Decoder> bytes_;
-  std::size_t rgb_size_ = 0, wave_size_ = 0;
+  LayeredItems<Rgb14Decoder, WavePacket14Decoder, Byte14Decoder> items_;
 };
 
 }  // namespace

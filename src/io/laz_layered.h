@@ -8,6 +8,8 @@
 #include <cstring>
 #include <functional>
 #include <memory>
+#include <optional>
+#include <vector>
 
 #include "laz_items.h"
 
@@ -100,6 +102,49 @@ class ChannelState {
 struct NirModels {
   SymbolModel byte_used{4};
   std::array<SymbolModel, 2> diff{SymbolModel(256), SymbolModel(256)};
+};
+
+// The items after POINT14 of a layered record (colour, waveform packet, extra bytes), as
+// decoders or encoders of either direction, each with its offset in the record.
+template <class Rgb, class Wave, class Bytes>
+struct LayeredItems {
+  explicit LayeredItems(const std::vector<Item>& items) {
+    std::size_t at = 30;
+    for (const Item& it : items) {
+      if (it.type == kRgb14 || it.type == kRgbNir14) rgb.emplace(it.type == kRgbNir14), rgb_at = at;
+      else if (it.type == kWavePacket14) wave.emplace(), wave_at = at;
+      else if (it.type == kByte14) bytes.emplace(it.size), bytes_at = at;
+      if (it.type != kPoint14) at += it.size;
+    }
+  }
+  // Calls f(item, its offset in the record) for each present item, in record order.
+  template <class F>
+  void each(F&& f) {
+    if (rgb) f(*rgb, rgb_at);
+    if (wave) f(*wave, wave_at);
+    if (bytes) f(*bytes, bytes_at);
+  }
+
+  std::optional<Rgb> rgb;
+  std::optional<Wave> wave;
+  std::optional<Bytes> bytes;
+  std::size_t rgb_at = 0, wave_at = 0, bytes_at = 0;
+};
+
+// WAVEPACKET14's per-channel state (the last packet, the models), for its decoder and encoder.
+class WavePacket14State {
+ protected:
+  using Last = std::array<unsigned char, kWavePacketSize>;
+  static std::unique_ptr<WavePacketModels> make() { return std::make_unique<WavePacketModels>(); }
+  void start(const unsigned char* first, int channel) {
+    Last last;
+    std::memcpy(last.data(), first, kWavePacketSize);
+    state_.first(channel, last, make());
+  }
+  // The last packet to predict from (ChannelState::select); its models are state_.models().
+  Last& select(int channel) { return state_.select(channel, make); }
+
+  ChannelState<Last, WavePacketModels> state_;
 };
 
 struct Rgb14Last {

@@ -129,6 +129,7 @@ class Rgb14Encoder {
  public:
   explicit Rgb14Encoder(bool nir) : nir_(nir) {}
   OutLayer& layer(int i) { return layers_[std::size_t(i)]; }
+  bool nir() const { return nir_; }
   void first(const unsigned char* item, int channel) {
     state_.first(channel, {get_rgb(item), nir_ ? get_u16(item + 6) : 0u}, make());
   }
@@ -160,25 +161,17 @@ class Rgb14Encoder {
 };
 
 // WAVEPACKET14: the waveform packet descriptor (the inverse of WavePacket14Decoder).
-class WavePacket14Encoder {
+class WavePacket14Encoder : WavePacket14State {
  public:
   OutLayer& layer() { return layer_; }
-  void first(const unsigned char* item, int channel) {
-    Last last;
-    std::memcpy(last.data(), item, kWavePacketSize);
-    state_.first(channel, last, make());
-  }
+  void first(const unsigned char* item, int channel) { start(item, channel); }
   void encode(const unsigned char* item, int channel) {
-    Last& last = state_.select(channel, make);
+    Last& last = select(channel);
     encode_wavepacket(layer_.enc, state_.models(), last.data(), item);
     std::memcpy(last.data(), item, kWavePacketSize);
   }
 
  private:
-  using Last = std::array<unsigned char, kWavePacketSize>;
-  static std::unique_ptr<WavePacketModels> make() { return std::make_unique<WavePacketModels>(); }
-
-  ChannelState<Last, WavePacketModels> state_;
   OutLayer layer_;
 };
 
@@ -214,43 +207,34 @@ class Byte14Encoder {
 
 class LayeredChunkEncoder : public ChunkEncoder {
  public:
-  LayeredChunkEncoder(const std::vector<Item>& items, std::size_t record_length) : record_length_(record_length) {
-    for (const Item& it : items) {
-      if (it.type == kRgb14 || it.type == kRgbNir14) rgb_.emplace(it.type == kRgbNir14), rgb_size_ = it.size;
-      else if (it.type == kWavePacket14) wave_.emplace(), wave_size_ = it.size;
-      else if (it.type == kByte14) bytes_.emplace(it.size);
-    }
-  }
+  LayeredChunkEncoder(const std::vector<Item>& items, std::size_t record_length)
+      : record_length_(record_length), items_(items) {}
   void add(const unsigned char* record) override {
     ++count_;
     if (count_ == 1) {
       first_.assign(record, record + record_length_);
       point_.first(record);
       const int ch = (record[15] >> 4) & 3;
-      if (rgb_) rgb_->first(record + 30, ch);
-      if (wave_) wave_->first(record + 30 + rgb_size_, ch);
-      if (bytes_) bytes_->first(record + 30 + rgb_size_ + wave_size_, ch);
+      items_.each([&](auto& item, std::size_t at) { item.first(record + at, ch); });
       return;
     }
     const int ch = point_.encode(record);
-    if (rgb_) rgb_->encode(record + 30, ch);
-    if (wave_) wave_->encode(record + 30 + rgb_size_, ch);
-    if (bytes_) bytes_->encode(record + 30 + rgb_size_ + wave_size_, ch);
+    items_.each([&](auto& item, std::size_t at) { item.encode(record + at, ch); });
   }
   // The first record, the count, the layer sizes, the layers (the XY layer always: it carries
   // every point's change mask).
   std::vector<unsigned char> finish() override {
     std::vector<OutLayer*> layers;
     for (int i = 0; i < kLayers; ++i) layers.push_back(&point_.layer(i));
-    if (rgb_) {
-      layers.push_back(&rgb_->layer(0));
-      if (rgb_size_ == 8) layers.push_back(&rgb_->layer(1));
+    if (auto& rgb = items_.rgb) {
+      layers.push_back(&rgb->layer(0));
+      if (rgb->nir()) layers.push_back(&rgb->layer(1));
     }
-    if (wave_) layers.push_back(&wave_->layer());
-    if (bytes_)
-      for (std::size_t i = 0; i < bytes_->size(); ++i) layers.push_back(&bytes_->layer(i));
+    if (items_.wave) layers.push_back(&items_.wave->layer());
+    if (items_.bytes)
+      for (std::size_t i = 0; i < items_.bytes->size(); ++i) layers.push_back(&items_.bytes->layer(i));
     point_.layer(kXY).changed = true;
-    if (wave_) wave_->layer().changed = true;  // always written: the decoder then never guesses
+    if (items_.wave) items_.wave->layer().changed = true;  // always written: the decoder then never guesses
     std::vector<unsigned char> out = std::move(first_);
     append_u32(out, count_);
     for (OutLayer* l : layers) {
@@ -271,10 +255,7 @@ class LayeredChunkEncoder : public ChunkEncoder {
   std::uint32_t count_ = 0;
   std::vector<unsigned char> first_;
   Point14Encoder point_;
-  std::optional<Rgb14Encoder> rgb_;
-  std::optional<WavePacket14Encoder> wave_;
-  std::optional<Byte14Encoder> bytes_;
-  std::size_t rgb_size_ = 0, wave_size_ = 0;
+  LayeredItems<Rgb14Encoder, WavePacket14Encoder, Byte14Encoder> items_;
 };
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "lodrefine/io/laz_write.h"
 #include "support/cli_fixtures.h"
 #include "support/io_fixtures.h"
+#include "support/laz_fixtures.h"
 #include "support/realdata.h"
 
 using namespace lodrefine;
@@ -138,13 +139,7 @@ std::string write_records(const std::string& path, const LasRecordFormat& format
   return path;
 }
 
-std::string read_records(const std::string& path) {
-  std::string all;
-  stream_las_records(path, [&](const LasHeader& h, const unsigned char* r) {
-    all.append(reinterpret_cast<const char*>(r), h.record_length);
-  });
-  return all;
-}
+std::string read_records(const std::string& path) { return fixtures::las_records(path); }
 
 // Index of the first differing record, for messages.
 std::size_t first_difference(const std::string& a, const std::string& b, std::uint32_t length) {
@@ -160,11 +155,6 @@ LasRecordFormat format_of(int f, std::uint32_t extra) {
   o.record_length = las_min_record_length(f) + extra;
   o.offset = Vec3(0, 0, -10);
   return o;
-}
-
-std::string lazperf_modules() {
-  if (const char* env = std::getenv("LODREFINE_LAZPERF_MODULES")) return env;
-  return "/tmp/lazjs/node_modules";
 }
 
 }  // namespace
@@ -252,12 +242,7 @@ TEST(LazWrite, RefusesFormatsItCannotWrite) {
 // the infrared from the previous channel but keeps it in the current one (our decoder and encoder do the same), while
 // laz-perf keeps it in the previous one; the two disagree there.
 TEST(LazWrite, LazPerfDecodesWhatWeWrite) {
-  const std::string script = std::string(LODREFINE_SOURCE_DIR) + "/tests/io/laz_reference_dump.js";
-  const std::string modules = lazperf_modules();
-  if (std::system("node --version >/dev/null 2>&1") != 0) GTEST_SKIP() << "node not installed";
-  if (!fs::exists(fs::path(modules) / "laz-perf"))
-    GTEST_SKIP() << "npm package laz-perf not under " << modules
-                 << " (mkdir -p /tmp/lazjs && cd /tmp/lazjs && npm install laz-perf@0.0.7)";
+  if (const std::string missing = fixtures::lazperf_missing(); !missing.empty()) GTEST_SKIP() << missing;
   for (const int f : kLazFormats) {
     if (wave_at(f) != kNone) continue;  // laz-perf reads no waveform packets
     for (const std::uint32_t extra : {0u, 4u}) {
@@ -266,7 +251,7 @@ TEST(LazWrite, LazPerfDecodesWhatWeWrite) {
       const std::string want = scan_records(f, o.record_length, 5001, 100u + unsigned(f), 0, f != 8);
       const std::string laz = write_records(temp_path("ours.laz"), o, true, want, 1000);
       const std::string dump = temp_path("ours.ref");
-      const std::string cmd = "node '" + script + "' '" + modules + "' '" + laz + "' '" + dump + "'";
+      const std::string cmd = fixtures::lazperf_command(laz, dump);
       ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
       const std::string ref = cli_fixtures::slurp(dump);
       ASSERT_EQ(ref.size(), want.size());
