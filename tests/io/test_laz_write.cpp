@@ -287,3 +287,26 @@ TEST(LazWrite, RealAhn3ReEncodesToTheSamePoints) {
   };
   EXPECT_TRUE(point_data(cli_fixtures::slurp(laz)) == point_data(cli_fixtures::slurp(data_path.string())));
 }
+
+// Waveform LAZ is checked as the other formats: the WAVEPACKET13 item in version 1 only, the
+// packet item present, a truncated chunk one line.
+TEST(LazWrite, WaveformItemsAreChecked) {
+  const LasRecordFormat o = format_of(4, 0);
+  const std::string good =
+      cli_fixtures::slurp(write_records(temp_path("f4.laz"), o, true, scan_records(4, o.record_length, 500, 9u), 200));
+  const std::size_t items = get<std::uint16_t>(good, 94) + 54 + 34;
+  ASSERT_EQ(get<std::uint16_t>(good, items + 12), 9);  // POINT10, GPSTIME11, WAVEPACKET13
+  const auto refused = [](std::string bytes, const std::string& fault) {
+    fixtures::expect_bytes_refused("bad.laz", bytes, fault, read_records);
+  };
+  std::string b = good;
+  fixtures::poke<std::uint16_t>(b, items + 12 + 4, 2);
+  refused(b, "LASzip item version 2 (point format 4 is read in version 1)");
+  b = good;
+  fixtures::poke<std::uint16_t>(b, items + 12, 0);  // the packet item made extra bytes
+  refused(b, "LASzip item type 0 does not fit point format 4");
+  const auto table = get<std::uint64_t>(good, get<std::uint32_t>(good, 96));
+  b = good.substr(0, std::size_t(table) - 300) + good.substr(std::size_t(table));
+  fixtures::poke<std::uint64_t>(b, get<std::uint32_t>(good, 96), table - 300);
+  refused(b, "does not fit the point data before the chunk table");
+}
