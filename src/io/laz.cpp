@@ -29,24 +29,26 @@ std::string check_items(const std::vector<Item>& items, int format, std::uint16_
     want = {kPoint14};
     if (format == 7) want.push_back(kRgb14);
     if (format == 8 || format == 10) want.push_back(kRgbNir14);
+    if (format == 9 || format == 10) want.push_back(kWavePacket14);
   } else {
     want = {kPoint10};
     if (format == 1 || format == 3 || format == 4 || format == 5) want.push_back(kGpsTime11);
     if (format == 2 || format == 3 || format == 5) want.push_back(kRgb12);
+    if (format == 4 || format == 5) want.push_back(kWavePacket13);
   }
   const std::uint16_t bytes_type = layered ? kByte14 : kByte, version = layered ? 3 : 2;
   std::uint32_t total = 0;
   std::size_t i = 0;
   for (const Item& it : items) {
-    if (it.type == kWavePacket13 || it.type == kWavePacket14)
-      return "waveform packets (point formats 4, 5, 9 and 10) are not supported in LAZ";
     const bool expected = i < want.size() ? it.type == want[i] : it.type == bytes_type && i == want.size();
     if (!expected)
       return "LASzip item type " + std::to_string(it.type) + " does not fit point format " + std::to_string(format);
-    if (it.version != version)
+    // WAVEPACKET13 has only version 1 (LASzip writes it beside version-2 items).
+    const std::uint16_t item_version = it.type == kWavePacket13 ? 1 : version;
+    if (it.version != item_version)
       return "LASzip item version " + std::to_string(it.version) + " (point format " + std::to_string(format) +
-             " is read in version " + std::to_string(version) + ")";
-    static const std::array<std::uint16_t, 15> kSize = {0, 0, 0, 0, 0, 0, 20, 8, 6, 0, 30, 6, 8, 0, 0};
+             " is read in version " + std::to_string(item_version) + ")";
+    static const std::array<std::uint16_t, 15> kSize = {0, 0, 0, 0, 0, 0, 20, 8, 6, 29, 30, 6, 8, 29, 0};
     const std::uint16_t size = it.type == bytes_type ? it.size : kSize[it.type];
     if (it.size != size || size == 0)
       return "LASzip item type " + std::to_string(it.type) + " of " + std::to_string(it.size) + " bytes";
@@ -89,7 +91,7 @@ class ChunkTable {
   std::vector<unsigned char> bytes_;
   std::optional<ByteReader> reader_;
   std::optional<ArithmeticDecoder> dec_;
-  IntegerDecoder ic_{32, 2};
+  IntegerCoder ic_{32, 2};
   bool started_ = false;
   std::uint32_t prev_count_ = 0, prev_bytes_ = 0;
 };

@@ -4,13 +4,15 @@
 // calls it for files whose header or VLRs say "compressed".
 //
 // Supported: the "laszip encoded" VLR (user id "laszip encoded", record 22204); compressor 2
-// (chunked, pointwise) with items POINT10, GPSTIME11, RGB12 and BYTE in version 2, i.e. point
-// formats 0–3 with any extra bytes; compressor 3 (chunked, layered: LASzip for LAS 1.4) with
-// POINT14, RGB14, RGBNIR14 and BYTE14 in version 3, i.e. formats 6–8 with extra bytes; chunk
-// tables of fixed and variable chunk sizes. Refused with one line naming what is missing:
-// waveform packets (formats 4, 5, 9, 10), item version 1 (LASzip 1.x), the unchunked
-// compressor 1.
+// (chunked, pointwise) with items POINT10, GPSTIME11, RGB12 and BYTE in version 2 and
+// WAVEPACKET13 in version 1, i.e. point formats 0–5 with any extra bytes; compressor 3 (chunked,
+// layered: LASzip for LAS 1.4) with POINT14, RGB14, RGBNIR14, WAVEPACKET14 and BYTE14 in version
+// 3, i.e. formats 6–10 with extra bytes; chunk tables of fixed and variable chunk sizes. Refused
+// with one line naming what is missing: other item versions (LASzip 1.x), the unchunked
+// compressor 1. The encoder (laz_write.cpp, the chunk encoders in laz_items.h) writes what this
+// decoder reads, on the same models.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <fstream>
 #include <functional>
@@ -49,5 +51,17 @@ Layout read_layout(const std::string& path, std::ifstream& in, std::uint64_t fil
 // (header.record_length bytes). Throws InputError on a truncated or corrupt chunk.
 void stream_records(const std::string& path, std::ifstream& in, std::uint64_t file_size, const LasHeader& header,
                     const Layout& layout, const std::function<void(const unsigned char*)>& on_record);
+
+// The fields of a LAS 1.2–1.4 public header block that the writers set (las.cpp).
+struct HeaderBlock {
+  int version_minor = 2;
+  int format_byte = 0;  // the point format, with bit 7 set for LAZ
+  std::uint32_t record_length = 0, point_offset = 0, vlr_count = 0;
+  std::uint64_t count = 0;
+  std::array<std::uint64_t, 15> by_return{};
+  Vec3 scale, offset, min, max;
+};
+// The header block's bytes (227, 235 or 375 by version); legacy counts 0 for formats 6–10.
+std::string las_header_block(const HeaderBlock& b);
 
 }  // namespace lodrefine::laz

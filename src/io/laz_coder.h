@@ -1,10 +1,13 @@
-// Internal to the io library's LAZ decoder (laz.h): LASzip's arithmetic decoder, its adaptive
-// bit and symbol models and the integer decompressor, after the published LASzip format, plus the
-// byte reader they decode from. All state is unsigned where the format wraps (corrector sums),
-// so no signed overflow or negative shift happens on any input.
+// Internal to the io library's LAZ codec (laz.h, laz_write.cpp): LASzip's arithmetic decoder and
+// encoder, their shared adaptive bit and symbol models and the integer coder (one set of
+// models, decoded from or encoded into), after the published LASzip format, plus the byte
+// reader they decode from. All state is unsigned where the format wraps (corrector sums), so no
+// signed overflow or negative shift happens on any input.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -158,12 +161,98 @@ class ArithmeticDecoder {
   std::uint32_t value_ = 0, length_ = 0xffffffffu;
 };
 
-// LASzip's integer decompressor: a value is a prediction plus a corrector whose bit length k
-// is coded per context, then its bits (the high ones modelled, the rest raw). The sum wraps
-// into the corrector range, as the encoder's difference did.
-class IntegerDecoder {
+// LASzip's arithmetic encoder (the decoder's inverse): appends to `out`; a carry runs back over
+// the bytes already written. done() flushes the interval with the padding the decoder reads.
+class ArithmeticEncoder {
  public:
-  explicit IntegerDecoder(std::uint32_t bits = 16, std::uint32_t contexts = 1, std::uint32_t bits_high = 8)
+  explicit ArithmeticEncoder(std::vector<unsigned char>& out) : out_(out), start_(out.size()) {}
+  void bit(BitModel& m, std::uint32_t sym) {
+    const std::uint32_t x = m.bit_0_prob * (length_ >> kBitLengthShift);
+    if (sym == 0) {
+      length_ = x;
+      ++m.bit_0_count;
+    } else {
+      add(x);
+      length_ -= x;
+    }
+    if (length_ < kMinLength) renormalise();
+    if (--m.until_update == 0) m.update();
+  }
+  void symbol(SymbolModel& m, std::uint32_t sym) {
+    if (sym + 1 == m.symbols) {  // the last symbol takes the rest of the interval
+      const std::uint32_t x = m.distribution[sym] * (length_ >> kSymbolLengthShift);
+      add(x);
+      length_ -= x;
+    } else {
+      const std::uint32_t x = m.distribution[sym] * (length_ >>= kSymbolLengthShift);
+      add(x);
+      length_ = m.distribution[sym + 1] * length_ - x;
+    }
+    if (length_ < kMinLength) renormalise();
+    ++m.count[sym];
+    if (--m.until_update == 0) m.update();
+  }
+  // `bits` (1..32) raw bits of `sym`, low 16 first when over 19 (as the decoder reads them).
+  void bits(std::uint32_t bits, std::uint32_t sym) {
+    if (bits > 19) {
+      raw(16, sym & 0xffff);
+      sym >>= 16;
+      bits -= 16;
+    }
+    raw(bits, sym);
+  }
+  void u32(std::uint32_t v) {
+    raw(16, v & 0xffff);
+    raw(16, v >> 16);
+  }
+  void done() {
+    const std::uint32_t init = base_;
+    const bool another_byte = length_ > 2 * kMinLength;
+    if (another_byte) {
+      base_ += kMinLength;
+      length_ = kMinLength >> 1;
+    } else {
+      base_ += kMinLength >> 1;
+      length_ = kMinLength >> 9;
+    }
+    if (init > base_) carry();
+    renormalise();
+    out_.insert(out_.end(), another_byte ? 3 : 2, 0);  // the decoder reads ahead
+  }
+
+ private:
+  void raw(std::uint32_t bits, std::uint32_t sym) {
+    add(sym * (length_ >>= bits));
+    if (length_ < kMinLength) renormalise();
+  }
+  void add(std::uint32_t x) {
+    const std::uint32_t init = base_;
+    base_ += x;
+    if (init > base_) carry();
+  }
+  void carry() {
+    std::size_t i = out_.size();
+    while (i > start_ && out_[i - 1] == 0xff) out_[--i] = 0;
+    if (i > start_) ++out_[i - 1];
+  }
+  void renormalise() {
+    do {
+      out_.push_back((unsigned char)(base_ >> 24));
+      base_ <<= 8;
+    } while ((length_ <<= 8) < kMinLength);
+  }
+
+  std::vector<unsigned char>& out_;
+  std::size_t start_;
+  std::uint32_t base_ = 0, length_ = 0xffffffffu;
+};
+
+// LASzip's integer compressor and decompressor: a value is a prediction plus a corrector whose
+// bit length k is coded per context, then its bits (the high ones modelled, the rest raw). The
+// corrector wraps into its range both ways, so every value of `bits` bits round-trips.
+class IntegerCoder {
+ public:
+  explicit IntegerCoder(std::uint32_t bits = 16, std::uint32_t contexts = 1, std::uint32_t bits_high = 8)
       : bits_high_(bits_high) {
     if (bits > 0 && bits < 32) {
       corr_bits_ = bits;
@@ -183,24 +272,50 @@ class IntegerDecoder {
     else if (real >= corr_range_) real -= corr_range_;
     return std::int32_t(real);
   }
+  // Codes `real` (a value of `bits` bits, signed or not as the caller's prediction) given `pred`.
+  void encode(ArithmeticEncoder& enc, std::int32_t pred, std::int32_t real, std::uint32_t context) {
+    std::int32_t corr = std::int32_t(std::uint32_t(real) - std::uint32_t(pred));  // 32 bits: wraps
+    if (corr_range_ != 0) {
+      const std::int64_t c = std::int64_t(real) - pred, range = corr_range_;
+      corr = std::int32_t(c < corr_min_ ? c + range : c > corr_min_ + range - 1 ? c - range : c);
+    }
+    write_corrector(enc, corr, k_models_[context]);
+  }
   std::uint32_t k() const { return k_; }
 
  private:
+  // The corrector model of each bit length is made on first use (LASzip makes all at once; an
+  // unused model's state never matters).
+  SymbolModel& corrector_model(std::uint32_t k) {
+    std::unique_ptr<SymbolModel>& model = corrector_[k - 1];
+    if (!model) model = std::make_unique<SymbolModel>(1u << std::min(k, bits_high_));
+    return *model;
+  }
   std::int32_t corrector(ArithmeticDecoder& dec, SymbolModel& k_model) {
     k_ = dec.symbol(k_model);
     if (k_ == 0) return std::int32_t(dec.bit(corrector0_));  // 0 or 1
     if (k_ >= 32) return corr_min_;
-    // The corrector model of each bit length is made on first use (LASzip makes all at once;
-    // an unused model's state never matters).
-    std::unique_ptr<SymbolModel>& model = corrector_[k_ - 1];
-    if (!model) model = std::make_unique<SymbolModel>(1u << std::min(k_, bits_high_));
-    std::uint32_t c = dec.symbol(*model);
+    std::uint32_t c = dec.symbol(corrector_model(k_));
     if (k_ > bits_high_) {
       const std::uint32_t low_bits = k_ - bits_high_;
       c = (c << low_bits) | dec.bits(low_bits);
     }
     // c in [2^(k-1), 2^k) stands for c + 1; c in [0, 2^(k-1)) for c - (2^k - 1).
     return std::int32_t(c >= (1u << (k_ - 1)) ? c + 1 : c - ((1u << k_) - 1));
+  }
+  // k: the smallest with c in [-(2^k - 1), 2^k]; then c mapped into [0, 2^k) as above.
+  void write_corrector(ArithmeticEncoder& enc, std::int32_t c, SymbolModel& k_model) {
+    std::uint32_t c1 = c <= 0 ? 0u - std::uint32_t(c) : std::uint32_t(c) - 1;
+    k_ = 0;
+    while (c1) c1 >>= 1, ++k_;
+    enc.symbol(k_model, k_);
+    if (k_ == 0) return enc.bit(corrector0_, std::uint32_t(c));
+    if (k_ >= 32) return;
+    const std::uint32_t v = c < 0 ? std::uint32_t(c) + ((1u << k_) - 1) : std::uint32_t(c) - 1;
+    if (k_ <= bits_high_) return enc.symbol(corrector_model(k_), v);
+    const std::uint32_t low_bits = k_ - bits_high_;
+    enc.symbol(corrector_model(k_), v >> low_bits);
+    enc.bits(low_bits, v & ((1u << low_bits) - 1));
   }
 
   std::uint32_t bits_high_, corr_bits_ = 32, corr_range_ = 0;

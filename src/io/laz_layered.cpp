@@ -9,7 +9,7 @@
 #include <memory>
 #include <optional>
 
-#include "laz_items.h"
+#include "laz_layered.h"
 
 namespace lodrefine::laz {
 namespace {
@@ -26,55 +26,14 @@ struct Layer {
   ArithmeticDecoder* operator->() { return &**this; }
 };
 
-// Contexts of POINT14 by (number of returns, return number): 6 for x/y, 8 levels for z.
-constexpr unsigned char kReturnMap6[16][16] = {
-    {0, 1, 2, 3, 4, 5, 3, 4, 4, 5, 5, 5, 5, 5, 5, 5}, {1, 0, 1, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3},
-    {2, 1, 2, 4, 4, 4, 4, 4, 4, 4, 4, 3, 3, 3, 3, 3}, {3, 3, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
-    {4, 3, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4}, {5, 3, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
-    {3, 3, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4}, {4, 3, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4},
-    {4, 3, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4}, {5, 3, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4},
-    {5, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 4, 4, 4},
-    {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4, 4}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4},
-    {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5}};
-unsigned return_level8(unsigned n, unsigned r) {
-  const unsigned d = n > r ? n - r : r - n;
-  return std::min(d, 7u);
-}
-
-// The 30 bytes of formats 6–10: x, y, z, intensity, returns (r | n << 4), flags (class flags,
-// channel << 4, scan direction << 6, edge << 7), class, user data, scan angle, source, time.
-struct Point14Context {
-  bool used = false;
-  unsigned char last[30] = {};
-  std::array<std::uint16_t, 8> last_intensity{};
-  std::array<std::int32_t, 8> last_z{};
-  std::array<Median5, 12> x_median, y_median;
-  bool gps_changed = false;
-  LazyModels changed_values{8, 128}, nr{16, 16}, rn{16, 16}, classification{64, 256}, flags{64, 64}, user_data{64, 256};
-  SymbolModel scanner_channel{3}, rn_gps_same{13};
-  IntegerDecoder ic_dx{32, 2}, ic_dy{32, 22}, ic_z{32, 20}, ic_intensity{16, 4}, ic_scan_angle{16, 2},
-      ic_point_source{16, 1};
-  GpsTimeDecoder time{true};
-
-  // A channel's first point continues from the point before it, of whatever channel.
-  void start_from(const unsigned char* point) {
-    used = true;
-    std::memcpy(last, point, 30);
-    last_z.fill(std::int32_t(get_u32(point + 8)));
-    last_intensity.fill(get_u16(point + 12));
-    time.seed(get_u64(point + 22));
-  }
-};
-
-// The layers of POINT14, in stream order.
-enum Point14Layer { kXY, kZ, kClass, kFlags, kIntensity, kScanAngle, kUserData, kPointSource, kGpsTime, kLayers };
-
 class Point14Decoder {
  public:
-  int channel() const { return channel_; }
+  // The context the other items of this point use (LASzip's reader, laz-perf): the channel
+  // on the chunk's first point and where it switches, 0 on every other point.
+  int item_context() const { return item_context_; }
   void first(ByteReader& in, unsigned char* out) {
     in.bytes(out, 30);
-    channel_ = (out[15] >> 4) & 3;
+    channel_ = item_context_ = (out[15] >> 4) & 3;
     context(channel_).start_from(out);
   }
   std::array<Layer, kLayers>& layers() { return layers_; }
@@ -88,6 +47,7 @@ class Point14Decoder {
     const bool gps_changed = changed & 16;
     int channel = channel_;
     if (changed & 64) channel_ = channel = int((unsigned(channel) + xy.symbol(prev.scanner_channel) + 1) % 4);
+    item_context_ = changed & 64 ? channel : 0;
     Point14Context& c = context(channel);
     if (!c.used) c.start_from(prev.last);
     unsigned char* p = c.last;
@@ -148,52 +108,7 @@ class Point14Decoder {
 
   std::array<std::unique_ptr<Point14Context>, 4> ctx_;
   std::array<Layer, kLayers> layers_;
-  int channel_ = 0;
-};
-
-// RGB14 / RGBNIR14 and BYTE14 keep their models and last values per scanner channel too. As
-// LASzip's v3 readers do (and laz-perf): a channel's first point continues from the channel
-// before it; after a switch back to a channel already seen in the chunk, the prediction still
-// comes from (and updates) the previous channel's last value, with the new channel's models.
-template <class Last, class Models>
-class ChannelState {
- public:
-  void first(int channel, const Last& value, std::unique_ptr<Models> models) {
-    current_ = channel;
-    ctx_[channel].used = true;
-    ctx_[channel].last = value;
-    ctx_[channel].models = std::move(models);
-  }
-  // The last value to predict from for a point of `channel`; makes its context when new.
-  Last& select(int channel, const std::function<std::unique_ptr<Models>()>& make) {
-    Last* last = &ctx_[current_].last;
-    if (channel != current_) {
-      current_ = channel;
-      if (!ctx_[channel].used) {
-        ctx_[channel].used = true;
-        ctx_[channel].last = *last;
-        ctx_[channel].models = make();
-        last = &ctx_[channel].last;
-      }
-    }
-    return *last;
-  }
-  Models& models() { return *ctx_[current_].models; }
-  Last& current_last() { return ctx_[current_].last; }
-
- private:
-  struct Context {
-    bool used = false;
-    Last last{};
-    std::unique_ptr<Models> models;
-  };
-  std::array<Context, 4> ctx_;
-  int current_ = 0;
-};
-
-struct NirModels {
-  SymbolModel byte_used{4};
-  std::array<SymbolModel, 2> diff{SymbolModel(256), SymbolModel(256)};
+  int channel_ = 0, item_context_ = 0;
 };
 
 // RGB14 (6 bytes) or RGBNIR14 (8 bytes: the colour and the near infrared, two layers).
@@ -205,6 +120,7 @@ class Rgb14Decoder {
     state_.first(channel, {get_rgb(out), nir_ ? get_u16(out + 6) : 0u}, make());
   }
   std::array<Layer, 2>& layers() { return layers_; }
+  bool nir() const { return nir_; }
   void next(unsigned char* out, int channel) {
     Last& last = state_.select(channel, make);
     if (layers_[0].present()) last.rgb = decode_rgb(*layers_[0], state_.models().rgb, last.rgb);
@@ -224,19 +140,32 @@ class Rgb14Decoder {
   }
 
  private:
-  struct Last {
-    std::array<std::uint32_t, 3> rgb{};
-    std::uint32_t nir = 0;
-  };
-  struct Models {
-    RgbModels rgb;
-    NirModels nir;
-  };
+  using Last = Rgb14Last;
+  using Models = Rgb14Models;
   static std::unique_ptr<Models> make() { return std::make_unique<Models>(); }
 
   bool nir_;
   ChannelState<Last, Models> state_;
   std::array<Layer, 2> layers_;
+};
+
+// WAVEPACKET14 (formats 9 and 10): the waveform packet descriptor in its own layer.
+class WavePacket14Decoder : WavePacket14State {
+ public:
+  void first(ByteReader& in, unsigned char* out, int channel) {
+    in.bytes(out, kWavePacketSize);
+    start(out, channel);
+  }
+  Layer& layer() { return layer_; }
+  void next(unsigned char* out, int channel) {
+    Last& last = select(channel);
+    if (layer_.present()) decode_wavepacket(*layer_, state_.models(), last.data(), out);
+    else std::memcpy(out, last.data(), kWavePacketSize);
+    std::memcpy(last.data(), out, kWavePacketSize);
+  }
+
+ private:
+  Layer layer_;
 };
 
 // BYTE14: each extra byte its own layer, a difference to its last value.
@@ -270,18 +199,12 @@ class Byte14Decoder {
 // One chunk of a layered (compressor 3) file.
 class LayeredChunk {
  public:
-  LayeredChunk(const std::vector<Item>& items, ByteReader& in) : in_(in) {
-    for (const Item& it : items) {
-      if (it.type == kRgb14 || it.type == kRgbNir14) rgb_.emplace(it.type == kRgbNir14), rgb_size_ = it.size;
-      else if (it.type == kByte14) bytes_.emplace(it.size);
-    }
-  }
+  LayeredChunk(const std::vector<Item>& items, ByteReader& in) : in_(in), items_(items) {}
   void decode(unsigned char* out) {
     if (first_) return decode_first(out);
     point_.next(out);
-    const int ch = point_.channel();
-    if (rgb_) rgb_->next(out + 30, ch);
-    if (bytes_) bytes_->next(out + 30 + rgb_size_, ch);
+    const int ch = point_.item_context();
+    items_.each([&](auto& item, std::size_t at) { item.next(out + at, ch); });
   }
 
  private:
@@ -289,19 +212,19 @@ class LayeredChunk {
   void decode_first(unsigned char* out) {
     first_ = false;
     point_.first(in_, out);
-    const int ch = point_.channel();
-    if (rgb_) rgb_->first(in_, out + 30, ch);
-    if (bytes_) bytes_->first(in_, out + 30 + rgb_size_, ch);
+    const int ch = point_.item_context();
+    items_.each([&](auto& item, std::size_t at) { item.first(in_, out + at, ch); });
     unsigned char b[4];
     in_.bytes(b, 4);  // the chunk's point count: the chunk table's is used
     std::vector<std::pair<Layer*, std::uint32_t>> sizes;
     for (Layer& l : point_.layers()) sizes.push_back({&l, read_u32()});
-    if (rgb_) {
-      sizes.push_back({&rgb_->layers()[0], read_u32()});
-      if (rgb_size_ == 8) sizes.push_back({&rgb_->layers()[1], read_u32()});
+    if (auto& rgb = items_.rgb) {
+      sizes.push_back({&rgb->layers()[0], read_u32()});
+      if (rgb->nir()) sizes.push_back({&rgb->layers()[1], read_u32()});
     }
-    if (bytes_)
-      for (Layer& l : bytes_->layers()) sizes.push_back({&l, read_u32()});
+    if (items_.wave) sizes.push_back({&items_.wave->layer(), read_u32()});
+    if (items_.bytes)
+      for (Layer& l : items_.bytes->layers()) sizes.push_back({&l, read_u32()});
     for (auto& [layer, size] : sizes) {
       if (size == 0) continue;
       const unsigned char* start = in_.take(size);
@@ -319,9 +242,7 @@ class LayeredChunk {
   ByteReader& in_;
   bool first_ = true;
   Point14Decoder point_;
-  std::optional<Rgb14Decoder> rgb_;
-  std::optional<Byte14Decoder> bytes_;
-  std::size_t rgb_size_ = 0;
+  LayeredItems<Rgb14Decoder, WavePacket14Decoder, Byte14Decoder> items_;
 };
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include "lodrefine/io/las.h"
 #include "support/cli_fixtures.h"
 #include "support/io_fixtures.h"
+#include "support/laz_fixtures.h"
 #include "support/realdata.h"
 
 using namespace lodrefine;
@@ -43,24 +44,10 @@ T peek(const unsigned char* p) {
   return v;
 }
 
-// All records of a LAS or LAZ file, concatenated.
-std::string records(const std::string& path) {
-  std::string all;
-  stream_las_records(path, [&](const LasHeader& h, const unsigned char* r) {
-    all.append(reinterpret_cast<const char*>(r), h.record_length);
-  });
-  return all;
-}
+std::string records(const std::string& path) { return fixtures::las_records(path); }
 
 void expect_error(const std::string& bytes, const std::string& fault) {
   fixtures::expect_bytes_refused("bad.laz", bytes, fault, records);
-}
-
-// Where laz-perf's node module may be: $LODREFINE_LAZPERF_MODULES, else the scratch folder
-// the README's install line uses.
-std::string lazperf_modules() {
-  if (const char* env = std::getenv("LODREFINE_LAZPERF_MODULES")) return env;
-  return "/tmp/lazjs/node_modules";
 }
 
 }  // namespace
@@ -121,16 +108,11 @@ TEST(Laz, RealAhn3HeaderBoundsAndClassHistogram) {
 
 TEST(Laz, DecodedRecordsEqualLazPerfByteForByte) {
   REQUIRE_REALDATA(kAhn3);
-  const std::string script = std::string(LODREFINE_SOURCE_DIR) + "/tests/io/laz_reference_dump.js";
-  const std::string modules = lazperf_modules();
-  if (std::system("node --version >/dev/null 2>&1") != 0) GTEST_SKIP() << "node not installed";
-  if (!fs::exists(fs::path(modules) / "laz-perf"))
-    GTEST_SKIP() << "npm package laz-perf not under " << modules
-                 << " (mkdir -p /tmp/lazjs && cd /tmp/lazjs && npm install laz-perf@0.0.7)";
+  if (const std::string missing = fixtures::lazperf_missing(); !missing.empty()) GTEST_SKIP() << missing;
   for (const char* rel : {kAhn3, kAhn3Small}) {
     const fs::path laz = fixtures::realdata_dir() / rel;
     const std::string dump = temp_path(laz.filename().string() + ".ref");
-    const std::string cmd = "node '" + script + "' '" + modules + "' '" + laz.string() + "' '" + dump + "'";
+    const std::string cmd = fixtures::lazperf_command(laz.string(), dump);
     ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
     const std::string ref = cli_fixtures::slurp(dump), ours = records(laz.string());
     ASSERT_EQ(ours.size(), ref.size()) << rel;
@@ -170,7 +152,7 @@ TEST(Laz, LyingHeadersAndTruncatedChunksAreOneLine) {
       {[&](std::string& b) { poke<std::uint16_t>(b, vlr, 1); }, "LASzip compressor 1 is not supported"},
       {[&](std::string& b) { poke<std::uint32_t>(b, vlr + 12, 0); }, "LASzip chunk size 0"},
       {[&](std::string& b) { poke<std::uint16_t>(b, vlr + 34 + 4, 1); }, "LASzip item version 1"},
-      {[&](std::string& b) { poke<std::uint16_t>(b, vlr + 34, 9); }, "waveform packets"},
+      {[&](std::string& b) { poke<std::uint16_t>(b, vlr + 34, 9); }, "LASzip item type 9 does not fit point format 1"},
       {[&](std::string& b) { poke<std::uint16_t>(b, vlr + 34 + 6, 8); }, "does not fit point format 1"},
       {[&](std::string& b) { poke<std::uint16_t>(b, vlr + 32, 60000); }, "item list does not fit"},
       {[](std::string& b) { b[104] = char(0x80); }, "LASzip item type 7 does not fit point format 0"},
@@ -290,17 +272,13 @@ TEST(Laz, EveryTruncationAndByteFlipIsOneLineOrTheSamePoints) {
 TEST(Laz, SampleFolderEqualsLazPerf) {
   const char* dir = std::getenv("LODREFINE_LAZ_SAMPLES");
   if (!dir) GTEST_SKIP() << "LODREFINE_LAZ_SAMPLES not set";
-  const std::string script = std::string(LODREFINE_SOURCE_DIR) + "/tests/io/laz_reference_dump.js";
-  const std::string modules = lazperf_modules();
-  if (std::system("node --version >/dev/null 2>&1") != 0 || !fs::exists(fs::path(modules) / "laz-perf"))
-    GTEST_SKIP() << "node or laz-perf missing";
+  if (const std::string missing = fixtures::lazperf_missing(); !missing.empty()) GTEST_SKIP() << missing;
   std::size_t same = 0;
   for (const auto& e : fs::directory_iterator(dir)) {
     if (e.path().extension() != ".laz") continue;
     const std::string dump = temp_path("sample.ref");
     fs::remove(dump);
-    const std::string cmd =
-        "node '" + script + "' '" + modules + "' '" + e.path().string() + "' '" + dump + "' 2>/dev/null";
+    const std::string cmd = fixtures::lazperf_command(e.path().string(), dump) + " 2>/dev/null";
     const bool reference = std::system(cmd.c_str()) == 0 && fs::exists(dump) && fs::file_size(dump) > 0;
     try {
       const std::string ours = records(e.path().string());

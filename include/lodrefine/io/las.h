@@ -1,5 +1,5 @@
 // Reading ASPRS LAS point clouds: versions 1.0–1.4, point data record formats 0–10,
-// uncompressed, and LASzip-compressed LAZ of point formats 0–3 (our own decoder, src/io/laz.cpp:
+// uncompressed, and LASzip-compressed LAZ of point formats 0–10 (our own decoder, src/io/laz.cpp:
 // Debian ships no LAS library, no PDAL, LASlib, liblas, LASzip or laz-perf). A small reader of
 // the public header block and the point records; other LAZ is refused with one line.
 #pragma once

@@ -1,0 +1,44 @@
+// LAZ test helpers shared by tests/io/test_laz.cpp and test_laz_write.cpp: the records of a LAS
+// or LAZ file, and the independent decoder (the npm package laz-perf under node, run by
+// tests/io/laz_reference_dump.js), which the tests skip without.
+#pragma once
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "lodrefine/io/las.h"
+
+namespace lodrefine::fixtures {
+
+// All records of a LAS or LAZ file, concatenated.
+inline std::string las_records(const std::string& path) {
+  std::string all;
+  stream_las_records(path, [&](const LasHeader& h, const unsigned char* r) {
+    all.append(reinterpret_cast<const char*>(r), h.record_length);
+  });
+  return all;
+}
+
+// Where laz-perf's node module may be: $LODREFINE_LAZPERF_MODULES, else the scratch folder
+// the README's install line uses.
+inline std::string lazperf_modules() {
+  if (const char* env = std::getenv("LODREFINE_LAZPERF_MODULES")) return env;
+  return "/tmp/lazjs/node_modules";
+}
+
+// Why laz-perf cannot run here (empty: it can).
+inline std::string lazperf_missing() {
+  if (std::system("node --version >/dev/null 2>&1") != 0) return "node not installed";
+  if (!std::filesystem::exists(std::filesystem::path(lazperf_modules()) / "laz-perf"))
+    return "npm package laz-perf not under " + lazperf_modules() +
+           " (mkdir -p /tmp/lazjs && cd /tmp/lazjs && npm install laz-perf@0.0.7)";
+  return {};
+}
+
+// The shell command that has laz-perf decode `laz` into the raw records file `dump`.
+inline std::string lazperf_command(const std::string& laz, const std::string& dump) {
+  const std::string script = std::string(LODREFINE_SOURCE_DIR) + "/tests/io/laz_reference_dump.js";
+  return "node '" + script + "' '" + lazperf_modules() + "' '" + laz + "' '" + dump + "'";
+}
+
+}  // namespace lodrefine::fixtures
