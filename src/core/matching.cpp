@@ -271,12 +271,17 @@ void match_plane(int p, const ScanPlane& sp, const std::vector<Wall>& walls, con
   }
 }
 
-// One scan plane per wall: the one with the most points in front of it.
+// One scan plane per wall: the best S_match (paper Sec. 3.1), then the most points in front of
+// it. Not the most points first: where the scan shows two facade lines in front of one wall, a
+// bay's front (nearer the scanner, never in the bay's shadow) has more points than the facade
+// line it stands on, whose points span the wall.
 std::vector<Match> best_plane_per_wall(const std::vector<Match>& matches) {
   std::map<int, Match> best;
   for (const auto& m : matches) {
     auto it = best.find(m.surface);
-    if (it == best.end() || m.owned.size() > it->second.owned.size()) best[m.surface] = m;
+    if (it == best.end() || m.s_match > it->second.s_match ||
+        (m.s_match == it->second.s_match && m.owned.size() > it->second.owned.size()))
+      best[m.surface] = m;
   }
   std::vector<Match> out;
   for (const auto& [s, m] : best) out.push_back(m);

@@ -138,6 +138,17 @@ INSTANTIATE_TEST_SUITE_P(AllTypes, SelectionDecidesType, ::testing::ValuesIn(all
 //   setback 1: 1.367 -> 1.262  setback 3: 1.378 -> 1.555 (WORSE than the coarse model)
 //   setback 4: 1.157 -> 0.585  setback 7: 1.182 kept      setback 8: 1.654 -> 1.237
 //   setback 9: 0.568 kept
+// Why (diagnosed 2026-12-02, still open):
+//   bay 3: the bay's front is a supporting plane, but its occupancy confidence is 0.70 (sparse
+//     points), one side is a hypothesised step wall without points, and the roof and ground
+//     pieces over the bay have confidence 0: the program's gain from adding the bay (about -2.4)
+//     does not pay for them and the new sharp edges (about +2.9).
+//   setback 3: the front line is 2.06 m before the coarse wall (beyond match_distance), so the
+//     wall matches only the line 0.27 m behind it and substitution moves the whole wall back;
+//     the front line is then 2.33 m from the start, beyond add_scan_planes' reach
+//     (match_distance + bbox_margin), and no supporting plane. The judge caps distances at
+//     match_distance, so that line's 6241 points weigh the same before and after: it cannot see
+//     the roof and facade getting worse.
 // Remove a seed from kKnownShort when the pipeline reaches it (the test prints "now reaches").
 const std::map<BuildingType, std::set<std::uint64_t>> kKnownShort{
     {BuildingType::Recess, {1, 2, 9}}, {BuildingType::Bay, {1, 3, 7}}, {BuildingType::Setback, {1, 3, 4, 7, 8, 9}}};

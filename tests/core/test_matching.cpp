@@ -346,9 +346,9 @@ TEST(Matching, SetbackWallDoesNotStealTheFrontsPoints) {
   EXPECT_NEAR(b->d_centroid, 0.3, 1e-9);
 }
 
-// Two planes in front of one wall: the wall takes the one with more points in front of it,
-// whatever their order.
-TEST(Matching, WallTakesThePlaneWithMostPointsInFront) {
+// Two planes in front of one wall: the wall takes the one whose points span it (the higher
+// S_match; here also the one with more points in front of it), whatever their order.
+TEST(Matching, WallTakesThePlaneWhosePointsSpanIt) {
   for (bool big_first : {false, true}) {
     Scene s(building());
     if (big_first) s.front_scan(-0.3, 0.0, 12.0);
@@ -358,6 +358,35 @@ TEST(Matching, WallTakesThePlaneWithMostPointsInFront) {
     ASSERT_TRUE(only_front_match(r));
     EXPECT_EQ(r.matches[0].scan_plane, big_first ? 0 : 1);
     EXPECT_EQ(int(r.matches[0].owned.size()), columns(12.0) * kRows);
+    EXPECT_NEAR(r.matches[0].d_centroid, 0.3, 1e-9);
+  }
+}
+
+// A bay: the facade line scanned 0.3 m in front of the wall on both sides of it (x in [0, 3] and
+// [9, 12]), the bay's front 1.2 m in front for x in [3, 9], nearer the scanner and sampled four
+// times as densely: it has more points in front of the wall (12221 against 3162), but the
+// facade line's span the wall (C_bbox 0.83 against 0.42). The wall takes the facade line; the
+// selection adds the bay where its points are.
+TEST(Matching, ABaysDenserFrontDoesNotTakeTheFacadeLineItStandsOn) {
+  for (bool bay_first : {false, true}) {
+    Scene s(building());
+    auto bay = [&] {
+      s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({3, -1.2, 0}, Vec3::UnitX(), 6.0, 0.5, 5.5), kStep / 2));
+    };
+    if (bay_first) bay();
+    s.front_scan(-0.3, 0.0, 3.0);
+    const ScanPlane right = grid_scan_plane(s.cloud, wall_patch({9, -0.3, 0}, Vec3::UnitX(), 3.0, 0.5, 5.5), kStep);
+    const int line_plane = int(s.planes.size()) - 1;
+    ScanPlane& line = s.planes[line_plane];
+    line.inliers.insert(line.inliers.end(), right.inliers.begin(), right.inliers.end());
+    line.centroid = Vec3(6.0, -0.3, 3.0);
+    if (!bay_first) bay();
+    const std::size_t line_points = s.planes[line_plane].inliers.size();
+    ASSERT_GT(s.planes[1 - line_plane].inliers.size(), 3 * line_points);
+    const MatchResult r = s.match();
+    ASSERT_TRUE(only_front_match(r));
+    EXPECT_EQ(r.matches[0].scan_plane, line_plane);
+    EXPECT_EQ(r.matches[0].owned.size(), line_points);
     EXPECT_NEAR(r.matches[0].d_centroid, 0.3, 1e-9);
   }
 }
