@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "lodrefine/core/topology.h"
@@ -138,8 +139,11 @@ std::pair<WorkPolygon, WorkPolygon> split(const WorkPolygon& poly, int self, int
   return {lo, hi};
 }
 
-// The plane's section of the region: a large square on the plane clipped by the 6 box planes.
-WorkPolygon section(int self, const PlaneBank& bank, const Region& region, int first_box) {
+// The plane's section of the region: a large square on the plane clipped by the 6 box planes,
+// then by those of the local box planes (first_local.. +5; -1: none) that cut into the region
+// (`inside[b]`).
+WorkPolygon section(int self, const PlaneBank& bank, const Region& region, int first_box, int first_local = -1,
+                    const std::array<bool, 6>& inside = {}) {
   const Plane& pl = bank.all[self];
   const auto [u, v] = pl.basis();
   const Vec3 c = pl.project(region.center);
@@ -148,7 +152,39 @@ WorkPolygon section(int self, const PlaneBank& bank, const Region& region, int f
   w.p = {c - r * u - r * v, c + r * u - r * v, c + r * u + r * v, c - r * u + r * v};
   w.line = {-1, -1, -1, -1};
   for (int b = 0; b < 6 && w.p.size() >= 3; ++b) w = split(w, self, first_box + b, bank).first;
+  for (int b = 0; first_local >= 0 && b < 6 && w.p.size() >= 3; ++b)
+    if (inside[b]) w = split(w, self, first_local + b, bank).first;
   return w;
+}
+
+// A plane's local box in the region's frame (coordinates along region.axes), cut to the region.
+struct LocalBox {
+  Vec3 lo, hi;
+  bool meets(const LocalBox& o) const {
+    return (lo.array() <= o.hi.array() + kVertexWeld).all() && (o.lo.array() <= hi.array() + kVertexWeld).all();
+  }
+};
+LocalBox local_box(const Region& region, const Region* reach) {
+  const Vec3 c = region.axes.transpose() * region.center;
+  LocalBox b{c - region.half, c + region.half};
+  if (reach == nullptr) return b;
+  const Vec3 rc = region.axes.transpose() * reach->center;
+  b.lo = b.lo.cwiseMax(rc - reach->half);
+  b.hi = b.hi.cwiseMin(rc + reach->half);
+  return b;
+}
+// Its 6 planes in Region::planes() order (+axis, -axis per axis), and which cut into the region.
+std::array<Plane, 6> local_planes(const Region& region, const LocalBox& b, std::array<bool, 6>& inside) {
+  const Vec3 c = region.axes.transpose() * region.center;
+  std::array<Plane, 6> out;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 a = region.axes.col(k);
+    out[2 * k] = Plane::through(region.axes * c + (b.hi[k] - c[k]) * a, a);
+    out[2 * k + 1] = Plane::through(region.axes * c + (b.lo[k] - c[k]) * a, -a);
+    inside[2 * k] = b.hi[k] < c[k] + region.half[k] - kOnCutPlane;
+    inside[2 * k + 1] = b.lo[k] > c[k] - region.half[k] + kOnCutPlane;
+  }
+  return out;
 }
 
 }  // namespace
@@ -259,6 +295,11 @@ std::vector<std::vector<int>> vertices_on_planes(const std::vector<Vec3>& V, con
 }  // namespace
 
 CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Region& region, double min_area) {
+  return build_candidates(planes, region, {}, std::numeric_limits<int>::max(), min_area);
+}
+
+CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Region& region,
+                              const std::vector<Region>& reach, int max_candidates, double min_area) {
   CandidateSet cs;
   cs.planes = planes;
   cs.region = region;
@@ -266,14 +307,24 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
   for (const auto& p : planes) bank.all.push_back(p.plane);
   const int first_box = int(bank.all.size());
   for (const auto& b : region.planes()) bank.all.push_back(b);
+  // Per plane, its local box and (when given) its 6 planes, after the region's in the bank.
+  const int first_local = int(bank.all.size());
+  std::vector<LocalBox> boxes;
+  std::vector<std::array<bool, 6>> inside(planes.size());
+  for (std::size_t i = 0; i < planes.size(); ++i) {
+    boxes.push_back(local_box(region, reach.empty() ? nullptr : &reach[i]));
+    for (const auto& b : local_planes(region, boxes[i], inside[i])) bank.all.push_back(b);
+  }
 
   PointWelder welder(kVertexWeld);
   std::vector<std::vector<int>> corners;  // per piece, in `welder`
+  auto over_cap = [&](std::size_t pieces) { return corners.size() + pieces > std::size_t(max_candidates); };
   for (int i = 0; i < int(planes.size()); ++i) {
-    std::vector<WorkPolygon> pieces{section(i, bank, region, first_box)};
+    const bool local = !reach.empty();
+    std::vector<WorkPolygon> pieces{section(i, bank, region, first_box, local ? first_local + 6 * i : -1, inside[i])};
     if (pieces[0].p.size() < 3) continue;
     for (int j = 0; j < int(planes.size()); ++j) {
-      if (j == i) continue;
+      if (j == i || !boxes[i].meets(boxes[j])) continue;
       std::vector<WorkPolygon> next;
       for (const auto& w : pieces) {
         auto [lo, hi] = split(w, i, j, bank);
@@ -281,6 +332,13 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
         if (hi.p.size() >= 3) next.push_back(std::move(hi));
       }
       pieces.swap(next);
+      if (over_cap(pieces.size())) {
+        CandidateSet capped;
+        capped.planes = planes;
+        capped.region = region;
+        capped.capped = true;
+        return capped;
+      }
     }
     for (const auto& w : pieces) {
       if (polygon_area(w.p) < min_area) continue;

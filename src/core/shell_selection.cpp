@@ -387,7 +387,17 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   // incumbent, and what no evidence reaches is fixed to it; without one everything is free.
   // Candidates fixed unselected that way (no support's evidence reaches them, the starting shell
   // has none there) are pruned: the program over the others is the same.
-  const CandidateSet all = build_candidates(s.planes, detail::building_region(start, s));
+  // Each plane is cut to where its faces can be (its start faces and scan points, grown by the
+  // farthest a wall may move), so a large building's program grows with its planes, not their cube.
+  const Region region = detail::building_region(start, s);
+  const CandidateSet all =
+      build_candidates(s.planes, region, detail::plane_reach(start, s, region, prm.match_distance + prm.bbox_margin));
+  if (all.capped) {
+    out.reason = "too many candidate faces (over " + std::to_string(kMaxCandidates) + " from " +
+                 std::to_string(s.planes.size()) + " planes)";
+    st.seconds = seconds_since(t0);
+    return out;
+  }
   const CandidateData all_d = describe_candidates(all, start, s, prm);
   const std::vector<char> all_warm = mended_start(all, all_d.in_start, prm);
   std::vector<char> keep(all.faces.size(), 1);

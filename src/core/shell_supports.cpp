@@ -175,4 +175,30 @@ Region building_region(const Mesh& start, const Supports& s) {
   return r;
 }
 
+std::vector<Region> plane_reach(const Mesh& start, const Supports& s, const Region& region, double margin) {
+  std::vector<Eigen::AlignedBox3d> box(s.planes.size());  // in the region's axes
+  for (std::size_t f = 0; f < start.faces.size(); ++f)
+    if (s.face_plane[f] >= 0)
+      for (int v : start.faces[f].v) box[s.face_plane[f]].extend(region.axes.transpose() * start.vertices[v]);
+  for (std::size_t k = 0; k < s.points.size(); ++k)
+    for (const auto& p : s.points[k]) box[k].extend(region.axes.transpose() * p);
+  for (std::size_t k = 0; k < box.size(); ++k) {
+    if (!box[k].isEmpty()) continue;
+    // A hypothesised wall: the slab of the start and the evidence it can reach.
+    const Plane& pl = s.planes[k].plane;
+    for (const auto& p : start.vertices)
+      if (std::abs(pl.distance(p)) <= margin) box[k].extend(region.axes.transpose() * p);
+    for (const auto& pts : s.points)
+      for (const auto& p : pts)
+        if (std::abs(pl.distance(p)) <= margin) box[k].extend(region.axes.transpose() * p);
+  }
+  std::vector<Region> out(s.planes.size(), region);
+  for (std::size_t k = 0; k < box.size(); ++k) {
+    if (box[k].isEmpty()) continue;  // nothing near: the whole region
+    out[k].center = region.axes * box[k].center();
+    out[k].half = 0.5 * box[k].sizes() + Vec3::Constant(margin);
+  }
+  return out;
+}
+
 }  // namespace lodrefine::detail

@@ -41,5 +41,9 @@ void add_step_walls(const Mesh& start, const Params& prm, Supports& s);
 // The region: the start and the scan evidence, in the axes of the start's largest wall, grown by
 // a margin.
 Region building_region(const Mesh& start, const Supports& s);
+// Per supporting plane, the box (region's axes) its candidates need: its start faces and its
+// scan points, grown by `margin` (the farthest a wall may move); a plane with neither (a
+// hypothesised wall) those of the start and the evidence within `margin` of it.
+std::vector<Region> plane_reach(const Mesh& start, const Supports& s, const Region& region, double margin);
 
 }  // namespace lodrefine::detail

@@ -65,6 +65,7 @@ struct CandidateSet {
   CandidateMesh mesh;
   std::vector<Candidate> faces;
   std::vector<CandidateEdge> edges;
+  bool capped = false;                    // build_candidates stopped at its cap: no candidates
   std::vector<int> corners(int f) const;  // indices into `vertices`, CCW
   std::vector<Vec3> polygon(int f) const;
 };
@@ -77,6 +78,21 @@ std::vector<Vec3> region_section(const Plane& plane, const Region& region);
 // nearly coincident planes that no face of a building is.
 constexpr double kMinCandidateArea = 1e-6;  // m^2
 CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Region& region,
+                              double min_area = kMinCandidateArea);
+
+// Local sections: plane i is cropped to `reach[i]` (a box with region's axes; it is intersected
+// with `region`) instead of the whole region, and split only by the planes whose boxes meet its
+// box. A large building's roof planes then split each other only where they are near, not all
+// with all (the cube of the planes); a plane along the whole building (a long facade, the
+// ground) is still cut by every plane along it. A face of plane i that
+// reaches its box's boundary has an edge no other face shares there: the selection leaves it
+// out, so each box must hold every face of plane i a shell may need (callers grow it by the
+// farthest a wall can move). reach.size() == planes.size().
+// At most `max_candidates` pieces are made: beyond, the set comes back empty with `capped` set
+// (bounded time and memory for untrusted input).
+constexpr int kMaxCandidates = 40000;
+CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Region& region,
+                              const std::vector<Region>& reach, int max_candidates = kMaxCandidates,
                               double min_area = kMinCandidateArea);
 
 // The candidates where keep[f], renumbered in order, on a mesh of their own; the edges in their
