@@ -387,11 +387,13 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   // incumbent, and what no evidence reaches is fixed to it; without one everything is free.
   // Candidates fixed unselected that way (no support's evidence reaches them, the starting shell
   // has none there) are pruned: the program over the others is the same.
-  // Each plane is cut to where its faces can be (its start faces and scan points, grown by the
-  // farthest a wall may move), so a large building's program grows with its planes, not their cube.
+  // Each plane is cut to where its faces can be (its start faces and scan points, grown by twice
+  // the farthest a wall may move: a face reaches a moved neighbour, whose corner with the next
+  // moved wall lies that far again; once measured lost a real building's refinement), so a large
+  // building's program does not grow with the cube of its planes.
   const Region region = detail::building_region(start, s);
-  const CandidateSet all =
-      build_candidates(s.planes, region, detail::plane_reach(start, s, region, prm.match_distance + prm.bbox_margin));
+  const double reach = 2.0 * (prm.match_distance + prm.bbox_margin);
+  const CandidateSet all = build_candidates(s.planes, region, detail::plane_reach(start, s, region, reach));
   if (all.capped) {
     out.reason = "too many candidate faces (over " + std::to_string(kMaxCandidates) + " from " +
                  std::to_string(s.planes.size()) + " planes)";

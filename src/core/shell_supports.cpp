@@ -197,6 +197,10 @@ std::vector<Region> plane_reach(const Mesh& start, const Supports& s, const Regi
     if (box[k].isEmpty()) continue;  // nothing near: the whole region
     out[k].center = region.axes * box[k].center();
     out[k].half = 0.5 * box[k].sizes() + Vec3::Constant(margin);
+    if (s.planes[k].from_scan) {  // a street scan sees a wall's lower storeys: it runs ground to roof
+      out[k].center.z() = region.center.z();
+      out[k].half.z() = region.half.z();
+    }
   }
   return out;
 }

@@ -43,7 +43,8 @@ void add_step_walls(const Mesh& start, const Params& prm, Supports& s);
 Region building_region(const Mesh& start, const Supports& s);
 // Per supporting plane, the box (region's axes) its candidates need: its start faces and its
 // scan points, grown by `margin` (the farthest a wall may move); a plane with neither (a
-// hypothesised wall) those of the start and the evidence within `margin` of it.
+// hypothesised wall) those of the start and the evidence within `margin` of it. A scanned wall
+// spans the region's height (a street scan sees its lower storeys only).
 std::vector<Region> plane_reach(const Mesh& start, const Supports& s, const Region& region, double margin);
 
 }  // namespace lodrefine::detail
