@@ -353,6 +353,11 @@ std::vector<char> mended_start(const CandidateSet& cs, const std::vector<char>& 
   return {};
 }
 
+// Buildings with fewer supporting planes are cut over the whole region (every dev tile building:
+// at most 31); local sections, which bound the large ones, changed a small real building's
+// program enough to lose its refinement (RealData.ThreeDBagSeqMovedWall).
+constexpr int kLocalSectionsFrom = 32;
+
 // Why the assembled shell cannot be written, or empty: validate_mesh's problem, or a face that
 // passes through one vertex twice (two pieces pinched together by the output weld or merge).
 std::string shell_problem(const Mesh& m, const Params& prm) {
@@ -393,7 +398,9 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   // building's program does not grow with the cube of its planes.
   const Region region = detail::building_region(start, s);
   const double reach = 2.0 * (prm.match_distance + prm.bbox_margin);
-  const CandidateSet all = build_candidates(s.planes, region, detail::plane_reach(start, s, region, reach));
+  const CandidateSet all = build_candidates(
+      s.planes, region,
+      int(s.planes.size()) < kLocalSectionsFrom ? std::vector<Region>{} : detail::plane_reach(start, s, region, reach));
   if (all.capped) {
     out.reason = "too many candidate faces (over " + std::to_string(kMaxCandidates) + " from " +
                  std::to_string(s.planes.size()) + " planes)";
