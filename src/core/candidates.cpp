@@ -21,6 +21,10 @@ constexpr double kVertexWeld = 1e-6;
 // A vertex splits another face's edge when within kVertexWeld of it and farther than this share
 // of the edge from either end (nearer, it is that end).
 constexpr double kEdgeEndShare = 1e-9;
+// A face's corners lie within kVertexWeld of its plane, so a vertex within kVertexWeld of one of
+// its edges lies within twice that of the plane: the vertices farther than this (m) from a
+// plane are never looked at for its faces' edges (the test is the same, on fewer vertices).
+constexpr double kNearPlane = 10 * kVertexWeld;
 
 }  // namespace
 
@@ -291,12 +295,18 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
 
   // Where a vertex of one face lies inside another face's edge (several planes meeting at a
   // point along the line), split that edge so that adjacency is exact.
-  for (auto& v : corners) {
+  std::vector<std::vector<int>> near_plane(planes.size());
+  for (int i = 0; i < int(planes.size()); ++i)
+    for (int w = 0; w < int(cs.vertices.size()); ++w)
+      if (std::abs(planes[i].plane.distance(cs.vertices[w])) <= kNearPlane) near_plane[i].push_back(w);
+  for (std::size_t f = 0; f < corners.size(); ++f) {
+    auto& v = corners[f];
     std::vector<int> out;
     for (std::size_t k = 0; k < v.size(); ++k) {
       const int a = v[k], b = v[(k + 1) % v.size()];
       out.push_back(a);
-      for (int x : vertices_on_segment(cs.vertices, a, b, SegmentRule{kVertexWeld, false, kEdgeEndShare}))
+      for (int x : vertices_on_segment(cs.vertices, a, b, SegmentRule{kVertexWeld, false, kEdgeEndShare},
+                                       &near_plane[cs.faces[f].plane]))
         out.push_back(x);
     }
     v = out;
