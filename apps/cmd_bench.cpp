@@ -58,6 +58,7 @@ SynthOptions synth_options(const BenchArgs& a) {
 void run_polyfit(const BenchArgs& a) {
   PolyfitOptions options = a.polyfit_options;
   options.planes = a.polyfit_planes == "scan" ? PolyfitPlanes::Scan : PolyfitPlanes::ModelAndScan;
+  const std::vector<BuildingFiles> files = a.tile.empty() ? std::vector<BuildingFiles>{} : discover_bench(a.tile);
   std::vector<PolyfitComparisonRow> rows;
   print_comparison_header(stdout);
   auto compare = [&](const BenchBuilding& b) {
@@ -65,7 +66,7 @@ void run_polyfit(const BenchArgs& a) {
     print_comparison_row(rows.back(), stdout);
   };
   if (!a.tile.empty()) {
-    for (const BuildingFiles& f : discover_bench(a.tile)) {
+    for (const BuildingFiles& f : files) {
       std::optional<BenchBuilding> b;
       try {
         b = read_bench_building(f);
