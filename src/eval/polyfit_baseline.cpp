@@ -20,9 +20,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <stdexcept>
 #include <exception>
 #include <new>
+#include <stdexcept>
 #include <tuple>
 
 #include "lodrefine/core/distance.h"
@@ -312,9 +312,7 @@ PolyfitResult child_result(int status, bool in_time, std::string bytes, const Po
 
 }  // namespace
 
-const char* polyfit_planes_name(PolyfitPlanes planes) {
-  return planes == PolyfitPlanes::Scan ? "scan" : "model+scan";
-}
+const char* polyfit_planes_name(PolyfitPlanes planes) { return planes == PolyfitPlanes::Scan ? "scan" : "model+scan"; }
 
 const char* polyfit_status_name(PolyfitStatus status) {
   switch (status) {
@@ -343,7 +341,6 @@ PolyfitResult polyfit_baseline(const Mesh& model, const PointCloud& cloud, const
   r.seconds = seconds_since(t0);
   return r;
 }
-
 
 PolyfitResult polyfit_baseline_isolated(const Mesh& model, const PointCloud& cloud, const Params& params,
                                         const PolyfitOptions& options) {

@@ -100,8 +100,7 @@ BenchBuilding read_bench_building(const BuildingFiles& f) {
   return b;
 }
 
-PolyfitComparisonRow compare_with_polyfit(const BenchBuilding& b, const Params& params,
-                                          const PolyfitOptions& options) {
+PolyfitComparisonRow compare_with_polyfit(const BenchBuilding& b, const Params& params, const PolyfitOptions& options) {
   PolyfitComparisonRow row;
   row.id = b.id, row.points = b.cloud.points.size();
   const Clock::time_point t0 = Clock::now();
@@ -127,7 +126,8 @@ PolyfitComparisonRow compare_with_polyfit(const BenchBuilding& b, const Params& 
   row.coarse_facade = ev.truth_facade_before, row.coarse_roof = ev.truth_roof_before;
   measure(row.lodrefine, ev);
   if (row.polyfit.produced)
-    measure(row.polyfit, evaluate_building(coarse, translated(row.baseline.mesh, -o), cloud, truth_ptr, params, scanned));
+    measure(row.polyfit,
+            evaluate_building(coarse, translated(row.baseline.mesh, -o), cloud, truth_ptr, params, scanned));
   row.baseline.mesh = Mesh{};
   return row;
 }
@@ -188,15 +188,17 @@ void print_comparison_row(const PolyfitComparisonRow& r, std::FILE* out) {
                metres(r.coarse_facade).c_str(), metres(r.lodrefine.truth_facade).c_str(),
                metres(r.polyfit.truth_facade).c_str(), metres(r.coarse_roof).c_str(),
                metres(r.lodrefine.truth_roof).c_str(), metres(r.polyfit.truth_roof).c_str());
-  if (!p.closed()) std::fprintf(out, "  %s: PolyFit %s: %s\n", r.id.c_str(), polyfit_status_name(p.status), p.reason.c_str());
+  if (!p.closed())
+    std::fprintf(out, "  %s: PolyFit %s: %s\n", r.id.c_str(), polyfit_status_name(p.status), p.reason.c_str());
   std::fflush(out);
 }
 
 void print_comparison_summary(const PolyfitComparison& s, const PolyfitOptions& options, std::FILE* out) {
-  std::fprintf(out, "\n%d buildings; PolyFit (%s planes, weights %.2f/%.2f/%.2f) closed %d, watertight %d; "
-               "lodrefine watertight %d\n", s.buildings, polyfit_planes_name(options.planes), options.wt_fitting,
-               options.wt_coverage, options.wt_complexity, s.polyfit_closed, s.polyfit_watertight,
-               s.lodrefine_watertight);
+  std::fprintf(out,
+               "\n%d buildings; PolyFit (%s planes, weights %.2f/%.2f/%.2f) closed %d, watertight %d; "
+               "lodrefine watertight %d\n",
+               s.buildings, polyfit_planes_name(options.planes), options.wt_fitting, options.wt_coverage,
+               options.wt_complexity, s.polyfit_closed, s.polyfit_watertight, s.lodrefine_watertight);
   std::fprintf(out, "PolyFit failures:");
   if (s.failures.empty()) std::fprintf(out, " none");
   for (const auto& [status, n] : s.failures) std::fprintf(out, " %s %d", status.c_str(), n);
@@ -205,7 +207,8 @@ void print_comparison_summary(const PolyfitComparison& s, const PolyfitOptions& 
                s.lodrefine_cpu_median, s.lodrefine_cpu_max);
   std::fprintf(out, "  PolyFit                %7.3f %7.3f |    %7.3f %7.3f\n", s.polyfit_median, s.polyfit_max,
                s.polyfit_cpu_median, s.polyfit_cpu_max);
-  std::fprintf(out, "PolyFit / lodrefine: %.1fx wall, %.1fx CPU (medians); per building (wall) median %.1fx, min %.1fx\n",
+  std::fprintf(out,
+               "PolyFit / lodrefine: %.1fx wall, %.1fx CPU (medians); per building (wall) median %.1fx, min %.1fx\n",
                s.ratio_of_medians, s.cpu_ratio_of_medians, s.ratio_median, s.ratio_min);
   std::fprintf(out, "truth RMSE (m)                 coarse lodrefine PolyFit\n");
   std::fprintf(out, "  facade, all buildings       %7.3f %9.3f       -\n", s.facade_coarse, s.facade_lodrefine);

@@ -57,8 +57,7 @@ void expect_box(const PolyfitResult& r, const Mesh& truth) {
 
 TEST(PolyfitBaseline, ScanPlanesCloseTheBoxOnTheTruth) {
   const Mesh truth = truth_box();
-  const PolyfitResult r =
-      polyfit_baseline(coarse_box(), full_scan(truth), Params{}, {PolyfitPlanes::Scan});
+  const PolyfitResult r = polyfit_baseline(coarse_box(), full_scan(truth), Params{}, {PolyfitPlanes::Scan});
   expect_box(r, truth);
   EXPECT_EQ(r.model_planes, 0);
   EXPECT_GT(r.points, 20000u);

@@ -28,18 +28,18 @@ struct PolyfitOptions {
   double wt_fitting = 0.43, wt_coverage = 0.27, wt_complexity = 0.30;
   // Bounds of polyfit_baseline_isolated's child process. CGAL's arrangement and its GLPK traits
   // have none (the arrangement alone took 2 GB and minutes on a dev-tile building).
-  double cpu_limit = 60.0;          // s of CPU time; beyond it: TimeLimit
+  double cpu_limit = 60.0;             // s of CPU time; beyond it: TimeLimit
   std::size_t memory_limit_mb = 2048;  // address space; beyond it an allocation fails: Error
 };
 
 enum class PolyfitStatus {
-  Closed,      // the selected faces, corners welded, close (every edge joins two faces); oriented outward
-  NotClosed,   // the program was solved but its faces do not close
+  Closed,     // the selected faces, corners welded, close (every edge joins two faces); oriented outward
+  NotClosed,  // the program was solved but its faces do not close
   // No face selected: the empty selection scored best (the coverage term outweighs the fitting
   // of sparse evidence), or glp_intopt returned 0 without a solution (CGAL's traits do not ask
   // glp_mip_status): the two look alike from outside.
   Empty,
-  Infeasible,  // glp_intopt failed (no feasible selection, or a solver error)
+  Infeasible,    // glp_intopt failed (no feasible selection, or a solver error)
   TooFewPlanes,  // fewer than 4 planes or candidate faces: PolyFit cannot close a surface
   TimeLimit,     // the child process ran out of its CPU time (or of 10x that in wall time)
   Error,         // an exception (bad model, CGAL precondition, out of memory)
@@ -52,7 +52,7 @@ struct PolyfitResult {
   Mesh mesh;           // input frame; the selected faces, corners welded (also when not closed), else empty
   int planes = 0;      // planes given to PolyFit (scan + model)
   int model_planes = 0;
-  int candidates = 0;  // candidate faces of the arrangement (0 when it was not built)
+  int candidates = 0;      // candidate faces of the arrangement (0 when it was not built)
   std::size_t points = 0;  // points given to PolyFit (scan points near the model + model samples)
   // Wall-clock seconds: the whole call; plane detection; CGAL (arrangement, confidences, solve).
   double seconds = 0, detection_seconds = 0, polyfit_seconds = 0;

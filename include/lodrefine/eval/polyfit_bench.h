@@ -36,7 +36,7 @@ BenchBuilding read_bench_building(const BuildingFiles& files);
 struct MethodRun {
   double seconds = 0.0;      // wall clock of the call
   double cpu_seconds = 0.0;  // its CPU time (the machine's load does not inflate it)
-  bool produced = false;  // a mesh to measure (lodrefine: always; PolyFit: when closed)
+  bool produced = false;     // a mesh to measure (lodrefine: always; PolyFit: when closed)
   bool watertight = false;
   std::optional<DistanceStats> truth_facade, truth_roof;
 };
@@ -50,11 +50,10 @@ struct PolyfitComparisonRow {
   PolyfitResult baseline;  // the mesh dropped; status, reason, planes, candidates, times
 };
 
-// Refines `b` with refine_building and reconstructs it with polyfit_baseline (same params, one
+// Refines `b` with refine_building and reconstructs it with polyfit_baseline_isolated (same params, one
 // after the other), and measures the coarse model and both outputs against its truth in its
 // local frame (evaluate_building: truth facade and roof distances, watertightness).
-PolyfitComparisonRow compare_with_polyfit(const BenchBuilding& b, const Params& params,
-                                          const PolyfitOptions& options);
+PolyfitComparisonRow compare_with_polyfit(const BenchBuilding& b, const Params& params, const PolyfitOptions& options);
 
 struct PolyfitComparison {
   int buildings = 0, polyfit_closed = 0, lodrefine_watertight = 0, polyfit_watertight = 0;
@@ -62,7 +61,7 @@ struct PolyfitComparison {
   double lodrefine_median = 0, lodrefine_max = 0, polyfit_median = 0, polyfit_max = 0;  // s, wall clock
   double lodrefine_cpu_median = 0, lodrefine_cpu_max = 0, polyfit_cpu_median = 0, polyfit_cpu_max = 0;
   double ratio_of_medians = 0, cpu_ratio_of_medians = 0;  // PolyFit's median / lodrefine's
-  double ratio_median = 0, ratio_min = 0;         // per building PolyFit / lodrefine
+  double ratio_median = 0, ratio_min = 0;                 // per building PolyFit / lodrefine
   // Truth RMSE pooled over the samples (m; NaN when none): over every building, and over those
   // PolyFit closed (the same buildings for the three columns).
   double facade_coarse = 0, facade_lodrefine = 0;
