@@ -108,7 +108,8 @@ bool shows_return(const PointCloud& cloud, const Plane& facade, const Plane& mov
 }
 
 // Points in the strips just past and just before a facade's end (t: position along the facade
-// towards the corner, measured from the wall's middle).
+// towards the corner, measured from the wall's middle): the street's ground at the wall's foot
+// `ground`, the facade at the corner's heights [z0, z1].
 struct EndStrips {
   int street_past = 0, street_before = 0;  // ground in front of the facade
   int front_past = 0;                      // in front of the facade at its height
@@ -116,7 +117,7 @@ struct EndStrips {
 };
 
 EndStrips end_strips(const PointCloud& cloud, const Plane& facade, const Vec3& o, const Vec3& u, double s, double end,
-                     double z0, double z1, const PlaneConfig& prm) {
+                     double ground, double z0, double z1, const PlaneConfig& prm) {
   const double za = z0 + kLowBand * (z1 - z0);
   const double on_plane = on_plane_band(prm);
   EndStrips e;
@@ -127,7 +128,7 @@ EndStrips end_strips(const PointCloud& cloud, const Plane& facade, const Vec3& o
     const double d = facade.distance(p);  // outwards: the street side
     const bool in_front = d > kStreetNear && d < kStreetFar;
     const bool high = p.z() > za && p.z() < z1;
-    if (in_front && p.z() < z0 + kGroundBand) ++(past ? e.street_past : e.street_before);
+    if (in_front && p.z() < ground + kGroundBand) ++(past ? e.street_past : e.street_before);
     if (in_front && high && past) ++e.front_past;
     if (std::abs(d) <= on_plane && high) ++(past ? e.facade_past : e.facade_before);
   }
@@ -221,15 +222,38 @@ bool same_end_over_the_height(const FacadeScan& f, const std::vector<double>& t)
   return bands >= kBands - 1 && hi - lo <= kEndSpread;
 }
 
+// The facade's scan over the heights [z0, z1] of one corner: where a facade steps (an upper
+// storey set back, a lower wing running on), its end at the corner shows only at those heights.
+FacadeScan at_heights(const FacadeScan& f, double z0, double z1) {
+  FacadeScan g = f;
+  g.pu.clear();
+  g.pz.clear();
+  g.z0 = z0;
+  g.z1 = z1;
+  for (std::size_t k = 0; k < f.pu.size(); ++k)
+    if (f.pz[k] >= z0 && f.pz[k] <= z1) {
+      g.pu.push_back(f.pu[k]);
+      g.pz.push_back(f.pz[k]);
+    }
+  return g;
+}
+
 // The move of the unscanned neighbour `a` (sharing `edges` with the scanned wall) to where the
 // facade's points end, when the scan shows that corner.
-std::optional<CornerMove> corner_at(const Mesh& mesh, const FacadeScan& f, const ScannedWall& w, int a,
+std::optional<CornerMove> corner_at(const Mesh& mesh, const FacadeScan& wall_scan, const ScannedWall& w, int a,
                                     const ModelSurface& as, const std::vector<std::pair<int, int>>& edges,
                                     const PointCloud& cloud, const MatchConfig& prm, const PlaneConfig& detection) {
-  // The corner on the scanned plane, at mid height of the shared edge.
-  double zc = 0.0;
-  for (const auto& [i, j] : edges) zc += 0.5 * (mesh.vertices[i].z() + mesh.vertices[j].z());
+  // The corner on the scanned plane, at mid height of the shared edge; the facade's points over
+  // the edge's heights (the street's ground stays at the wall's foot).
+  double zc = 0.0, ze0 = 1e300, ze1 = -1e300;
+  for (const auto& [i, j] : edges) {
+    zc += 0.5 * (mesh.vertices[i].z() + mesh.vertices[j].z());
+    ze0 = std::min({ze0, mesh.vertices[i].z(), mesh.vertices[j].z()});
+    ze1 = std::max({ze1, mesh.vertices[i].z(), mesh.vertices[j].z()});
+  }
   zc /= double(edges.size());
+  const FacadeScan f = at_heights(wall_scan, ze0, ze1);
+  if (f.pu.empty()) return std::nullopt;
   const auto c = meet(w.plane, as.plane, Plane(Vec3::UnitZ(), -zc));
   if (!c) return std::nullopt;
   const double uc = (*c - f.o).dot(f.u) - f.u_mid;
@@ -249,8 +273,8 @@ std::optional<CornerMove> corner_at(const Mesh& mesh, const FacadeScan& f, const
   // facade's points end, or an open end on a facade the scan found misplaced.
   const Plane moved(as.plane.n, as.plane.d - as.plane.n.dot(s * gap * f.u));
   if (!shows_return(cloud, w.plane, moved, side_of(mesh, as, w.plane), f.z0, f.z1, detection) &&
-      !(f.displaced &&
-        ends_in_the_open(end_strips(cloud, w.plane, f.o, f.u, s, end + s * f.u_mid, f.z0, f.z1, detection))))
+      !(f.displaced && ends_in_the_open(end_strips(cloud, w.plane, f.o, f.u, s, end + s * f.u_mid, wall_scan.z0, f.z0,
+                                                   f.z1, detection))))
     return std::nullopt;
   if (!same_end_over_the_height(f, t)) return std::nullopt;
   CornerMove cm;

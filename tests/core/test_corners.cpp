@@ -70,6 +70,76 @@ void add_street(Scene& s, double to) {
     for (double y = -1.0; y > -8.0; y -= 0.1) s.cloud.points.emplace_back(x, y, 0.02);
 }
 
+// Two storeys, front wall y = 0 facing -y: the lower one [0,12] x [0,8] x [0,3], the upper one
+// set back at x = 9 ([0,9] x [0,8] x [3,6]). The front is one L-shaped wall; the upper storey's
+// side wall x = 9 meets it only over z in [3, 6].
+Mesh two_storeys() {
+  const double profile[6][2] = {{0, 0}, {12, 0}, {12, 3}, {9, 3}, {9, 6}, {0, 6}};  // (x, z)
+  Mesh soup;
+  soup.id = "two storeys";
+  auto add = [&](std::vector<Vec3> pts, Semantic sem) {
+    Face face;
+    face.sem = sem;
+    for (const auto& p : pts) {
+      face.v.push_back(int(soup.vertices.size()));
+      soup.vertices.push_back(p);
+    }
+    soup.faces.push_back(face);
+  };
+  std::vector<Vec3> front, back;
+  for (const auto& q : profile) {
+    front.emplace_back(q[0], 0, q[1]);
+    back.insert(back.begin(), Vec3(q[0], 8, q[1]));
+  }
+  add(front, Semantic::Wall);
+  add(back, Semantic::Wall);
+  for (int k = 0; k < 6; ++k) {
+    const auto& a = profile[k];
+    const auto& b = profile[(k + 1) % 6];
+    const Semantic sem = a[1] == b[1] ? (a[1] == 0 ? Semantic::Ground : Semantic::Roof) : Semantic::Wall;
+    add({{a[0], 0, a[1]}, {a[0], 8, a[1]}, {b[0], 8, b[1]}, {b[0], 0, b[1]}}, sem);
+  }
+  return repair_model(soup, 0.01);
+}
+
+// The two storeys' front scanned `offset` in front of the model's, the lower storey to x = 12
+// (where the model has it), the upper one to x = 9.5 (0.5 m past the model's step); optionally
+// the upper storey's side wall seen obliquely 1 m behind the facade; the street to x = 16.
+Scene stepped_scene(double offset, bool side) {
+  Scene s;
+  s.mesh = two_storeys();
+  s.surfaces = model_surfaces(s.mesh);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.005);
+  ScanPlane sp;
+  for (double z = 0.1; z < 5.9; z += 0.05)
+    for (double x = 0.02; x < (z < 3.0 ? 11.98 : 9.5); x += 0.05) {
+      sp.inliers.push_back(int(s.cloud.points.size()));
+      s.cloud.points.emplace_back(x, -offset + noise(rng), z);
+    }
+  if (side)
+    for (double y = 0.05 - offset; y < 1.0; y += 0.05)
+      for (double z = 3.1; z < 5.9; z += 0.05) s.cloud.points.emplace_back(9.5 + noise(rng), y, z);
+  sp.plane = Plane(Vec3(0, -1, 0), -offset);
+  sp.facade = true;
+  s.planes.push_back(sp);
+  for (int k = 0; k < int(s.surfaces.size()); ++k)
+    if (s.surfaces[k].plane.n.y() < -0.99) s.scanned.push_back({k, 0, sp.plane});
+  for (double x = -3.0; x < 16.0; x += 0.1)
+    for (double y = -1.0; y > -8.0; y -= 0.1) s.cloud.points.emplace_back(x, y, 0.02);
+  return s;
+}
+
+// The one move of a stepped scene: the upper storey's side wall (x = 9) to x = 9.5.
+void expect_upper_side_wall_moved(const Scene& s, const std::vector<CornerMove>& moves) {
+  ASSERT_EQ(moves.size(), 1u) << "the lower storey ends where the model has it";
+  const ModelSurface& wall = s.surfaces[moves[0].move.surface];
+  EXPECT_GT(wall.plane.n.x(), 0.99);
+  EXPECT_NEAR(wall.plane.distance(Vec3(9, 0, 4)), 0.0, 1e-9) << "the step at x = 9, not the wing's end";
+  EXPECT_NEAR(moves[0].move.plane.distance(Vec3(9.5, 0, 4)), 0.0, 0.06);
+  EXPECT_NEAR(moves[0].shift, 0.5, 0.06);
+}
+
 }  // namespace
 
 TEST(Corners, SideWallMovesToWhereTheFacadeEnds) {
@@ -174,4 +244,21 @@ TEST(Corners, AMisplacedFacadeShadowedByAVanMovesNothing) {
   for (double x = 11.3; x < 13.5; x += 0.05)
     for (double z = 0.1; z < 2.5; z += 0.05) s.cloud.points.emplace_back(x, -2.0, z);
   EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}).empty());
+}
+
+// A facade that steps: the upper storey's end shows only in the points at its own heights (the
+// lower storey runs on to x = 12 below it). Its side wall, seen where the upper facade ends,
+// moves there.
+TEST(Corners, AnUpperStoreysSideWallMovesToWhereItsFacadeEnds) {
+  const Scene s = stepped_scene(0.0, true);
+  expect_upper_side_wall_moved(
+      s, corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}));
+}
+
+// The same on a facade the scan moves 0.4 m, the upper storey's side wall not scanned: the
+// upper facade ends in the open at its own heights.
+TEST(Corners, AMisplacedUpperStoreyEndingInTheOpenMovesItsSideWall) {
+  const Scene s = stepped_scene(0.4, false);
+  expect_upper_side_wall_moved(
+      s, corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}));
 }
