@@ -44,6 +44,11 @@ constexpr double kStreetNear = 0.3, kStreetFar = 10.0;
 constexpr double kGroundBand = 0.3;
 constexpr double kStreetGoesOn = 0.5;
 constexpr double kClearInFront = 0.05;
+// A flush neighbour: the facade's outline is read in bands of kHeightBand (m); at least kBands
+// of them must show the corner, from kAboveTop (m) over the wall's top for a taller neighbour
+// (a gutter or a roof's edge there does not count).
+constexpr double kHeightBand = 0.5;
+constexpr double kAboveTop = 0.3;
 // A facade the scan moves by this much on average is misplaced beyond doubt: scan planes are good
 // to a centimetre or two, airborne LoD2 facades are decimetres off.
 constexpr double kMisplacedFacade = 0.1;
@@ -72,12 +77,6 @@ double side_of(const Mesh& mesh, const ModelSurface& wall, const Plane& facade) 
   for (int f : wall.faces)
     for (int v : mesh.faces[f].v) sum += facade.distance(mesh.vertices[v]);
   return sum >= 0 ? 1.0 : -1.0;
-}
-
-// A point within this of a scan plane lies on it: the plane's noise band, at least the corner
-// tolerance.
-double on_plane_band(const PlaneConfig& prm) {
-  return std::max(kCornerTolerance, kOffPlaneEpsilons * prm.ransac_epsilon);
 }
 
 // Whether points lie on the side wall's new plane `moved`, off the facade plane on the wall's
@@ -238,6 +237,60 @@ FacadeScan at_heights(const FacadeScan& f, double z0, double z1) {
   return g;
 }
 
+// Per band of kHeightBand from z0 up (n bands), the largest position t below `hi` of the points
+// (positions t, heights z) at or past `lo`; -1e300 for a band without any.
+std::vector<double> band_ends(const std::vector<double>& t, const std::vector<double>& z, double z0, int n, double lo,
+                              double hi) {
+  std::vector<double> ends(std::size_t(n), -1e300);
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    const int b = int(std::floor((z[k] - z0) / kHeightBand));
+    if (b >= 0 && b < n && t[k] >= lo && t[k] < hi) ends[std::size_t(b)] = std::max(ends[std::size_t(b)], t[k]);
+  }
+  return ends;
+}
+
+// The edge where consecutive bands (from the first that has points) end short of `stop` (a
+// band whose points run on to it is the flush facade): the farthest end (a window near the edge
+// ends its band short), when at least kBands of them end within kEndSpread of it.
+std::optional<double> one_edge(const std::vector<double>& ends, double stop) {
+  std::vector<double> run;
+  for (double e : ends) {
+    if (e < -1e299 && run.empty()) continue;  // bands the scan does not reach
+    if (e < -1e299 || e > stop) break;
+    run.push_back(e);
+  }
+  if (run.empty()) return std::nullopt;
+  const double edge = *std::max_element(run.begin(), run.end());
+  const auto at_edge = std::count_if(run.begin(), run.end(), [&](double e) { return e >= edge - kEndSpread; });
+  if (at_edge < kBands) return std::nullopt;
+  return edge;
+}
+
+// Where a facade that runs on past the corner at uc into a flush neighbour's (one plane below
+// the lower roof) shows the party wall, within `reach` of the corner (t: position along the
+// facade towards the corner): the wall's own points above a lower neighbour end there, top
+// bands down; or the points of a taller neighbour above the wall's top (`top`) start there.
+std::optional<double> flush_neighbour_edge(const PointCloud& cloud, const FacadeScan& f, const Plane& facade, double s,
+                                           double uc, double reach, double top, const PlaneConfig& prm) {
+  std::vector<double> t(f.pu.size());
+  for (std::size_t k = 0; k < t.size(); ++k) t[k] = s * f.pu[k];
+  const int n = int(std::ceil((f.z1 - f.z0) / kHeightBand));
+  std::vector<double> own = band_ends(t, f.pz, f.z0, n, uc - reach, uc + reach);
+  std::reverse(own.begin(), own.end());
+  if (auto e = one_edge(own, uc + reach - kRunGap)) return e;
+  // The taller neighbour's points, positions negated: their start is the largest.
+  const double on_plane = on_plane_band(prm), z0 = top + kAboveTop;
+  std::vector<double> back, z;
+  for (const auto& p : cloud.points)
+    if (p.z() >= z0 && std::abs(facade.distance(p)) <= on_plane) {
+      back.push_back(-s * ((p - f.o).dot(f.u) - f.u_mid));
+      z.push_back(p.z());
+    }
+  const auto e = one_edge(band_ends(back, z, z0, 2 * kBands, -uc - reach, -uc + reach), -uc + reach - kRunGap);
+  if (!e) return std::nullopt;
+  return -*e;
+}
+
 // The move of the unscanned neighbour `a` (sharing `edges` with the scanned wall) to where the
 // facade's points end, when the scan shows that corner.
 std::optional<CornerMove> corner_at(const Mesh& mesh, const FacadeScan& wall_scan, const ScannedWall& w, int a,
@@ -260,28 +313,37 @@ std::optional<CornerMove> corner_at(const Mesh& mesh, const FacadeScan& wall_sca
   const double s = uc >= 0 ? 1.0 : -1.0;
   std::vector<double> t(f.pu.size());
   for (std::size_t k = 0; k < f.pu.size(); ++k) t[k] = s * f.pu[k];
-  const double end = run_end(t);
+  double end = run_end(t);
   if (end < 0) return std::nullopt;
+  // A facade running on past the corner into a flush neighbour's: on a facade the scan found
+  // misplaced, the party wall where one of the two is taller is the corner (corners.h).
+  std::optional<double> party_wall;
+  if (end - s * uc > prm.match_distance && f.displaced)
+    party_wall = flush_neighbour_edge(cloud, f, w.plane, s, s * uc, prm.match_distance, wall_scan.z1, detection);
+  if (party_wall) end = *party_wall;
   const double gap = end - s * uc;  // > 0: the scan runs past the corner
   if (std::abs(gap) <= kCornerTolerance || std::abs(gap) > prm.match_distance) return std::nullopt;
-  // Points of this plane again past the end, short of the corner: the run ended at a gap in the
-  // facade (a recessed entrance), not at the building's edge.
-  int beyond = 0;
-  for (double x : t) beyond += x > end + kRunGap && x <= s * uc + prm.match_distance;
-  if (beyond > kStrayPoints) return std::nullopt;
-  // The scan must show the corner itself (corners.h): a return onto the side wall where the
-  // facade's points end, or an open end on a facade the scan found misplaced.
   const Plane moved(as.plane.n, as.plane.d - as.plane.n.dot(s * gap * f.u));
-  if (!shows_return(cloud, w.plane, moved, side_of(mesh, as, w.plane), f.z0, f.z1, detection) &&
-      !(f.displaced && ends_in_the_open(end_strips(cloud, w.plane, f.o, f.u, s, end + s * f.u_mid, wall_scan.z0, f.z0,
-                                                   f.z1, detection))))
-    return std::nullopt;
-  if (!same_end_over_the_height(f, t)) return std::nullopt;
+  if (!party_wall) {
+    // Points of this plane again past the end, short of the corner: the run ended at a gap in
+    // the facade (a recessed entrance), not at the building's edge.
+    int beyond = 0;
+    for (double x : t) beyond += x > end + kRunGap && x <= s * uc + prm.match_distance;
+    if (beyond > kStrayPoints) return std::nullopt;
+    // The scan must show the corner itself (corners.h): a return onto the side wall where the
+    // facade's points end, or an open end on a facade the scan found misplaced.
+    if (!shows_return(cloud, w.plane, moved, side_of(mesh, as, w.plane), f.z0, f.z1, detection) &&
+        !(f.displaced && ends_in_the_open(end_strips(cloud, w.plane, f.o, f.u, s, end + s * f.u_mid, wall_scan.z0, f.z0,
+                                                     f.z1, detection))))
+      return std::nullopt;
+    if (!same_end_over_the_height(f, t)) return std::nullopt;
+  }
   CornerMove cm;
   cm.move.surface = a;
   cm.move.plane = moved;
   cm.scanned_surface = w.surface;
   cm.shift = gap;
+  if (party_wall) cm.flush_facade = w.plane;
   return cm;
 }
 
@@ -305,6 +367,10 @@ std::vector<CornerMove> agreed_moves(const std::map<int, std::vector<CornerMove>
 }
 
 }  // namespace
+
+double on_plane_band(const PlaneConfig& prm) {
+  return std::max(kCornerTolerance, kOffPlaneEpsilons * prm.ransac_epsilon);
+}
 
 std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
                                      const std::vector<ScannedWall>& scanned, const PointCloud& cloud,

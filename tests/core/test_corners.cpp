@@ -130,6 +130,31 @@ Scene stepped_scene(double offset, bool side) {
   return s;
 }
 
+// The box's front scanned `offset` in front of the model's to x = 11.3 (where the building
+// really ends) and on, flush, over a terraced neighbour's facade from x = 11.3 to 20 up to
+// `neighbour_top` (lower or taller than the box's 6 m); the street in front.
+Scene terraced_scene(double offset, double neighbour_top) {
+  Scene s = scene(11.3, 0.0, offset);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.005);
+  for (double x = 11.32; x < 20.0; x += 0.05)
+    for (double z = 0.1; z < neighbour_top; z += 0.05) {
+      s.planes[0].inliers.push_back(int(s.cloud.points.size()));
+      s.cloud.points.emplace_back(x, -offset + noise(rng), z);
+    }
+  add_street(s, 20.0);
+  return s;
+}
+
+// The one move of a terraced scene: the right side wall (the party wall) to x = 11.3.
+void expect_party_wall_moved(const Scene& s, const std::vector<CornerMove>& moves) {
+  ASSERT_EQ(moves.size(), 1u);
+  EXPECT_GT(s.surfaces[moves[0].move.surface].plane.n.x(), 0.99) << "the right side wall";
+  EXPECT_NEAR(moves[0].move.plane.distance(Vec3(11.3, 0, 0)), 0.0, 0.06);
+  ASSERT_TRUE(moves[0].flush_facade.has_value());
+  EXPECT_NEAR(moves[0].flush_facade->distance(Vec3(15, -0.4, 2)), 0.0, 1e-9) << "the scanned facade's plane";
+}
+
 // The one move of a stepped scene: the upper storey's side wall (x = 9) to x = 9.5.
 void expect_upper_side_wall_moved(const Scene& s, const std::vector<CornerMove>& moves) {
   ASSERT_EQ(moves.size(), 1u) << "the lower storey ends where the model has it";
@@ -261,4 +286,36 @@ TEST(Corners, AMisplacedUpperStoreyEndingInTheOpenMovesItsSideWall) {
   const Scene s = stepped_scene(0.4, false);
   expect_upper_side_wall_moved(
       s, corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}));
+}
+
+// Terraced houses, the facade misplaced 0.4 m and flush with a lower neighbour's: below 3 m the
+// scan runs on, above it the facade's own points end at the party wall.
+TEST(Corners, AMisplacedFacadeAboveALowerFlushNeighbourMovesThePartyWall) {
+  const Scene s = terraced_scene(0.4, 3.0);
+  expect_party_wall_moved(s,
+                          corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}));
+}
+
+// The same beside a taller neighbour (9 m): its facade's points above this roof start at the
+// party wall.
+TEST(Corners, AMisplacedFacadeBelowATallerFlushNeighbourMovesThePartyWall) {
+  const Scene s = terraced_scene(0.4, 9.0);
+  expect_party_wall_moved(s,
+                          corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}));
+}
+
+// A correct facade with the same neighbours: the scan shows no misplaced wall, and a flush
+// neighbour's outline alone moves nothing.
+TEST(Corners, ACorrectFacadeBesideAFlushNeighbourMovesNothing) {
+  for (double top : {3.0, 9.0}) {
+    const Scene s = terraced_scene(0.0, top);
+    EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}).empty())
+        << "neighbour " << top << " m high";
+  }
+}
+
+// A flush neighbour of one height with this facade: no outline step, no party wall, no move.
+TEST(Corners, AMisplacedFacadeFlushWithAnEqualNeighbourMovesNothing) {
+  const Scene s = terraced_scene(0.4, 5.9);
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}).empty());
 }
