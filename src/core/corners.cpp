@@ -305,6 +305,7 @@ std::optional<CornerMove> corner_at(const Mesh& mesh, const FacadeScan& wall_sca
     ze1 = std::max({ze1, mesh.vertices[i].z(), mesh.vertices[j].z()});
   }
   zc /= double(edges.size());
+  const double edge_u = (mesh.vertices[edges.front().first] - wall_scan.o).dot(wall_scan.u) - wall_scan.u_mid;
   const FacadeScan f = at_heights(wall_scan, ze0, ze1);
   if (f.pu.empty()) return std::nullopt;
   const auto c = meet(w.plane, as.plane, Plane(Vec3::UnitZ(), -zc));
@@ -332,9 +333,14 @@ std::optional<CornerMove> corner_at(const Mesh& mesh, const FacadeScan& wall_sca
     if (beyond > kStrayPoints) return std::nullopt;
     // The scan must show the corner itself (corners.h): a return onto the side wall where the
     // facade's points end, or an open end on a facade the scan found misplaced.
+    // An open end at the model's own corner edge (the facade's outline at those heights) agrees
+    // with the model: a skewed side wall's corner slides along the facade as the facade moves,
+    // and a scan that just ends where the model does shows nothing more (no points, no evidence).
+    const bool off_the_edge = std::abs(end - s * edge_u) > kCornerTolerance;
     if (!shows_return(cloud, w.plane, moved, side_of(mesh, as, w.plane), f.z0, f.z1, detection) &&
-        !(f.displaced && ends_in_the_open(end_strips(cloud, w.plane, f.o, f.u, s, end + s * f.u_mid, wall_scan.z0, f.z0,
-                                                     f.z1, detection))))
+        !(f.displaced && off_the_edge &&
+          ends_in_the_open(
+              end_strips(cloud, w.plane, f.o, f.u, s, end + s * f.u_mid, wall_scan.z0, f.z0, f.z1, detection))))
       return std::nullopt;
     if (!same_end_over_the_height(f, t)) return std::nullopt;
   }

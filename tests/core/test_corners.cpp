@@ -11,11 +11,13 @@ using namespace lodrefine;
 
 namespace {
 
-// A closed box [0,12] x [0,8] x [0,6] (front wall y = 0 faces -y).
-Mesh box() {
+// A closed box [0,12] x [0,8] x [0,6] (front wall y = 0 faces -y); its right side wall runs from
+// (12, 0) back to (back_right, 8) (skewed when not 12).
+Mesh box(double back_right = 12.0) {
   Mesh soup;
   soup.id = "box";
-  const Vec3 c[8] = {{0, 0, 0}, {12, 0, 0}, {12, 8, 0}, {0, 8, 0}, {0, 0, 6}, {12, 0, 6}, {12, 8, 6}, {0, 8, 6}};
+  const double r = back_right;
+  const Vec3 c[8] = {{0, 0, 0}, {12, 0, 0}, {r, 8, 0}, {0, 8, 0}, {0, 0, 6}, {12, 0, 6}, {r, 8, 6}, {0, 8, 6}};
   const int quads[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
   const Semantic sem[6] = {Semantic::Ground, Semantic::Roof, Semantic::Wall,
                            Semantic::Wall,   Semantic::Wall, Semantic::Wall};
@@ -41,10 +43,10 @@ struct Scene {
 
 // The front facade scanned from x = 0 to x = `end`, `offset` metres in front of the model's
 // (a misplaced model facade when > 0); optionally the right side wall seen obliquely for `side`
-// metres behind the facade at x = `end`.
-Scene scene(double end, double side, double offset = 0.0) {
+// metres behind the facade at x = `end`. The box's right side wall runs back to `back_right`.
+Scene scene(double end, double side, double offset = 0.0, double back_right = 12.0) {
   Scene s;
-  s.mesh = box();
+  s.mesh = box(back_right);
   s.surfaces = model_surfaces(s.mesh);
   std::mt19937 rng(3);
   std::normal_distribution<double> noise(0.0, 0.005);
@@ -317,5 +319,16 @@ TEST(Corners, ACorrectFacadeBesideAFlushNeighbourMovesNothing) {
 // A flush neighbour of one height with this facade: no outline step, no party wall, no move.
 TEST(Corners, AMisplacedFacadeFlushWithAnEqualNeighbourMovesNothing) {
   const Scene s = terraced_scene(0.4, 5.9);
+  EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}).empty());
+}
+
+// A facade the scan moves 0.4 m out whose points end where the model's facade ends (x = 12, the
+// corner's edge), the street scanned on past it: the scan agrees with the model's extent. The
+// side wall, skewed 22 deg from perpendicular (to x = 15.2 at the back), meets the moved
+// facade's plane at x = 11.84: the end 0.16 m past that is the corner sliding along the moved
+// facade, no evidence the side wall is off (City3D AHN3 building 00005).
+TEST(Corners, AMisplacedFacadeEndingAtTheModelsCornerMovesNoSkewedSideWall) {
+  Scene s = scene(12.0, 0.0, 0.4, 15.2);
+  add_street(s, 16.0);
   EXPECT_TRUE(corner_moves(s.mesh, s.surfaces, s.scanned, s.cloud, s.planes, MatchConfig{}, PlaneConfig{}).empty());
 }

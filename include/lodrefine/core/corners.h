@@ -5,7 +5,8 @@
 // and the scan must show the corner, one of:
 //  - the return: points on the side wall's new plane where the facade's points end;
 //  - an open end on a facade the scan itself moves by decimetres: the street scanned on past the
-//    end, nothing in front hiding the facade there, no facade beyond. Open ends look the same
+//    end, nothing in front hiding the facade there, no facade beyond, and the end off the model's
+//    own corner edge (there the scan agrees with the model). Open ends look the same
 //    where a scan of a correct neighbour was cut off, so they count only on a building the scan
 //    already shows mis-modelled.
 //  - a party wall on a facade the scan moves by decimetres that runs on, flush, into a
