@@ -219,7 +219,10 @@ std::optional<Mesh> starting_shell(const Mesh& current, const std::vector<ModelS
     refined = substitute_valid(current, surfaces, all, prm, trace.substitution.emplace(RefineTrace::Substitution{}));
   if (refined) {
     for (const auto& mv : moves) trace.facades.push_back(describe_move(current, surfaces, mv, "scan"));
-    for (const auto& c : corners) trace.facades.push_back(describe_move(current, surfaces, c.move, "corner"));
+    for (const auto& c : corners) {
+      trace.facades.push_back(describe_move(current, surfaces, c.move, "corner"));
+      trace.facades.back().wall.flush_facade = c.flush_facade;
+    }
   } else if (!corners.empty() && !moves.empty()) {
     refined = substitute_valid(current, surfaces, moves, prm,
                                trace.substitution_without_corners.emplace(RefineTrace::Substitution{}));
