@@ -341,7 +341,10 @@ SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& pg,
   res.variables = glp_get_num_cols(p.lp);
   res.constraints = glp_get_num_rows(p.lp);
   res.nonzeros = int(p.ia.size()) - 1;
-  if (!feasible) return done(SolveStatus::Infeasible);
+  if (!feasible) {  // no selection, not the fixed and forced values that contradict each other
+    res.selected.assign(cs.faces.size(), 0);
+    return done(SolveStatus::Infeasible);
+  }
   if (res.variables == 0) {  // everything fixed: the fixed selection is the answer
     res.ok = true;
     return done(SolveStatus::Optimal);

@@ -54,18 +54,6 @@ void add_point(PolyfitInput& in, const Vec3& p, const Vec3& normal, int plane) {
   in.points.emplace_back(Point(p.x(), p.y(), p.z()), Vector(normal.x(), normal.y(), normal.z()), plane);
 }
 
-// The region refine_building detects planes in: the model's box grown by the matching distance
-// and the arrangement's margins (refine.cpp's cloud_near), so both methods see the same points.
-PointCloud scan_near(const Mesh& local_model, const PointCloud& cloud, const Vec3& origin, const Params& params) {
-  const Eigen::AlignedBox3d box = bounding_box(local_model.vertices);
-  const Vec3 pad = Vec3::Constant(params.match_distance + params.bbox_margin) + params.bbox_expand * box.sizes();
-  const Eigen::AlignedBox3d region(box.min() - pad, box.max() + pad);
-  PointCloud local;
-  for (const auto& p : cloud.points)
-    if (region.contains(p - origin)) local.points.push_back(p - origin);
-  return local;
-}
-
 // Every scan point near the model (the unassigned ones widen PolyFit's bounding box, as a
 // crop's points would), with its plane's normal and index.
 void add_scan(PolyfitInput& in, const PointCloud& scan, const std::vector<ScanPlane>& planes) {
@@ -169,7 +157,7 @@ void run(const Mesh& model, const PointCloud& cloud, const Params& params, const
   const Vec3 origin = local_origin(model);
   const Mesh local_model = translated(model, -origin);
   if (local_model.vertices.empty()) throw InputError("the model has no vertices");
-  const PointCloud scan = scan_near(local_model, cloud, origin, params);
+  const PointCloud scan = cloud_near(local_model, cloud, origin, params);
   const Clock::time_point t0 = Clock::now();
   const std::vector<ScanPlane> planes = detect_planes(scan, params);
   r.detection_seconds = seconds_since(t0);
