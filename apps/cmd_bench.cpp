@@ -1,15 +1,19 @@
 // `lodrefine bench`: generates a tile of test buildings in memory, refines each one and
-// prints time per stage and per building, with accuracy against the known truth. Speed and
+// prints time per stage and per building, with accuracy against the known truth. With
+// --polyfit, CGAL's PolyFit runs beside lodrefine on each building (generated or read from
+// --tile) and the table compares their time and accuracy (eval/polyfit_bench.h). Speed and
 // memory are measured here, never in timed tests.
 #include <sys/resource.h>
 
 #include <chrono>
 #include <cstdio>
+#include <optional>
 
 #include "commands.h"
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/eval/eval.h"
+#include "lodrefine/eval/polyfit_bench.h"
 #include "lodrefine/synth/synth.h"
 #include "options.h"
 
@@ -22,10 +26,14 @@ struct BenchArgs {
   int seed = 1;
   int points = 30000;
   int facades = 0;
+  bool polyfit = false;
+  std::string tile;  // a dev tile or run folder instead of generated buildings (with --polyfit)
+  std::string polyfit_planes = "model+scan";
+  PolyfitOptions polyfit_options;
   Params params;
 };
 
-void run(const BenchArgs& a) {
+std::vector<BuildingType> bench_types(const BenchArgs& a) {
   std::vector<BuildingType> types;
   for (const auto& t : a.types) {
     if (t == "all") {
@@ -35,9 +43,53 @@ void run(const BenchArgs& a) {
       types.push_back(building_type_from_name(t));
     }
   }
+  return types;
+}
+
+SynthOptions synth_options(const BenchArgs& a) {
   SynthOptions opt;
   opt.target_points = a.points;
   opt.scanned_facades = a.facades;
+  return opt;
+}
+
+// lodrefine and PolyFit on each building, a row as each finishes, then the summary. A building
+// whose files cannot be read is reported and skipped; PolyFit's failures are rows.
+void run_polyfit(const BenchArgs& a) {
+  PolyfitOptions options = a.polyfit_options;
+  options.planes = a.polyfit_planes == "scan" ? PolyfitPlanes::Scan : PolyfitPlanes::ModelAndScan;
+  const std::vector<BuildingFiles> files = a.tile.empty() ? std::vector<BuildingFiles>{} : discover_bench(a.tile);
+  std::vector<PolyfitComparisonRow> rows;
+  print_comparison_header(stdout);
+  auto compare = [&](const BenchBuilding& b) {
+    rows.push_back(compare_with_polyfit(b, a.params, options));
+    print_comparison_row(rows.back(), stdout);
+  };
+  if (!a.tile.empty()) {
+    for (const BuildingFiles& f : files) {
+      std::optional<BenchBuilding> b;
+      try {
+        b = read_bench_building(f);
+      } catch (const InputError& e) {
+        std::printf("  %s: skipped: %s\n", f.id.c_str(), e.what());
+        continue;
+      }
+      compare(*b);
+    }
+  } else {
+    for (BuildingType type : bench_types(a))
+      for (int k = 0; k < a.count; ++k) {
+        SynthBuilding s = make_building(type, std::uint64_t(a.seed + k), synth_options(a));
+        compare({s.id, std::move(s.coarse), std::move(s.truth), std::move(s.cloud), s.scanned_truth_faces});
+      }
+  }
+  print_comparison_summary(summarize_comparison(rows), options, stdout);
+}
+
+void run(const BenchArgs& a) {
+  if (a.polyfit) return run_polyfit(a);
+  const std::vector<BuildingType> types = bench_types(a);
+  const SynthOptions opt = synth_options(a);
   std::printf("%-24s %7s %6s %5s %6s %6s | %7s %7s %7s %7s %7s | %8s %8s | %s\n", "building", "points", "planes",
               "cand", "mipvar", "mip_s", "repair", "planes", "match", "replace", "total", "facade0", "facade1",
               "outcome");
@@ -100,6 +152,23 @@ void add_bench_command(CLI::App& app) {
   add_ranged_option(cmd, "--points", args.points, "Target facade points per building", 100, 10000000);
   add_ranged_option(cmd, "--facades", args.facades,
                     "Scanned facades per building (0: random 1..3, as in the generator)", 0, 20);
+  auto* polyfit = cmd->add_flag("--polyfit", args.polyfit,
+                                "Run CGAL's PolyFit beside lodrefine on each building; print both methods' "
+                                "time and truth accuracy and PolyFit's failures");
+  cmd->add_option("--tile", args.tile,
+                  "With --polyfit: the buildings of a dev tile (models/, clouds/, truth/) or a run "
+                  "folder (<id>/coarse.obj, cloud.ply, truth.obj) instead of generated ones")
+      ->check(CLI::ExistingDirectory)
+      ->needs(polyfit);
+  cmd->add_option("--polyfit-planes", args.polyfit_planes,
+                  "PolyFit's planes: the scan's (lodrefine's plane stage), or those and the coarse model's")
+      ->check(CLI::IsMember({"scan", "model+scan"}))
+      ->capture_default_str()
+      ->needs(polyfit);
+  add_ranged_option(cmd, "--polyfit-cpu-limit", args.polyfit_options.cpu_limit,
+                    "CPU seconds PolyFit may take per building (it runs in a child process; beyond: time-limit)", 1.0,
+                    86400.0)
+      ->needs(polyfit);
   add_param_options(cmd, args.params);
   cmd->callback([] { run(args); });
 }

@@ -44,6 +44,11 @@ constexpr double kStreetNear = 0.3, kStreetFar = 10.0;
 constexpr double kGroundBand = 0.3;
 constexpr double kStreetGoesOn = 0.5;
 constexpr double kClearInFront = 0.05;
+// A flush neighbour: the facade's outline is read in bands of kHeightBand (m); at least kBands
+// of them must show the corner, from kAboveTop (m) over the wall's top for a taller neighbour
+// (a gutter or a roof's edge there does not count).
+constexpr double kHeightBand = 0.5;
+constexpr double kAboveTop = 0.3;
 // A facade the scan moves by this much on average is misplaced beyond doubt: scan planes are good
 // to a centimetre or two, airborne LoD2 facades are decimetres off.
 constexpr double kMisplacedFacade = 0.1;
@@ -74,12 +79,6 @@ double side_of(const Mesh& mesh, const ModelSurface& wall, const Plane& facade) 
   return sum >= 0 ? 1.0 : -1.0;
 }
 
-// A point within this of a scan plane lies on it: the plane's noise band, at least the corner
-// tolerance.
-double on_plane_band(const PlaneConfig& prm) {
-  return std::max(kCornerTolerance, kOffPlaneEpsilons * prm.ransac_epsilon);
-}
-
 // Whether points lie on the side wall's new plane `moved`, off the facade plane on the wall's
 // `side`, over the upper part of the facade's height [z0, z1] (ground and clutter below do not
 // count): the return the scanner saw where the facade turns the corner.
@@ -108,7 +107,8 @@ bool shows_return(const PointCloud& cloud, const Plane& facade, const Plane& mov
 }
 
 // Points in the strips just past and just before a facade's end (t: position along the facade
-// towards the corner, measured from the wall's middle).
+// towards the corner, measured from the wall's middle): the street's ground at the wall's foot
+// `ground`, the facade at the corner's heights [z0, z1].
 struct EndStrips {
   int street_past = 0, street_before = 0;  // ground in front of the facade
   int front_past = 0;                      // in front of the facade at its height
@@ -116,7 +116,7 @@ struct EndStrips {
 };
 
 EndStrips end_strips(const PointCloud& cloud, const Plane& facade, const Vec3& o, const Vec3& u, double s, double end,
-                     double z0, double z1, const PlaneConfig& prm) {
+                     double ground, double z0, double z1, const PlaneConfig& prm) {
   const double za = z0 + kLowBand * (z1 - z0);
   const double on_plane = on_plane_band(prm);
   EndStrips e;
@@ -127,7 +127,7 @@ EndStrips end_strips(const PointCloud& cloud, const Plane& facade, const Vec3& o
     const double d = facade.distance(p);  // outwards: the street side
     const bool in_front = d > kStreetNear && d < kStreetFar;
     const bool high = p.z() > za && p.z() < z1;
-    if (in_front && p.z() < z0 + kGroundBand) ++(past ? e.street_past : e.street_before);
+    if (in_front && p.z() < ground + kGroundBand) ++(past ? e.street_past : e.street_before);
     if (in_front && high && past) ++e.front_past;
     if (std::abs(d) <= on_plane && high) ++(past ? e.facade_past : e.facade_before);
   }
@@ -221,43 +221,135 @@ bool same_end_over_the_height(const FacadeScan& f, const std::vector<double>& t)
   return bands >= kBands - 1 && hi - lo <= kEndSpread;
 }
 
+// The facade's scan over the heights [z0, z1] of one corner: where a facade steps (an upper
+// storey set back, a lower wing running on), its end at the corner shows only at those heights.
+FacadeScan at_heights(const FacadeScan& f, double z0, double z1) {
+  FacadeScan g = f;
+  g.pu.clear();
+  g.pz.clear();
+  g.z0 = z0;
+  g.z1 = z1;
+  for (std::size_t k = 0; k < f.pu.size(); ++k)
+    if (f.pz[k] >= z0 && f.pz[k] <= z1) {
+      g.pu.push_back(f.pu[k]);
+      g.pz.push_back(f.pz[k]);
+    }
+  return g;
+}
+
+// Per band of kHeightBand from z0 up (n bands), the largest position t below `hi` of the points
+// (positions t, heights z) at or past `lo`; -1e300 for a band without any.
+std::vector<double> band_ends(const std::vector<double>& t, const std::vector<double>& z, double z0, int n, double lo,
+                              double hi) {
+  std::vector<double> ends(std::size_t(n), -1e300);
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    const int b = int(std::floor((z[k] - z0) / kHeightBand));
+    if (b >= 0 && b < n && t[k] >= lo && t[k] < hi) ends[std::size_t(b)] = std::max(ends[std::size_t(b)], t[k]);
+  }
+  return ends;
+}
+
+// The edge where consecutive bands (from the first that has points) end short of `stop` (a
+// band whose points run on to it is the flush facade): the farthest end (a window near the edge
+// ends its band short), when at least kBands of them end within kEndSpread of it.
+std::optional<double> one_edge(const std::vector<double>& ends, double stop) {
+  std::vector<double> run;
+  for (double e : ends) {
+    if (e < -1e299 && run.empty()) continue;  // bands the scan does not reach
+    if (e < -1e299 || e > stop) break;
+    run.push_back(e);
+  }
+  if (run.empty()) return std::nullopt;
+  const double edge = *std::max_element(run.begin(), run.end());
+  const auto at_edge = std::count_if(run.begin(), run.end(), [&](double e) { return e >= edge - kEndSpread; });
+  if (at_edge < kBands) return std::nullopt;
+  return edge;
+}
+
+// Where a facade that runs on past the corner at uc into a flush neighbour's (one plane below
+// the lower roof) shows the party wall, within `reach` of the corner (t: position along the
+// facade towards the corner): the wall's own points above a lower neighbour end there, top
+// bands down; or the points of a taller neighbour above the wall's top (`top`) start there.
+std::optional<double> flush_neighbour_edge(const PointCloud& cloud, const FacadeScan& f, const Plane& facade, double s,
+                                           double uc, double reach, double top, const PlaneConfig& prm) {
+  std::vector<double> t(f.pu.size());
+  for (std::size_t k = 0; k < t.size(); ++k) t[k] = s * f.pu[k];
+  const int n = int(std::ceil((f.z1 - f.z0) / kHeightBand));
+  std::vector<double> own = band_ends(t, f.pz, f.z0, n, uc - reach, uc + reach);
+  std::reverse(own.begin(), own.end());
+  if (auto e = one_edge(own, uc + reach - kRunGap)) return e;
+  // The taller neighbour's points, positions negated: their start is the largest.
+  const double on_plane = on_plane_band(prm), z0 = top + kAboveTop;
+  std::vector<double> back, z;
+  for (const auto& p : cloud.points)
+    if (p.z() >= z0 && std::abs(facade.distance(p)) <= on_plane) {
+      back.push_back(-s * ((p - f.o).dot(f.u) - f.u_mid));
+      z.push_back(p.z());
+    }
+  const auto e = one_edge(band_ends(back, z, z0, 2 * kBands, -uc - reach, -uc + reach), -uc + reach - kRunGap);
+  if (!e) return std::nullopt;
+  return -*e;
+}
+
 // The move of the unscanned neighbour `a` (sharing `edges` with the scanned wall) to where the
 // facade's points end, when the scan shows that corner.
-std::optional<CornerMove> corner_at(const Mesh& mesh, const FacadeScan& f, const ScannedWall& w, int a,
+std::optional<CornerMove> corner_at(const Mesh& mesh, const FacadeScan& wall_scan, const ScannedWall& w, int a,
                                     const ModelSurface& as, const std::vector<std::pair<int, int>>& edges,
                                     const PointCloud& cloud, const MatchConfig& prm, const PlaneConfig& detection) {
-  // The corner on the scanned plane, at mid height of the shared edge.
-  double zc = 0.0;
-  for (const auto& [i, j] : edges) zc += 0.5 * (mesh.vertices[i].z() + mesh.vertices[j].z());
+  // The corner on the scanned plane, at mid height of the shared edge; the facade's points over
+  // the edge's heights (the street's ground stays at the wall's foot).
+  double zc = 0.0, ze0 = 1e300, ze1 = -1e300;
+  for (const auto& [i, j] : edges) {
+    zc += 0.5 * (mesh.vertices[i].z() + mesh.vertices[j].z());
+    ze0 = std::min({ze0, mesh.vertices[i].z(), mesh.vertices[j].z()});
+    ze1 = std::max({ze1, mesh.vertices[i].z(), mesh.vertices[j].z()});
+  }
   zc /= double(edges.size());
+  const double edge_u = (mesh.vertices[edges.front().first] - wall_scan.o).dot(wall_scan.u) - wall_scan.u_mid;
+  const FacadeScan f = at_heights(wall_scan, ze0, ze1);
+  if (f.pu.empty()) return std::nullopt;
   const auto c = meet(w.plane, as.plane, Plane(Vec3::UnitZ(), -zc));
   if (!c) return std::nullopt;
   const double uc = (*c - f.o).dot(f.u) - f.u_mid;
   const double s = uc >= 0 ? 1.0 : -1.0;
   std::vector<double> t(f.pu.size());
   for (std::size_t k = 0; k < f.pu.size(); ++k) t[k] = s * f.pu[k];
-  const double end = run_end(t);
+  double end = run_end(t);
   if (end < 0) return std::nullopt;
+  // A facade running on past the corner into a flush neighbour's: on a facade the scan found
+  // misplaced, the party wall where one of the two is taller is the corner (corners.h).
+  std::optional<double> party_wall;
+  if (end - s * uc > prm.match_distance && f.displaced)
+    party_wall = flush_neighbour_edge(cloud, f, w.plane, s, s * uc, prm.match_distance, wall_scan.z1, detection);
+  if (party_wall) end = *party_wall;
   const double gap = end - s * uc;  // > 0: the scan runs past the corner
   if (std::abs(gap) <= kCornerTolerance || std::abs(gap) > prm.match_distance) return std::nullopt;
-  // Points of this plane again past the end, short of the corner: the run ended at a gap in the
-  // facade (a recessed entrance), not at the building's edge.
-  int beyond = 0;
-  for (double x : t) beyond += x > end + kRunGap && x <= s * uc + prm.match_distance;
-  if (beyond > kStrayPoints) return std::nullopt;
-  // The scan must show the corner itself (corners.h): a return onto the side wall where the
-  // facade's points end, or an open end on a facade the scan found misplaced.
   const Plane moved(as.plane.n, as.plane.d - as.plane.n.dot(s * gap * f.u));
-  if (!shows_return(cloud, w.plane, moved, side_of(mesh, as, w.plane), f.z0, f.z1, detection) &&
-      !(f.displaced &&
-        ends_in_the_open(end_strips(cloud, w.plane, f.o, f.u, s, end + s * f.u_mid, f.z0, f.z1, detection))))
-    return std::nullopt;
-  if (!same_end_over_the_height(f, t)) return std::nullopt;
+  if (!party_wall) {
+    // Points of this plane again past the end, short of the corner: the run ended at a gap in
+    // the facade (a recessed entrance), not at the building's edge.
+    int beyond = 0;
+    for (double x : t) beyond += x > end + kRunGap && x <= s * uc + prm.match_distance;
+    if (beyond > kStrayPoints) return std::nullopt;
+    // The scan must show the corner itself (corners.h): a return onto the side wall where the
+    // facade's points end, or an open end on a facade the scan found misplaced.
+    // An open end at the model's own corner edge (the facade's outline at those heights) agrees
+    // with the model: a skewed side wall's corner slides along the facade as the facade moves,
+    // and a scan that just ends where the model does shows nothing more (no points, no evidence).
+    const bool off_the_edge = std::abs(end - s * edge_u) > kCornerTolerance;
+    if (!shows_return(cloud, w.plane, moved, side_of(mesh, as, w.plane), f.z0, f.z1, detection) &&
+        !(f.displaced && off_the_edge &&
+          ends_in_the_open(
+              end_strips(cloud, w.plane, f.o, f.u, s, end + s * f.u_mid, wall_scan.z0, f.z0, f.z1, detection))))
+      return std::nullopt;
+    if (!same_end_over_the_height(f, t)) return std::nullopt;
+  }
   CornerMove cm;
   cm.move.surface = a;
   cm.move.plane = moved;
   cm.scanned_surface = w.surface;
   cm.shift = gap;
+  if (party_wall) cm.flush_facade = w.plane;
   return cm;
 }
 
@@ -281,6 +373,10 @@ std::vector<CornerMove> agreed_moves(const std::map<int, std::vector<CornerMove>
 }
 
 }  // namespace
+
+double on_plane_band(const PlaneConfig& prm) {
+  return std::max(kCornerTolerance, kOffPlaneEpsilons * prm.ransac_epsilon);
+}
 
 std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
                                      const std::vector<ScannedWall>& scanned, const PointCloud& cloud,

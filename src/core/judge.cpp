@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "lodrefine/core/corners.h"
 #include "lodrefine/core/distance.h"
 #include "lodrefine/core/matching.h"
 
@@ -96,8 +97,17 @@ struct Region {
   }
 };
 
+// Whether p is a flush neighbour's: past a wall moved to the party wall, on or behind the
+// facade's plane (its facade, window recesses and all).
+bool neighbours(const Vec3& p, const std::vector<JudgedWall>& walls, double on_plane) {
+  for (const auto& w : walls)
+    if (w.flush_facade && w.flush_facade->distance(p) <= on_plane && w.to.distance(p) > 0) return true;
+  return false;
+}
+
 // The points near either model with their capped distances.
-std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const PointCloud& cloud, double cap) {
+std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const std::vector<JudgedWall>& walls,
+                                    const PointCloud& cloud, double cap, double on_plane) {
   Eigen::AlignedBox3d box = bounding_box(before.vertices);
   box.extend(bounding_box(after.vertices));
   const double ground = box.min().z() + kGroundBand;
@@ -106,7 +116,7 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
   const MeshDistance d0(before), d1(after);
   std::vector<PointFit> out;
   for (const auto& p : cloud.points) {
-    if (!box.contains(p) || p.z() < ground) continue;
+    if (!box.contains(p) || p.z() < ground || neighbours(p, walls, on_plane)) continue;
     const auto a = d0.nearest(p, false), b = d1.nearest(p, false);
     if (a.distance > cap && b.distance > cap) continue;
     out.push_back({std::min(a.distance, cap), std::min(b.distance, cap), a.face, b.face});
@@ -122,7 +132,7 @@ Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vec
   const double cap = prm.match_distance, changed = detection.ransac_epsilon;
   std::vector<PointFit> points;
   try {
-    points = judged_points(before, after, cloud, cap);
+    points = judged_points(before, after, walls, cloud, cap, on_plane_band(detection));
   } catch (const InputError& e) {
     j.ok = false;
     j.check = "building";

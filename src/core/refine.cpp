@@ -21,18 +21,6 @@ constexpr double kOriginGrid = 100.0;
 // steps (the same wall re-found after another moved has the same position within rounding).
 constexpr double kPositionSteps = 100.0;
 
-// The cloud near the model, in its local frame (crops may carry whole streets): the model's
-// box grown by the matching distance and the arrangement's region margins.
-PointCloud cloud_near(const Mesh& local_model, const PointCloud& cloud, const Vec3& origin, const RefineConfig& prm) {
-  const Eigen::AlignedBox3d box = bounding_box(local_model.vertices);
-  const Vec3 pad = Vec3::Constant(prm.match_distance + prm.bbox_margin) + prm.bbox_expand * box.sizes();
-  const Eigen::AlignedBox3d near(box.min() - pad, box.max() + pad);
-  PointCloud local;
-  for (const auto& p : cloud.points)
-    if (near.contains(p - origin)) local.points.push_back(p - origin);
-  return local;
-}
-
 // A moved wall for the report, on the mesh (and its surfaces) the move was made on.
 RefineTrace::FacadeMove describe_move(const Mesh& mesh, const std::vector<ModelSurface>& surfaces, const WallMove& move,
                                       const char* evidence) {
@@ -219,7 +207,10 @@ std::optional<Mesh> starting_shell(const Mesh& current, const std::vector<ModelS
     refined = substitute_valid(current, surfaces, all, prm, trace.substitution.emplace(RefineTrace::Substitution{}));
   if (refined) {
     for (const auto& mv : moves) trace.facades.push_back(describe_move(current, surfaces, mv, "scan"));
-    for (const auto& c : corners) trace.facades.push_back(describe_move(current, surfaces, c.move, "corner"));
+    for (const auto& c : corners) {
+      trace.facades.push_back(describe_move(current, surfaces, c.move, "corner"));
+      trace.facades.back().wall.flush_facade = c.flush_facade;
+    }
   } else if (!corners.empty() && !moves.empty()) {
     refined = substitute_valid(current, surfaces, moves, prm,
                                trace.substitution_without_corners.emplace(RefineTrace::Substitution{}));
@@ -263,6 +254,16 @@ RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::
 }
 
 }  // namespace
+
+PointCloud cloud_near(const Mesh& local_model, const PointCloud& cloud, const Vec3& origin, const RefineConfig& prm) {
+  const Eigen::AlignedBox3d box = bounding_box(local_model.vertices);
+  const Vec3 pad = Vec3::Constant(prm.match_distance + prm.bbox_margin) + prm.bbox_expand * box.sizes();
+  const Eigen::AlignedBox3d near(box.min() - pad, box.max() + pad);
+  PointCloud local;
+  for (const auto& p : cloud.points)
+    if (near.contains(p - origin)) local.points.push_back(p - origin);
+  return local;
+}
 
 const char* outcome_name(Outcome outcome) {
   switch (outcome) {

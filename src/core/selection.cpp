@@ -101,64 +101,89 @@ bool every_edge_used_0_or_2(const CandidateSet& cs, const std::vector<char>& sel
   return true;
 }
 
-SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& pg, const SelectionConfig& prm,
-                             double time_limit) {
-  const auto t0 = std::chrono::steady_clock::now();
-  SelectionResult res;
-  const int nf = int(cs.faces.size()), ne = int(cs.edges.size());
+namespace {
+
+// The faces the edge constraints alone decide, given the fixed ones (a reduction GLPK's MIP
+// presolver makes, but it is off when a warm start is given, and without it the search over the
+// undecided faces is many times slower): an edge with fixed faces summing to c (its outside
+// count included) and one free face forces that face to c (0 + x or 1 + x must be 0 or 2); with
+// c = 2 every free face is 0. Repeated until nothing changes. Contradictions are left to the
+// caller. `fixed` as SelectionProgram::fixed, never empty.
+std::vector<int> forced_by_edges(const CandidateSet& cs, std::vector<int> fixed, const std::vector<int>& outside) {
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (std::size_t e = 0; e < cs.edges.size(); ++e) {
+      int constant = outside.empty() ? 0 : outside[e], free = 0;
+      for (int f : cs.edges[e].faces) {
+        if (fixed[f] < 0) ++free;
+        else constant += fixed[f];
+      }
+      if (free == 0 || constant > 2) continue;
+      if (constant == 2 || free == 1) {
+        for (int f : cs.edges[e].faces)
+          if (fixed[f] < 0) fixed[f] = constant == 2 ? 0 : constant;
+        changed = true;
+      }
+    }
+  }
+  return fixed;
+}
+
+// The program's view of the candidates: fixed values, and a GLPK column (1-based) per free
+// candidate, 0 for a fixed one.
+struct Columns {
+  const SelectionProgram& pg;
+  std::vector<int> fixed;  // pg.fixed and the faces the edges force (forced_by_edges)
+  std::vector<int> col;
+  int free = 0;
+  int fixed_value(int f) const { return fixed[f]; }
+  int outside(int e) const { return pg.outside.empty() ? 0 : pg.outside[e]; }
+  bool warm(int f) const { return !pg.warm.empty() && pg.warm[f]; }
+};
+
+// Decides the variables: a column per free candidate; fixed ones take their value in `res`.
+Columns candidate_columns(const CandidateSet& cs, const SelectionProgram& pg, SelectionResult& res) {
+  const int nf = int(cs.faces.size());
+  Columns c{pg, forced_by_edges(cs, pg.fixed.empty() ? std::vector<int>(nf, -1) : pg.fixed, pg.outside),
+            std::vector<int>(nf, 0), 0};
   res.selected.assign(nf, 0);
-  auto fixed_value = [&](int f) { return pg.fixed.empty() ? -1 : pg.fixed[f]; };
-  auto outside = [&](int e) { return pg.outside.empty() ? 0 : pg.outside[e]; };
-  // Column of each free face (1-based), 0 for a fixed one.
-  std::vector<int> col(nf, 0);
-  int free_faces = 0;
   for (int f = 0; f < nf; ++f) {
-    if (fixed_value(f) >= 0) ++res.fixed, res.selected[f] = char(fixed_value(f));
-    else col[f] = ++free_faces;
+    if (c.fixed_value(f) >= 0) ++res.fixed, res.selected[f] = char(c.fixed_value(f));
+    else c.col[f] = ++c.free;
+    res.forced += c.fixed_value(f) >= 0 && (pg.fixed.empty() || pg.fixed[f] < 0);
   }
-  res.column = col;
-  auto done = [&](SolveStatus status) {
-    res.status = status;
-    res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return res;
-  };
-  if (nf == 0) return done(SolveStatus::NoCandidates);  // GLPK aborts on empty column sets
+  res.column = c.col;
+  return c;
+}
 
-  // The starting point, checked against every edge: GLPK takes a heuristic solution unchecked.
-  res.warm_given = !pg.warm.empty();
-  if (res.warm_given) {
-    res.warm_feasible = every_edge_used_0_or_2(cs, pg.warm, pg.outside);
-    for (int f = 0; f < nf; ++f)
-      res.warm_feasible = res.warm_feasible && (fixed_value(f) < 0 || fixed_value(f) == pg.warm[f]);
-  }
+// Whether the starting point may be handed to GLPK, which takes a heuristic solution unchecked:
+// every edge used 0 or 2 times, and the fixed candidates as fixed.
+bool warm_start_feasible(const CandidateSet& cs, const Columns& c) {
+  if (!every_edge_used_0_or_2(cs, c.pg.warm, c.pg.outside)) return false;
+  for (int f = 0; f < int(cs.faces.size()); ++f)
+    if (c.fixed_value(f) >= 0 && c.fixed_value(f) != c.pg.warm[f]) return false;
+  return true;
+}
 
-  double total_area = 0.0;
-  for (const auto& f : cs.faces) total_area += f.area;
-  const double uniform_sharp = ne > 0 ? prm.lambda_complexity * total_area / ne : 0.0;
-
-  glp_term_out(GLP_OFF);
+// The GLPK problem under construction: its matrix triplets (1-based) and the starting value of
+// each column (start[0] unused, like GLPK's).
+struct Program {
   glp_prob* lp = glp_create_prob();
-  glp_set_obj_dir(lp, GLP_MIN);
-  if (free_faces > 0) glp_add_cols(lp, free_faces);
-  for (int f = 0; f < nf; ++f) {
-    if (col[f] == 0) continue;
-    glp_set_col_kind(lp, col[f], GLP_BV);
-    glp_set_obj_coef(lp, col[f], prm.lambda_coverage * pg.cost[f]);
-  }
-  std::vector<double> start{0.0};  // 1-based like GLPK's columns
-  for (int f = 0; f < nf; ++f)
-    if (col[f] > 0) start.push_back(res.warm_given ? double(pg.warm[f]) : 0.0);
-  auto new_binary = [&](double cost, double value) {
+  std::vector<int> ia{0}, ja{0};
+  std::vector<double> ar{0.0};
+  std::vector<double> start{0.0};
+  Program() { glp_set_obj_dir(lp, GLP_MIN); }
+  ~Program() { glp_delete_prob(lp); }
+  Program(const Program&) = delete;
+  Program& operator=(const Program&) = delete;
+  int new_binary(double cost, double value) {
     const int c = glp_add_cols(lp, 1);
     glp_set_col_kind(lp, c, GLP_BV);
     glp_set_obj_coef(lp, c, cost);
     start.push_back(value);
     return c;
-  };
-
-  std::vector<int> ia{0}, ja{0};
-  std::vector<double> ar{0.0};
-  auto add_row = [&](const std::vector<std::pair<int, double>>& terms, int type, double lo, double hi) {
+  }
+  void add_row(const std::vector<std::pair<int, double>>& terms, int type, double lo, double hi) {
     const int r = glp_add_rows(lp, 1);
     glp_set_row_bnds(lp, r, type, lo, hi);
     for (const auto& [c, val] : combined(terms)) {
@@ -166,60 +191,83 @@ SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& pg,
       ja.push_back(c);
       ar.push_back(val);
     }
-  };
-  bool contradiction = false;  // fixed faces alone leave an edge with 1 or 3+ faces
-  for (int e = 0; e < ne; ++e) {
-    const auto& edge = cs.edges[e];
-    // sum x_free + constant = 2 y
-    std::vector<std::pair<int, double>> terms;
-    int constant = outside(e), warm_count = outside(e);
-    for (int f : edge.faces) {
-      if (col[f] > 0) terms.emplace_back(col[f], 1.0);
-      else constant += fixed_value(f);
-      if (res.warm_given) warm_count += pg.warm[f];
-    }
-    if (terms.empty()) {
-      contradiction = contradiction || (constant != 0 && constant != 2);
-    } else {
-      terms.emplace_back(new_binary(0.0, warm_count == 2 ? 1.0 : 0.0), -2.0);
-      add_row(terms, GLP_FX, -constant, -constant);
-    }
-    const double sharp = pg.sharp_cost.empty() ? uniform_sharp : pg.sharp_cost[e];
-    if (sharp <= 0) continue;
-    int s = 0;  // s >= xi + xj - 1 for faces of different planes
-    for (std::size_t i = 0; i < edge.faces.size(); ++i)
-      for (std::size_t j = i + 1; j < edge.faces.size(); ++j) {
-        const int fi = edge.faces[i], fj = edge.faces[j];
-        if (cs.faces[fi].plane == cs.faces[fj].plane) continue;
-        if (fixed_value(fi) == 0 || fixed_value(fj) == 0) continue;
-        if (col[fi] == 0 && col[fj] == 0) continue;  // both fixed in: a constant
-        if (s == 0) s = new_binary(sharp, res.warm_given && pg.warm[fi] && pg.warm[fj] ? 1.0 : 0.0);
-        else if (res.warm_given && pg.warm[fi] && pg.warm[fj]) start[s] = 1.0;
-        std::vector<std::pair<int, double>> t{{s, 1.0}};
-        double rhs = -1.0;
-        for (int g : {fi, fj}) {
-          if (col[g] > 0) t.emplace_back(col[g], -1.0);
-          else rhs += 1.0;  // fixed in
-        }
-        add_row(t, GLP_LO, rhs, 0.0);
-      }
   }
-  res.variables = glp_get_num_cols(lp);
-  res.constraints = glp_get_num_rows(lp);
-  res.nonzeros = int(ia.size()) - 1;
-  if (contradiction) {
-    glp_delete_prob(lp);
-    return done(SolveStatus::Infeasible);
-  }
-  if (res.variables == 0) {  // everything fixed: the fixed selection is the answer
-    glp_delete_prob(lp);
-    res.ok = true;
-    return done(SolveStatus::Optimal);
-  }
-  glp_load_matrix(lp, int(ia.size()) - 1, ia.data(), ja.data(), ar.data());
+};
 
-  Search search;
-  if (res.warm_feasible) search.start = start;
+// The data term: each free candidate's column costs lambda_coverage times its coverage cost.
+void add_coverage_objective(Program& p, const CandidateSet& cs, const Columns& c, const SelectionConfig& prm) {
+  if (c.free > 0) glp_add_cols(p.lp, c.free);
+  for (int f = 0; f < int(cs.faces.size()); ++f) {
+    if (c.col[f] == 0) continue;
+    glp_set_col_kind(p.lp, c.col[f], GLP_BV);
+    glp_set_obj_coef(p.lp, c.col[f], prm.lambda_coverage * c.pg.cost[f]);
+    p.start.push_back(c.warm(f) ? 1.0 : 0.0);
+  }
+}
+
+// The PolyFit complexity per edge when the program gives none: lambda_complexity * total area /
+// edges.
+double uniform_sharp_cost(const CandidateSet& cs, const SelectionConfig& prm) {
+  double total_area = 0.0;
+  for (const auto& f : cs.faces) total_area += f.area;
+  return cs.edges.empty() ? 0.0 : prm.lambda_complexity * total_area / double(cs.edges.size());
+}
+
+// Edge e used by 0 or 2 selected faces: sum x_free + constant = 2 y, y binary. Returns false when
+// the fixed faces alone use it once or 3+ times (the program is infeasible).
+bool add_edge_constraint(Program& p, const CandidateSet& cs, const Columns& c, int e) {
+  std::vector<std::pair<int, double>> terms;
+  int constant = c.outside(e), warm_count = c.outside(e);
+  for (int f : cs.edges[e].faces) {
+    if (c.col[f] > 0) terms.emplace_back(c.col[f], 1.0);
+    else constant += c.fixed_value(f);
+    warm_count += c.warm(f);
+  }
+  if (terms.empty()) return constant == 0 || constant == 2;
+  terms.emplace_back(p.new_binary(0.0, warm_count == 2 ? 1.0 : 0.0), -2.0);
+  p.add_row(terms, GLP_FX, -constant, -constant);
+  return true;
+}
+
+// The complexity term of edge e: one binary s costing `sharp`, with s >= xi + xj - 1 for every
+// two of its faces on different planes (fixed faces folded in; none when one is fixed out or
+// both are fixed in).
+void add_sharp_edge(Program& p, const CandidateSet& cs, const Columns& c, int e, double sharp) {
+  const auto& faces = cs.edges[e].faces;
+  int s = 0;
+  for (std::size_t i = 0; i < faces.size(); ++i)
+    for (std::size_t j = i + 1; j < faces.size(); ++j) {
+      const int fi = faces[i], fj = faces[j];
+      if (cs.faces[fi].plane == cs.faces[fj].plane) continue;
+      if (c.fixed_value(fi) == 0 || c.fixed_value(fj) == 0) continue;
+      if (c.col[fi] == 0 && c.col[fj] == 0) continue;  // both fixed in: a constant
+      const bool both_warm = c.warm(fi) && c.warm(fj);
+      if (s == 0) s = p.new_binary(sharp, both_warm ? 1.0 : 0.0);
+      else if (both_warm) p.start[s] = 1.0;
+      std::vector<std::pair<int, double>> t{{s, 1.0}};
+      double rhs = -1.0;
+      for (int g : {fi, fj}) {
+        if (c.col[g] > 0) t.emplace_back(c.col[g], -1.0);
+        else rhs += 1.0;  // fixed in
+      }
+      p.add_row(t, GLP_LO, rhs, 0.0);
+    }
+}
+
+// Every edge's constraint and complexity term; false when the fixed faces contradict one.
+bool add_edges(Program& p, const CandidateSet& cs, const Columns& c, const SelectionConfig& prm) {
+  const double uniform_sharp = uniform_sharp_cost(cs, prm);
+  bool feasible = true;
+  for (int e = 0; e < int(cs.edges.size()); ++e) {
+    feasible = add_edge_constraint(p, cs, c, e) && feasible;
+    const double sharp = c.pg.sharp_cost.empty() ? uniform_sharp : c.pg.sharp_cost[e];
+    if (sharp > 0) add_sharp_edge(p, cs, c, e, sharp);
+  }
+  return feasible;
+}
+
+// Branch and cut with MIR, Gomory, cover and clique cuts, the gap and the time limit (s).
+glp_iocp search_parameters(const SelectionConfig& prm, double time_limit, Search& search) {
   glp_iocp parm;
   glp_init_iocp(&parm);
   parm.mir_cuts = GLP_ON;
@@ -231,12 +279,16 @@ SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& pg,
   parm.msg_lev = GLP_MSG_OFF;
   parm.cb_func = on_search;
   parm.cb_info = &search;
+  return parm;
+}
+
+// Solves the MIP; returns GLPK's return code. With a warm start the callback sees the original
+// columns only without the MIP presolver, which then needs an optimal basis of the LP relaxation.
+int solve(glp_prob* lp, glp_iocp& parm, bool warm) {
   int ret = 0;
-  if (search.start.empty()) {
+  if (!warm) {
     parm.presolve = GLP_ON;
   } else {
-    // The callback sees the original columns only without the MIP presolver, which then needs
-    // an optimal basis of the LP relaxation.
     glp_smcp lpp;
     glp_init_smcp(&lpp);
     lpp.msg_lev = GLP_MSG_OFF;
@@ -249,20 +301,64 @@ SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& pg,
     parm.tm_lim = std::max(1, parm.tm_lim - int(spent_ms));
   }
   if (ret == 0) ret = glp_intopt(lp, &parm);
+  return ret;
+}
+
+// What GLPK made of it: the status from glp_intopt's return code and glp_mip_status (a zero
+// return code alone is not success: only a primal feasible MIP point counts), the gap, the warm
+// start's fate and the selection.
+void read_solution(glp_prob* lp, int ret, const Search& search, const Columns& c, SelectionResult& res) {
   const int status = glp_mip_status(lp);
   res.status = classify(ret, status);
   res.glpk_code = ret;
   res.warm_asked = search.asked;
   res.warm_accepted = search.accepted;
   res.gap = status == GLP_OPT ? 0.0 : search.gap;
-  // A zero return code alone is not success: only a primal feasible MIP point counts.
   res.ok = status == GLP_OPT || status == GLP_FEAS;
-  if (res.ok) {
-    res.objective = glp_mip_obj_val(lp);
-    for (int f = 0; f < nf; ++f)
-      if (col[f] > 0) res.selected[f] = glp_mip_col_val(lp, col[f]) > kChosen;
+  if (!res.ok) return;
+  res.objective = glp_mip_obj_val(lp);
+  for (std::size_t f = 0; f < c.col.size(); ++f)
+    if (c.col[f] > 0) res.selected[f] = glp_mip_col_val(lp, c.col[f]) > kChosen;
+}
+
+}  // namespace
+
+SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& pg, const SelectionConfig& prm,
+                             double time_limit) {
+  const auto t0 = std::chrono::steady_clock::now();
+  SelectionResult res;
+  const Columns c = candidate_columns(cs, pg, res);
+  auto done = [&](SolveStatus status) {
+    res.status = status;
+    res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return res;
+  };
+  if (cs.faces.empty()) return done(SolveStatus::NoCandidates);  // GLPK aborts on empty column sets
+  res.warm_given = !pg.warm.empty();
+  res.warm_feasible = res.warm_given && warm_start_feasible(cs, c);
+
+  glp_term_out(GLP_OFF);
+  Program p;
+  add_coverage_objective(p, cs, c, prm);
+  const bool feasible = add_edges(p, cs, c, prm);
+  res.variables = glp_get_num_cols(p.lp);
+  res.constraints = glp_get_num_rows(p.lp);
+  res.nonzeros = int(p.ia.size()) - 1;
+  if (!feasible) {  // no selection, not the fixed and forced values that contradict each other
+    res.selected.assign(cs.faces.size(), 0);
+    return done(SolveStatus::Infeasible);
   }
-  glp_delete_prob(lp);
+  if (res.variables == 0) {  // everything fixed: the fixed selection is the answer
+    res.ok = true;
+    return done(SolveStatus::Optimal);
+  }
+  glp_load_matrix(p.lp, int(p.ia.size()) - 1, p.ia.data(), p.ja.data(), p.ar.data());
+
+  Search search;
+  if (res.warm_feasible) search.start = p.start;
+  glp_iocp parm = search_parameters(prm, time_limit, search);
+  const int ret = solve(p.lp, parm, !search.start.empty());
+  read_solution(p.lp, ret, search, c, res);
   return done(res.status);
 }
 

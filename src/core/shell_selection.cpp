@@ -10,7 +10,7 @@
 #include "lodrefine/core/confidence.h"
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/core/matching.h"
-#include "lodrefine/core/repair.h"
+#include "lodrefine/core/shell_trace.h"
 #include "lodrefine/core/topology.h"
 #include "lodrefine/core/validate.h"
 #include "shell_supports.h"
@@ -77,15 +77,13 @@ double share(const std::vector<Vec2>& poly, const CellSet& cells) {
   return cells.count(cell_key((long long)std::floor(c.x() / kCell), (long long)std::floor(c.y() / kCell))) ? 1.0 : 0.0;
 }
 
-// What the program knows of each candidate.
-struct CandidateData {
-  std::vector<char> in_start;   // the starting shell has a face there
-  std::vector<int> start_face;  // which one (-1: none)
-  std::vector<double> confidence;
-  std::vector<char> in_zone;  // scan evidence reaches it
-};
+// What the program knows of each candidate, as face property maps of the candidate mesh:
+// "f:in_start" (bool: the starting shell has a face there), "f:source" (int: that face's source,
+// -1 without one), "f:confidence" (double: the data term's c), "f:in_zone" (bool: scan evidence
+// reaches it). The selection adds "f:variable" (GLPK column, 0: fixed) and "f:chosen".
+using FaceIndex = CandidateMesh::Face_index;
 
-CandidateData describe_candidates(const CandidateSet& cs, const Mesh& start, const Supports& s, const Params& prm) {
+void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s, const Params& prm) {
   const int np = int(s.planes.size());
   std::vector<Frame2> frames;
   for (const auto& sp : s.planes) frames.push_back(frame_of(sp.plane, cs.region.center));
@@ -129,13 +127,12 @@ CandidateData describe_candidates(const CandidateSet& cs, const Mesh& start, con
     zones.emplace_back(b.min() - grow, b.max() + grow);
   }
 
-  CandidateData d;
-  const int nf = int(cs.faces.size());
-  d.in_start.assign(nf, 0);
-  d.start_face.assign(nf, -1);
-  d.confidence.assign(nf, 0.0);
-  d.in_zone.assign(nf, 0);
-  for (int f = 0; f < nf; ++f) {
+  auto in_start = cs.mesh.add_property_map<FaceIndex, bool>("f:in_start", false).first;
+  auto source = cs.mesh.add_property_map<FaceIndex, int>("f:source", -1).first;
+  auto confidence = cs.mesh.add_property_map<FaceIndex, double>("f:confidence", 0.0).first;
+  auto in_zone = cs.mesh.add_property_map<FaceIndex, bool>("f:in_zone", false).first;
+  for (int f = 0; f < int(cs.faces.size()); ++f) {
+    const FaceIndex fi(f);
     const int k = cs.faces[f].plane;
     const std::vector<int> corners = cs.corners(f);
     std::vector<Vec2> poly;
@@ -143,36 +140,37 @@ CandidateData describe_candidates(const CandidateSet& cs, const Mesh& start, con
     const Vec2 c = frames[k](cs.faces[f].centroid);
     for (const auto& [sf, sp] : start_faces[k])
       if (point_in_polygon_2d(c, sp)) {
-        d.in_start[f] = 1;
-        d.start_face[f] = sf;
+        in_start[fi] = true;
+        source[fi] = start.faces[sf].source;
         break;
       }
     const double scanned = share(poly, own[k]);
-    const double prior = d.in_start[f] ? 1.0 - share(poly, other[k]) : 0.0;
-    d.confidence[f] = std::max(scanned, prior);
+    const double prior = in_start[fi] ? 1.0 - share(poly, other[k]) : 0.0;
+    confidence[fi] = std::max(scanned, prior);
     std::vector<Vec3> pts{cs.faces[f].centroid};
     for (int v : corners) pts.push_back(cs.vertices[v]);
+    bool reached = false;
     for (const auto& z : zones)
-      for (const auto& p : pts) d.in_zone[f] = d.in_zone[f] || z.contains(cs.region.axes.transpose() * p);
+      for (const auto& p : pts) reached = reached || z.contains(cs.region.axes.transpose() * p);
+    in_zone[fi] = reached;
   }
-  return d;
 }
 
-// Arrangement vertices closer than this (m) are one in the output: planes meeting almost at a
-// point leave edges of fractions of a millimetre, which CityJSON's millimetre grid or a
-// reader's weld collapses; the output is validated after this weld.
-constexpr double kOutputWeld = 1e-3;
+// A face map of `from` on the candidates `to` = kept_candidates(from, keep).
+template <class T>
+void carry(const CandidateSet& from, CandidateSet& to, const std::vector<char>& keep, const std::string& name) {
+  const auto in = from.mesh.property_map<FaceIndex, T>(name).first;
+  auto out = to.mesh.add_property_map<FaceIndex, T>(name, T()).first;
+  int g = 0;
+  for (std::size_t f = 0; f < keep.size(); ++f)
+    if (keep[f]) out[FaceIndex(g++)] = in[FaceIndex(f)];
+}
 
-// The candidates' own vectors for the faces and the program (kept_candidates for pruning).
-CandidateData kept(const CandidateData& d, const std::vector<char>& keep) {
-  CandidateData out;
-  for (std::size_t f = 0; f < keep.size(); ++f) {
-    if (!keep[f]) continue;
-    out.in_start.push_back(d.in_start[f]);
-    out.start_face.push_back(d.start_face[f]);
-    out.confidence.push_back(d.confidence[f]);
-    out.in_zone.push_back(d.in_zone[f]);
-  }
+// A boolean face map as 0/1 per candidate (a selection).
+std::vector<char> face_flags(const CandidateSet& cs, const std::string& name) {
+  const auto map = cs.mesh.property_map<FaceIndex, bool>(name).first;
+  std::vector<char> out;
+  for (auto f : cs.mesh.faces()) out.push_back(char(map[f]));
   return out;
 }
 
@@ -183,14 +181,7 @@ std::vector<char> kept(const std::vector<char>& v, const std::vector<char>& keep
   return out;
 }
 
-// The program's figures per candidate as property maps of the candidate mesh: "f:confidence"
-// (the data term's c), "f:variable" (GLPK column, 0: fixed) and "f:chosen" (selected).
-using FaceIndex = CandidateMesh::Face_index;
-void record_confidence(CandidateSet& cs, const std::vector<double>& confidence) {
-  auto map = cs.mesh.add_property_map<FaceIndex, double>("f:confidence", 0.0).first;
-  for (auto f : cs.mesh.faces()) map[f] = confidence[std::size_t(f)];
-}
-
+// The selection as the face maps "f:variable" and "f:chosen".
 void record_selection(CandidateSet& cs, const SelectionResult& sel) {
   auto variable = cs.mesh.add_property_map<FaceIndex, int>("f:variable", 0).first;
   auto chosen = cs.mesh.add_property_map<FaceIndex, bool>("f:chosen", false).first;
@@ -198,28 +189,6 @@ void record_selection(CandidateSet& cs, const SelectionResult& sel) {
     variable[f] = sel.column.empty() ? 0 : sel.column[std::size_t(f)];
     chosen[f] = sel.selected[std::size_t(f)] != 0;
   }
-}
-
-// The chosen candidates (the mesh's "f:chosen") as one mesh on the arrangement's own vertices
-// (those within kOutputWeld joined), oriented outward, coplanar neighbours merged.
-Mesh assemble(const CandidateSet& cs, const CandidateData& d, const Mesh& start, const Supports& s) {
-  Mesh m;
-  m.id = start.id;
-  const auto chosen = cs.mesh.property_map<FaceIndex, bool>("f:chosen").first;
-  PointWelder welder(kOutputWeld);
-  for (int f = 0; f < int(cs.faces.size()); ++f) {
-    if (!chosen[FaceIndex(f)]) continue;
-    Face face;
-    for (int v : cs.corners(f)) face.v.push_back(welder.add(cs.vertices[v]));
-    drop_repeats(face.v);
-    const int k = cs.faces[f].plane;
-    face.sem = k < s.start_planes ? s.planes[k].sem : Semantic::Wall;
-    face.source = d.start_face[f] >= 0 ? start.faces[d.start_face[f]].source : -1;
-    if (face.v.size() >= 3) m.faces.push_back(std::move(face));
-  }
-  m.vertices = welder.points();
-  orient_outward(m);
-  return merge_coplanar_faces(m);
 }
 
 // Output vertices within this (m) of a starting-shell vertex are put back on it: the plane meets
@@ -398,7 +367,7 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   // building's program does not grow with the cube of its planes.
   const Region region = detail::building_region(start, s);
   const double reach = 2.0 * (prm.match_distance + prm.bbox_margin);
-  const CandidateSet all = build_candidates(
+  CandidateSet all = build_candidates(
       s.planes, region,
       int(s.planes.size()) < kLocalSectionsFrom ? std::vector<Region>{} : detail::plane_reach(start, s, region, reach));
   if (all.capped) {
@@ -407,18 +376,21 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
     st.seconds = seconds_since(t0);
     return out;
   }
-  const CandidateData all_d = describe_candidates(all, start, s, prm);
-  const std::vector<char> all_warm = mended_start(all, all_d.in_start, prm);
+  describe_candidates(all, start, s, prm);
+  const std::vector<char> all_warm = mended_start(all, face_flags(all, "f:in_start"), prm);
+  const auto all_in_zone = all.mesh.property_map<FaceIndex, bool>("f:in_zone").first;
   std::vector<char> keep(all.faces.size(), 1);
   if (!all_warm.empty())
-    for (std::size_t f = 0; f < keep.size(); ++f) keep[f] = all_d.in_zone[f] || all_warm[f];
+    for (std::size_t f = 0; f < keep.size(); ++f) keep[f] = all_in_zone[FaceIndex(f)] || all_warm[f];
   CandidateSet cs = kept_candidates(all, keep);
-  const CandidateData d = kept(all_d, keep);
+  carry<bool>(all, cs, keep, "f:in_start");
+  carry<int>(all, cs, keep, "f:source");
+  carry<double>(all, cs, keep, "f:confidence");
+  carry<bool>(all, cs, keep, "f:in_zone");
   const std::vector<char> warm = all_warm.empty() ? all_warm : kept(all_warm, keep);
   st.candidates = int(cs.faces.size());
   st.candidates_pruned = int(all.faces.size()) - st.candidates;
   st.edges = int(cs.edges.size());
-  record_confidence(cs, d.confidence);
 
   SelectionProgram pg;
   const auto confidence = cs.mesh.property_map<FaceIndex, double>("f:confidence").first;
@@ -427,7 +399,8 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   for (const auto& e : cs.edges) pg.sharp_cost.push_back(prm.lambda_complexity * e.length * kSharpEdgeWidth);
   if (!warm.empty()) {
     pg.warm = warm;
-    for (int f = 0; f < int(cs.faces.size()); ++f) pg.fixed.push_back(d.in_zone[f] ? -1 : int(warm[f]));
+    const auto in_zone = cs.mesh.property_map<FaceIndex, bool>("f:in_zone").first;
+    for (int f = 0; f < int(cs.faces.size()); ++f) pg.fixed.push_back(in_zone[FaceIndex(f)] ? -1 : int(warm[f]));
   }
   auto finish = [&](const std::string& reason) {
     out.reason = reason;
@@ -437,7 +410,7 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   // A selection whose shell does not validate (two shells touching, faces meeting at a point)
   // is excluded: its changes from the starting shell are fixed back, and the program solved
   // again (at most kRetries times).
-  const std::vector<char>& base = warm.empty() ? d.in_start : warm;
+  const std::vector<char> base = warm.empty() ? face_flags(cs, "f:in_start") : warm;
   const EvidenceReach evidence(st.evidence);
   std::string problem;
   int beyond_rounds = 0;  // solves redone for changes beyond the evidence (not counted as attempts)
@@ -456,7 +429,8 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
     st.candidates_changed = 0;
     for (int f = 0; f < int(cs.faces.size()); ++f) st.candidates_changed += sel.selected[f] != base[f];
     record_selection(cs, sel);
-    out.mesh = assemble(cs, d, start, s);
+    out.mesh = traced_shell(cs);
+    out.mesh.id = start.id;
     st.faces_from_selection = int(out.mesh.faces.size());
     problem = shell_problem(out.mesh, prm);
     if (problem.empty()) {

@@ -37,6 +37,7 @@ json selection_json(const ShellSelectionStats& st, const std::string& reason) {
             {"variables", m.variables},
             {"constraints", m.constraints},
             {"fixed_candidates", m.fixed},
+            {"forced_candidates", m.forced},
             {"gap", m.gap},
             {"objective", m.objective},
             {"seconds", st.seconds},

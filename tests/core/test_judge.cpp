@@ -151,3 +151,27 @@ TEST(Judge, AMoveWithinTheScansNoiseIsNoGain) {
   EXPECT_EQ(j.check, "gain");
   EXPECT_EQ(j.building.better, 0u);
 }
+
+// Terraced houses: the front runs on, flush, into the neighbour's facade past x = 12, and the
+// party wall moved from x = 12 to 11.3 (corners.h). The neighbour's facade points and window
+// recesses past it got farther from this building; on the party wall's evidence they are the
+// neighbour's and are not judged.
+TEST(Judge, AFlushNeighboursPointsPastThePartyWallAreNotJudged) {
+  const Mesh coarse = box({0, 0, 0}, {12, 8, 6}), refined = box({0, 0, 0}, {11.3, 8, 6});
+  PointCloud cloud;
+  scan_front(cloud, 0.0, 0.5, 11.3);
+  scan_front(cloud, 0.0, 11.3, 14.0, 2);  // the neighbour's facade
+  scan_front(cloud, 0.2, 12.5, 13.5, 3);  // a window recess of the neighbour
+  JudgedWall party;
+  party.polygons = {{{12, 0, 0}, {12, 8, 0}, {12, 8, 6}, {12, 0, 6}}};
+  party.from = Plane(kX, -12.0);
+  party.to = Plane(kX, -11.3);
+  party.corner = true;
+  const Judgement refused = judge_refinement(coarse, refined, {party}, cloud, MatchConfig{}, PlaneConfig{});
+  EXPECT_FALSE(refused.ok) << "without the party wall's evidence the neighbour's points count";
+  party.flush_facade = Plane(-kY, 0.0);
+  const Judgement j = judge_refinement(coarse, refined, {party}, cloud, MatchConfig{}, PlaneConfig{});
+  EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
+  EXPECT_EQ(j.building.worse, 0u);
+  EXPECT_LT(j.building.points, refused.building.points);
+}

@@ -7,9 +7,11 @@
 // Inputs are in one (local) frame; distances in metres. A point is judged when it lies within
 // MatchConfig::match_distance of either model (the cap: farther points are another object's) and
 // above the lowest model vertex + kGroundBand (street ground in front of a wall moved inwards
-// would count against a right move). Its distance to each model is capped at match_distance.
+// would count against a right move), and not a flush neighbour's (JudgedWall::flush_facade). Its
+// distance to each model is capped at match_distance.
 #pragma once
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,6 +28,9 @@ struct JudgedWall {
   std::vector<std::vector<Vec3>> polygons;  // its faces before the move
   Plane from, to;                           // its plane before and after (oriented outwards)
   bool corner = false;                      // moved on corner evidence (the scan shows its corner, not its face)
+  // Moved to a flush neighbour's party wall (corners.h): the facade's plane; points on or behind
+  // it past the wall's new plane are the neighbour's and are not judged.
+  std::optional<Plane> flush_facade;
 };
 
 struct Judgement {

@@ -102,6 +102,12 @@ struct RefineResult {
 // range).
 RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const RefineConfig& config);
 
+// The scan points refine_building works on, in the model's local frame (`origin` subtracted;
+// crops may carry whole streets): those inside the model's bounding box grown by
+// match_distance + bbox_margin (m) and bbox_expand of its size on each side. `local_model` is in
+// the local frame already.
+PointCloud cloud_near(const Mesh& local_model, const PointCloud& cloud, const Vec3& origin, const RefineConfig& prm);
+
 // The local origin used for a model: its bounding-box minimum rounded down to 100 m, so
 // that all computation runs on small coordinates.
 Vec3 local_origin(const Mesh& model);

@@ -35,6 +35,7 @@ struct SelectionResult {
   std::string status_text() const { return status_name(status, glpk_code); }
   int variables = 0, constraints = 0, nonzeros = 0;
   int fixed = 0;           // candidates fixed before solving (constants, not columns)
+  int forced = 0;          // of those, free in the program but decided by its edge constraints
   double objective = 0.0;  // of the free columns (fixed faces' costs are constants)
   double gap = 0.0;        // relative MIP gap when the search ended (0: proven optimal)
   double seconds = 0.0;
@@ -56,6 +57,8 @@ struct SelectionResult {
 // - `warm[f]`: a starting selection (0/1 per candidate); empty: none. It must agree with
 //   `fixed`; if it satisfies every edge constraint it is given to GLPK as the first incumbent
 //   (presolve is then off: the callback works on the original columns).
+// Faces the edge constraints decide from the fixed ones (an edge with one free face, or two
+// fixed selected faces) are fixed too before GLPK sees the program (SelectionResult::forced).
 struct SelectionProgram {
   std::vector<double> cost;
   std::vector<int> outside;
