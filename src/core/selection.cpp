@@ -294,6 +294,7 @@ int solve(glp_prob* lp, glp_iocp& parm, bool warm) {
     lpp.msg_lev = GLP_MSG_OFF;
     lpp.presolve = GLP_ON;
     lpp.tm_lim = parm.tm_lim;
+    const auto t0 = std::chrono::steady_clock::now();
     ret = glp_simplex(lp, &lpp);
     parm.presolve = GLP_OFF;
     // The relaxation spent part of the budget: the search gets what is left, not all of it again.
