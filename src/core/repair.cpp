@@ -212,30 +212,10 @@ std::vector<std::vector<Adjacent>> adjacency(const std::vector<Face>& faces, con
 // BFS over manifold edges reversing faces so that neighbours traverse their shared edge in
 // opposite directions; toggles `flipped` for reversed faces. Returns each face's component.
 std::vector<int> orient_consistently(std::vector<Face>& faces, std::vector<char>& flipped) {
-  const auto adj = adjacency(faces, edge_uses(faces));
-  std::vector<int> comp(faces.size(), -1);
-  std::vector<char> flip(faces.size(), 0);
-  int ncomp = 0;
-  for (std::size_t s = 0; s < faces.size(); ++s) {
-    if (comp[s] >= 0) continue;
-    std::queue<int> q;
-    q.push(int(s));
-    comp[s] = ncomp;
-    while (!q.empty()) {
-      const int f = q.front();
-      q.pop();
-      for (const auto& [g, same] : adj[f]) {
-        if (comp[g] >= 0) continue;  // a conflict here is non-orientable; validation reports it
-        comp[g] = ncomp;
-        flip[g] = char(flip[f] ^ same);
-        q.push(g);
-      }
-    }
-    ++ncomp;
-  }
+  const AgreeingParts a = agreeing_parts(adjacency(faces, edge_uses(faces)));
   for (std::size_t f = 0; f < faces.size(); ++f)
-    if (flip[f]) std::reverse(faces[f].v.begin(), faces[f].v.end()), flipped[f] ^= 1;
-  return comp;
+    if (a.flip[f]) std::reverse(faces[f].v.begin(), faces[f].v.end()), flipped[f] ^= 1;
+  return a.part;
 }
 
 // Reverses every component whose enclosed volume is negative.

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <queue>
 #include <set>
 #include <utility>
 
@@ -115,26 +114,10 @@ void orient(const std::vector<Meeting>& meet, Trace& t) {
     adj[m.f].emplace_back(m.g, m.same);
     adj[m.g].emplace_back(m.f, m.same);
   }
-  std::vector<int> part(n, -1);
-  std::vector<char> flip(n, 0);
-  int parts = 0;
-  for (std::size_t s = 0; s < n; ++s) {
-    if (part[s] >= 0) continue;
-    std::queue<int> q;
-    q.push(int(s));
-    part[s] = parts;
-    while (!q.empty()) {
-      const int f = q.front();
-      q.pop();
-      for (const auto& [g, same] : adj[f]) {
-        if (part[g] >= 0) continue;  // a conflict here is non-orientable: validation reports it
-        part[g] = parts;
-        flip[g] = char(flip[f] ^ same);
-        q.push(g);
-      }
-    }
-    ++parts;
-  }
+  const AgreeingParts a = agreeing_parts(adj);
+  const auto& part = a.part;
+  const auto& flip = a.flip;
+  const int parts = a.parts;
   std::vector<std::vector<Face>> oriented(static_cast<std::size_t>(parts));
   for (std::size_t f = 0; f < n; ++f) {
     Face face = t.faces[f];

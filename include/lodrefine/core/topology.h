@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <queue>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -116,6 +117,38 @@ class PointWelder {
 
 // ---------------------------------------------------------------------------------------------
 // Edges and components
+
+// Faces put in agreement over their adjacency, breadth first from each component's first face:
+// adj[f] lists (neighbour, same) with `same` when both faces run their shared edge the same way.
+// Each face's component and whether it must be reversed to agree with that first face; a
+// conflict (a non-orientable component) is left to validation.
+struct AgreeingParts {
+  std::vector<int> part;
+  std::vector<char> flip;
+  int parts = 0;
+};
+template <class Adjacent>
+AgreeingParts agreeing_parts(const std::vector<std::vector<Adjacent>>& adj) {
+  AgreeingParts r{std::vector<int>(adj.size(), -1), std::vector<char>(adj.size(), 0), 0};
+  for (std::size_t s = 0; s < adj.size(); ++s) {
+    if (r.part[s] >= 0) continue;
+    std::queue<int> q;
+    q.push(int(s));
+    r.part[s] = r.parts;
+    while (!q.empty()) {
+      const int f = q.front();
+      q.pop();
+      for (const auto& [g, same] : adj[std::size_t(f)]) {
+        if (r.part[std::size_t(g)] >= 0) continue;
+        r.part[std::size_t(g)] = r.parts;
+        r.flip[std::size_t(g)] = char(r.flip[std::size_t(f)] ^ same);
+        q.push(g);
+      }
+    }
+    ++r.parts;
+  }
+  return r;
+}
 
 // Each undirected edge (lower vertex index first) with the faces using it, in face order;
 // `forward` when the face runs from the lower to the higher vertex. A face's repeated
