@@ -51,9 +51,15 @@ Region Region::around(const std::vector<Vec3>& pts, double relative, double abso
   return r;
 }
 
+CandidateMap<int> CandidateSet::supports() const { return mesh.property_map<CandidateFace, int>("f:support").first; }
+CandidateMap<double> CandidateSet::areas() const { return mesh.property_map<CandidateFace, double>("f:area").first; }
+CandidateMap<Vec3> CandidateSet::centroids() const {
+  return mesh.property_map<CandidateFace, Vec3>("f:centroid").first;
+}
+
 std::vector<int> CandidateSet::corners(int f) const {
   std::vector<int> out;
-  if (f >= int(mesh.number_of_faces())) return out;
+  if (f >= size()) return out;
   const auto point = mesh.property_map<CandidateMesh::Vertex_index, int>("v:point").first;
   for (auto h : CGAL::halfedges_around_face(mesh.halfedge(CandidateMesh::Face_index(f)), mesh))
     out.push_back(point[mesh.source(h)]);
@@ -201,12 +207,21 @@ std::vector<Vec3> region_section(const Plane& plane, const Region& region) {
 
 namespace {
 
+// What a piece carries into its face's maps.
+struct Piece {
+  int plane = -1;
+  double area = 0.0;
+  Vec3 centroid = Vec3::Zero();
+};
+
 // The pieces as faces of `cs.mesh`, one component per supporting plane (`corners[f]`: piece f's
-// corners in `cs.vertices`, its plane cs.faces[f].plane; pieces come plane by plane). A piece the
+// corners in `cs.vertices`, its plane pieces[f].plane; pieces come plane by plane). A piece the
 // component cannot take (it would make the component non-manifold: overlapping slivers, a corner
 // repeated) becomes a component of its own; the fans are by point, so its edges still count.
-void build_mesh(CandidateSet& cs, const std::vector<std::vector<int>>& corners) {
-  auto support = cs.mesh.add_property_map<CandidateMesh::Face_index, int>("f:support", -1).first;
+void build_mesh(CandidateSet& cs, const std::vector<Piece>& pieces, const std::vector<std::vector<int>>& corners) {
+  auto support = cs.mesh.add_property_map<CandidateFace, int>("f:support", -1).first;
+  auto area = cs.mesh.add_property_map<CandidateFace, double>("f:area", 0.0).first;
+  auto centroid = cs.mesh.add_property_map<CandidateFace, Vec3>("f:centroid", Vec3::Zero()).first;
   auto point = cs.mesh.add_property_map<CandidateMesh::Vertex_index, int>("v:point", -1).first;
   std::vector<CandidateMesh::Vertex_index> of_point(cs.vertices.size());
   std::vector<int> plane_of_vertex(cs.vertices.size(), -1);
@@ -217,7 +232,7 @@ void build_mesh(CandidateSet& cs, const std::vector<std::vector<int>>& corners) 
     return v;
   };
   for (int f = 0; f < int(corners.size()); ++f) {
-    const int k = cs.faces[f].plane;
+    const int k = pieces[f].plane;
     std::vector<CandidateMesh::Vertex_index> vs;
     for (int id : corners[f]) {
       if (plane_of_vertex[id] != k) of_point[id] = new_vertex(id), plane_of_vertex[id] = k;
@@ -229,6 +244,8 @@ void build_mesh(CandidateSet& cs, const std::vector<std::vector<int>>& corners) 
       face = cs.mesh.add_face(vs);
     }
     support[face] = k;
+    area[face] = pieces[f].area;
+    centroid[face] = pieces[f].centroid;
   }
 }
 
@@ -317,6 +334,7 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
   }
 
   PointWelder welder(kVertexWeld);
+  std::vector<Piece> kept;
   std::vector<std::vector<int>> corners;  // per piece, in `welder`
   auto over_cap = [&](std::size_t pieces) { return corners.size() + pieces > std::size_t(max_candidates); };
   for (int i = 0; i < int(planes.size()); ++i) {
@@ -342,7 +360,7 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
     }
     for (const auto& w : pieces) {
       if (polygon_area(w.p) < min_area) continue;
-      Candidate c;
+      Piece c;
       c.plane = i;
       std::vector<int> v;
       for (const auto& x : w.p) v.push_back(welder.add(x));
@@ -353,7 +371,7 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
       if (newell_normal(poly).dot(planes[i].plane.n) < 0) std::reverse(v.begin(), v.end());
       c.area = polygon_area(poly);
       c.centroid = polygon_centroid(poly);
-      cs.faces.push_back(std::move(c));
+      kept.push_back(c);
       corners.push_back(std::move(v));
     }
   }
@@ -371,12 +389,12 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
       const int a = v[k], b = v[(k + 1) % v.size()];
       out.push_back(a);
       for (int x : vertices_on_segment(cs.vertices, a, b, SegmentRule{kVertexWeld, false, kEdgeEndShare},
-                                       &on_plane[cs.faces[f].plane]))
+                                       &on_plane[kept[f].plane]))
         out.push_back(x);
     }
     v = out;
   }
-  build_mesh(cs, corners);
+  build_mesh(cs, kept, corners);
   build_fans(cs, corners);
   return cs;
 }
@@ -386,15 +404,20 @@ CandidateSet kept_candidates(const CandidateSet& cs, const std::vector<char>& ke
   out.planes = cs.planes;
   out.region = cs.region;
   out.vertices = cs.vertices;
-  std::vector<int> index(cs.faces.size(), -1);
+  const auto support = cs.supports();
+  const auto area = cs.areas();
+  const auto centroid = cs.centroids();
+  std::vector<int> index(cs.size(), -1);
+  std::vector<Piece> pieces;
   std::vector<std::vector<int>> corners;
-  for (int f = 0; f < int(cs.faces.size()); ++f) {
+  for (int f = 0; f < cs.size(); ++f) {
     if (!keep[f]) continue;
-    index[f] = int(out.faces.size());
-    out.faces.push_back(cs.faces[f]);
+    index[f] = int(pieces.size());
+    const CandidateFace fi(f);
+    pieces.push_back({support[fi], area[fi], centroid[fi]});
     corners.push_back(cs.corners(f));
   }
-  build_mesh(out, corners);
+  build_mesh(out, pieces, corners);
   for (const auto& e : cs.edges) {
     CandidateEdge k = e;
     k.faces.clear();

@@ -101,17 +101,20 @@ std::vector<Confidence> candidate_confidence(const CandidateSet& cs, const std::
   for (std::size_t pl = 0; pl < cs.planes.size(); ++pl)
     for (const auto& c : clouds) views[pl].push_back(view_cloud(cs.planes[pl].plane, c, prm));
 
-  std::vector<Confidence> out(cs.faces.size());
-  for (int f = 0; f < int(cs.faces.size()); ++f) {
+  const auto support = cs.supports();
+  const auto areas = cs.areas();
+  std::vector<Confidence> out(cs.size());
+  for (int f = 0; f < cs.size(); ++f) {
     const auto poly = cs.polygon(f);
-    const Plane& cp = cs.planes[cs.faces[f].plane].plane;
-    const double area = cs.faces[f].area;
+    const int k = support[CandidateFace(f)];
+    const Plane& cp = cs.planes[k].plane;
+    const double area = areas[CandidateFace(f)];
     for (int r = 0; r < int(model.size()); ++r) {
       const double s = model_score(poly, cp, area, model[r], model_planes[r], prm);
       if (s > out[f].value) out[f] = {s, r, -1};
     }
     for (int r = 0; r < int(clouds.size()); ++r) {
-      const double s = cloud_score(poly, cp, area, views[cs.faces[f].plane][r]);
+      const double s = cloud_score(poly, cp, area, views[k][r]);
       if (s > out[f].value) out[f] = {s, -1, r};
     }
   }

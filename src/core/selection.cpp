@@ -143,7 +143,7 @@ struct Columns {
 
 // Decides the variables: a column per free candidate; fixed ones take their value in `res`.
 Columns candidate_columns(const CandidateSet& cs, const SelectionProgram& pg, SelectionResult& res) {
-  const int nf = int(cs.faces.size());
+  const int nf = cs.size();
   Columns c{pg, forced_by_edges(cs, pg.fixed.empty() ? std::vector<int>(nf, -1) : pg.fixed, pg.outside),
             std::vector<int>(nf, 0), 0};
   res.selected.assign(nf, 0);
@@ -160,7 +160,7 @@ Columns candidate_columns(const CandidateSet& cs, const SelectionProgram& pg, Se
 // every edge used 0 or 2 times, and the fixed candidates as fixed.
 bool warm_start_feasible(const CandidateSet& cs, const Columns& c) {
   if (!every_edge_used_0_or_2(cs, c.pg.warm, c.pg.outside)) return false;
-  for (int f = 0; f < int(cs.faces.size()); ++f)
+  for (int f = 0; f < cs.size(); ++f)
     if (c.fixed_value(f) >= 0 && c.fixed_value(f) != c.pg.warm[f]) return false;
   return true;
 }
@@ -197,7 +197,7 @@ struct Program {
 // The data term: each free candidate's column costs lambda_coverage times its coverage cost.
 void add_coverage_objective(Program& p, const CandidateSet& cs, const Columns& c, const SelectionConfig& prm) {
   if (c.free > 0) glp_add_cols(p.lp, c.free);
-  for (int f = 0; f < int(cs.faces.size()); ++f) {
+  for (int f = 0; f < cs.size(); ++f) {
     if (c.col[f] == 0) continue;
     glp_set_col_kind(p.lp, c.col[f], GLP_BV);
     glp_set_obj_coef(p.lp, c.col[f], prm.lambda_coverage * c.pg.cost[f]);
@@ -209,7 +209,8 @@ void add_coverage_objective(Program& p, const CandidateSet& cs, const Columns& c
 // edges.
 double uniform_sharp_cost(const CandidateSet& cs, const SelectionConfig& prm) {
   double total_area = 0.0;
-  for (const auto& f : cs.faces) total_area += f.area;
+  const auto area = cs.areas();
+  for (auto f : cs.mesh.faces()) total_area += area[f];
   return cs.edges.empty() ? 0.0 : prm.lambda_complexity * total_area / double(cs.edges.size());
 }
 
@@ -232,13 +233,14 @@ bool add_edge_constraint(Program& p, const CandidateSet& cs, const Columns& c, i
 // The complexity term of edge e: one binary s costing `sharp`, with s >= xi + xj - 1 for every
 // two of its faces on different planes (fixed faces folded in; none when one is fixed out or
 // both are fixed in).
-void add_sharp_edge(Program& p, const CandidateSet& cs, const Columns& c, int e, double sharp) {
+void add_sharp_edge(Program& p, const CandidateSet& cs, const CandidateMap<int>& support, const Columns& c, int e,
+                    double sharp) {
   const auto& faces = cs.edges[e].faces;
   int s = 0;
   for (std::size_t i = 0; i < faces.size(); ++i)
     for (std::size_t j = i + 1; j < faces.size(); ++j) {
       const int fi = faces[i], fj = faces[j];
-      if (cs.faces[fi].plane == cs.faces[fj].plane) continue;
+      if (support[CandidateFace(fi)] == support[CandidateFace(fj)]) continue;
       if (c.fixed_value(fi) == 0 || c.fixed_value(fj) == 0) continue;
       if (c.col[fi] == 0 && c.col[fj] == 0) continue;  // both fixed in: a constant
       const bool both_warm = c.warm(fi) && c.warm(fj);
@@ -257,11 +259,12 @@ void add_sharp_edge(Program& p, const CandidateSet& cs, const Columns& c, int e,
 // Every edge's constraint and complexity term; false when the fixed faces contradict one.
 bool add_edges(Program& p, const CandidateSet& cs, const Columns& c, const SelectionConfig& prm) {
   const double uniform_sharp = uniform_sharp_cost(cs, prm);
+  const auto support = cs.supports();
   bool feasible = true;
   for (int e = 0; e < int(cs.edges.size()); ++e) {
     feasible = add_edge_constraint(p, cs, c, e) && feasible;
     const double sharp = c.pg.sharp_cost.empty() ? uniform_sharp : c.pg.sharp_cost[e];
-    if (sharp > 0) add_sharp_edge(p, cs, c, e, sharp);
+    if (sharp > 0) add_sharp_edge(p, cs, support, c, e, sharp);
   }
   return feasible;
 }
@@ -334,7 +337,7 @@ SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& pg,
     res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return res;
   };
-  if (cs.faces.empty()) return done(SolveStatus::NoCandidates);  // GLPK aborts on empty column sets
+  if (cs.size() == 0) return done(SolveStatus::NoCandidates);  // GLPK aborts on empty column sets
   res.warm_given = !pg.warm.empty();
   res.warm_feasible = res.warm_given && warm_start_feasible(cs, c);
 
@@ -346,7 +349,7 @@ SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& pg,
   res.constraints = glp_get_num_rows(p.lp);
   res.nonzeros = int(p.ia.size()) - 1;
   if (!feasible) {  // no selection, not the fixed and forced values that contradict each other
-    res.selected.assign(cs.faces.size(), 0);
+    res.selected.assign(cs.size(), 0);
     return done(SolveStatus::Infeasible);
   }
   if (res.variables == 0) {  // everything fixed: the fixed selection is the answer

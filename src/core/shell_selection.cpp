@@ -131,13 +131,15 @@ void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s,
   auto source = cs.mesh.add_property_map<FaceIndex, int>("f:source", -1).first;
   auto confidence = cs.mesh.add_property_map<FaceIndex, double>("f:confidence", 0.0).first;
   auto in_zone = cs.mesh.add_property_map<FaceIndex, bool>("f:in_zone", false).first;
-  for (int f = 0; f < int(cs.faces.size()); ++f) {
+  const auto support = cs.supports();
+  const auto centroid = cs.centroids();
+  for (int f = 0; f < cs.size(); ++f) {
     const FaceIndex fi(f);
-    const int k = cs.faces[f].plane;
+    const int k = support[fi];
     const std::vector<int> corners = cs.corners(f);
     std::vector<Vec2> poly;
     for (int v : corners) poly.push_back(frames[k](cs.vertices[v]));
-    const Vec2 c = frames[k](cs.faces[f].centroid);
+    const Vec2 c = frames[k](centroid[fi]);
     for (const auto& [sf, sp] : start_faces[k])
       if (point_in_polygon_2d(c, sp)) {
         in_start[fi] = true;
@@ -147,7 +149,7 @@ void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s,
     const double scanned = share(poly, own[k]);
     const double prior = in_start[fi] ? 1.0 - share(poly, other[k]) : 0.0;
     confidence[fi] = std::max(scanned, prior);
-    std::vector<Vec3> pts{cs.faces[f].centroid};
+    std::vector<Vec3> pts{centroid[fi]};
     for (int v : corners) pts.push_back(cs.vertices[v]);
     bool reached = false;
     for (const auto& z : zones)
@@ -256,7 +258,7 @@ class EvidenceReach {
 std::vector<int> changes_beyond_evidence(const CandidateSet& cs, const std::vector<char>& selected,
                                          const std::vector<char>& base, const EvidenceReach& evidence) {
   std::vector<int> out;
-  for (int f = 0; f < int(cs.faces.size()); ++f) {
+  for (int f = 0; f < cs.size(); ++f) {
     if (selected[f] == base[f]) continue;
     for (int v : cs.corners(f))
       if (!evidence.reaches(cs.vertices[v])) {
@@ -290,7 +292,7 @@ constexpr int kMendRings = 2, kMendTries = 3;
 constexpr int kRetries = 2;
 std::vector<char> mended_start(const CandidateSet& cs, const std::vector<char>& in_start, const Params& prm) {
   if (every_edge_used_0_or_2(cs, in_start)) return in_start;
-  std::vector<char> near(cs.faces.size(), 0);
+  std::vector<char> near(cs.size(), 0);
   for (const auto& e : cs.edges) {
     int n = 0;
     for (int f : e.faces) n += in_start[f];
@@ -309,8 +311,9 @@ std::vector<char> mended_start(const CandidateSet& cs, const std::vector<char>& 
       near.swap(grown);
     }
     SelectionProgram pg;
-    for (int f = 0; f < int(cs.faces.size()); ++f) {
-      pg.cost.push_back(in_start[f] ? -cs.faces[f].area : cs.faces[f].area);
+    const auto area = cs.areas();
+    for (int f = 0; f < cs.size(); ++f) {
+      pg.cost.push_back(in_start[f] ? -area[FaceIndex(f)] : area[FaceIndex(f)]);
       pg.fixed.push_back(near[f] ? -1 : int(in_start[f]));
     }
     pg.sharp_cost.assign(cs.edges.size(), 0.0);
@@ -379,7 +382,7 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   describe_candidates(all, start, s, prm);
   const std::vector<char> all_warm = mended_start(all, face_flags(all, "f:in_start"), prm);
   const auto all_in_zone = all.mesh.property_map<FaceIndex, bool>("f:in_zone").first;
-  std::vector<char> keep(all.faces.size(), 1);
+  std::vector<char> keep(all.size(), 1);
   if (!all_warm.empty())
     for (std::size_t f = 0; f < keep.size(); ++f) keep[f] = all_in_zone[FaceIndex(f)] || all_warm[f];
   CandidateSet cs = kept_candidates(all, keep);
@@ -388,19 +391,20 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   carry<double>(all, cs, keep, "f:confidence");
   carry<bool>(all, cs, keep, "f:in_zone");
   const std::vector<char> warm = all_warm.empty() ? all_warm : kept(all_warm, keep);
-  st.candidates = int(cs.faces.size());
-  st.candidates_pruned = int(all.faces.size()) - st.candidates;
+  st.candidates = cs.size();
+  st.candidates_pruned = all.size() - st.candidates;
   st.edges = int(cs.edges.size());
 
   SelectionProgram pg;
   const auto confidence = cs.mesh.property_map<FaceIndex, double>("f:confidence").first;
-  for (int f = 0; f < int(cs.faces.size()); ++f)
-    pg.cost.push_back(coverage_cost(cs.faces[f].area, confidence[FaceIndex(f)], prm.tau_cov));
+  const auto area = cs.areas();
+  for (int f = 0; f < cs.size(); ++f)
+    pg.cost.push_back(coverage_cost(area[FaceIndex(f)], confidence[FaceIndex(f)], prm.tau_cov));
   for (const auto& e : cs.edges) pg.sharp_cost.push_back(prm.lambda_complexity * e.length * kSharpEdgeWidth);
   if (!warm.empty()) {
     pg.warm = warm;
     const auto in_zone = cs.mesh.property_map<FaceIndex, bool>("f:in_zone").first;
-    for (int f = 0; f < int(cs.faces.size()); ++f) pg.fixed.push_back(in_zone[FaceIndex(f)] ? -1 : int(warm[f]));
+    for (int f = 0; f < cs.size(); ++f) pg.fixed.push_back(in_zone[FaceIndex(f)] ? -1 : int(warm[f]));
   }
   auto finish = [&](const std::string& reason) {
     out.reason = reason;
@@ -427,7 +431,7 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
       }
     }
     st.candidates_changed = 0;
-    for (int f = 0; f < int(cs.faces.size()); ++f) st.candidates_changed += sel.selected[f] != base[f];
+    for (int f = 0; f < cs.size(); ++f) st.candidates_changed += sel.selected[f] != base[f];
     record_selection(cs, sel);
     out.mesh = traced_shell(cs);
     out.mesh.id = start.id;
@@ -440,7 +444,7 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
         problem = "it moves the model where the scan shows nothing";
     }
     if (problem.empty() || st.candidates_changed == 0 || warm.empty() || attempt == kRetries) break;
-    for (int f = 0; f < int(cs.faces.size()); ++f)
+    for (int f = 0; f < cs.size(); ++f)
       if (sel.selected[f] != base[f]) pg.fixed[f] = int(base[f]);
   }
   if (st.candidates_changed == 0) {

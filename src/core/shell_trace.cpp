@@ -43,9 +43,10 @@ bool runs(const std::vector<int>& corners, int a, int b) {
 void trace_faces(const CandidateSet& cs, Trace& t) {
   const auto chosen = cs.mesh.property_map<FaceIndex, bool>("f:chosen").first;
   const auto source = cs.mesh.property_map<FaceIndex, int>("f:source");
-  std::vector<std::vector<int>> pieces(cs.faces.size());
+  const auto support = cs.supports();
+  std::vector<std::vector<int>> pieces(cs.size());
   DisjointSets same(cs.vertices.size());
-  for (int f = 0; f < int(cs.faces.size()); ++f) {
+  for (int f = 0; f < cs.size(); ++f) {
     if (!chosen[FaceIndex(f)]) continue;
     pieces[f] = cs.corners(f);
     const auto& c = pieces[f];
@@ -54,10 +55,10 @@ void trace_faces(const CandidateSet& cs, Trace& t) {
       if ((cs.vertices[a] - cs.vertices[b]).norm() < kCollapsedEdge) same.unite(a, b);
     }
   }
-  t.face_of.assign(cs.faces.size(), -1);
+  t.face_of.assign(cs.size(), -1);
   t.vertex_of.assign(cs.vertices.size(), -1);
   std::vector<int> of_root(cs.vertices.size(), -1);
-  for (int f = 0; f < int(cs.faces.size()); ++f) {
+  for (int f = 0; f < cs.size(); ++f) {
     if (pieces[f].empty()) continue;
     Face face;
     for (int p : pieces[f]) {
@@ -68,7 +69,7 @@ void trace_faces(const CandidateSet& cs, Trace& t) {
     }
     drop_repeats(face.v);
     if (face.v.size() < 3) continue;
-    face.sem = cs.planes[cs.faces[f].plane].sem;
+    face.sem = cs.planes[support[FaceIndex(f)]].sem;
     face.source = source.second ? source.first[FaceIndex(f)] : -1;
     t.face_of[f] = int(t.faces.size());
     t.candidate.push_back(f);
@@ -164,7 +165,8 @@ std::vector<int> outline(const std::vector<Face>& faces, const std::vector<int>&
 // within kCoplanarMergeDistance of the other's plane) with the same semantic. Supporting planes
 // a few millimetres apart (a scan plane beside a model wall) otherwise leave slivers that high.
 bool coplanar(const CandidateSet& cs, const Trace& t, int f, int g) {
-  const int k = cs.faces[t.candidate[f]].plane, l = cs.faces[t.candidate[g]].plane;
+  const auto support = cs.supports();
+  const int k = support[FaceIndex(t.candidate[f])], l = support[FaceIndex(t.candidate[g])];
   if (k == l) return true;
   if (t.faces[f].sem != t.faces[g].sem) return false;
   const Plane& pk = cs.planes[k].plane;

@@ -42,6 +42,7 @@
 #include "lodrefine/io/files.h"
 #include "lodrefine/io/obj.h"
 #include "lodrefine/io/refine_report.h"
+#include "support/candidate_fixtures.h"
 
 using namespace lodrefine;
 
@@ -793,14 +794,7 @@ TEST(BadInputRegression, FaceListedTwiceOnAnEdgeDoesNotAbortTheSolver) {
   ASSERT_GE(pid, 0);
   if (pid == 0) {
     ::close(2);  // GLPK prints its error before aborting
-    CandidateSet cs;
-    Candidate c;
-    c.plane = 0;
-    c.area = 1.0;
-    cs.faces = {c, c};
-    CandidateEdge e;
-    e.faces = {0, 0, 1};
-    cs.edges = {e};
+    const CandidateSet cs = fixtures::hand_built({0, 0}, {1.0, 1.0}, {{0, 0, 1}});
     const SelectionResult r = select_faces(cs, {-1.0, -1.0}, {0}, Params{});
     ::_exit(r.status == SolveStatus::NotRun ? 1 : 0);
   }
@@ -818,38 +812,30 @@ TEST(BadInputRegression, FaceListedTwiceOnAnEdgeDoesNotAbortTheSolver) {
 CandidateSet hard_program(int faces, int edges, unsigned seed, std::vector<double>& cost, std::vector<int>& outside) {
   std::mt19937 rng(seed);
   std::uniform_int_distribution<int> pick(0, faces - 1);
-  CandidateSet cs;
+  std::vector<int> plane;
+  std::vector<double> area;
   for (int f = 0; f < faces; ++f) {
-    Candidate c;
-    c.plane = f % 7;
-    c.area = 1.0 + f % 5;
-    cs.faces.push_back(c);
+    plane.push_back(f % 7);
+    area.push_back(1.0 + f % 5);
     cost.push_back((f % 3) - 1.0);
   }
+  std::vector<std::vector<int>> fans;
   for (int e = 0; e < edges; ++e) {
-    CandidateEdge ce;
-    while (ce.faces.size() < 3) {
+    std::vector<int> fan;
+    while (fan.size() < 3) {
       const int f = pick(rng);
-      if (std::find(ce.faces.begin(), ce.faces.end(), f) == ce.faces.end()) ce.faces.push_back(f);
+      if (std::find(fan.begin(), fan.end(), f) == fan.end()) fan.push_back(f);
     }
-    cs.edges.push_back(ce);
+    fans.push_back(fan);
     outside.push_back(int(rng() % 2));
   }
-  return cs;
+  return fixtures::hand_built(plane, area, fans);
 }
 
 TEST(BadInputSolver, InfeasibleProgramIsReportedNotSelected) {
   // Face 0 alone on two edges: once with the outside surface (x0 + 1 = 2 y0 -> x0 = 1), once
   // without (x0 = 2 y1 -> x0 = 0). No selection satisfies both.
-  CandidateSet cs;
-  Candidate c;
-  c.plane = 0;
-  c.area = 1.0;
-  cs.faces = {c};
-  CandidateEdge e0, e1;
-  e0.faces = {0};
-  e1.faces = {0};
-  cs.edges = {e0, e1};
+  const CandidateSet cs = fixtures::hand_built({0}, {1.0}, {{0}, {0}});
   const SelectionResult r = select_faces(cs, {-1.0}, {1, 0}, Params{});
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.status_text(), "infeasible");
@@ -873,7 +859,7 @@ TEST(BadInputSolver, TimeLimitWithoutSolutionIsReported) {
   EXPECT_NE(r.status_text().find("time limit"), std::string::npos) << r.status_text();
   if (!r.ok) {
     EXPECT_EQ(r.status_text(), "time limit (no solution)");
-    EXPECT_EQ(r.selected, std::vector<char>(cs.faces.size(), 0));
+    EXPECT_EQ(r.selected, std::vector<char>(std::size_t(cs.size()), 0));
   } else {
     EXPECT_EQ(r.status_text(), "feasible (time limit)");
   }
@@ -907,7 +893,9 @@ CandidateSet cube_program(std::vector<double>& cost, std::vector<int>& outside) 
   Region region;
   region.half = Vec3::Constant(2.0);
   CandidateSet cs = build_candidates(planes, region);
-  for (const auto& f : cs.faces) cost.push_back(f.centroid.lpNorm<Eigen::Infinity>() <= 1.0 + 1e-9 ? -f.area : f.area);
+  for (int f = 0; f < cs.size(); ++f)
+    cost.push_back(fixtures::centroid_of(cs, f).lpNorm<Eigen::Infinity>() <= 1.0 + 1e-9 ? -fixtures::area_of(cs, f)
+                                                                                        : fixtures::area_of(cs, f));
   outside.assign(cs.edges.size(), 0);
   return cs;
 }
@@ -916,7 +904,7 @@ TEST(BadInputSolver, OneMillisecondLimitFailsEvenAnEasyProgram) {
   std::vector<double> cost;
   std::vector<int> outside;
   const CandidateSet cs = cube_program(cost, outside);
-  ASSERT_GE(cs.faces.size(), 6u);
+  ASSERT_GE(cs.size(), 6);
   const SelectionResult easy = select_faces(cs, cost, outside, Params{});
   ASSERT_TRUE(easy.ok) << easy.status_text();
   EXPECT_EQ(easy.status_text(), "optimal");
@@ -928,7 +916,7 @@ TEST(BadInputSolver, OneMillisecondLimitFailsEvenAnEasyProgram) {
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.status_text(), "time limit (no solution)");
   EXPECT_EQ(std::count(r.selected.begin(), r.selected.end(), 1), 0);
-  add_row("select_faces: cube arrangement (" + std::to_string(cs.faces.size()) + " candidates), 1 ms limit",
+  add_row("select_faces: cube arrangement (" + std::to_string(cs.size()) + " candidates), 1 ms limit",
           "ok=false, status '" + r.status_text() + "' (30 s limit: '" + easy.status_text() + "')", 0);
 }
 

@@ -14,9 +14,9 @@ TEST(Candidates, BoxArrangementHasNinePiecesPerPlane) {
   const auto planes = box_planes(10, 8, 6);
   const Region region = box_region(10, 8, 6);
   const CandidateSet cs = build_candidates(planes, region);
-  ASSERT_EQ(cs.faces.size(), 54u);  // each plane section is cut by 4 perpendicular planes into 3x3
+  ASSERT_EQ(cs.size(), 54);  // each plane section is cut by 4 perpendicular planes into 3x3
   double total = 0.0;
-  for (const auto& f : cs.faces) total += f.area;
+  for (int f = 0; f < cs.size(); ++f) total += area_of(cs, f);
   // Sections: planes x=const are (8+2*1.8)x(6+2*1.6) ... compare with the region's cross-sections.
   const double expect = 2 * (2 * region.half.y() * 2 * region.half.z()) +
                         2 * (2 * region.half.x() * 2 * region.half.z()) +
@@ -36,7 +36,7 @@ TEST(Candidates, NearAxisAlignedPlanesGiveFiniteVertices) {
   planes[5].plane = Plane(Vec3(2e-18, -1e-19, 1), -6);
   const Region region = box_region(10, 8, 6);
   const CandidateSet cs = build_candidates(planes, region);
-  ASSERT_EQ(cs.faces.size(), 54u);
+  ASSERT_EQ(cs.size(), 54);
   for (const auto& v : cs.vertices) EXPECT_TRUE(region.contains(v, 1e-6)) << v.transpose();
 }
 
@@ -45,12 +45,11 @@ TEST(Candidates, NearAxisAlignedPlanesGiveFiniteVertices) {
 // different planes never do (their edges meet only in the fans).
 TEST(Candidates, LiveOnASurfaceMeshOneComponentPerPlane) {
   const CandidateSet cs = build_candidates(box_planes(10, 8, 6), box_region(10, 8, 6));
-  ASSERT_EQ(cs.mesh.number_of_faces(), cs.faces.size());
+  ASSERT_EQ(int(cs.mesh.number_of_faces()), cs.size());
   ASSERT_TRUE(CGAL::is_valid_polygon_mesh(cs.mesh));
   const auto support = cs.mesh.property_map<CandidateMesh::Face_index, int>("f:support");
   ASSERT_TRUE(support.second);
-  for (int f = 0; f < int(cs.faces.size()); ++f)
-    EXPECT_EQ(support.first[CandidateMesh::Face_index(f)], cs.faces[f].plane);
+  for (int f = 0; f < cs.size(); ++f) EXPECT_EQ(support.first[CandidateMesh::Face_index(f)], plane_of(cs, f));
   int shared = 0;
   for (auto e : cs.mesh.edges()) {
     const auto h = cs.mesh.halfedge(e);
@@ -78,10 +77,10 @@ TEST(Candidates, LiveOnASurfaceMeshOneComponentPerPlane) {
 TEST(Candidates, KeptCandidatesAreTheSameProgram) {
   const double a = 10, b = 8, c = 6;
   const CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
-  std::vector<char> keep(cs.faces.size(), 0);
-  for (std::size_t f = 0; f < keep.size(); ++f) keep[f] = inside_box(cs.faces[f].centroid, a, b, c);
+  std::vector<char> keep(std::size_t(cs.size()), 0);
+  for (std::size_t f = 0; f < keep.size(); ++f) keep[f] = inside_box(centroid_of(cs, f), a, b, c);
   const CandidateSet k = kept_candidates(cs, keep);
-  ASSERT_EQ(k.faces.size(), 6u);
+  ASSERT_EQ(k.size(), 6);
   EXPECT_EQ(k.mesh.number_of_faces(), 6u);
   int box_edges = 0;
   for (const auto& e : k.edges) {
@@ -90,7 +89,7 @@ TEST(Candidates, KeptCandidatesAreTheSameProgram) {
   }
   EXPECT_EQ(box_edges, 12);
   std::vector<double> cost;
-  for (const auto& f : k.faces) cost.push_back(-f.area);
+  for (int f = 0; f < k.size(); ++f) cost.push_back(-area_of(k, f));
   const SelectionResult r = select_faces(k, cost, std::vector<int>(k.edges.size(), 0), Params{});
   ASSERT_TRUE(r.ok) << r.status_text();
   EXPECT_EQ(std::count(r.selected.begin(), r.selected.end(), 1), 6);
@@ -146,9 +145,9 @@ struct Terrace {
   }
   // The candidates on the terrace's surface: inside on one side of the face, outside on the other.
   std::vector<char> shell(const CandidateSet& cs) const {
-    std::vector<char> on(cs.faces.size(), 0);
-    for (std::size_t f = 0; f < cs.faces.size(); ++f) {
-      const Vec3 c = cs.faces[f].centroid, d = 1e-4 * cs.planes[cs.faces[f].plane].plane.n;
+    std::vector<char> on(std::size_t(cs.size()), 0);
+    for (std::size_t f = 0; f < std::size_t(cs.size()); ++f) {
+      const Vec3 c = centroid_of(cs, f), d = 1e-4 * cs.planes[plane_of(cs, f)].plane.n;
       on[f] = inside(c + d) != inside(c - d);
     }
     return on;
@@ -178,7 +177,7 @@ TEST(Candidates, LocalSectionsGrowLinearlyOnATerrace) {
     const Terrace t{n};
     std::vector<Region> reach;
     const auto planes = t.planes(reach);
-    return build_candidates(planes, t.region(), local ? reach : std::vector<Region>{}).faces.size();
+    return build_candidates(planes, t.region(), local ? reach : std::vector<Region>{}).size();
   };
   // Measured: 274, 1462, 3942 pieces (the long front, back and ground planes still meet every
   // plane along them); over the whole region 568 -> 17354 from 4 to 16 houses.
@@ -196,7 +195,7 @@ TEST(Candidates, LocalSectionsGrowLinearlyOnATerrace) {
     const std::vector<char> shell = t.shell(cs);
     EXPECT_TRUE(every_edge_used_0_or_2(cs, shell)) << n << " houses";
     double area = 0.0;
-    for (std::size_t f = 0; f < shell.size(); ++f) area += shell[f] ? cs.faces[f].area : 0.0;
+    for (std::size_t f = 0; f < shell.size(); ++f) area += shell[f] ? area_of(cs, f) : 0.0;
     EXPECT_NEAR(area, t.surface_area(), 1e-6) << n << " houses";
   }
 }
@@ -208,9 +207,9 @@ TEST(Candidates, StopsAtTheCap) {
   const auto planes = t.planes(reach);
   const CandidateSet all = build_candidates(planes, t.region(), reach);
   EXPECT_FALSE(all.capped);
-  const CandidateSet cs = build_candidates(planes, t.region(), reach, int(all.faces.size()) / 2);
+  const CandidateSet cs = build_candidates(planes, t.region(), reach, all.size() / 2);
   EXPECT_TRUE(cs.capped);
-  EXPECT_TRUE(cs.faces.empty());
+  EXPECT_TRUE(cs.size() == 0);
   EXPECT_TRUE(cs.edges.empty());
-  EXPECT_FALSE(build_candidates(planes, t.region(), reach, int(all.faces.size())).capped);
+  EXPECT_FALSE(build_candidates(planes, t.region(), reach, all.size()).capped);
 }

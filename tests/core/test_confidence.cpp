@@ -23,13 +23,13 @@ TEST(Confidence, BoxFacesAreFullyCoveredByTheirModelReferences) {
   const double a = 10, b = 8, c = 6;
   const CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
   const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, Params{});
-  ASSERT_EQ(conf.size(), cs.faces.size());
+  ASSERT_EQ(conf.size(), std::size_t(cs.size()));
   int full = 0;
-  for (std::size_t f = 0; f < cs.faces.size(); ++f) {
-    if (inside_box(cs.faces[f].centroid, a, b, c)) {
+  for (std::size_t f = 0; f < std::size_t(cs.size()); ++f) {
+    if (inside_box(centroid_of(cs, f), a, b, c)) {
       ++full;
       EXPECT_NEAR(conf[f].value, 1.0, 1e-9) << "face " << f;
-      EXPECT_EQ(conf[f].model_ref, cs.planes[cs.faces[f].plane].source) << "face " << f;
+      EXPECT_EQ(conf[f].model_ref, cs.planes[plane_of(cs, f)].source) << "face " << f;
       EXPECT_EQ(conf[f].cloud_ref, -1);
     } else {
       EXPECT_NEAR(conf[f].value, 0.0, 1e-9) << "face " << f;
@@ -45,8 +45,8 @@ TEST(Confidence, CloudReferenceCoversTheShareItsPointsSpan) {
   const double a = 10, b = 8, c = 6;
   const CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
   int front = -1;
-  for (int f = 0; f < int(cs.faces.size()); ++f)
-    if (cs.planes[cs.faces[f].plane].source == 2 && inside_box(cs.faces[f].centroid, a, b, c)) front = f;
+  for (int f = 0; f < cs.size(); ++f)
+    if (cs.planes[plane_of(cs, f)].source == 2 && inside_box(centroid_of(cs, f), a, b, c)) front = f;
   ASSERT_GE(front, 0);
   auto half_front = [](double y) {
     CloudReference ref;
@@ -56,7 +56,7 @@ TEST(Confidence, CloudReferenceCoversTheShareItsPointsSpan) {
   };
   for (double y : {0.0, -0.1}) {
     const auto conf = candidate_confidence(cs, {}, {half_front(y)}, Params{});
-    for (int f = 0; f < int(cs.faces.size()); ++f) {
+    for (int f = 0; f < cs.size(); ++f) {
       if (f == front) continue;
       EXPECT_NEAR(conf[f].value, 0.0, 1e-9) << "face " << f;
     }

@@ -16,8 +16,8 @@ TEST(Selection, RecoversTheClosedBoxFromConfidence) {
   const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, prm);
   std::vector<double> cost;
   int full = 0;
-  for (std::size_t f = 0; f < cs.faces.size(); ++f) {
-    cost.push_back(coverage_cost(cs.faces[f].area, conf[f].value, prm.tau_cov));
+  for (std::size_t f = 0; f < std::size_t(cs.size()); ++f) {
+    cost.push_back(coverage_cost(area_of(cs, f), conf[f].value, prm.tau_cov));
     full += conf[f].value > 0.99;
   }
   EXPECT_EQ(full, 6);
@@ -26,11 +26,11 @@ TEST(Selection, RecoversTheClosedBoxFromConfidence) {
   EXPECT_EQ(sel.status_text(), "optimal");
   double area = 0.0;
   int count = 0;
-  for (std::size_t f = 0; f < cs.faces.size(); ++f)
+  for (std::size_t f = 0; f < std::size_t(cs.size()); ++f)
     if (sel.selected[f]) {
       ++count;
-      area += cs.faces[f].area;
-      EXPECT_TRUE(inside_box(cs.faces[f].centroid, a, b, c));
+      area += area_of(cs, f);
+      EXPECT_TRUE(inside_box(centroid_of(cs, f), a, b, c));
     }
   EXPECT_EQ(count, 6);
   EXPECT_NEAR(area, 2 * (a * b + b * c + a * c), 1e-6);
@@ -47,7 +47,7 @@ TEST(Selection, InfeasibleBoundaryIsReportedNotCrashed) {
   std::vector<SupportPlane> planes = {{Plane(Vec3(0, 0, 1), -1), Semantic::Roof, false, 0}};
   const Region region = Region::around({Vec3(0, 0, 0), Vec3(2, 2, 2)}, 0.0, 0.5);
   const CandidateSet cs = build_candidates(planes, region);
-  ASSERT_EQ(cs.faces.size(), 1u);
+  ASSERT_EQ(cs.size(), 1);
   std::vector<int> outside(cs.edges.size(), 0);
   outside[0] = 1;  // one continuing edge: the face must be selected, then 3 edges are open
   Params prm;
@@ -62,10 +62,10 @@ TEST(Selection, StartsFromAClosedWarmStartAndRefusesAnOpenOne) {
   Params prm;
   const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, prm);
   SelectionProgram pg;
-  std::vector<char> box(cs.faces.size(), 0);
-  for (std::size_t f = 0; f < cs.faces.size(); ++f) {
-    pg.cost.push_back(coverage_cost(cs.faces[f].area, conf[f].value, prm.tau_cov));
-    box[f] = inside_box(cs.faces[f].centroid, a, b, c);
+  std::vector<char> box(std::size_t(cs.size()), 0);
+  for (std::size_t f = 0; f < std::size_t(cs.size()); ++f) {
+    pg.cost.push_back(coverage_cost(area_of(cs, f), conf[f].value, prm.tau_cov));
+    box[f] = inside_box(centroid_of(cs, f), a, b, c);
   }
   EXPECT_TRUE(every_edge_used_0_or_2(cs, box));
   pg.warm = box;
@@ -97,10 +97,10 @@ TEST(Selection, FixedFacesAreConstantsOfTheProgram) {
   const CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
   Params prm;
   SelectionProgram pg;
-  std::vector<char> box(cs.faces.size(), 0);
+  std::vector<char> box(std::size_t(cs.size()), 0);
   int inside = 0;
-  for (std::size_t f = 0; f < cs.faces.size(); ++f) {
-    box[f] = inside_box(cs.faces[f].centroid, a, b, c);
+  for (std::size_t f = 0; f < std::size_t(cs.size()); ++f) {
+    box[f] = inside_box(centroid_of(cs, f), a, b, c);
     inside += box[f];
     pg.cost.push_back(box[f] ? -1.0 : 1.0);
     pg.fixed.push_back(box[f] ? 1 : -1);  // the box fixed in, the rest free
@@ -112,11 +112,11 @@ TEST(Selection, FixedFacesAreConstantsOfTheProgram) {
   // The box's edges are each used twice by it: every other face there is decided 0 by the edge
   // constraints, and so on outwards; nothing is left for GLPK (its presolve would find the same,
   // but it is off under a warm start).
-  EXPECT_EQ(sel.forced, int(cs.faces.size()) - inside);
+  EXPECT_EQ(sel.forced, cs.size() - inside);
   EXPECT_EQ(sel.variables, 0);
   // Everything fixed, the box one face short: the constants alone break an edge constraint.
-  for (std::size_t f = 0; f < cs.faces.size(); ++f) pg.fixed[f] = box[f];
-  for (std::size_t f = 0; f < cs.faces.size(); ++f)
+  for (std::size_t f = 0; f < std::size_t(cs.size()); ++f) pg.fixed[f] = box[f];
+  for (std::size_t f = 0; f < std::size_t(cs.size()); ++f)
     if (box[f]) {
       pg.fixed[f] = 0;
       break;

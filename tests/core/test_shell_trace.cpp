@@ -41,11 +41,11 @@ template <class Solid>
 void choose_boundary(CandidateSet& cs, Solid solid, double eps) {
   auto chosen = cs.mesh.add_property_map<FaceIndex, bool>("f:chosen", false).first;
   auto source = cs.mesh.add_property_map<FaceIndex, int>("f:source", -1).first;
-  for (int f = 0; f < int(cs.faces.size()); ++f) {
-    const Vec3& c = cs.faces[f].centroid;
-    const Vec3 n = cs.planes[cs.faces[f].plane].plane.n;
+  for (int f = 0; f < cs.size(); ++f) {
+    const Vec3& c = centroid_of(cs, f);
+    const Vec3 n = cs.planes[plane_of(cs, f)].plane.n;
     chosen[FaceIndex(f)] = solid(c - eps * n) != solid(c + eps * n);
-    source[FaceIndex(f)] = cs.faces[f].plane;
+    source[FaceIndex(f)] = plane_of(cs, f);
   }
 }
 
@@ -143,8 +143,8 @@ TEST(ShellTrace, FacesCarrySemanticAndSource) {
 TEST(ShellTrace, OpenSelectionStaysOpen) {
   CandidateSet cs = recess_selection();
   auto chosen = cs.mesh.property_map<FaceIndex, bool>("f:chosen").first;
-  for (int f = 0; f < int(cs.faces.size()); ++f)
-    if (cs.faces[f].plane == 5) chosen[FaceIndex(f)] = false;
+  for (int f = 0; f < cs.size(); ++f)
+    if (plane_of(cs, f) == 5) chosen[FaceIndex(f)] = false;
   const Mesh m = traced_shell(cs);
   EXPECT_EQ(m.faces.size(), 9u);
   EXPECT_GT(validate_mesh(m, 1e-6).boundary_edges, 0);

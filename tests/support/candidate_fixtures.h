@@ -35,6 +35,43 @@ inline std::vector<ModelReference> box_references(double a, double b, double c) 
           {{Vec3(0, 0, c), Vec3(a, 0, c), Vec3(a, b, c), Vec3(0, b, c)}}};
 }
 
+// Candidate f's face maps (candidates.h).
+inline int plane_of(const CandidateSet& cs, int f) { return cs.supports()[CandidateFace(f)]; }
+inline double area_of(const CandidateSet& cs, int f) { return cs.areas()[CandidateFace(f)]; }
+inline Vec3 centroid_of(const CandidateSet& cs, int f) { return cs.centroids()[CandidateFace(f)]; }
+
+// A program built by hand: candidate f on plane plane[f] with area area[f], each a polygon of its
+// own (a corner per fan it is on, at least 3; the corners are points no other face has), and
+// the fans `edges` (the candidates along each, in order; one listed twice is on it twice).
+inline CandidateSet hand_built(const std::vector<int>& plane, const std::vector<double>& area,
+                               const std::vector<std::vector<int>>& edges) {
+  CandidateSet cs;
+  auto support = cs.mesh.add_property_map<CandidateFace, int>("f:support", -1).first;
+  auto areas = cs.mesh.add_property_map<CandidateFace, double>("f:area", 0.0).first;
+  cs.mesh.add_property_map<CandidateFace, Vec3>("f:centroid", Vec3::Zero());
+  auto point = cs.mesh.add_property_map<CandidateMesh::Vertex_index, int>("v:point", -1).first;
+  std::vector<std::size_t> uses(plane.size(), 0);
+  for (const auto& e : edges)
+    for (int f : e) ++uses[std::size_t(f)];
+  for (std::size_t f = 0; f < plane.size(); ++f) {
+    std::vector<CandidateMesh::Vertex_index> loop;
+    for (std::size_t k = 0; k < std::max<std::size_t>(3, uses[f]); ++k) {
+      const Vec3 x(double(k), double(f), 0.0);
+      point[loop.emplace_back(cs.mesh.add_vertex({x.x(), x.y(), x.z()}))] = int(cs.vertices.size());
+      cs.vertices.push_back(x);
+    }
+    const auto face = cs.mesh.add_face(loop);
+    support[face] = plane[f];
+    areas[face] = area[f];
+  }
+  for (const auto& e : edges) {
+    CandidateEdge ce;
+    ce.faces = e;
+    cs.edges.push_back(ce);
+  }
+  return cs;
+}
+
 inline bool inside_box(const Vec3& p, double a, double b, double c) {
   return p.x() > -1e-9 && p.x() < a + 1e-9 && p.y() > -1e-9 && p.y() < b + 1e-9 && p.z() > -1e-9 && p.z() < c + 1e-9;
 }

@@ -37,13 +37,9 @@ struct Region {
 };
 
 using CandidateMesh = CGAL::Surface_mesh<CGAL::Simple_cartesian<double>::Point_3>;
-
-// What the program needs of candidate f (face f of CandidateSet::mesh): its plane and size.
-struct Candidate {
-  int plane = -1;  // index into CandidateSet::planes
-  double area = 0.0;
-  Vec3 centroid = Vec3::Zero();
-};
+using CandidateFace = CandidateMesh::Face_index;
+template <class T>
+using CandidateMap = CandidateMesh::Property_map<CandidateFace, T>;
 
 // One segment of the arrangement and the candidates along it (CGAL's hypothesis calls it an
 // Intersection): 2 in a plane's interior, more where 3+ planes share the line.
@@ -55,17 +51,21 @@ struct CandidateEdge {
 };
 
 // The candidates. `mesh` holds them: face f is candidate f, CCW about its plane's normal, with
-// the property maps "f:support" (the supporting plane) and "v:point" (the vertex's index in
-// `vertices`, the same point in every component). `faces` and `edges` are the program's view
-// (a program may also be built by hand, without a mesh: then corners() is empty).
+// the property maps "f:support" (int: its plane, an index into `planes`), "f:area" (double, m^2),
+// "f:centroid" (Vec3) and "v:point" (the vertex's index in `vertices`, the same point in every
+// component). `edges` is the program's view of adjacency.
 struct CandidateSet {
   std::vector<SupportPlane> planes;
   Region region;
   std::vector<Vec3> vertices;
   CandidateMesh mesh;
-  std::vector<Candidate> faces;
   std::vector<CandidateEdge> edges;
-  bool capped = false;                    // build_candidates stopped at its cap: no candidates
+  bool capped = false;  // build_candidates stopped at its cap: no candidates
+  int size() const { return int(mesh.number_of_faces()); }
+  // The face maps above (present on every set build_candidates or kept_candidates returns).
+  CandidateMap<int> supports() const;
+  CandidateMap<double> areas() const;
+  CandidateMap<Vec3> centroids() const;
   std::vector<int> corners(int f) const;  // indices into `vertices`, CCW
   std::vector<Vec3> polygon(int f) const;
 };
