@@ -72,6 +72,17 @@ std::vector<Vec3> CandidateSet::polygon(int f) const {
   return pts;
 }
 
+std::pair<int, int> CandidateSet::ends(const CandidateEdge& e) const {
+  const auto point = mesh.property_map<CandidateMesh::Vertex_index, int>("v:point").first;
+  const int s = point[mesh.source(e.front())], t = point[mesh.target(e.front())];
+  return {std::min(s, t), std::max(s, t)};
+}
+
+double CandidateSet::length(const CandidateEdge& e) const {
+  const auto [a, b] = ends(e);
+  return (vertices[a] - vertices[b]).norm();
+}
+
 namespace {
 
 // A convex polygon under construction: vertex positions and, per edge i (v[i] -> v[i+1]), the
@@ -218,13 +229,16 @@ struct Piece {
 // corners in `cs.vertices`, its plane pieces[f].plane; pieces come plane by plane). A piece the
 // component cannot take (it would make the component non-manifold: overlapping slivers, a corner
 // repeated) becomes a component of its own; the fans are by point, so its edges still count.
-void build_mesh(CandidateSet& cs, const std::vector<Piece>& pieces, const std::vector<std::vector<int>>& corners) {
+// Returns per face the halfedge that leaves its first corner.
+std::vector<CandidateHalfedge> build_mesh(CandidateSet& cs, const std::vector<Piece>& pieces,
+                                          const std::vector<std::vector<int>>& corners) {
   auto support = cs.mesh.add_property_map<CandidateFace, int>("f:support", -1).first;
   auto area = cs.mesh.add_property_map<CandidateFace, double>("f:area", 0.0).first;
   auto centroid = cs.mesh.add_property_map<CandidateFace, Vec3>("f:centroid", Vec3::Zero()).first;
   auto point = cs.mesh.add_property_map<CandidateMesh::Vertex_index, int>("v:point", -1).first;
   std::vector<CandidateMesh::Vertex_index> of_point(cs.vertices.size());
   std::vector<int> plane_of_vertex(cs.vertices.size(), -1);
+  std::vector<CandidateHalfedge> first;
   auto new_vertex = [&](int id) {
     const Vec3& x = cs.vertices[id];
     const auto v = cs.mesh.add_vertex(CandidateMesh::Point(x.x(), x.y(), x.z()));
@@ -246,58 +260,45 @@ void build_mesh(CandidateSet& cs, const std::vector<Piece>& pieces, const std::v
     support[face] = k;
     area[face] = pieces[f].area;
     centroid[face] = pieces[f].centroid;
+    first.push_back(cs.mesh.halfedge(vs[0], vs[1]));
   }
+  return first;
 }
 
 // The fans (CGAL's extract_adjacency): every halfedge of a face, by the points at its ends; the
-// edges in order of their first appearance (faces in order, each from its first corner).
-void build_fans(CandidateSet& cs, const std::vector<std::vector<int>>& corners) {
+// edges in order of their first appearance (faces in order, each from its first corner,
+// `first`), the halfedges of each in face order.
+void build_fans(CandidateSet& cs, const std::vector<CandidateHalfedge>& first) {
   const auto point = cs.mesh.property_map<CandidateMesh::Vertex_index, int>("v:point").first;
   struct Side {
-    int a, b, face, order;
+    int a, b;
+    CandidateHalfedge h;
   };
-  std::vector<Side> sides;
-  for (auto f : cs.mesh.faces())
-    for (auto h : CGAL::halfedges_around_face(cs.mesh.halfedge(f), cs.mesh)) {
+  std::vector<Side> sides;  // by order of appearance
+  for (const auto h0 : first)
+    for (auto h : CGAL::halfedges_around_face(h0, cs.mesh)) {
       const int s = point[cs.mesh.source(h)], t = point[cs.mesh.target(h)];
-      sides.push_back({std::min(s, t), std::max(s, t), int(f), 0});
+      sides.push_back({std::min(s, t), std::max(s, t), h});
     }
-  // halfedges_around_face starts where Surface_mesh put the face's halfedge: order each face's
-  // sides from its first corner, as the pieces were cut.
-  for (std::size_t i = 0, f = 0; i < sides.size(); ++f) {
-    const std::vector<int> c = cs.corners(int(f));  // from the face's halfedge
-    const int shift = int(std::find(c.begin(), c.end(), corners[f][0]) - c.begin());
-    const int n = int(c.size());
-    for (int k = 0; k < n; ++k) sides[i + k].order = int(i) + (k + n - shift) % n;
-    i += n;
-  }
   std::vector<int> by_end(sides.size());
   std::iota(by_end.begin(), by_end.end(), 0);
   std::stable_sort(by_end.begin(), by_end.end(), [&](int x, int y) {
-    return std::tie(sides[x].a, sides[x].b, sides[x].order) < std::tie(sides[y].a, sides[y].b, sides[y].order);
+    return std::tie(sides[x].a, sides[x].b, x) < std::tie(sides[y].a, sides[y].b, y);
   });
   std::vector<std::pair<int, CandidateEdge>> fans;  // first appearance, fan
-  const auto box = cs.region.planes();
   for (std::size_t i = 0; i < by_end.size();) {
     const Side& s = sides[by_end[i]];
     CandidateEdge e;
-    e.a = s.a;
-    e.b = s.b;
-    e.length = (cs.vertices[s.a] - cs.vertices[s.b]).norm();
-    for (int bp = 0; bp < 6; ++bp)
-      if (std::abs(box[bp].distance(cs.vertices[s.a])) < kVertexWeld &&
-          std::abs(box[bp].distance(cs.vertices[s.b])) < kVertexWeld)
-        e.box_plane = bp;
-    int first = s.order;
+    int appears = by_end[i];
     for (; i < by_end.size() && sides[by_end[i]].a == s.a && sides[by_end[i]].b == s.b; ++i) {
-      e.faces.push_back(sides[by_end[i]].face);
-      first = std::min(first, sides[by_end[i]].order);
+      e.push_back(sides[by_end[i]].h);
+      appears = std::min(appears, by_end[i]);
     }
-    std::sort(e.faces.begin(), e.faces.end());
-    fans.emplace_back(first, std::move(e));
+    std::stable_sort(e.begin(), e.end(), [&](auto x, auto y) { return cs.face(x) < cs.face(y); });
+    fans.emplace_back(appears, std::move(e));
   }
   std::sort(fans.begin(), fans.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-  for (auto& [first, e] : fans) cs.edges.push_back(std::move(e));
+  for (auto& [appears, e] : fans) cs.edges.push_back(std::move(e));
 }
 
 // Per support plane, the vertices within kPlaneReach of it, by index.
@@ -394,8 +395,7 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
     }
     v = out;
   }
-  build_mesh(cs, kept, corners);
-  build_fans(cs, corners);
+  build_fans(cs, build_mesh(cs, kept, corners));
   return cs;
 }
 
@@ -417,13 +417,25 @@ CandidateSet kept_candidates(const CandidateSet& cs, const std::vector<char>& ke
     pieces.push_back({support[fi], area[fi], centroid[fi]});
     corners.push_back(cs.corners(f));
   }
-  build_mesh(out, pieces, corners);
+  const std::vector<CandidateHalfedge> first = build_mesh(out, pieces, corners);
+  // A kept face's k-th halfedge from its face's halfedge (where corners() starts) is the k-th of
+  // its copy from the copy's first corner.
+  std::vector<CandidateHalfedge> copy(cs.mesh.number_of_halfedges());
+  for (int f = 0; f < cs.size(); ++f) {
+    if (index[f] < 0) continue;
+    const CandidateHalfedge h0 = cs.mesh.halfedge(CandidateFace(f));
+    CandidateHalfedge h = h0, g = first[std::size_t(index[f])];
+    do {
+      copy[std::size_t(h)] = g;
+      h = cs.mesh.next(h);
+      g = out.mesh.next(g);
+    } while (h != h0);
+  }
   for (const auto& e : cs.edges) {
-    CandidateEdge k = e;
-    k.faces.clear();
-    for (int f : e.faces)
-      if (index[f] >= 0) k.faces.push_back(index[f]);
-    if (!k.faces.empty()) out.edges.push_back(std::move(k));
+    CandidateEdge k;
+    for (auto h : e)
+      if (index[cs.face(h)] >= 0) k.push_back(copy[std::size_t(h)]);
+    if (!k.empty()) out.edges.push_back(std::move(k));
   }
   return out;
 }

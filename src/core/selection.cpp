@@ -95,7 +95,7 @@ bool every_edge_used_0_or_2(const CandidateSet& cs, const std::vector<char>& sel
                             const std::vector<int>& outside) {
   for (std::size_t e = 0; e < cs.edges.size(); ++e) {
     int n = outside.empty() ? 0 : outside[e];
-    for (int f : cs.edges[e].faces) n += selected[f];
+    for (auto h : cs.edges[e]) n += selected[cs.face(h)];
     if (n != 0 && n != 2) return false;
   }
   return true;
@@ -114,14 +114,15 @@ std::vector<int> forced_by_edges(const CandidateSet& cs, std::vector<int> fixed,
     changed = false;
     for (std::size_t e = 0; e < cs.edges.size(); ++e) {
       int constant = outside.empty() ? 0 : outside[e], free = 0;
-      for (int f : cs.edges[e].faces) {
+      for (auto h : cs.edges[e]) {
+        const int f = cs.face(h);
         if (fixed[f] < 0) ++free;
         else constant += fixed[f];
       }
       if (free == 0 || constant > 2) continue;
       if (constant == 2 || free == 1) {
-        for (int f : cs.edges[e].faces)
-          if (fixed[f] < 0) fixed[f] = constant == 2 ? 0 : constant;
+        for (auto h : cs.edges[e])
+          if (fixed[cs.face(h)] < 0) fixed[cs.face(h)] = constant == 2 ? 0 : constant;
         changed = true;
       }
     }
@@ -219,7 +220,8 @@ double uniform_sharp_cost(const CandidateSet& cs, const SelectionConfig& prm) {
 bool add_edge_constraint(Program& p, const CandidateSet& cs, const Columns& c, int e) {
   std::vector<std::pair<int, double>> terms;
   int constant = c.outside(e), warm_count = c.outside(e);
-  for (int f : cs.edges[e].faces) {
+  for (auto h : cs.edges[e]) {
+    const int f = cs.face(h);
     if (c.col[f] > 0) terms.emplace_back(c.col[f], 1.0);
     else constant += c.fixed_value(f);
     warm_count += c.warm(f);
@@ -235,7 +237,8 @@ bool add_edge_constraint(Program& p, const CandidateSet& cs, const Columns& c, i
 // both are fixed in).
 void add_sharp_edge(Program& p, const CandidateSet& cs, const CandidateMap<int>& support, const Columns& c, int e,
                     double sharp) {
-  const auto& faces = cs.edges[e].faces;
+  std::vector<int> faces;
+  for (auto h : cs.edges[e]) faces.push_back(cs.face(h));
   int s = 0;
   for (std::size_t i = 0; i < faces.size(); ++i)
     for (std::size_t j = i + 1; j < faces.size(); ++j) {

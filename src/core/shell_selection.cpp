@@ -295,18 +295,18 @@ std::vector<char> mended_start(const CandidateSet& cs, const std::vector<char>& 
   std::vector<char> near(cs.size(), 0);
   for (const auto& e : cs.edges) {
     int n = 0;
-    for (int f : e.faces) n += in_start[f];
+    for (auto h : e) n += in_start[cs.face(h)];
     if (n != 0 && n != 2)
-      for (int f : e.faces) near[f] = 1;
+      for (auto h : e) near[cs.face(h)] = 1;
   }
   for (int attempt = 0; attempt < kMendTries; ++attempt) {
     for (int ring = 0; ring < kMendRings; ++ring) {
       std::vector<char> grown = near;
       for (const auto& e : cs.edges) {
         bool touches = false;
-        for (int f : e.faces) touches = touches || near[f];
+        for (auto h : e) touches = touches || near[cs.face(h)];
         if (touches)
-          for (int f : e.faces) grown[f] = 1;
+          for (auto h : e) grown[cs.face(h)] = 1;
       }
       near.swap(grown);
     }
@@ -400,7 +400,7 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   const auto area = cs.areas();
   for (int f = 0; f < cs.size(); ++f)
     pg.cost.push_back(coverage_cost(area[FaceIndex(f)], confidence[FaceIndex(f)], prm.tau_cov));
-  for (const auto& e : cs.edges) pg.sharp_cost.push_back(prm.lambda_complexity * e.length * kSharpEdgeWidth);
+  for (const auto& e : cs.edges) pg.sharp_cost.push_back(prm.lambda_complexity * cs.length(e) * kSharpEdgeWidth);
   if (!warm.empty()) {
     pg.warm = warm;
     const auto in_zone = cs.mesh.property_map<FaceIndex, bool>("f:in_zone").first;

@@ -20,22 +20,13 @@ using FaceIndex = CandidateMesh::Face_index;
 
 // The shell under construction: one face per chosen candidate that keeps 3 corners.
 struct Trace {
-  std::vector<int> candidate;             // per face
-  std::vector<std::vector<int>> corners;  // per face: its candidate's points, CCW about the plane
-  std::vector<int> face_of;               // per candidate: its face, -1 when not chosen or gone
-  std::vector<int> vertex_of;             // per point: its output vertex (-1: unused)
+  std::vector<int> candidate;  // per face
+  std::vector<int> face_of;    // per candidate: its face, -1 when not chosen or gone
+  std::vector<int> vertex_of;  // per point: its output vertex (-1: unused)
   std::vector<Vec3> vertices;
   std::vector<Face> faces;
   std::vector<char> reversed;  // per face: runs against its plane's normal
 };
-
-// Whether `corners` runs from point a to point b (else b to a, or not along a-b).
-bool runs(const std::vector<int>& corners, int a, int b) {
-  const std::size_t n = corners.size();
-  for (std::size_t i = 0; i < n; ++i)
-    if (corners[i] == a) return corners[(i + 1) % n] == b;
-  return false;
-}
 
 // The chosen candidates' faces on output vertices: the points of a chosen edge shorter than
 // kCollapsedEdge are one vertex, numbered by first appearance (its first point gives the
@@ -73,14 +64,13 @@ void trace_faces(const CandidateSet& cs, Trace& t) {
     face.source = source.second ? source.first[FaceIndex(f)] : -1;
     t.face_of[f] = int(t.faces.size());
     t.candidate.push_back(f);
-    t.corners.push_back(std::move(pieces[f]));
     t.faces.push_back(std::move(face));
   }
 }
 
 // Two faces of the shell along one segment (its fans, CandidateSet::edges, joined where short
-// edges collapsed), and whether they run along it in the same direction as their candidates
-// are (CCW about their planes).
+// edges collapsed), and whether they run along it in the same direction as their candidates'
+// halfedges do (CCW about their planes).
 struct Meeting {
   int f = -1, g = -1;
   bool same = false;
@@ -89,14 +79,16 @@ struct Meeting {
 std::vector<Meeting> meetings(const CandidateSet& cs, const Trace& t) {
   // Per output segment: its faces, each with whether it runs from a to b.
   std::map<std::pair<int, int>, std::vector<std::pair<int, bool>>> along;
+  const auto point = cs.mesh.property_map<CandidateMesh::Vertex_index, int>("v:point").first;
   for (const auto& e : cs.edges) {
-    const int a = t.vertex_of[e.a], b = t.vertex_of[e.b];
+    const auto [ea, eb] = cs.ends(e);
+    const int a = t.vertex_of[ea], b = t.vertex_of[eb];
     if (a < 0 || b < 0 || a == b) continue;  // unused or collapsed
     auto& faces = along[edge_key(a, b)];
-    for (int c : e.faces) {
-      const int f = t.face_of[c];
+    for (auto h : e) {
+      const int f = t.face_of[cs.face(h)];
       if (f < 0 || std::any_of(faces.begin(), faces.end(), [&](const auto& x) { return x.first == f; })) continue;
-      faces.emplace_back(f, runs(t.corners[f], e.a, e.b) == (a < b));
+      faces.emplace_back(f, (point[cs.mesh.source(h)] == ea) == (a < b));
     }
   }
   std::vector<Meeting> out;

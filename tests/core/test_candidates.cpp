@@ -24,8 +24,12 @@ TEST(Candidates, BoxArrangementHasNinePiecesPerPlane) {
   EXPECT_NEAR(total, expect, 1e-6);
   // Interior edges (not on the region boundary) are shared by exactly 4 faces (2 planes x 2 sides).
   for (const auto& e : cs.edges) {
-    if (e.box_plane >= 0) EXPECT_EQ(e.faces.size(), 1u);
-    else EXPECT_EQ(e.faces.size(), 4u);
+    const auto [a, b] = cs.ends(e);
+    bool on_box = false;
+    for (const Plane& p : region.planes())
+      on_box = on_box || (std::abs(p.distance(cs.vertices[a])) < 1e-6 && std::abs(p.distance(cs.vertices[b])) < 1e-6);
+    if (on_box) EXPECT_EQ(e.size(), 1u);
+    else EXPECT_EQ(e.size(), 4u);
   }
 }
 
@@ -59,17 +63,30 @@ TEST(Candidates, LiveOnASurfaceMeshOneComponentPerPlane) {
   }
   // Each 3x3 plane section has 12 interior edges.
   EXPECT_EQ(shared, 6 * 12);
-  // Every fan lists each face whose boundary runs along it, and that face has the segment.
-  for (const auto& e : cs.edges)
-    for (int f : e.faces) {
+  // Every fan lists a halfedge of each face whose boundary runs along it: that halfedge runs
+  // along the segment, and its face has the segment. Inside a component the two faces of a mesh
+  // edge are in one fan, through the halfedge and its opposite.
+  const auto point = cs.mesh.property_map<CandidateMesh::Vertex_index, int>("v:point").first;
+  int opposite_pairs = 0;
+  for (const auto& e : cs.edges) {
+    const auto [ea, eb] = cs.ends(e);
+    for (auto h : e) {
+      const int f = cs.face(h);
+      const int s = point[cs.mesh.source(h)], t = point[cs.mesh.target(h)];
+      EXPECT_EQ(std::min(s, t), ea);
+      EXPECT_EQ(std::max(s, t), eb);
       const auto c = cs.corners(f);
       bool has = false;
       for (std::size_t k = 0; k < c.size(); ++k) {
         const int a = c[k], b = c[(k + 1) % c.size()];
-        has = has || (std::min(a, b) == e.a && std::max(a, b) == e.b);
+        has = has || (std::min(a, b) == ea && std::max(a, b) == eb);
       }
-      EXPECT_TRUE(has) << "face " << f << " listed on edge " << e.a << "-" << e.b;
+      EXPECT_TRUE(has) << "face " << f << " listed on edge " << ea << "-" << eb;
+      opposite_pairs +=
+          !cs.mesh.is_border(cs.mesh.opposite(h)) && std::count(e.begin(), e.end(), cs.mesh.opposite(h)) == 1;
     }
+  }
+  EXPECT_EQ(opposite_pairs, 2 * shared);
 }
 
 // Pruning the candidates a program fixes unselected: the box's six faces alone, each on its 4
@@ -84,8 +101,8 @@ TEST(Candidates, KeptCandidatesAreTheSameProgram) {
   EXPECT_EQ(k.mesh.number_of_faces(), 6u);
   int box_edges = 0;
   for (const auto& e : k.edges) {
-    if (e.faces.size() == 2) ++box_edges;
-    for (int f : e.faces) EXPECT_LT(f, 6);
+    if (e.size() == 2) ++box_edges;
+    for (auto h : e) EXPECT_LT(k.face(h), 6);
   }
   EXPECT_EQ(box_edges, 12);
   std::vector<double> cost;

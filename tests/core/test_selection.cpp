@@ -37,7 +37,7 @@ TEST(Selection, RecoversTheClosedBoxFromConfidence) {
   // Every edge carries 0 or 2 selected faces.
   for (const auto& e : cs.edges) {
     int n = 0;
-    for (int f : e.faces) n += sel.selected[f];
+    for (auto h : e) n += sel.selected[cs.face(h)];
     EXPECT_TRUE(n == 0 || n == 2);
   }
 }

@@ -53,6 +53,7 @@ inline CandidateSet hand_built(const std::vector<int>& plane, const std::vector<
   std::vector<std::size_t> uses(plane.size(), 0);
   for (const auto& e : edges)
     for (int f : e) ++uses[std::size_t(f)];
+  std::vector<CandidateHalfedge> next_side;  // per candidate: its halfedge for its next fan
   for (std::size_t f = 0; f < plane.size(); ++f) {
     std::vector<CandidateMesh::Vertex_index> loop;
     for (std::size_t k = 0; k < std::max<std::size_t>(3, uses[f]); ++k) {
@@ -63,10 +64,14 @@ inline CandidateSet hand_built(const std::vector<int>& plane, const std::vector<
     const auto face = cs.mesh.add_face(loop);
     support[face] = plane[f];
     areas[face] = area[f];
+    next_side.push_back(cs.mesh.halfedge(face));
   }
   for (const auto& e : edges) {
     CandidateEdge ce;
-    ce.faces = e;
+    for (int f : e) {
+      ce.push_back(next_side[std::size_t(f)]);
+      next_side[std::size_t(f)] = cs.mesh.next(next_side[std::size_t(f)]);
+    }
     cs.edges.push_back(ce);
   }
   return cs;

@@ -11,6 +11,7 @@
 #include <CGAL/Surface_mesh.h>
 
 #include <array>
+#include <utility>
 #include <vector>
 
 #include "lodrefine/core/geometry.h"
@@ -41,19 +42,20 @@ using CandidateFace = CandidateMesh::Face_index;
 template <class T>
 using CandidateMap = CandidateMesh::Property_map<CandidateFace, T>;
 
-// One segment of the arrangement and the candidates along it (CGAL's hypothesis calls it an
-// Intersection): 2 in a plane's interior, more where 3+ planes share the line.
-struct CandidateEdge {
-  int a = -1, b = -1;      // its ends (CandidateSet::vertices), a < b
-  std::vector<int> faces;  // incident candidates, in face order
-  int box_plane = -1;      // 0..5 when the edge lies on the region's boundary
-  double length = 0.0;
-};
+using CandidateHalfedge = CandidateMesh::Halfedge_index;
+
+// One segment of the arrangement and the candidates along it, as CGAL's hypothesis has it (its
+// Intersection): the halfedges of the faces along the segment, one per face (a face along it
+// twice, twice), in face order, each running as its face does. 2 in a plane's interior (a
+// halfedge and its opposite), more where 3+ planes share the line, 1 on the region's boundary.
+using CandidateEdge = std::vector<CandidateHalfedge>;
 
 // The candidates. `mesh` holds them: face f is candidate f, CCW about its plane's normal, with
 // the property maps "f:support" (int: its plane, an index into `planes`), "f:area" (double, m^2),
 // "f:centroid" (Vec3) and "v:point" (the vertex's index in `vertices`, the same point in every
-// component). `edges` is the program's view of adjacency.
+// component). Adjacency is the halfedge structure's: `edges` are the fans (CandidateEdge) in
+// order of first appearance (faces in order, each from its first corner), the constraints of
+// the selection (selection.h).
 struct CandidateSet {
   std::vector<SupportPlane> planes;
   Region region;
@@ -62,12 +64,15 @@ struct CandidateSet {
   std::vector<CandidateEdge> edges;
   bool capped = false;  // build_candidates stopped at its cap: no candidates
   int size() const { return int(mesh.number_of_faces()); }
+  int face(CandidateHalfedge h) const { return int(mesh.face(h)); }
   // The face maps above (present on every set build_candidates or kept_candidates returns).
   CandidateMap<int> supports() const;
   CandidateMap<double> areas() const;
   CandidateMap<Vec3> centroids() const;
   std::vector<int> corners(int f) const;  // indices into `vertices`, CCW
   std::vector<Vec3> polygon(int f) const;
+  std::pair<int, int> ends(const CandidateEdge& e) const;  // its ends in `vertices`, smaller first
+  double length(const CandidateEdge& e) const;             // m
 };
 
 // The convex polygon where `plane` crosses `region` (empty if it misses it), CCW about plane.n.
@@ -95,8 +100,9 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
                               const std::vector<Region>& reach, int max_candidates = kMaxCandidates,
                               double min_area = kMinCandidateArea);
 
-// The candidates where keep[f], renumbered in order, on a mesh of their own; the edges in their
-// order, without the dropped faces (an edge left with none goes). Pruning candidates a program
+// The candidates where keep[f], renumbered in order, on a mesh of their own (the face maps
+// above; not those callers added); the edges in their order, on the new mesh's halfedges,
+// without the dropped faces (an edge left with none goes). Pruning candidates a program
 // fixes unselected leaves the program over the others the same.
 CandidateSet kept_candidates(const CandidateSet& cs, const std::vector<char>& keep);
 

@@ -4,10 +4,10 @@
 // - Vertices are the mesh's: a corner of a chosen face is its vertex's point (the "v:point" map,
 //   one point for every component through it); a chosen edge shorter than kCollapsedEdge joins
 //   its two ends.
-// - Which chosen faces meet along a segment comes from its fan (CandidateSet::edges). Each face
-//   is its candidate, CCW about its supporting plane's normal or reversed: neighbours across a
-//   fan of two chosen faces run along it in opposite directions, and each such connected part
-//   encloses a positive volume.
+// - Which chosen faces meet along a segment, and in which direction each runs along it, comes
+//   from its fan of halfedges (CandidateSet::edges). Each face is its candidate, CCW about its
+//   supporting plane's normal or reversed: neighbours across a fan of two chosen faces run along
+//   it in opposite directions, and each such connected part encloses a positive volume.
 // - Chosen neighbours on one supporting plane (a fan of two chosen faces, both on it) become one
 //   polygon when their outline is one simple loop (else they stay apart); a corner then used by
 //   only two faces lies on the line of their planes' meet and is dropped.
