@@ -131,29 +131,38 @@ std::vector<int> forced_by_edges(const CandidateSet& cs, std::vector<int> fixed,
 }
 
 // The program's view of the candidates: fixed values, and a GLPK column (1-based) per free
-// candidate, 0 for a fixed one.
+// candidate, 0 for a fixed one (the face map "f:variable"); the answer in "f:selected".
 struct Columns {
   const SelectionProgram& pg;
   std::vector<int> fixed;  // pg.fixed and the faces the edges force (forced_by_edges)
-  std::vector<int> col;
+  CandidateMap<int> variable;
+  CandidateMap<bool> selected;
+  int faces = 0;
   int free = 0;
+  int column(int f) const { return variable[CandidateFace(f)]; }
   int fixed_value(int f) const { return fixed[f]; }
   int outside(int e) const { return pg.outside.empty() ? 0 : pg.outside[e]; }
   bool warm(int f) const { return !pg.warm.empty() && pg.warm[f]; }
 };
 
-// Decides the variables: a column per free candidate; fixed ones take their value in `res`.
-Columns candidate_columns(const CandidateSet& cs, const SelectionProgram& pg, SelectionResult& res) {
+// Decides the variables: a column per free candidate; fixed ones take their value in
+// "f:selected".
+Columns candidate_columns(CandidateSet& cs, const SelectionProgram& pg, SelectionResult& res) {
   const int nf = cs.size();
-  Columns c{pg, forced_by_edges(cs, pg.fixed.empty() ? std::vector<int>(nf, -1) : pg.fixed, pg.outside),
-            std::vector<int>(nf, 0), 0};
-  res.selected.assign(nf, 0);
+  Columns c{pg,
+            forced_by_edges(cs, pg.fixed.empty() ? std::vector<int>(nf, -1) : pg.fixed, pg.outside),
+            cs.mesh.add_property_map<CandidateFace, int>("f:variable", 0).first,
+            cs.mesh.add_property_map<CandidateFace, bool>("f:selected", false).first,
+            nf,
+            0};
   for (int f = 0; f < nf; ++f) {
-    if (c.fixed_value(f) >= 0) ++res.fixed, res.selected[f] = char(c.fixed_value(f));
-    else c.col[f] = ++c.free;
+    const CandidateFace fi(f);
+    c.variable[fi] = 0;
+    c.selected[fi] = false;
+    if (c.fixed_value(f) >= 0) ++res.fixed, c.selected[fi] = c.fixed_value(f) != 0;
+    else c.variable[fi] = ++c.free;
     res.forced += c.fixed_value(f) >= 0 && (pg.fixed.empty() || pg.fixed[f] < 0);
   }
-  res.column = c.col;
   return c;
 }
 
@@ -199,9 +208,9 @@ struct Program {
 void add_coverage_objective(Program& p, const CandidateSet& cs, const Columns& c, const SelectionConfig& prm) {
   if (c.free > 0) glp_add_cols(p.lp, c.free);
   for (int f = 0; f < cs.size(); ++f) {
-    if (c.col[f] == 0) continue;
-    glp_set_col_kind(p.lp, c.col[f], GLP_BV);
-    glp_set_obj_coef(p.lp, c.col[f], prm.lambda_coverage * c.pg.cost[f]);
+    if (c.column(f) == 0) continue;
+    glp_set_col_kind(p.lp, c.column(f), GLP_BV);
+    glp_set_obj_coef(p.lp, c.column(f), prm.lambda_coverage * c.pg.cost[f]);
     p.start.push_back(c.warm(f) ? 1.0 : 0.0);
   }
 }
@@ -222,7 +231,7 @@ bool add_edge_constraint(Program& p, const CandidateSet& cs, const Columns& c, i
   int constant = c.outside(e), warm_count = c.outside(e);
   for (auto h : cs.edges[e]) {
     const int f = cs.face(h);
-    if (c.col[f] > 0) terms.emplace_back(c.col[f], 1.0);
+    if (c.column(f) > 0) terms.emplace_back(c.column(f), 1.0);
     else constant += c.fixed_value(f);
     warm_count += c.warm(f);
   }
@@ -245,14 +254,14 @@ void add_sharp_edge(Program& p, const CandidateSet& cs, const CandidateMap<int>&
       const int fi = faces[i], fj = faces[j];
       if (support[CandidateFace(fi)] == support[CandidateFace(fj)]) continue;
       if (c.fixed_value(fi) == 0 || c.fixed_value(fj) == 0) continue;
-      if (c.col[fi] == 0 && c.col[fj] == 0) continue;  // both fixed in: a constant
+      if (c.column(fi) == 0 && c.column(fj) == 0) continue;  // both fixed in: a constant
       const bool both_warm = c.warm(fi) && c.warm(fj);
       if (s == 0) s = p.new_binary(sharp, both_warm ? 1.0 : 0.0);
       else if (both_warm) p.start[s] = 1.0;
       std::vector<std::pair<int, double>> t{{s, 1.0}};
       double rhs = -1.0;
       for (int g : {fi, fj}) {
-        if (c.col[g] > 0) t.emplace_back(c.col[g], -1.0);
+        if (c.column(g) > 0) t.emplace_back(c.column(g), -1.0);
         else rhs += 1.0;  // fixed in
       }
       p.add_row(t, GLP_LO, rhs, 0.0);
@@ -314,7 +323,7 @@ int solve(glp_prob* lp, glp_iocp& parm, bool warm) {
 // What GLPK made of it: the status from glp_intopt's return code and glp_mip_status (a zero
 // return code alone is not success: only a primal feasible MIP point counts), the gap, the warm
 // start's fate and the selection.
-void read_solution(glp_prob* lp, int ret, const Search& search, const Columns& c, SelectionResult& res) {
+void read_solution(glp_prob* lp, int ret, const Search& search, Columns& c, SelectionResult& res) {
   const int status = glp_mip_status(lp);
   res.status = classify(ret, status);
   res.glpk_code = ret;
@@ -322,19 +331,22 @@ void read_solution(glp_prob* lp, int ret, const Search& search, const Columns& c
   res.warm_accepted = search.accepted;
   res.gap = status == GLP_OPT ? 0.0 : search.gap;
   res.ok = status == GLP_OPT || status == GLP_FEAS;
-  if (!res.ok) return;
+  if (!res.ok) {
+    for (int f = 0; f < c.faces; ++f) c.selected[CandidateFace(f)] = false;
+    return;
+  }
   res.objective = glp_mip_obj_val(lp);
-  for (std::size_t f = 0; f < c.col.size(); ++f)
-    if (c.col[f] > 0) res.selected[f] = glp_mip_col_val(lp, c.col[f]) > kChosen;
+  for (int f = 0; f < c.faces; ++f)
+    if (c.column(f) > 0) c.selected[CandidateFace(f)] = glp_mip_col_val(lp, c.column(f)) > kChosen;
 }
 
 }  // namespace
 
-SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& pg, const SelectionConfig& prm,
+SelectionResult select_faces(CandidateSet& cs, const SelectionProgram& pg, const SelectionConfig& prm,
                              double time_limit) {
   const auto t0 = std::chrono::steady_clock::now();
   SelectionResult res;
-  const Columns c = candidate_columns(cs, pg, res);
+  Columns c = candidate_columns(cs, pg, res);
   auto done = [&](SolveStatus status) {
     res.status = status;
     res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -352,7 +364,7 @@ SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& pg,
   res.constraints = glp_get_num_rows(p.lp);
   res.nonzeros = int(p.ia.size()) - 1;
   if (!feasible) {  // no selection, not the fixed and forced values that contradict each other
-    res.selected.assign(cs.size(), 0);
+    for (auto f : cs.mesh.faces()) c.selected[f] = false;
     return done(SolveStatus::Infeasible);
   }
   if (res.variables == 0) {  // everything fixed: the fixed selection is the answer
@@ -369,7 +381,7 @@ SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& pg,
   return done(res.status);
 }
 
-SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& cost, const std::vector<int>& outside,
+SelectionResult select_faces(CandidateSet& cs, const std::vector<double>& cost, const std::vector<int>& outside,
                              const SelectionConfig& prm, const std::vector<int>* fixed) {
   SelectionProgram pg;
   pg.cost = cost;
@@ -378,8 +390,16 @@ SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& 
   return select_faces(cs, pg, prm);
 }
 
-SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& program, const SelectionConfig& config) {
+SelectionResult select_faces(CandidateSet& cs, const SelectionProgram& program, const SelectionConfig& config) {
   return select_faces(cs, program, config, config.mip_time_limit);
+}
+
+std::vector<char> selected_faces(const CandidateSet& cs) {
+  const auto selected = cs.mesh.property_map<CandidateFace, bool>("f:selected");
+  std::vector<char> out(std::size_t(cs.size()), 0);
+  if (selected.second)
+    for (auto f : cs.mesh.faces()) out[std::size_t(f)] = char(selected.first[f]);
+  return out;
 }
 
 }  // namespace lodrefine

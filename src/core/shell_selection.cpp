@@ -80,7 +80,7 @@ double share(const std::vector<Vec2>& poly, const CellSet& cells) {
 // What the program knows of each candidate, as face property maps of the candidate mesh:
 // "f:in_start" (bool: the starting shell has a face there), "f:source" (int: that face's source,
 // -1 without one), "f:confidence" (double: the data term's c), "f:in_zone" (bool: scan evidence
-// reaches it). The selection adds "f:variable" (GLPK column, 0: fixed) and "f:chosen".
+// reaches it). The selection adds "f:variable" (GLPK column, 0: fixed) and "f:selected".
 using FaceIndex = CandidateMesh::Face_index;
 
 void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s, const Params& prm) {
@@ -183,16 +183,6 @@ std::vector<char> kept(const std::vector<char>& v, const std::vector<char>& keep
   return out;
 }
 
-// The selection as the face maps "f:variable" and "f:chosen".
-void record_selection(CandidateSet& cs, const SelectionResult& sel) {
-  auto variable = cs.mesh.add_property_map<FaceIndex, int>("f:variable", 0).first;
-  auto chosen = cs.mesh.add_property_map<FaceIndex, bool>("f:chosen", false).first;
-  for (auto f : cs.mesh.faces()) {
-    variable[f] = sel.column.empty() ? 0 : sel.column[std::size_t(f)];
-    chosen[f] = sel.selected[std::size_t(f)] != 0;
-  }
-}
-
 // Output vertices within this (m) of a starting-shell vertex are put back on it: the plane meets
 // of the arrangement only approximate a model that is planar within tolerance, and where the
 // selection changed nothing a roof must not move by that. Used only when the shell still
@@ -290,7 +280,7 @@ bool moves_beyond_evidence(const Mesh& m, const Mesh& start, const EvidenceReach
 // change costing its area. Empty when it cannot be mended.
 constexpr int kMendRings = 2, kMendTries = 3;
 constexpr int kRetries = 2;
-std::vector<char> mended_start(const CandidateSet& cs, const std::vector<char>& in_start, const Params& prm) {
+std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_start, const Params& prm) {
   if (every_edge_used_0_or_2(cs, in_start)) return in_start;
   std::vector<char> near(cs.size(), 0);
   for (const auto& e : cs.edges) {
@@ -320,7 +310,7 @@ std::vector<char> mended_start(const CandidateSet& cs, const std::vector<char>& 
     SelectionConfig mend = prm;  // the costs are areas: weight 1
     mend.lambda_coverage = 1.0;
     const SelectionResult r = select_faces(cs, pg, mend);
-    if (r.ok) return r.selected;
+    if (r.ok) return selected_faces(cs);
   }
   return {};
 }
@@ -422,8 +412,9 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
     st.selection = select_faces(cs, pg, prm);
     const auto& sel = st.selection;
     if (!sel.ok) return finish("face selection " + sel.status_text());
+    const std::vector<char> selected = selected_faces(cs);
     if (!warm.empty() && beyond_rounds < kRetries) {
-      const std::vector<int> beyond = changes_beyond_evidence(cs, sel.selected, base, evidence);
+      const std::vector<int> beyond = changes_beyond_evidence(cs, selected, base, evidence);
       if (!beyond.empty()) {
         for (int f : beyond) pg.fixed[f] = int(base[f]);
         ++beyond_rounds, --attempt;
@@ -431,8 +422,7 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
       }
     }
     st.candidates_changed = 0;
-    for (int f = 0; f < cs.size(); ++f) st.candidates_changed += sel.selected[f] != base[f];
-    record_selection(cs, sel);
+    for (int f = 0; f < cs.size(); ++f) st.candidates_changed += selected[f] != base[f];
     out.mesh = traced_shell(cs);
     out.mesh.id = start.id;
     st.faces_from_selection = int(out.mesh.faces.size());
@@ -445,7 +435,7 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
     }
     if (problem.empty() || st.candidates_changed == 0 || warm.empty() || attempt == kRetries) break;
     for (int f = 0; f < cs.size(); ++f)
-      if (sel.selected[f] != base[f]) pg.fixed[f] = int(base[f]);
+      if (selected[f] != base[f]) pg.fixed[f] = int(base[f]);
   }
   if (st.candidates_changed == 0) {
     // The program chose its starting shell: it is written with the start's own faces, whose

@@ -32,7 +32,7 @@ struct Trace {
 // kCollapsedEdge are one vertex, numbered by first appearance (its first point gives the
 // position), the faces in candidate order.
 void trace_faces(const CandidateSet& cs, Trace& t) {
-  const auto chosen = cs.mesh.property_map<FaceIndex, bool>("f:chosen").first;
+  const auto chosen = cs.mesh.property_map<FaceIndex, bool>("f:selected").first;
   const auto source = cs.mesh.property_map<FaceIndex, int>("f:source");
   const auto support = cs.supports();
   std::vector<std::vector<int>> pieces(cs.size());

@@ -794,7 +794,7 @@ TEST(BadInputRegression, FaceListedTwiceOnAnEdgeDoesNotAbortTheSolver) {
   ASSERT_GE(pid, 0);
   if (pid == 0) {
     ::close(2);  // GLPK prints its error before aborting
-    const CandidateSet cs = fixtures::hand_built({0, 0}, {1.0, 1.0}, {{0, 0, 1}});
+    CandidateSet cs = fixtures::hand_built({0, 0}, {1.0, 1.0}, {{0, 0, 1}});
     const SelectionResult r = select_faces(cs, {-1.0, -1.0}, {0}, Params{});
     ::_exit(r.status == SolveStatus::NotRun ? 1 : 0);
   }
@@ -835,16 +835,17 @@ CandidateSet hard_program(int faces, int edges, unsigned seed, std::vector<doubl
 TEST(BadInputSolver, InfeasibleProgramIsReportedNotSelected) {
   // Face 0 alone on two edges: once with the outside surface (x0 + 1 = 2 y0 -> x0 = 1), once
   // without (x0 = 2 y1 -> x0 = 0). No selection satisfies both.
-  const CandidateSet cs = fixtures::hand_built({0}, {1.0}, {{0}, {0}});
+  CandidateSet cs = fixtures::hand_built({0}, {1.0}, {{0}, {0}});
   const SelectionResult r = select_faces(cs, {-1.0}, {1, 0}, Params{});
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.status_text(), "infeasible");
-  EXPECT_EQ(r.selected, std::vector<char>(1, 0));
+  EXPECT_EQ(selected_faces(cs), std::vector<char>(1, 0));
   add_row("select_faces: infeasible program", "ok=false, status '" + r.status_text() + "'", 0);
 }
 
 TEST(BadInputSolver, NoCandidatesIsReported) {
-  const SelectionResult r = select_faces(CandidateSet{}, {}, {}, Params{});
+  CandidateSet none;
+  const SelectionResult r = select_faces(none, {}, {}, Params{});
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.status_text(), "no candidates");
 }
@@ -852,14 +853,14 @@ TEST(BadInputSolver, NoCandidatesIsReported) {
 TEST(BadInputSolver, TimeLimitWithoutSolutionIsReported) {
   std::vector<double> cost;
   std::vector<int> outside;
-  const CandidateSet cs = hard_program(3000, 4000, 3, cost, outside);
+  CandidateSet cs = hard_program(3000, 4000, 3, cost, outside);
   Params prm;
   prm.mip_time_limit = 0.01;
   const SelectionResult r = select_faces(cs, cost, outside, prm);
   EXPECT_NE(r.status_text().find("time limit"), std::string::npos) << r.status_text();
   if (!r.ok) {
     EXPECT_EQ(r.status_text(), "time limit (no solution)");
-    EXPECT_EQ(r.selected, std::vector<char>(std::size_t(cs.size()), 0));
+    EXPECT_EQ(selected_faces(cs), std::vector<char>(std::size_t(cs.size()), 0));
   } else {
     EXPECT_EQ(r.status_text(), "feasible (time limit)");
   }
@@ -903,19 +904,21 @@ CandidateSet cube_program(std::vector<double>& cost, std::vector<int>& outside) 
 TEST(BadInputSolver, OneMillisecondLimitFailsEvenAnEasyProgram) {
   std::vector<double> cost;
   std::vector<int> outside;
-  const CandidateSet cs = cube_program(cost, outside);
+  CandidateSet cs = cube_program(cost, outside);
   ASSERT_GE(cs.size(), 6);
   const SelectionResult easy = select_faces(cs, cost, outside, Params{});
   ASSERT_TRUE(easy.ok) << easy.status_text();
   EXPECT_EQ(easy.status_text(), "optimal");
-  EXPECT_EQ(std::count(easy.selected.begin(), easy.selected.end(), 1), 6);
+  const std::vector<char> chosen = selected_faces(cs);
+  EXPECT_EQ(std::count(chosen.begin(), chosen.end(), 1), 6);
   // GLPK stops at its first time check when tm_lim <= 1 ms: a deterministic solver fault.
   Params prm;
   prm.mip_time_limit = 0.001;
   const SelectionResult r = select_faces(cs, cost, outside, prm);
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.status_text(), "time limit (no solution)");
-  EXPECT_EQ(std::count(r.selected.begin(), r.selected.end(), 1), 0);
+  const std::vector<char> none = selected_faces(cs);
+  EXPECT_EQ(std::count(none.begin(), none.end(), 1), 0);
   add_row("select_faces: cube arrangement (" + std::to_string(cs.size()) + " candidates), 1 ms limit",
           "ok=false, status '" + r.status_text() + "' (30 s limit: '" + easy.status_text() + "')", 0);
 }

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <set>
 
 #include "lodrefine/core/candidates.h"
 #include "lodrefine/core/selection.h"
@@ -96,7 +97,7 @@ TEST(Candidates, KeptCandidatesAreTheSameProgram) {
   const CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
   std::vector<char> keep(std::size_t(cs.size()), 0);
   for (std::size_t f = 0; f < keep.size(); ++f) keep[f] = inside_box(centroid_of(cs, f), a, b, c);
-  const CandidateSet k = kept_candidates(cs, keep);
+  CandidateSet k = kept_candidates(cs, keep);
   ASSERT_EQ(k.size(), 6);
   EXPECT_EQ(k.mesh.number_of_faces(), 6u);
   int box_edges = 0;
@@ -109,8 +110,14 @@ TEST(Candidates, KeptCandidatesAreTheSameProgram) {
   for (int f = 0; f < k.size(); ++f) cost.push_back(-area_of(k, f));
   const SelectionResult r = select_faces(k, cost, std::vector<int>(k.edges.size(), 0), Params{});
   ASSERT_TRUE(r.ok) << r.status_text();
-  EXPECT_EQ(std::count(r.selected.begin(), r.selected.end(), 1), 6);
-  EXPECT_EQ(r.column.size(), 6u);
+  const std::vector<char> selected = selected_faces(k);
+  EXPECT_EQ(std::count(selected.begin(), selected.end(), 1), 6);
+  // The program's variables are face maps: a column for each of the six (none is fixed).
+  const auto variable = k.mesh.property_map<CandidateFace, int>("f:variable");
+  ASSERT_TRUE(variable.second);
+  std::set<int> columns;
+  for (auto f : k.mesh.faces()) columns.insert(variable.first[f]);
+  EXPECT_EQ(columns, (std::set<int>{1, 2, 3, 4, 5, 6}));
 }
 
 namespace {

@@ -11,7 +11,7 @@ using namespace lodrefine::fixtures;
 
 TEST(Selection, RecoversTheClosedBoxFromConfidence) {
   const double a = 10, b = 8, c = 6;
-  const CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
+  CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
   Params prm;
   const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, prm);
   std::vector<double> cost;
@@ -24,10 +24,11 @@ TEST(Selection, RecoversTheClosedBoxFromConfidence) {
   const SelectionResult sel = select_faces(cs, cost, std::vector<int>(cs.edges.size(), 0), prm);
   ASSERT_TRUE(sel.ok) << sel.status_text();
   EXPECT_EQ(sel.status_text(), "optimal");
+  const std::vector<char> selected = selected_faces(cs);
   double area = 0.0;
   int count = 0;
   for (std::size_t f = 0; f < std::size_t(cs.size()); ++f)
-    if (sel.selected[f]) {
+    if (selected[f]) {
       ++count;
       area += area_of(cs, f);
       EXPECT_TRUE(inside_box(centroid_of(cs, f), a, b, c));
@@ -37,7 +38,7 @@ TEST(Selection, RecoversTheClosedBoxFromConfidence) {
   // Every edge carries 0 or 2 selected faces.
   for (const auto& e : cs.edges) {
     int n = 0;
-    for (auto h : e) n += sel.selected[cs.face(h)];
+    for (auto h : e) n += selected[cs.face(h)];
     EXPECT_TRUE(n == 0 || n == 2);
   }
 }
@@ -46,7 +47,7 @@ TEST(Selection, InfeasibleBoundaryIsReportedNotCrashed) {
   // One plane only: its faces can never close, yet the boundary demands a continuation.
   std::vector<SupportPlane> planes = {{Plane(Vec3(0, 0, 1), -1), Semantic::Roof, false, 0}};
   const Region region = Region::around({Vec3(0, 0, 0), Vec3(2, 2, 2)}, 0.0, 0.5);
-  const CandidateSet cs = build_candidates(planes, region);
+  CandidateSet cs = build_candidates(planes, region);
   ASSERT_EQ(cs.size(), 1);
   std::vector<int> outside(cs.edges.size(), 0);
   outside[0] = 1;  // one continuing edge: the face must be selected, then 3 edges are open
@@ -58,7 +59,7 @@ TEST(Selection, InfeasibleBoundaryIsReportedNotCrashed) {
 
 TEST(Selection, StartsFromAClosedWarmStartAndRefusesAnOpenOne) {
   const double a = 10, b = 8, c = 6;
-  const CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
+  CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
   Params prm;
   const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, prm);
   SelectionProgram pg;
@@ -74,7 +75,7 @@ TEST(Selection, StartsFromAClosedWarmStartAndRefusesAnOpenOne) {
   EXPECT_TRUE(sel.warm_given);
   EXPECT_TRUE(sel.warm_feasible);
   EXPECT_TRUE(sel.warm_text() == "accepted" || sel.warm_text() == "not needed") << sel.warm_text();
-  EXPECT_EQ(sel.selected, box);
+  EXPECT_EQ(selected_faces(cs), box);
   EXPECT_EQ(sel.gap, 0.0);
 
   // One face short of the box: an open start is not handed to GLPK.
@@ -89,12 +90,12 @@ TEST(Selection, StartsFromAClosedWarmStartAndRefusesAnOpenOne) {
   const SelectionResult r = select_faces(cs, pg, prm);
   EXPECT_FALSE(r.warm_feasible);
   EXPECT_EQ(r.warm_text(), "infeasible");
-  EXPECT_EQ(r.selected, box);  // the program still finds the box
+  EXPECT_EQ(selected_faces(cs), box);  // the program still finds the box
 }
 
 TEST(Selection, FixedFacesAreConstantsOfTheProgram) {
   const double a = 10, b = 8, c = 6;
-  const CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
+  CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
   Params prm;
   SelectionProgram pg;
   std::vector<char> box(std::size_t(cs.size()), 0);
@@ -108,7 +109,7 @@ TEST(Selection, FixedFacesAreConstantsOfTheProgram) {
   const SelectionResult sel = select_faces(cs, pg, prm);
   ASSERT_TRUE(sel.ok) << sel.status_text();
   EXPECT_EQ(sel.fixed - sel.forced, inside);
-  EXPECT_EQ(sel.selected, box);
+  EXPECT_EQ(selected_faces(cs), box);
   // The box's edges are each used twice by it: every other face there is decided 0 by the edge
   // constraints, and so on outwards; nothing is left for GLPK (its presolve would find the same,
   // but it is off under a warm start).

@@ -39,7 +39,7 @@ std::vector<SupportPlane> recess_planes() {
 // `eps` m off the centroid); each candidate's source is its plane's.
 template <class Solid>
 void choose_boundary(CandidateSet& cs, Solid solid, double eps) {
-  auto chosen = cs.mesh.add_property_map<FaceIndex, bool>("f:chosen", false).first;
+  auto chosen = cs.mesh.add_property_map<FaceIndex, bool>("f:selected", false).first;
   auto source = cs.mesh.add_property_map<FaceIndex, int>("f:source", -1).first;
   for (int f = 0; f < cs.size(); ++f) {
     const Vec3& c = centroid_of(cs, f);
@@ -142,7 +142,7 @@ TEST(ShellTrace, FacesCarrySemanticAndSource) {
 // not mend): the open edges are boundary edges of the output.
 TEST(ShellTrace, OpenSelectionStaysOpen) {
   CandidateSet cs = recess_selection();
-  auto chosen = cs.mesh.property_map<FaceIndex, bool>("f:chosen").first;
+  auto chosen = cs.mesh.property_map<FaceIndex, bool>("f:selected").first;
   for (int f = 0; f < cs.size(); ++f)
     if (plane_of(cs, f) == 5) chosen[FaceIndex(f)] = false;
   const Mesh m = traced_shell(cs);

@@ -26,10 +26,10 @@ enum class SolveStatus {
 // "optimal", "feasible (time limit)", "infeasible", "time limit (no solution)", ...
 std::string status_name(SolveStatus status, int glpk_code = 0);
 
+// The program's figures (its variables and answer are face maps of the candidate mesh: see
+// select_faces).
 struct SelectionResult {
-  bool ok = false;             // a feasible selection satisfying every edge constraint
-  std::vector<char> selected;  // per candidate
-  std::vector<int> column;     // per candidate: its GLPK column (1-based), 0 when fixed
+  bool ok = false;  // a feasible selection satisfying every edge constraint
   SolveStatus status = SolveStatus::NotRun;
   int glpk_code = 0;  // glp_intopt's return code
   std::string status_text() const { return status_name(status, glpk_code); }
@@ -68,10 +68,13 @@ struct SelectionProgram {
 };
 // `time_limit` (s, > 0): GLPK's budget for this program, explicit so that a caller that solved
 // before passes what is left of mip_time_limit.
-SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& program, const SelectionConfig& config,
+// Writes the program's variables and its answer as face maps of `cs.mesh` (replacing those of an
+// earlier solve): "f:variable" (int: the candidate's GLPK column, 1-based; 0 when fixed) and
+// "f:selected" (bool: chosen; all false when the result is not ok).
+SelectionResult select_faces(CandidateSet& cs, const SelectionProgram& program, const SelectionConfig& config,
                              double time_limit);
 // The same with the whole budget, config.mip_time_limit.
-SelectionResult select_faces(const CandidateSet& cs, const SelectionProgram& program, const SelectionConfig& config);
+SelectionResult select_faces(CandidateSet& cs, const SelectionProgram& program, const SelectionConfig& config);
 
 // Whether every edge of `cs` is used by 0 or 2 of the `selected` candidates (plus `outside[e]`;
 // empty: none): the program's constraint, for checking a starting point or a result.
@@ -79,7 +82,10 @@ bool every_edge_used_0_or_2(const CandidateSet& cs, const std::vector<char>& sel
                             const std::vector<int>& outside = {});
 
 // The same with `cost`, `outside` and optionally `fixed` (see SelectionProgram).
-SelectionResult select_faces(const CandidateSet& cs, const std::vector<double>& cost, const std::vector<int>& outside,
+SelectionResult select_faces(CandidateSet& cs, const std::vector<double>& cost, const std::vector<int>& outside,
                              const SelectionConfig& config, const std::vector<int>* fixed = nullptr);
+
+// The face map "f:selected" of `cs.mesh` as 0/1 per candidate (all 0 without it).
+std::vector<char> selected_faces(const CandidateSet& cs);
 
 }  // namespace lodrefine

@@ -22,7 +22,8 @@ struct CandidateSet;  // candidates.h
 // of fractions of a millimetre, which CityJSON's millimetre grid or a reader's weld collapses.
 constexpr double kCollapsedEdge = 1e-3;
 
-// The polygon mesh of the candidates chosen in `cs.mesh`'s "f:chosen" (bool, required).
+// The polygon mesh of the candidates chosen in `cs.mesh`'s "f:selected" (bool, required: the
+// selection's answer, select_faces).
 // Per output face: the semantic of its supporting plane (CandidateSet::planes[].sem) and the
 // source in the face map "f:source" (int, optional: -1 without it); a merged polygon takes its
 // largest piece's. Vertex positions are CandidateSet::vertices (same frame). The mesh is
