@@ -18,10 +18,18 @@ constexpr double kChosen = 0.5;
 // glp_iocp::tm_lim is an int of milliseconds: longer limits are cut to this (~23 days).
 constexpr double kMaxTimeLimitMs = 2.0e9;
 
+// glp_intopt's and glp_simplex's return code: the work budget (GLP_ESTOP from our callback,
+// GLP_EITLIM from the relaxation's iteration limit) or the wall-clock ceiling.
+bool at_budget(int ret) { return ret == GLP_ESTOP || ret == GLP_EITLIM; }
+
 SolveStatus classify(int ret, int status) {
   if (status == GLP_OPT) return SolveStatus::Optimal;
-  if (status == GLP_FEAS) return ret == GLP_ETMLIM ? SolveStatus::FeasibleTimeLimit : SolveStatus::Feasible;
+  if (status == GLP_FEAS) {
+    if (at_budget(ret)) return SolveStatus::FeasibleBudget;
+    return ret == GLP_ETMLIM ? SolveStatus::FeasibleTimeLimit : SolveStatus::Feasible;
+  }
   if (status == GLP_NOFEAS || ret == GLP_ENOPFS) return SolveStatus::Infeasible;
+  if (at_budget(ret)) return SolveStatus::BudgetNoSolution;
   if (ret == GLP_ETMLIM) return SolveStatus::TimeLimitNoSolution;
   if (ret == GLP_ENODFS) return SolveStatus::NoDualFeasible;
   return SolveStatus::SolverFailure;
@@ -35,8 +43,10 @@ std::string status_name(SolveStatus status, int glpk_code) {
     case SolveStatus::NoCandidates: return "no candidates";
     case SolveStatus::Optimal: return "optimal";
     case SolveStatus::Feasible: return "feasible";
+    case SolveStatus::FeasibleBudget: return "feasible (budget)";
     case SolveStatus::FeasibleTimeLimit: return "feasible (time limit)";
     case SolveStatus::Infeasible: return "infeasible";
+    case SolveStatus::BudgetNoSolution: return "budget (no solution)";
     case SolveStatus::TimeLimitNoSolution: return "time limit (no solution)";
     case SolveStatus::NoDualFeasible: return "no dual feasible solution";
     case SolveStatus::SolverFailure: break;
@@ -53,17 +63,43 @@ std::string SelectionResult::warm_text() const {
 
 namespace {
 
-// The heuristic callback's state: the starting point (GLPK's 1-based column values) and what
-// GLPK made of it; the last relative gap seen.
+// The search's work, counted in tableau entries (rows x columns of the problem GLPK works on):
+// each LP solve of the search (a node, or a round of cuts at the root, whose generators scan the
+// tableau; measured 3-5 ns of CPU per entry on the real dev tile's 1,300-5,700 column programs) and each simplex
+// iteration of the relaxation (one row and one column: rows + columns). A count of what GLPK
+// did, not of seconds, so a search that reaches it ends at the same point on any machine load.
+double tableau_size(glp_prob* lp) { return double(glp_get_num_rows(lp)) * double(glp_get_num_cols(lp)); }
+
+// The callback's state: the starting point (GLPK's 1-based column values) and what GLPK made of
+// it; the last relative gap seen; the work done and the budget.
 struct Search {
   std::vector<double> start;  // empty: no warm start
   bool asked = false, accepted = false;
   double gap = 0.0;
+  double work = 0.0, budget = 0.0;
+  int solves = 0;  // LP solves begun in the search
 };
+
+// Whether the search has spent its budget: checked before an LP solve (the root's first always
+// runs, so a warm start reaches GLPK) and before a round of cuts (what they cost is like a solve).
+bool budget_spent(glp_tree* tree, Search& s, int reason) {
+  const double next = tableau_size(glp_ios_get_prob(tree));
+  if (reason == GLP_IPREPRO) {
+    if (s.solves > 0 && s.work + next > s.budget) return true;
+    s.work += next, ++s.solves;
+    return false;
+  }
+  return reason == GLP_ICUTGEN && s.work + next > s.budget;
+}
 
 void on_search(glp_tree* tree, void* info) {
   auto& s = *static_cast<Search*>(info);
-  switch (glp_ios_reason(tree)) {
+  const int reason = glp_ios_reason(tree);
+  if (budget_spent(tree, s, reason)) {
+    glp_ios_terminate(tree);
+    return;
+  }
+  switch (reason) {
     case GLP_IHEUR:
       if (!s.asked && !s.start.empty()) {
         s.asked = true;
@@ -281,7 +317,8 @@ bool add_edges(Program& p, const CandidateSet& cs, const Columns& c, const Selec
   return feasible;
 }
 
-// Branch and cut with MIR, Gomory, cover and clique cuts, the gap and the time limit (s).
+// Branch and cut with MIR, Gomory, cover and clique cuts, the gap, the work budget (tableau
+// entries) and the wall-clock ceiling (s).
 glp_iocp search_parameters(const SelectionConfig& prm, double time_limit, Search& search) {
   glp_iocp parm;
   glp_init_iocp(&parm);
@@ -294,12 +331,14 @@ glp_iocp search_parameters(const SelectionConfig& prm, double time_limit, Search
   parm.msg_lev = GLP_MSG_OFF;
   parm.cb_func = on_search;
   parm.cb_info = &search;
+  search.budget = prm.mip_work_limit * 1e6;
   return parm;
 }
 
 // Solves the MIP; returns GLPK's return code. With a warm start the callback sees the original
-// columns only without the MIP presolver, which then needs an optimal basis of the LP relaxation.
-int solve(glp_prob* lp, glp_iocp& parm, bool warm) {
+// columns only without the MIP presolver, which then needs an optimal basis of the LP relaxation;
+// its iterations count against the work budget (each rows + columns entries).
+int solve(glp_prob* lp, glp_iocp& parm, Search& search, bool warm) {
   int ret = 0;
   if (!warm) {
     parm.presolve = GLP_ON;
@@ -309,8 +348,11 @@ int solve(glp_prob* lp, glp_iocp& parm, bool warm) {
     lpp.msg_lev = GLP_MSG_OFF;
     lpp.presolve = GLP_ON;
     lpp.tm_lim = parm.tm_lim;
+    const double per_iteration = double(glp_get_num_rows(lp)) + double(glp_get_num_cols(lp));
+    lpp.it_lim = int(std::min(2.0e9, std::floor(search.budget / per_iteration)));
     const auto t0 = std::chrono::steady_clock::now();
     ret = glp_simplex(lp, &lpp);
+    search.work += per_iteration * glp_get_it_cnt(lp);
     parm.presolve = GLP_OFF;
     // The relaxation spent part of the budget: the search gets what is left, not all of it again.
     const double spent_ms = 1000.0 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -330,6 +372,7 @@ void read_solution(glp_prob* lp, int ret, const Search& search, Columns& c, Sele
   res.warm_asked = search.asked;
   res.warm_accepted = search.accepted;
   res.gap = status == GLP_OPT ? 0.0 : search.gap;
+  res.work = search.work / 1e6;
   res.ok = status == GLP_OPT || status == GLP_FEAS;
   if (!res.ok) {
     for (int f = 0; f < c.faces; ++f) c.selected[CandidateFace(f)] = false;
@@ -338,6 +381,17 @@ void read_solution(glp_prob* lp, int ret, const Search& search, Columns& c, Sele
   res.objective = glp_mip_obj_val(lp);
   for (int f = 0; f < c.faces; ++f)
     if (c.column(f) > 0) c.selected[CandidateFace(f)] = glp_mip_col_val(lp, c.column(f)) > kChosen;
+}
+
+// The relaxation ended at the budget or the ceiling before the search began: the warm start,
+// feasible, is the best selection known.
+void take_start(glp_prob* lp, const Search& search, Columns& c, int ret, SelectionResult& res) {
+  res.status = ret == GLP_ETMLIM ? SolveStatus::FeasibleTimeLimit : SolveStatus::FeasibleBudget;
+  res.ok = true;
+  res.objective = 0.0;
+  for (int j = 1; j < int(search.start.size()); ++j) res.objective += glp_get_obj_coef(lp, j) * search.start[j];
+  for (int f = 0; f < c.faces; ++f)
+    c.selected[CandidateFace(f)] = c.column(f) > 0 ? search.start[c.column(f)] > kChosen : c.fixed_value(f) == 1;
 }
 
 }  // namespace
@@ -376,8 +430,9 @@ SelectionResult select_faces(CandidateSet& cs, const SelectionProgram& pg, const
   Search search;
   if (res.warm_feasible) search.start = p.start;
   glp_iocp parm = search_parameters(prm, time_limit, search);
-  const int ret = solve(p.lp, parm, !search.start.empty());
+  const int ret = solve(p.lp, parm, search, !search.start.empty());
   read_solution(p.lp, ret, search, c, res);
+  if (!res.ok && !search.start.empty() && (at_budget(ret) || ret == GLP_ETMLIM)) take_start(p.lp, search, c, ret, res);
   return done(res.status);
 }
 

@@ -42,6 +42,7 @@ json selection_json(const ShellSelectionStats& st, const std::string& reason) {
             {"objective", m.objective},
             {"seconds", st.seconds},
             {"solver_seconds", m.seconds},
+            {"work", m.work},
             {"faces_from_selection", st.faces_from_selection},
             {"candidates_changed", st.candidates_changed},
             {"warm_start", m.warm_text()}};

@@ -86,7 +86,8 @@ Figures expect_selection_decided(const Mesh& coarse, const Mesh& truth, const Po
   if (!r.trace.selection) return fig;
   const auto& sel = *r.trace.selection;
   EXPECT_TRUE(sel.selection.status == SolveStatus::Optimal || sel.selection.status == SolveStatus::Feasible ||
-              sel.selection.status == SolveStatus::FeasibleTimeLimit)
+              sel.selection.status == SolveStatus::FeasibleTimeLimit ||
+              sel.selection.status == SolveStatus::FeasibleBudget)
       << sel.selection.status_text();
   EXPECT_GT(sel.faces_from_selection, 0);
   EXPECT_EQ(sel.faces_from_selection, int(r.mesh.faces.size()));

@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <random>
 
+#include "lodrefine/core/candidates.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/core/validate.h"
@@ -142,4 +144,63 @@ TEST(Refine, ACorrectTerracedHouseBesideAMisplacedOneIsLeftAsItIs) {
     const double x = p.x() - kOrigin.x();
     EXPECT_TRUE(std::abs(x - 12) <= prm.weld_tolerance || std::abs(x - 24) <= prm.weld_tolerance) << x;
   }
+}
+
+namespace {
+
+// A 12 x 8.5 m block, its front wall 0.5 m out, under a roof of 1 m pyramids of four heights
+// (so that no two triangles share a plane): hundreds of supporting planes that reach each other.
+Mesh pyramid_roofed_block(int nx, int ny) {
+  const double x1 = 12.0, y0 = -0.5, y1 = 8.0, h = 7.0;
+  const double dx = x1 / nx, dy = (y1 - y0) / ny;
+  Mesh m;
+  auto vertex = [&](double x, double y, double z) {
+    m.vertices.push_back(Vec3(x, y, z));
+    return int(m.vertices.size()) - 1;
+  };
+  std::vector<int> grid;  // the roof's eaves grid, (nx + 1) x (ny + 1)
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) grid.push_back(vertex(i * dx, y0 + j * dy, h));
+  auto at = [&](int i, int j) { return grid[j * (nx + 1) + i]; };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const double rise = 0.5 + 0.25 * ((i + 2 * j) % 4);  // slopes 45-68 degrees, beyond merge_angle_deg
+      const int apex = vertex((i + 0.5) * dx, y0 + (j + 0.5) * dy, h + rise);
+      const int a = at(i, j), b = at(i + 1, j), c = at(i + 1, j + 1), d = at(i, j + 1);
+      for (const auto& [p, q] : {std::pair{a, b}, {b, c}, {c, d}, {d, a}})
+        m.faces.push_back({{p, q, apex}, Semantic::Roof});
+    }
+  const int g[4] = {vertex(0, y0, 0), vertex(x1, y0, 0), vertex(x1, y1, 0), vertex(0, y1, 0)};
+  m.faces.push_back({{g[0], g[3], g[2], g[1]}, Semantic::Ground});
+  Face front{{g[0], g[1]}, Semantic::Wall}, right{{g[1], g[2]}, Semantic::Wall};
+  Face back{{g[2], g[3]}, Semantic::Wall}, left{{g[3], g[0]}, Semantic::Wall};
+  for (int i = nx; i >= 0; --i) front.v.push_back(at(i, 0));
+  for (int j = ny; j >= 0; --j) right.v.push_back(at(nx, j));
+  for (int i = 0; i <= nx; ++i) back.v.push_back(at(i, ny));
+  for (int j = 0; j <= ny; ++j) left.v.push_back(at(0, j));
+  for (Face* f : {&front, &right, &back, &left}) m.faces.push_back(*f);
+  m = as_soup(translated(m, kOrigin));
+  m.id = "pyramids";
+  return m;
+}
+
+}  // namespace
+
+// A building whose arrangement passes kMaxCandidates is kept, with the reason, at once (the cap
+// is what bounds its time and memory: without it this one grows past 100,000 candidates).
+TEST(Refine, ABuildingBeyondTheCandidateCapIsKeptQuickly) {
+  const Mesh coarse = pyramid_roofed_block(12, 8);
+  const PointCloud cloud = scan_front(0.0, 0.5, 11.5, 5.0, 1);
+  const auto t0 = std::chrono::steady_clock::now();
+  const RefineResult r = refine_building(coarse, cloud, Params{});
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_TRUE(r.valid) << r.reason;
+  EXPECT_EQ(r.outcome, Outcome::Kept) << r.reason << " planes "
+                                      << (r.trace.selection ? r.trace.selection->supporting_planes : -1) << " cands "
+                                      << (r.trace.selection ? r.trace.selection->candidates : -1);
+  EXPECT_NE(r.reason.find("too many candidate faces (over " + std::to_string(kMaxCandidates) + " from "),
+            std::string::npos)
+      << r.reason;
+  EXPECT_EQ(r.mesh.faces.size(), coarse.faces.size());
+  EXPECT_LT(seconds, 20.0) << "the cap did not bound the time";
 }

@@ -1,6 +1,11 @@
 // Stage 4b: face selection by GLPK over the candidate arrangement.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <cmath>
+#include <random>
+#include <thread>
+
 #include "lodrefine/core/candidates.h"
 #include "lodrefine/core/confidence.h"
 #include "lodrefine/core/selection.h"
@@ -125,4 +130,96 @@ TEST(Selection, FixedFacesAreConstantsOfTheProgram) {
   const SelectionResult bad = select_faces(cs, pg, prm);
   EXPECT_FALSE(bad.ok);
   EXPECT_EQ(bad.status_text(), "infeasible");
+}
+
+namespace {
+
+// A program GLPK cannot close at its root: the box's planes and 3 more per axis cut through it,
+// every candidate's cost pseudo-random in [-1, 1] per m^2, the box as the (closed) warm start.
+CandidateSet crossed_box_program(SelectionProgram& pg) {
+  const double a = 10, b = 8, c = 6;
+  std::vector<SupportPlane> planes = box_planes(a, b, c);
+  for (int k = 1; k <= 3; ++k) {
+    planes.push_back({Plane(Vec3(1, 0, 0), -a * k / 4.0), Semantic::Wall, false, int(planes.size())});
+    planes.push_back({Plane(Vec3(0, 1, 0), -b * k / 4.0), Semantic::Wall, false, int(planes.size())});
+    planes.push_back({Plane(Vec3(0, 0, 1), -c * k / 4.0), Semantic::Roof, false, int(planes.size())});
+  }
+  CandidateSet cs = build_candidates(planes, box_region(a, b, c));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const auto areas = cs.areas();
+  const auto centroids = cs.centroids();
+  for (auto f : cs.mesh.faces()) {
+    const Vec3 p = centroids[f];
+    pg.cost.push_back(unit(rng) * areas[f]);
+    pg.warm.push_back(inside_box(p, a, b, c) &&
+                      (std::abs(p.x()) < 1e-9 || std::abs(p.x() - a) < 1e-9 || std::abs(p.y()) < 1e-9 ||
+                       std::abs(p.y() - b) < 1e-9 || std::abs(p.z()) < 1e-9 || std::abs(p.z() - c) < 1e-9));
+  }
+  return cs;
+}
+
+}  // namespace
+
+// The search ends at a count of GLPK's work, not at a wall-clock limit: the same selection,
+// status and work on every run, whatever the time limit and however busy the machine is.
+TEST(Selection, TheWorkBudgetEndsTheSearchAtTheSamePointUnderAnyLoad) {
+  SelectionProgram pg;
+  CandidateSet cs = crossed_box_program(pg);
+  ASSERT_TRUE(every_edge_used_0_or_2(cs, pg.warm));
+  Params prm;
+  prm.mip_work_limit = 2.0;
+  const SelectionResult quiet = select_faces(cs, pg, prm);
+  const std::vector<char> quiet_selected = selected_faces(cs);
+  ASSERT_TRUE(quiet.ok) << quiet.status_text();
+  ASSERT_EQ(quiet.status, SolveStatus::FeasibleBudget) << quiet.status_text();
+  EXPECT_EQ(quiet.status_text(), "feasible (budget)");
+  EXPECT_GT(quiet.gap, 0.0);
+  EXPECT_LE(quiet.work, prm.mip_work_limit);
+  EXPECT_TRUE(every_edge_used_0_or_2(cs, quiet_selected));
+
+  std::atomic<bool> stop{false};
+  std::vector<std::thread> burners;
+  for (int t = 0; t < 2; ++t)
+    burners.emplace_back([&stop] {
+      volatile double x = 1.0;
+      while (!stop) x = x * 1.0000001 + 1e-9;
+    });
+  std::vector<SelectionResult> runs;
+  std::vector<std::vector<char>> selections;
+  for (double limit : {prm.mip_time_limit, 3600.0, 1000.0}) {
+    if (limit == 1000.0) {  // and once more on a quiet machine
+      stop = true;
+      for (auto& t : burners) t.join();
+    }
+    runs.push_back(select_faces(cs, pg, prm, limit));
+    selections.push_back(selected_faces(cs));
+  }
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const SelectionResult& r = runs[i];
+    EXPECT_EQ(r.status, quiet.status) << r.status_text();
+    EXPECT_EQ(selections[i], quiet_selected);
+    EXPECT_EQ(r.objective, quiet.objective);
+    EXPECT_EQ(r.work, quiet.work);
+    EXPECT_EQ(r.gap, quiet.gap);
+  }
+  // A larger budget goes on from where this one stopped: the budget is what ended it.
+  prm.mip_work_limit = 20.0;
+  const SelectionResult more = select_faces(cs, pg, prm);
+  ASSERT_TRUE(more.ok) << more.status_text();
+  EXPECT_GT(more.work, 2.0);
+  EXPECT_LE(more.objective, quiet.objective);
+}
+
+// No budget for even the LP relaxation: the closed warm start is the selection, at the budget.
+TEST(Selection, AtTheBudgetBeforeTheSearchTheWarmStartIsTaken) {
+  SelectionProgram pg;
+  CandidateSet cs = crossed_box_program(pg);
+  Params prm;
+  prm.mip_work_limit = 0.0;
+  const SelectionResult r = select_faces(cs, pg, prm);
+  ASSERT_TRUE(r.ok) << r.status_text();
+  EXPECT_EQ(r.status_text(), "feasible (budget)");
+  EXPECT_EQ(selected_faces(cs), pg.warm);
+  EXPECT_EQ(r.work, 0.0);
 }

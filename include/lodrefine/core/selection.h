@@ -17,13 +17,16 @@ enum class SolveStatus {
   NoCandidates,  // an empty program (GLPK aborts on one; never handed to it)
   Optimal,
   Feasible,           // stopped at the gap
-  FeasibleTimeLimit,  // a selection, not proven optimal
+  FeasibleBudget,     // a selection, not proven optimal: the work budget (mip_work_limit) was spent
+  FeasibleTimeLimit,  // the same at the wall-clock ceiling (mip_time_limit; load-dependent)
   Infeasible,
+  BudgetNoSolution,
   TimeLimitNoSolution,
   NoDualFeasible,
   SolverFailure,  // any other glp_intopt return code (SelectionResult::glpk_code)
 };
-// "optimal", "feasible (time limit)", "infeasible", "time limit (no solution)", ...
+// "optimal", "feasible (budget)", "feasible (time limit)", "infeasible", "budget (no solution)",
+// "time limit (no solution)", ...
 std::string status_name(SolveStatus status, int glpk_code = 0);
 
 // The program's figures (its variables and answer are face maps of the candidate mesh: see
@@ -38,6 +41,7 @@ struct SelectionResult {
   int forced = 0;          // of those, free in the program but decided by its edge constraints
   double objective = 0.0;  // of the free columns (fixed faces' costs are constants)
   double gap = 0.0;        // relative MIP gap when the search ended (0: proven optimal)
+  double work = 0.0;       // the search's work, millions of tableau entries (see mip_work_limit)
   double seconds = 0.0;
   // The starting selection (SelectionProgram::warm): handed to GLPK's heuristic callback, and
   // whether GLPK accepted it as an incumbent (not needed: the search ended before asking).
@@ -66,8 +70,10 @@ struct SelectionProgram {
   std::vector<double> sharp_cost;
   std::vector<char> warm;
 };
-// `time_limit` (s, > 0): GLPK's budget for this program, explicit so that a caller that solved
-// before passes what is left of mip_time_limit.
+// The search ends at config.mip_work_limit (a count of GLPK's work, so the result does not depend
+// on the machine's load) or, as a last-resort safety ceiling far above it, at `time_limit`
+// (wall-clock s, > 0), explicit so that a caller that solved before passes what is left of
+// mip_time_limit. Either way the best selection found, at least a feasible warm start, is taken.
 // Writes the program's variables and its answer as face maps of `cs.mesh` (replacing those of an
 // earlier solve): "f:variable" (int: the candidate's GLPK column, 1-based; 0 when fixed) and
 // "f:selected" (bool: chosen; all false when the result is not ok).
