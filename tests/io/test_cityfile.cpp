@@ -8,16 +8,19 @@
 #include "support/mesh_fixtures.h"
 #include "support/scan_fixtures.h"
 
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
 #include <random>
+#include <thread>
 
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/refine.h"
+#include "lodrefine/core/selection.h"
 #include "lodrefine/core/validate.h"
 #include "lodrefine/io/cityfile.h"
 #include "lodrefine/io/citygml.h"
@@ -629,6 +632,47 @@ TEST(CityFile, JobsWriteTheSameBytesAsOneAtATime) {
     EXPECT_EQ(order[1], order[3]) << name << ": outcomes not in file order";
     EXPECT_GT(written[1].size(), 1000u);
   }
+}
+
+// Buildings whose selection ends at the work budget (made small here so that every search does)
+// select the same faces on a pool of 2 and one at a time, while other threads load the CPU: the
+// budget counts GLPK's work, not seconds.
+TEST(CityFile, JobsWriteTheSameBytesWhenSelectionsEndAtTheBudget) {
+  const std::string dir = test_dir();
+  PointCloud cloud;
+  const std::vector<SynthBuilding> bs = synth_street(
+      {BuildingType::LShape, BuildingType::TShape, BuildingType::Stepped, BuildingType::Hip}, 43, 5000, 4, cloud);
+  write_file_atomic(dir + "/city.json", synth_city(bs, Vec3(93000, 436000, 0)).dump());
+  write_ply(dir + "/cloud.ply", cloud);
+  Params prm;
+  prm.mip_work_limit = 0.02;
+  std::atomic<bool> stop{false};
+  std::vector<std::thread> burners;
+  for (int t = 0; t < 2; ++t)
+    burners.emplace_back([&stop] {
+      volatile double x = 1.0;
+      while (!stop) x = x * 1.0000001 + 1e-9;
+    });
+  std::map<int, std::string> written;
+  int at_budget = 0;
+  for (int jobs : {1, 2}) {
+    CityRefineOptions o;
+    o.jobs = jobs;
+    o.on_building = [&](const Mesh&, const CityBuildingOutcome*, const RefineResult* r, const PointCloud*) {
+      if (jobs == 1 && r != nullptr && r->trace.selection &&
+          r->trace.selection->selection.status == SolveStatus::FeasibleBudget)
+        ++at_budget;
+    };
+    const std::string out = dir + "/out" + std::to_string(jobs) + ".city.json";
+    const CityRefineSummary s = refine_city(dir + "/city.json", dir + "/cloud.ply", out, prm, o);
+    EXPECT_GE(s.refined, 1);
+    std::ifstream f(out, std::ios::binary);
+    written[jobs].assign(std::istreambuf_iterator<char>(f), {});
+  }
+  stop = true;
+  for (auto& t : burners) t.join();
+  EXPECT_GE(at_budget, 1) << "no selection reached the budget: the test shows nothing";
+  EXPECT_EQ(written[1], written[2]) << "--jobs 2 wrote other bytes than --jobs 1";
 }
 
 // The progress line: redrawn in place on a terminal (a pty from script(1)), absent from a
