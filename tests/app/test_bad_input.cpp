@@ -1010,6 +1010,16 @@ TEST(BadInputSecurity, CityFilesRefusedInOneLineNamingTheFile) {
        "\n{\"type\":\"CityJSONFeature\",\"CityObjects\":{},\"vertices\":[]}\n"},
       {"deep.city.json", R"({"type":"CityJSON","version":"2.0","CityObjects":{},"vertices":[],"x":)" +
                              std::string(100000, '[') + std::string(100000, ']') + "}"},
+      // A second "CityObjects" replaced the first (its buildings gone without a word).
+      {"twice.city.json",
+       R"({"type":"CityJSON","version":"2.0","CityObjects":{"A":{"type":"Building"}},"vertices":[],"CityObjects":{}})"},
+      // Non-string "version" / "type": a raw json type_error, exit 1, after the crop.
+      {"version.city.json", R"({"type":"CityJSON","version":2,"CityObjects":{},"vertices":[]})"},
+      {"type.city.json", R"({"type":"CityJSON","version":"1.1","CityObjects":{"A":{"type":5}},"vertices":[]})"},
+      {"feature.city.jsonl",
+       R"({"type":"CityJSON","version":"2.0","transform":{"scale":[1,1,1],"translate":[0,0,0]},"CityObjects":{},"vertices":[]})"
+       "\n{\"type\":5,\"CityObjects\":{},\"vertices\":[]}\n"},
+      {"seqheader.city.jsonl", "{\"type\":5}\n{\"type\":\"CityJSONFeature\",\"CityObjects\":{},\"vertices\":[]}\n"},
   };
   for (const auto& [name, text] : files) {
     const std::string model = dir + "/" + name;
