@@ -38,6 +38,13 @@ int create_temp_file(const std::string& dir, const std::string& for_path, std::s
 }
 
 AtomicFile::AtomicFile(const std::string& path) : path_(path) {
+  // Renaming over a FIFO, device or socket (or a link to one, /dev/stdout) would replace it:
+  // a reader of the FIFO hangs, and under root a device node becomes a regular file.
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode))
+    throw std::runtime_error("cannot write " + path +
+                             ": not a regular file (a FIFO, device or socket); outputs are written to a "
+                             "temporary file renamed into place: give a file path");
   fd_ = create_temp_file(fs::path(path).parent_path().string(), path, tmp_);
 }
 

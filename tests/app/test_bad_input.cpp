@@ -1204,7 +1204,21 @@ TEST(BadInputFiles, RefineRefusesOutputsThatAreInputs) {
       run_cli("refine --model " + dir + "/city.json --cloud " + cloud + " --out " + dir + "/city.json", dir);
   expect_one_error_line(c, "is the --model file");
   EXPECT_EQ(read_text(dir + "/city.json"), box_city({"B"}));
-  add_row("refine: --out/--report = --model/--cloud (links, ../)", "refused before reading", c.exit);
+  // --html, the city refine's review page, replaced the model, the cloud or the city file out.
+  for (const auto& [outputs, says] : std::vector<std::pair<std::string, std::string>>{
+           {" --out " + dir + "/r.json --html " + dir + "/city.json", "--html is the --model file"},
+           {" --out " + dir + "/r.json --html " + cloud, "--html is the --cloud file"},
+           {" --out " + dir + "/r.json --html " + dir + "/sub/../r.json", "--html is the --out file"},
+           {" --out " + dir + "/r.json --report " + dir + "/h.html --html " + dir + "/h.html",
+            "--html is the --report file"}}) {
+    const CliRun h = run_cli("refine --model " + dir + "/city.json --cloud " + cloud + outputs, dir);
+    expect_one_error_line(h, says);
+    EXPECT_EQ(read_text(dir + "/city.json"), box_city({"B"})) << outputs;
+    EXPECT_EQ(read_text(cloud), valid_cloud()) << outputs;
+    EXPECT_FALSE(fs::exists(dir + "/r.json")) << outputs;
+  }
+  add_row("refine: --out/--report/--html = --model/--cloud or each other (links, ../)", "refused before reading",
+          c.exit);
 }
 
 // A report never names a model that is not there; an output folder that takes no file is

@@ -35,7 +35,8 @@ int create_temp_file(const std::string& dir, const std::string& for_path, std::s
 
 // A file written through a temporary beside the target (create_temp_file) and renamed over it
 // on commit(); the temporary is removed if commit() is never reached (an exception; a kill -9
-// leaves a ".lodrefine-tmp-*"). A symlink at `path` is replaced, never followed. Constructing
+// leaves a ".lodrefine-tmp-*"). A symlink at `path` is replaced, never followed; a FIFO, device
+// or socket there (or a link to one, /dev/stdout) is refused, never replaced. Constructing
 // one is also the check that `path` can be written (its folder exists and is writable). For
 // outputs written in pieces (streams); write_file_atomic for one piece.
 class AtomicFile {
