@@ -102,17 +102,8 @@ void check_output_dir(const std::string& path) {
 // as files: links and other spellings of one path count). --html too: it replaced the model,
 // the cloud or the city file out without a word.
 void check_outputs_are_new(const RefineArgs& a) {
-  const std::pair<const char*, const std::string*> ins[] = {{"--model", &a.model}, {"--cloud", &a.cloud}};
-  const std::pair<const char*, const std::string*> outs[] = {
-      {"--out", &a.out}, {"--report", &a.report}, {"--html", &a.html}};
-  for (const auto& [out_name, out] : outs)
-    for (const auto& [in_name, in] : ins)
-      if (!out->empty() && same_file(*out, *in))
-        throw InputError(*out + ": " + out_name + " is the " + in_name + " file; it would be overwritten");
-  for (std::size_t i = 0; i < std::size(outs); ++i)
-    for (std::size_t j = 0; j < i; ++j)
-      if (!outs[i].second->empty() && same_file(*outs[j].second, *outs[i].second))
-        throw InputError(*outs[i].second + ": " + outs[i].first + " is the " + outs[j].first + " file");
+  refuse_overwrites({{"--model", a.model}, {"--cloud", a.cloud}},
+                    {{"--out", a.out}, {"--report", a.report}, {"--html", a.html}});
 }
 
 // "12 refined, 3 kept, 1 kept-invalid": the progress line's tally.

@@ -145,6 +145,19 @@ bool same_file(const std::string& a, const std::string& b) {
   return where(a) == where(b);
 }
 
+void refuse_overwrites(const std::vector<FileOption>& inputs, const std::vector<FileOption>& outputs) {
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const FileOption& out = outputs[i];
+    if (out.path.empty()) continue;
+    for (const FileOption& in : inputs)
+      if (!in.path.empty() && same_file(out.path, in.path))
+        throw InputError(out.path + ": " + out.name + " is the " + in.name + " file; it would be overwritten");
+    for (std::size_t j = 0; j < i; ++j)
+      if (!outputs[j].path.empty() && same_file(out.path, outputs[j].path))
+        throw InputError(out.path + ": " + out.name + " is the " + outputs[j].name + " file");
+  }
+}
+
 namespace {
 
 bool safe_char(char c) {

@@ -1221,6 +1221,29 @@ TEST(BadInputFiles, RefineRefusesOutputsThatAreInputs) {
           c.exit);
 }
 
+// eval's outputs replaced its inputs without a word (--json r.obj --refined r.obj).
+TEST(BadInputFiles, EvalRefusesOutputsThatAreInputs) {
+  const std::string dir = temp_dir("eval_same");
+  const std::string model = dir + "/model.obj", refined = dir + "/refined.obj", cloud = dir + "/cloud.ply";
+  write_text(model, valid_model());
+  write_text(refined, valid_model());
+  write_text(cloud, valid_cloud());
+  const std::string in = "eval --original " + model + " --refined " + refined + " --cloud " + cloud;
+  for (const auto& [outputs, says] : std::vector<std::pair<std::string, std::string>>{
+           {" --json " + refined, "--json is the --refined file"},
+           {" --csv " + dir + "/./model.obj", "--csv is the --original file"},
+           {" --json " + cloud, "--json is the --cloud file"},
+           {" --json " + dir + "/e.json --csv " + dir + "/e.json", "--csv is the --json file"}}) {
+    const CliRun r = run_cli(in + outputs, dir);
+    expect_one_error_line(r, says);
+    EXPECT_EQ(read_text(model), valid_model()) << outputs;
+    EXPECT_EQ(read_text(refined), valid_model()) << outputs;
+    EXPECT_EQ(read_text(cloud), valid_cloud()) << outputs;
+    EXPECT_FALSE(fs::exists(dir + "/e.json")) << outputs;
+  }
+  add_row("eval: --json/--csv/... = --original/--refined/--cloud or each other", "refused before reading", 2);
+}
+
 // A report never names a model that is not there; an output folder that takes no file is
 // found before the work (single building and city file). /proc/self takes no new file, even for root.
 TEST(BadInputFiles, UnwritableOutputFailsFirstAndLeavesNoReport) {

@@ -76,6 +76,16 @@ void require_regular_file(const std::string& path);
 // refuse an output that would overwrite an input, or another output, before reading anything.
 bool same_file(const std::string& a, const std::string& b);
 
+// A command's file option: its name ("--out") and path (empty: not given).
+struct FileOption {
+  const char* name;
+  std::string path;
+};
+// Throws InputError "<path>: <output> is the <input> file; it would be overwritten", or "<path>:
+// <output> is the <other output> file", when an output given is an input or another output
+// (same_file). Called before anything is read.
+void refuse_overwrites(const std::vector<FileOption>& inputs, const std::vector<FileOption>& outputs);
+
 // Names for untrusted ids (CityObject ids, file stems) in file and folder names that make, the
 // shell and every file system take as they are.
 //
