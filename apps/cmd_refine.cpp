@@ -98,16 +98,12 @@ void check_output_dir(const std::string& path) {
   }
 }
 
-// Refuses, before anything is read, an output that is an input or the other output (compared
-// as files: links and other spellings of one path count).
+// Refuses, before anything is read, an output that is an input or another output (compared
+// as files: links and other spellings of one path count). --html too: it replaced the model,
+// the cloud or the city file out without a word.
 void check_outputs_are_new(const RefineArgs& a) {
-  const std::pair<const char*, const std::string*> ins[] = {{"--model", &a.model}, {"--cloud", &a.cloud}};
-  const std::pair<const char*, const std::string*> outs[] = {{"--out", &a.out}, {"--report", &a.report}};
-  for (const auto& [out_name, out] : outs)
-    for (const auto& [in_name, in] : ins)
-      if (!out->empty() && same_file(*out, *in))
-        throw InputError(*out + ": " + out_name + " is the " + in_name + " file; it would be overwritten");
-  if (!a.report.empty() && same_file(a.out, a.report)) throw InputError(a.report + ": --report is the --out file");
+  refuse_overwrites({{"--model", a.model}, {"--cloud", a.cloud}},
+                    {{"--out", a.out}, {"--report", a.report}, {"--html", a.html}});
 }
 
 // "12 refined, 3 kept, 1 kept-invalid": the progress line's tally.

@@ -100,6 +100,19 @@ bool apply_gate(const EvalOptions& a, const GateInputs& in, const RunFigures& ru
 
 void check_options(const EvalOptions& a) {
   a.params.validate();
+  // An output given as an input (--json r.obj --refined r.obj) replaced it without a word.
+  refuse_overwrites({{"--original", a.original},
+                     {"--refined", a.refined},
+                     {"--cloud", a.cloud},
+                     {"--truth", a.truth},
+                     {"--meta", a.meta},
+                     {"--baseline", a.baseline_in},
+                     {"--gates", a.gates}},
+                    {{"--json", a.json_out},
+                     {"--csv", a.csv_out},
+                     {"--html", a.html_out},
+                     {"--write-baseline", a.baseline_out},
+                     {"--junit", a.junit_out}});
   if (!a.dir.empty() && !a.cloud_options.classes.empty())
     throw InputError(a.dir + ": --classes applies to --cloud; a run folder holds cropped PLY clouds");
   if (a.dir.empty() && (a.original.empty() || a.refined.empty() || a.cloud.empty()))

@@ -31,6 +31,15 @@ constexpr std::size_t kMaxSequenceHeader = 1 << 20;
 // Buildings in flight per thread of the pool (see in_order_pool).
 constexpr int kItemsPerJob = 16;
 
+// A string member of an untrusted object; `otherwise` when it is absent or no string (the
+// reader refuses a "version" or "type" that is no string, with the file's name; value() would
+// throw a raw type_error).
+std::string text_member(const json& j, const char* key, const std::string& otherwise = "") {
+  if (!j.is_object()) return otherwise;
+  const auto it = j.find(key);
+  return it != j.end() && it->is_string() ? it->get<std::string>() : otherwise;
+}
+
 // The outcome of one building in the three words of the report, with its reason: anything
 // refine_building does not call "refined" is kept (its original geometry stays), and a kept
 // building whose repaired original is not valid either is kept-invalid.
@@ -216,7 +225,7 @@ void refine_document(json& doc, const CityJsonTransform& tf, const std::vector<C
 // GenericCityObject extension type now core. A 2.0 input is not touched.
 void upgrade_objects(json& objects) {
   for (auto& [id, obj] : objects.items()) {
-    if (obj.value("type", "") == "+GenericCityObject") obj["type"] = "GenericCityObject";
+    if (text_member(obj, "type") == "+GenericCityObject") obj["type"] = "GenericCityObject";
     if (!obj.contains("geometry") || !obj["geometry"].is_array()) continue;
     for (auto& g : obj["geometry"])
       if (g.is_object() && g.contains("lod") && g["lod"].is_number()) {
@@ -308,7 +317,8 @@ std::uint64_t check_cloud_reaches(const std::vector<CropTarget>& targets, const 
 // A CityJSONSeq feature as a CityJSON document the reader takes: the header's transform
 // with the feature's objects and vertices.
 json feature_document(const json& header, json feature) {
-  json d = {{"type", "CityJSON"}, {"version", header.value("version", "2.0")}, {"transform", header.at("transform")}};
+  json d = {
+      {"type", "CityJSON"}, {"version", text_member(header, "version", "2.0")}, {"transform", header.at("transform")}};
   d["CityObjects"] = std::move(feature["CityObjects"]);
   d["vertices"] = std::move(feature["vertices"]);
   return d;
@@ -326,7 +336,7 @@ json sequence_header(const std::string& model_path) {
   } catch (const InputError&) {
     return nullptr;  // not a sequence header: the whole file is parsed, and refused with the reason
   }
-  if (!first.is_object() || first.value("type", "") != "CityJSON" ||
+  if (!first.is_object() || text_member(first, "type") != "CityJSON" ||
       (first.contains("CityObjects") && !first["CityObjects"].empty()))
     return nullptr;
   while (std::getline(in, line))
@@ -337,7 +347,7 @@ json sequence_header(const std::string& model_path) {
 // One line of a CityJSONSeq after the header; `where` names it in the error.
 json parse_feature(const std::string& line, const std::string& where) {
   json feature = parse_city_json(line, where);
-  if (!feature.is_object() || feature.value("type", "") != "CityJSONFeature")
+  if (!feature.is_object() || text_member(feature, "type") != "CityJSONFeature")
     throw InputError(where + ": expected a CityJSONFeature object");
   return feature;
 }
@@ -348,7 +358,7 @@ json parse_feature(const std::string& line, const std::string& where) {
 CityRefineSummary refine_sequence(const json& header, const std::string& model_path, const std::string& cloud_path,
                                   const std::string& out_path, const Params& params, const CityRefineOptions& options) {
   CityRefineSummary sum;
-  sum.input_format = "CityJSONSeq " + header.value("version", std::string("?"));
+  sum.input_format = "CityJSONSeq " + text_member(header, "version", "?");
   if (!header.contains("transform"))
     throw InputError(model_path + ": line 1: a CityJSONSeq header needs a \"transform\"");
   // The header checked by the reader (transform shape, scale) before transform_of trusts it.
@@ -392,7 +402,7 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
   t = Clock::now();
   AtomicFile out(out_path);
   json h = header;
-  const bool upgrade = header.value("version", "") != "2.0";
+  const bool upgrade = text_member(header, "version") != "2.0";
   if (upgrade) upgrade_header(h);
   h["version"] = "2.0";
   out.write(h.dump(-1, ' ', false, json::error_handler_t::replace) + "\n");
@@ -494,8 +504,7 @@ CityRefineSummary refine_city(const std::string& model_path, const std::string& 
   } else {
     const std::string text = read_text(model_path);
     doc = parse_city_json(text, model_path);
-    format =
-        "CityJSON " + (doc.contains("version") && doc["version"].is_string() ? doc["version"].get<std::string>() : "?");
+    format = "CityJSON " + text_member(doc, "version", "?");
   }
   const CityJsonFile file = read_cityjson_document(doc, model_path, options.lod);
   sum.input_format = format;
@@ -515,7 +524,7 @@ CityRefineSummary refine_city(const std::string& model_path, const std::string& 
   sum.seconds_crop = seconds_since(t);
 
   t = Clock::now();
-  if (doc.value("version", "") != "2.0") {
+  if (text_member(doc, "version") != "2.0") {
     upgrade_header(doc);
     upgrade_objects(doc["CityObjects"]);
   }

@@ -101,6 +101,7 @@ class Reader {
     if (!root.is_object() || member(root, "type") != "CityJSON")
       fail("not a CityJSON file (no \"type\": \"CityJSON\")");
     const json& version = member(root, "version");
+    if (!version.is_null() && !version.is_string()) fail("\"version\" is not a string");
     if (version.is_string()) out.version = version.get<std::string>();
     if (root.contains("transform")) {
       const json& t = root["transform"];
@@ -145,6 +146,7 @@ class Reader {
       where_ = (outer.empty() ? "" : outer + ": ") + "object " + one_line(id, 60);
       if (!obj.is_object()) fail("is not a JSON object");
       const json& type = member(obj, "type");
+      if (!type.is_null() && !type.is_string()) fail("\"type\" is not a string");
       if (type != "Building" && type != "BuildingPart") continue;
       const json* geom = best_lod2(obj);
       if (geom == nullptr) {
@@ -255,7 +257,7 @@ class Reader {
           if (v.is_number_integer() || v.is_number_unsigned()) {
             const long long k = v.get<long long>();
             if (k < 0 || k >= static_cast<long long>(surface_sem.size()))
-              fail("semantics value " + std::to_string(k) + " has no semantic surface");
+              fail("semantics value " + v.dump() + " has no semantic surface");  // as written: 2^63 is no -2^63
             sem = surface_sem[k];
           } else if (!v.is_null()) {
             fail("semantics values do not match the " + type + " boundaries");
@@ -299,8 +301,7 @@ class Reader {
           fail(type + " boundaries are not nested as the type needs");
         const long long i = ji.get<long long>();
         if (i < 0 || i >= static_cast<long long>(vertices.size()))
-          fail("vertex index " + std::to_string(i) + " is out of range (" + std::to_string(vertices.size()) +
-               " vertices)");
+          fail("vertex index " + ji.dump() + " is out of range (" + std::to_string(vertices.size()) + " vertices)");
         if (r == 0) ring.push_back(int(i));
       }
     }
@@ -377,7 +378,10 @@ class Reader {
 };
 
 // Refuses what the DOM parser would take silently or with a raw message: nesting deeper than
-// kMaxJsonDepth, and a CityObjects id given twice (the parser keeps one of the two objects).
+// kMaxJsonDepth, and a key given twice in one object (the parser keeps the last one: a second
+// "CityObjects" or "vertices" would replace the first without a word, a CityObjects id given
+// twice would lose a building, and other readers may keep the first). Free-form data
+// (attributes, metadata, addresses, extension members) keeps JSON's last-one-wins rule.
 class ParseGuard {
  public:
   explicit ParseGuard(const std::string& name) : name_(name) {}
@@ -385,20 +389,47 @@ class ParseGuard {
     using E = nlohmann::detail::parse_event_t;
     if ((event == E::object_start || event == E::array_start) && depth >= kMaxJsonDepth)
       throw InputError(name_ + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
-    if (event != E::key) return true;
-    if (depth == 1) {
-      in_objects_ = parsed == "CityObjects";  // the root's member whose object opens next
-    } else if (depth == 2 && in_objects_ && !ids_.insert(parsed.get<std::string>()).second) {
-      throw InputError(name_ + ": CityObjects id " + one_line(parsed.get<std::string>(), 60) +
-                       " appears twice (two objects under one id; one would be lost)");
-    }
+    if (event == E::object_start || event == E::array_start) open(event == E::object_start);
+    else if ((event == E::object_end || event == E::array_end) && !frames_.empty()) frames_.pop_back();
+    else if (event == E::key && !frames_.empty()) key(parsed.get<std::string>());
     return true;
   }
 
  private:
+  struct Frame {
+    bool free = false;          // free-form data: keys may repeat
+    bool city_objects = false;  // the root's "CityObjects": its keys are ids
+    std::string last_key;       // the member whose value opens next (objects)
+    std::unordered_set<std::string> keys;
+  };
+
+  static bool free_form(const std::string& key) {
+    return key == "attributes" || key == "metadata" || key == "address" || (!key.empty() && key[0] == '+');
+  }
+
+  void open(bool object) {
+    Frame f;
+    if (!frames_.empty()) {
+      const Frame& parent = frames_.back();
+      f.free = parent.free || free_form(parent.last_key);
+      f.city_objects = object && frames_.size() == 1 && parent.last_key == "CityObjects";
+    }
+    frames_.push_back(std::move(f));
+  }
+
+  void key(const std::string& k) {
+    Frame& f = frames_.back();
+    f.last_key = k;
+    if (f.free || f.keys.insert(k).second) return;
+    if (f.city_objects)
+      throw InputError(name_ + ": CityObjects id " + one_line(k, 60) +
+                       " appears twice (two objects under one id; one would be lost)");
+    throw InputError(name_ + ": key \"" + one_line(k, 60) +
+                     "\" appears twice in one object (JSON keeps only one of them; readers differ on which)");
+  }
+
   const std::string& name_;
-  bool in_objects_ = false;
-  std::unordered_set<std::string> ids_;
+  std::vector<Frame> frames_;
 };
 
 }  // namespace

@@ -38,6 +38,13 @@ int create_temp_file(const std::string& dir, const std::string& for_path, std::s
 }
 
 AtomicFile::AtomicFile(const std::string& path) : path_(path) {
+  // Renaming over a FIFO, device or socket (or a link to one, /dev/stdout) would replace it:
+  // a reader of the FIFO hangs, and under root a device node becomes a regular file.
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode))
+    throw std::runtime_error("cannot write " + path +
+                             ": not a regular file (a FIFO, device or socket); outputs are written to a "
+                             "temporary file renamed into place: give a file path");
   fd_ = create_temp_file(fs::path(path).parent_path().string(), path, tmp_);
 }
 
@@ -136,6 +143,19 @@ bool same_file(const std::string& a, const std::string& b) {
     return (ec ? abs.parent_path() : parent) / abs.filename();
   };
   return where(a) == where(b);
+}
+
+void refuse_overwrites(const std::vector<FileOption>& inputs, const std::vector<FileOption>& outputs) {
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const FileOption& out = outputs[i];
+    if (out.path.empty()) continue;
+    for (const FileOption& in : inputs)
+      if (!in.path.empty() && same_file(out.path, in.path))
+        throw InputError(out.path + ": " + out.name + " is the " + in.name + " file; it would be overwritten");
+    for (std::size_t j = 0; j < i; ++j)
+      if (!outputs[j].path.empty() && same_file(out.path, outputs[j].path))
+        throw InputError(out.path + ": " + out.name + " is the " + outputs[j].name + " file");
+  }
 }
 
 namespace {

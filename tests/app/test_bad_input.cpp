@@ -1001,6 +1001,16 @@ TEST(BadInputSecurity, CityFilesRefusedInOneLineNamingTheFile) {
        "\n{\"type\":\"CityJSONFeature\",\"CityObjects\":{},\"vertices\":[]}\n"},
       {"deep.city.json", R"({"type":"CityJSON","version":"2.0","CityObjects":{},"vertices":[],"x":)" +
                              std::string(100000, '[') + std::string(100000, ']') + "}"},
+      // A second "CityObjects" replaced the first (its buildings gone without a word).
+      {"twice.city.json",
+       R"({"type":"CityJSON","version":"2.0","CityObjects":{"A":{"type":"Building"}},"vertices":[],"CityObjects":{}})"},
+      // Non-string "version" / "type": a raw json type_error, exit 1, after the crop.
+      {"version.city.json", R"({"type":"CityJSON","version":2,"CityObjects":{},"vertices":[]})"},
+      {"type.city.json", R"({"type":"CityJSON","version":"1.1","CityObjects":{"A":{"type":5}},"vertices":[]})"},
+      {"feature.city.jsonl",
+       R"({"type":"CityJSON","version":"2.0","transform":{"scale":[1,1,1],"translate":[0,0,0]},"CityObjects":{},"vertices":[]})"
+       "\n{\"type\":5,\"CityObjects\":{},\"vertices\":[]}\n"},
+      {"seqheader.city.jsonl", "{\"type\":5}\n{\"type\":\"CityJSONFeature\",\"CityObjects\":{},\"vertices\":[]}\n"},
   };
   for (const auto& [name, text] : files) {
     const std::string model = dir + "/" + name;
@@ -1185,7 +1195,44 @@ TEST(BadInputFiles, RefineRefusesOutputsThatAreInputs) {
       run_cli("refine --model " + dir + "/city.json --cloud " + cloud + " --out " + dir + "/city.json", dir);
   expect_one_error_line(c, "is the --model file");
   EXPECT_EQ(read_text(dir + "/city.json"), box_city({"B"}));
-  add_row("refine: --out/--report = --model/--cloud (links, ../)", "refused before reading", c.exit);
+  // --html, the city refine's review page, replaced the model, the cloud or the city file out.
+  for (const auto& [outputs, says] : std::vector<std::pair<std::string, std::string>>{
+           {" --out " + dir + "/r.json --html " + dir + "/city.json", "--html is the --model file"},
+           {" --out " + dir + "/r.json --html " + cloud, "--html is the --cloud file"},
+           {" --out " + dir + "/r.json --html " + dir + "/sub/../r.json", "--html is the --out file"},
+           {" --out " + dir + "/r.json --report " + dir + "/h.html --html " + dir + "/h.html",
+            "--html is the --report file"}}) {
+    const CliRun h = run_cli("refine --model " + dir + "/city.json --cloud " + cloud + outputs, dir);
+    expect_one_error_line(h, says);
+    EXPECT_EQ(read_text(dir + "/city.json"), box_city({"B"})) << outputs;
+    EXPECT_EQ(read_text(cloud), valid_cloud()) << outputs;
+    EXPECT_FALSE(fs::exists(dir + "/r.json")) << outputs;
+  }
+  add_row("refine: --out/--report/--html = --model/--cloud or each other (links, ../)", "refused before reading",
+          c.exit);
+}
+
+// eval's outputs replaced its inputs without a word (--json r.obj --refined r.obj).
+TEST(BadInputFiles, EvalRefusesOutputsThatAreInputs) {
+  const std::string dir = temp_dir("eval_same");
+  const std::string model = dir + "/model.obj", refined = dir + "/refined.obj", cloud = dir + "/cloud.ply";
+  write_text(model, valid_model());
+  write_text(refined, valid_model());
+  write_text(cloud, valid_cloud());
+  const std::string in = "eval --original " + model + " --refined " + refined + " --cloud " + cloud;
+  for (const auto& [outputs, says] : std::vector<std::pair<std::string, std::string>>{
+           {" --json " + refined, "--json is the --refined file"},
+           {" --csv " + dir + "/./model.obj", "--csv is the --original file"},
+           {" --json " + cloud, "--json is the --cloud file"},
+           {" --json " + dir + "/e.json --csv " + dir + "/e.json", "--csv is the --json file"}}) {
+    const CliRun r = run_cli(in + outputs, dir);
+    expect_one_error_line(r, says);
+    EXPECT_EQ(read_text(model), valid_model()) << outputs;
+    EXPECT_EQ(read_text(refined), valid_model()) << outputs;
+    EXPECT_EQ(read_text(cloud), valid_cloud()) << outputs;
+    EXPECT_FALSE(fs::exists(dir + "/e.json")) << outputs;
+  }
+  add_row("eval: --json/--csv/... = --original/--refined/--cloud or each other", "refused before reading", 2);
 }
 
 // A report never names a model that is not there; an output folder that takes no file is

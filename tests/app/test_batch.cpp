@@ -382,6 +382,28 @@ TEST(BatchIds, UnsafeFolderNamesAreRefusedBeforeAnythingRuns) {
   fs::remove_all(base);
 }
 
+// The run folder's own name reaches make's command line from the dispatchers: "$(shell ...)"
+// in it ran the command (make expands "$" in a command-line variable).
+TEST(BatchIds, RunFolderNamedWithMakeSyntaxRunsNothing) {
+  const fs::path base = fresh_dir("batch_dollar");
+  const fs::path run = base / "r$(shell touch PWNED)";
+  make_tile(run, 1);
+  for (const char* script : {"parallel_batch.sh", "slurm_batch.sh"}) {
+    const fs::path err = base / "err.txt";
+    EXPECT_EQ(shell("cd " + shell_quoted(base) + " && LODREFINE=" + shell_quoted(kBinary) +
+                    " HOME=" + shell_quoted(base) + " " + shell_quoted(kSource / "scripts" / script) + " " +
+                    shell_quoted(run) + " > /dev/null 2> " + shell_quoted(err)),
+              2)
+        << script;
+    const std::string message = read_text(err);
+    EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
+    EXPECT_EQ(message.rfind("lodrefine: error: ", 0), 0u) << message;
+    EXPECT_NE(message.find("holding \"$\""), std::string::npos) << message;
+    EXPECT_TRUE(pwned(base).empty()) << script;
+  }
+  fs::remove_all(base);
+}
+
 // Leftovers: the batch removes lodrefine's own temporaries of a killed run, and never a user's
 // file that merely has ".tmp." in its name.
 TEST(BatchIds, OnlyLodrefineTemporariesAreCleanedUp) {

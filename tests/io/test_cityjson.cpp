@@ -302,6 +302,44 @@ TEST(CityJsonSecurity, DeepNestingOverflowsAndDuplicatesAreOneLine) {
   EXPECT_EQ(parse_cityjson(cube_document("2.0", ok + R"(,"attributes":{"k":1,"k":2}})")).buildings.size(), 1u);
 }
 
+// A key given twice where the reader looks (the root, transform, an object, a geometry): JSON
+// keeps the last one, so one of two "CityObjects" (and its buildings) vanished without a word,
+// and other readers may keep the first. Wrong types of "version" and "type" were a raw
+// type_error (exit 1, no file name) from the city writer, after the whole crop.
+TEST(CityJsonSecurity, KeysGivenTwiceAndNonStringTypesAreOneLine) {
+  const std::string ok = R"("A":{"type":"Building","geometry":[)" + cube_solid("\"2\"") + "]}";
+  const std::string doc = cube_document("2.0", ok);
+  const std::string tail = doc.substr(0, doc.size() - 1);  // without the closing brace
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {tail + R"(,"CityObjects":{}})", "bad.json: key \"CityObjects\" appears twice in one object"},
+      {tail + R"(,"vertices":[]})", "bad.json: key \"vertices\" appears twice in one object"},
+      {cube_document("2.0", ok).replace(doc.find(R"("scale")"), 0, R"("scale":[1,1,1],)"),
+       "bad.json: key \"scale\" appears twice in one object"},
+      {cube_document("2.0", R"("A":{"type":"Building","type":"Bridge","geometry":[)" + cube_solid("\"2\"") + "]}"),
+       "bad.json: key \"type\" appears twice in one object"},
+      {cube_document("2.0", R"("A":{"type":"Building","geometry":[)" +
+                                cube_solid("\"2\"").replace(1, 0, R"("boundaries":[],)") + "]}"),
+       "bad.json: key \"boundaries\" appears twice in one object"},
+      {cube_document("2.0", ok + R"(,"B":{"type":5})"), "bad.json: object B: \"type\" is not a string"},
+      {R"({"type":"CityJSON","version":2,"CityObjects":{},"vertices":[]})", "bad.json: \"version\" is not a string"},
+      // 2^63 was shown as -9223372036854775808.
+      {cube_document("2.0", ok).replace(doc.find("[[[[0,"), 6, "[[[[9223372036854775808,"),
+       "bad.json: object A: vertex index 9223372036854775808 is out of range"},
+  };
+  for (const auto& [text, expect] : bad) {
+    const std::string msg = refusal_of(text);
+    EXPECT_EQ(msg.rfind(expect, 0), 0u) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  }
+  // Free-form data keeps JSON's rule (the last one counts): attributes, metadata, addresses.
+  const std::string free_form =
+      cube_document("2.0", R"("A":{"type":"Building","attributes":{"k":1,"k":{"n":1,"n":2}},"address":[{"a":1,"a":2}],)"
+                           R"("geometry":[)" +
+                               cube_solid("\"2\"") + "]}");
+  EXPECT_EQ(
+      parse_cityjson(free_form.substr(0, free_form.size() - 1) + R"(,"metadata":{"t":1,"t":2}})").buildings.size(), 1u);
+}
+
 // Issue 15, item 12: a ring pinched at one vertex 6000 times took minutes (cubic split).
 TEST(CityJsonSecurity, RingPinchedThousandsOfTimesSplitsInLinearTime) {
   const int petals = 6000;

@@ -11,6 +11,7 @@
 #include <limits>
 #include <set>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "lodrefine/io/files.h"
@@ -59,6 +60,41 @@ TEST(IoWrite, AtomicWriteReplacesAndLeavesNoTempOnFailure) {
   std::size_t entries = 0;
   for ([[maybe_unused]] const auto& e : fs::directory_iterator(fs::path(path).parent_path())) ++entries;
   EXPECT_EQ(entries, 1u);  // no leftover .lodrefine-tmp-*
+}
+
+// An output that is a FIFO, a device or a socket (or a link to one: /dev/stdout) was renamed
+// over: a reader waiting on the FIFO hung, and under root `--out /dev/full` or `--report
+// /dev/stdout` replaced the device node with a regular file.
+TEST(IoWrite, AtomicWriteRefusesToReplaceAFifoOrDevice) {
+  const std::string dir = temp_path("special_outputs");
+  fs::create_directories(dir);
+  const std::string fifo = dir + "/pipe", link = dir + "/stdout";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  fs::create_symlink(fifo, link);
+  for (const std::string& path : {fifo, link}) {
+    try {
+      write_file_atomic(path, "x");
+      FAIL() << path << ": written";
+    } catch (const std::runtime_error& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind("cannot write " + path + ": not a regular file", 0), 0u) << msg;
+    }
+  }
+  EXPECT_TRUE(fs::is_fifo(fifo));
+  EXPECT_TRUE(fs::is_symlink(link));
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++entries;
+  EXPECT_EQ(entries, 2u);  // no temporary left
+  // A link to a regular file is still replaced, never followed.
+  const std::string target = dir + "/target", link2 = dir + "/link2";
+  write_file_atomic(target, "kept");
+  fs::create_symlink(target, link2);
+  write_file_atomic(link2, "new");
+  EXPECT_FALSE(fs::is_symlink(link2));
+  std::ifstream in(target);
+  std::string s;
+  std::getline(in, s);
+  EXPECT_EQ(s, "kept");
 }
 
 // ---------------------------------------------------------------------------------------------

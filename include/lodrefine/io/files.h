@@ -35,7 +35,8 @@ int create_temp_file(const std::string& dir, const std::string& for_path, std::s
 
 // A file written through a temporary beside the target (create_temp_file) and renamed over it
 // on commit(); the temporary is removed if commit() is never reached (an exception; a kill -9
-// leaves a ".lodrefine-tmp-*"). A symlink at `path` is replaced, never followed. Constructing
+// leaves a ".lodrefine-tmp-*"). A symlink at `path` is replaced, never followed; a FIFO, device
+// or socket there (or a link to one, /dev/stdout) is refused, never replaced. Constructing
 // one is also the check that `path` can be written (its folder exists and is writable). For
 // outputs written in pieces (streams); write_file_atomic for one piece.
 class AtomicFile {
@@ -74,6 +75,16 @@ void require_regular_file(const std::string& path);
 // hard links and `./x` vs `x` all count), else the same real parent folder and name. Used to
 // refuse an output that would overwrite an input, or another output, before reading anything.
 bool same_file(const std::string& a, const std::string& b);
+
+// A command's file option: its name ("--out") and path (empty: not given).
+struct FileOption {
+  const char* name;
+  std::string path;
+};
+// Throws InputError "<path>: <output> is the <input> file; it would be overwritten", or "<path>:
+// <output> is the <other output> file", when an output given is an input or another output
+// (same_file). Called before anything is read.
+void refuse_overwrites(const std::vector<FileOption>& inputs, const std::vector<FileOption>& outputs);
 
 // Names for untrusted ids (CityObject ids, file stems) in file and folder names that make, the
 // shell and every file system take as they are.
