@@ -244,8 +244,7 @@ RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::
   }
   std::vector<JudgedWall> moved;
   for (const auto& f : trace.facades) moved.push_back(f.wall);
-  const Judgement& verdict = trace.judgement.emplace(
-      judge_refinement(kept, chosen.mesh, moved, local, prm, prm, planes, prm.match_distance + prm.bbox_margin));
+  const Judgement& verdict = trace.judgement.emplace(judge_refinement(kept, chosen.mesh, moved, local, prm, prm));
   if (!verdict.ok)
     return run.finish(Outcome::Kept, "not written: never worse, " + verdict.check + " check: " + verdict.detail, kept);
   return run.finish(Outcome::Refined,

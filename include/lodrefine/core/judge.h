@@ -8,10 +8,7 @@
 // MatchConfig::match_distance of either model (the cap: farther points are another object's) and
 // above the lowest model vertex + kGroundBand (street ground in front of a wall moved inwards
 // would count against a right move), and not a flush neighbour's (JudgedWall::flush_facade). Its
-// distance to each model is capped at match_distance. A scanned facade line farther off is the
-// building's, not another object's: an inlier of a facade scan plane whose nearest point on
-// either model lies inside a face facing like the plane (within match_angle_deg) is judged up
-// to `facade_reach` and capped there, so a move away from a dense facade line 2 m out counts.
+// distance to each model is capped at match_distance.
 #pragma once
 #include <cstddef>
 #include <optional>
@@ -20,7 +17,6 @@
 
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/core/params.h"
-#include "lodrefine/core/planes.h"
 #include "lodrefine/core/types.h"
 
 namespace lodrefine {
@@ -50,10 +46,7 @@ struct Judgement {
   std::vector<Fit> walls;  // per JudgedWall, its region
 };
 
-// Whether `after` may replace `before` (both closed meshes, same frame as `cloud`). `planes`:
-// the scan planes detected in `cloud` (indices into it), for the facade lines beyond
-// match_distance, judged up to `facade_reach` (m; refine: match_distance + bbox_margin, the
-// reach of the selection's scan supports); without them every point is capped at match_distance.
+// Whether `after` may replace `before` (both closed meshes, same frame as `cloud`).
 // - building: refused when the capped RMS of every judged point grows by more than kRmsSlack,
 //   or when more than kWorseShare of the points that changed (by more than
 //   PlaneConfig::ransac_epsilon) got farther;
@@ -73,7 +66,6 @@ constexpr double kWorseShare = 0.25;
 constexpr int kMinGain = 50;
 constexpr double kMinRmsGain = 0.001;  // m
 Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vector<JudgedWall>& walls,
-                           const PointCloud& cloud, const MatchConfig& match, const PlaneConfig& detection,
-                           const std::vector<ScanPlane>& planes = {}, double facade_reach = 0.0);
+                           const PointCloud& cloud, const MatchConfig& match, const PlaneConfig& detection);
 
 }  // namespace lodrefine
