@@ -343,16 +343,24 @@ void add_street(Scene& sc, int budget, double noise, Rng& r) {
       push_clutter(sc, street_point(*w, r.uniform(w->smin - 2, w->smax + 2), r.uniform(0, 8), sc.z0), -3, noise, r);
 }
 
+// Whether the ground past a scanned facade's end (along `dir`), as deep behind the facade as a
+// neighbour reaches, is clear of the building: not a concave corner, nor the end of a wall that
+// stands forward of the rest of its facade (a setback's front line, a bay), where a neighbour
+// would stand in front of the building's own walls.
+bool open_end(const Scene& sc, const ScanWall& w, double end, double dir) {
+  for (double along : {0.5, 2.0, 4.0, 8.0})
+    for (double behind = 1.0; behind <= 6.0; behind += 1.0)
+      if (point_in_polygon_2d(xy(street_point(w, end + along * dir, -behind, 0)), sc.footprint)) return false;
+  return true;
+}
+
 // Pieces of the next building: a wall continuing past one end of a scanned facade (slightly
-// offset) and/or the neighbour's side wall across a gap. Only at ends where the building does
-// not continue itself (not at concave corners).
+// offset) and/or the neighbour's side wall across a gap. Only at open ends (open_end).
 void add_neighbour(Scene& sc, int budget, double noise, Rng& r) {
   std::vector<std::pair<const ScanWall*, double>> ends;  // wall, direction along u
   for (const ScanWall* w : sc.street_walls())
-    for (double dir : {-1.0, 1.0}) {
-      const double end = dir > 0 ? w->smax : w->smin;
-      if (!point_in_polygon_2d(xy(street_point(*w, end + 2 * dir, -1.0, 0)), sc.footprint)) ends.emplace_back(w, dir);
-    }
+    for (double dir : {-1.0, 1.0})
+      if (open_end(sc, *w, dir > 0 ? w->smax : w->smin, dir)) ends.emplace_back(w, dir);
   if (ends.empty()) return;
   const auto [w, dir] = ends[r.integer(0, int(ends.size()) - 1)];
   const double end = dir > 0 ? w->smax : w->smin;

@@ -130,15 +130,16 @@ INSTANTIATE_TEST_SUITE_P(AllTypes, SelectionDecidesType, ::testing::ValuesIn(all
 // cannot reach them; the selection must add them: each building is refined, its scanned walls
 // within kOnTruth of the truth.
 //
-// KNOWN SHORT (measured 2026-12-01 on main + this generator, target_points 20000): the
-// pipeline does not reach the truth on these seeds. They are still checked for a valid, closed,
-// 2-manifold shell and a solved selection, but NOT for being refined, on the truth or not worse;
-// their figures are printed. Truth facade RMSE coarse -> output (m), "kept" when not refined:
-//   recess 1: 0.754 -> 0.310   recess 2: 0.976 -> 0.340   recess 9: 0.402 -> 0.406
-//   bay 1: 0.462 kept          bay 3: 0.896 -> 0.471      bay 7: 0.505 -> 0.386
-//   setback 1: 1.367 -> 1.262  setback 3: 1.378 -> 1.555 (WORSE than the coarse model)
+// KNOWN SHORT (measured 2026-12-02, target_points 20000): the pipeline does not reach the
+// truth on these seeds. They are still checked for a valid, closed, 2-manifold shell and a
+// solved selection, but NOT for being refined, on the truth or not worse; their figures are
+// printed. Truth facade RMSE coarse -> output (m), "kept" when not refined:
+//   recess 9: 0.402 -> 0.406   bay 1: 0.462 kept          bay 3: 0.896 -> 0.471
+//   bay 7: 0.505 -> 0.386      setback 1: 1.367 -> 0.201  setback 3: 1.378 -> 1.555 (WORSE)
 //   setback 4: 1.157 -> 0.585  setback 7: 1.182 kept      setback 8: 1.654 -> 1.237
-//   setback 9: 0.568 kept
+// (recess 1 and 2 and setback 9 reach the truth since the generator no longer stands a
+// neighbour's side wall in the recess or before the rear line: the selection had taken it for
+// the side of a bay.)
 // Why (diagnosed 2026-12-02, still open):
 //   bay 3: the bay's front is a supporting plane, but its occupancy confidence is 0.70 (sparse
 //     points), one side is a hypothesised step wall without points, and the roof and ground
@@ -149,10 +150,15 @@ INSTANTIATE_TEST_SUITE_P(AllTypes, SelectionDecidesType, ::testing::ValuesIn(all
 //     the front line is then 2.33 m from the start, beyond add_scan_planes' reach
 //     (match_distance + bbox_margin), and no supporting plane. The judge caps distances at
 //     match_distance, so that line's 6241 points weigh the same before and after: it cannot see
-//     the roof and facade getting worse.
+//     the roof and facade getting worse. Judging a facade scan plane's points in front of a
+//     moved wall's outline up to that reach refuses this move, but also refuses a right one:
+//     generated gable 11 (CityFile.GeneratedCityRefinedIntoCityJson2, truth 0.274 -> 0.011 m)
+//     has a neighbour's side wall across an alley before its moved gable end. What tells the
+//     two apart is still to be found (a setback's front line stands where the rear line has no
+//     points; a neighbour across a gap stands before the wall's own points).
 // Remove a seed from kKnownShort when the pipeline reaches it (the test prints "now reaches").
 const std::map<BuildingType, std::set<std::uint64_t>> kKnownShort{
-    {BuildingType::Recess, {1, 2, 9}}, {BuildingType::Bay, {1, 3, 7}}, {BuildingType::Setback, {1, 3, 4, 7, 8, 9}}};
+    {BuildingType::Recess, {9}}, {BuildingType::Bay, {1, 3, 7}}, {BuildingType::Setback, {1, 3, 4, 7, 8}}};
 constexpr std::uint64_t kStreetSeeds = 10;
 
 class SelectionAddsFaces : public ::testing::TestWithParam<BuildingType> {};

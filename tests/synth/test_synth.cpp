@@ -367,6 +367,31 @@ TEST(SynthOptionsEffect, NuisancesAddEveryClutterClass) {
   EXPECT_GT(seen[-4], 0);  // neighbour
 }
 
+// A neighbour stands past an open end of the street facade: never in the building's own
+// footprint hull (in a recess, or before a setback's rear line, where it once stood against the
+// facade and the selection took its side wall for a bay's side).
+TEST(SynthNuisances, NoNeighbourStandsInTheBuildingsFootprintHull) {
+  int neighbours = 0;
+  for (BuildingType t : {BuildingType::Recess, BuildingType::Bay, BuildingType::Setback, BuildingType::LShape})
+    for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+      const auto b = make_building(t, seed);
+      SCOPED_TRACE(b.id);
+      std::vector<Vec2> xy;
+      for (const auto& v : b.truth.vertices) xy.emplace_back(v.x(), v.y());
+      const std::vector<Vec2> hull = convex_hull_2d(xy);
+      for (std::size_t i = 0; i < b.cloud.points.size(); ++i) {
+        if (b.point_label[i] != -4) continue;
+        ++neighbours;
+        const Vec2 q(b.cloud.points[i].x(), b.cloud.points[i].y());
+        double edge = 1e300;
+        for (std::size_t k = 0; k < hull.size(); ++k)
+          edge = std::min(edge, segment_distance_2d(q, hull[k], hull[(k + 1) % hull.size()]));
+        ASSERT_FALSE(point_in_polygon_2d(q, hull) && edge > 0.05) << "a neighbour point " << edge << " m inside";
+      }
+    }
+  EXPECT_GT(neighbours, 0);
+}
+
 TEST(SynthDefects, LoggedDefectsArePresentInTheSoup) {
   int missing_ground = 0, duplicates = 0, reversed = 0, gaps = 0;
   for (std::uint64_t seed = 1; seed <= 24; ++seed) {
