@@ -171,13 +171,6 @@ struct Thinning {
   }
 };
 
-// The voxel edge detection thins to: detect_voxel when set, none when 0, else (negative) the
-// largest voxel whose neighbouring representatives on a plane, a voxel diagonal apart, stay
-// within ransac_cluster_epsilon: RANSAC's connectivity is then that of the full cloud.
-double detection_voxel(const PlaneConfig& prm) {
-  return prm.detect_voxel >= 0.0 ? prm.detect_voxel : prm.ransac_cluster_epsilon / std::sqrt(2.0);
-}
-
 // The cloud grouped by voxels of `voxel` (no thinning when 0 or when the grid would not fit the
 // key). Copies of a point are found within their voxel, by sorting it.
 Thinning thin_to_voxels(const PointCloud& cloud, double voxel) {
@@ -356,7 +349,7 @@ std::vector<std::vector<int>> take_back(const PointCloud& cloud, const Thinning&
 std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const PlaneConfig& prm) {
   std::vector<ScanPlane> result;
   if (cloud.points.size() < min_cloud_points(prm)) return result;
-  Thinning thinning = thin_to_voxels(cloud, detection_voxel(prm));
+  Thinning thinning = thin_to_voxels(cloud, prm.detect_voxel);
   std::size_t distinct = thinning.distinct;
   if (!thinning.thinned()) {
     thinning.reps = distinct_points(cloud, prm);
