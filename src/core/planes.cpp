@@ -3,9 +3,7 @@
 #include "lodrefine/core/planes.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Orthogonal_k_neighbor_search.h>
 #include <CGAL/Random.h>
-#include <CGAL/Search_traits_3.h>
 #include <CGAL/Shape_detection/Efficient_RANSAC.h>
 #include <CGAL/pca_estimate_normals.h>
 #include <CGAL/property_map.h>
@@ -14,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <tuple>
 #include <unordered_map>
 
@@ -120,6 +119,12 @@ std::size_t min_cloud_points(const PlaneConfig& prm) {
   return std::size_t(std::max(prm.ransac_min_points, prm.normal_neighbors + 1));
 }
 
+// Whether a cloud of `distinct` distinct points can hold a plane: enough of them, spanning enough.
+bool holds_planes(const PointCloud& cloud, std::size_t distinct, const PlaneConfig& prm) {
+  return distinct >= min_cloud_points(prm) &&
+         bounding_box(cloud.points).diagonal().norm() >= kMinExtentEpsilons * prm.ransac_epsilon;
+}
+
 // Exact duplicates carry no shape and make RANSAC's octree loop forever (a cloud of one repeated
 // point hangs it). The cloud's distinct points in file order (which keeps runs reproducible), or
 // none when they are too few or span too little to hold a plane.
@@ -133,19 +138,24 @@ std::vector<int> distinct_points(const PointCloud& cloud, const PlaneConfig& prm
   std::sort(order.begin(), order.end(), less);
   order.erase(std::unique(order.begin(), order.end(), [&](int a, int b) { return cloud.points[a] == cloud.points[b]; }),
               order.end());
-  if (order.size() < min_cloud_points(prm)) return {};
-  if (bounding_box(cloud.points, order).diagonal().norm() < kMinExtentEpsilons * prm.ransac_epsilon) return {};
+  if (!holds_planes(cloud, order.size(), prm)) return {};
   std::sort(order.begin(), order.end());
   return order;
 }
 
-// One representative point per voxel: detection's cost grows with the points, not with the
-// facade area, so a dense scan is thinned to the voxel size before detection.
+// The cloud grouped by voxel, one representative point per voxel: detection's cost grows with
+// the points, not with the facade area, so a dense scan is thinned to the voxel size before
+// detection. The groups serve the representatives' normals and the take-back without a tree.
 struct Thinning {
   Vec3 lo = Vec3::Zero();
-  double size = 0.0;                                 // voxel edge (m); 0: no thinning
-  std::vector<int> reps;                             // cloud indices, one per occupied voxel
-  std::unordered_map<std::uint64_t, int> voxel_rep;  // voxel key -> position in reps
+  double size = 0.0;                                // voxel edge (m); 0: no thinning
+  std::vector<int> reps;                            // cloud indices: each voxel's first point, voxels in file order
+  std::vector<int> voxel_of;                        // per cloud point, its voxel (position in reps)
+  std::vector<int> first;                           // voxel v holds members[first[v] .. first[v + 1])
+  std::vector<int> members;                         // cloud indices by voxel, copies of a point adjacent
+  std::vector<char> copy;                           // per member: an exact copy of the member before it
+  std::unordered_map<std::uint64_t, int> voxel_id;  // voxel key -> position in reps
+  std::size_t distinct = 0;                         // points that are not copies
 
   bool thinned() const { return size > 0.0; }
   Eigen::Array3i cell(const Vec3& p) const { return ((p - lo) / size).array().floor().cast<int>(); }
@@ -153,28 +163,46 @@ struct Thinning {
     return (std::uint64_t(c.x()) << (2 * kVoxelKeyBits)) | (std::uint64_t(c.y()) << kVoxelKeyBits) |
            std::uint64_t(c.z());
   }
-  // The position in reps of the voxel at `c`, or -1 (none there, or outside the grid).
-  int rep_at(const Eigen::Array3i& c) const {
+  // The voxel at `c`, or -1 (none there, or outside the grid).
+  int voxel_at(const Eigen::Array3i& c) const {
     if ((c < 0).any() || (c >= (1 << kVoxelKeyBits)).any()) return -1;
-    const auto it = voxel_rep.find(key(c));
-    return it == voxel_rep.end() ? -1 : it->second;
+    const auto it = voxel_id.find(key(c));
+    return it == voxel_id.end() ? -1 : it->second;
   }
 };
 
-// The first distinct point of each voxel of `prm.detect_voxel` (all of them when it is 0 or the
-// grid would not fit the key).
-Thinning thin_to_voxels(const PointCloud& cloud, const std::vector<int>& order, const PlaneConfig& prm) {
+// The cloud grouped by voxels of `voxel` (no thinning when 0 or when the grid would not fit the
+// key). Copies of a point are found within their voxel, by sorting it.
+Thinning thin_to_voxels(const PointCloud& cloud, double voxel) {
   Thinning t;
-  const Eigen::AlignedBox3d box = bounding_box(cloud.points, order);
-  const double voxel = prm.detect_voxel;
-  if (voxel <= 0 || (box.diagonal() / voxel).maxCoeff() >= double((1 << kVoxelKeyBits) - 1)) {
-    t.reps = order;
-    return t;
-  }
+  const Eigen::AlignedBox3d box = bounding_box(cloud.points);
+  if (voxel <= 0 || (box.diagonal() / voxel).maxCoeff() >= double((1 << kVoxelKeyBits) - 1)) return t;
   t.lo = box.min();
   t.size = voxel;
-  for (int i : order)
-    if (t.voxel_rep.emplace(Thinning::key(t.cell(cloud.points[i])), int(t.reps.size())).second) t.reps.push_back(i);
+  const int n = int(cloud.points.size());
+  t.voxel_of.resize(std::size_t(n));
+  for (int i = 0; i < n; ++i) {
+    const auto [it, added] = t.voxel_id.emplace(Thinning::key(t.cell(cloud.points[i])), int(t.reps.size()));
+    if (added) t.reps.push_back(i);
+    t.voxel_of[i] = it->second;
+  }
+  t.first.assign(t.reps.size() + 1, 0);
+  for (int v : t.voxel_of) ++t.first[std::size_t(v) + 1];
+  for (std::size_t v = 0; v < t.reps.size(); ++v) t.first[v + 1] += t.first[v];
+  t.members.resize(std::size_t(n));
+  std::vector<int> next(t.first.begin(), t.first.end() - 1);
+  for (int i = 0; i < n; ++i) t.members[std::size_t(next[t.voxel_of[i]]++)] = i;
+  t.copy.assign(std::size_t(n), 0);
+  auto less = [&](int a, int b) {
+    const auto &p = cloud.points[a], &q = cloud.points[b];
+    return std::tie(p.x(), p.y(), p.z(), a) < std::tie(q.x(), q.y(), q.z(), b);
+  };
+  for (std::size_t v = 0; v < t.reps.size(); ++v) {
+    std::sort(t.members.begin() + t.first[v], t.members.begin() + t.first[v + 1], less);
+    for (int m = t.first[v] + 1; m < t.first[v + 1]; ++m)
+      t.copy[std::size_t(m)] = cloud.points[t.members[m]] == cloud.points[t.members[m - 1]];
+  }
+  t.distinct = std::size_t(std::count(t.copy.begin(), t.copy.end(), 0));
   return t;
 }
 
@@ -192,23 +220,60 @@ double detection_cluster_epsilon(const Thinning& t, const PlaneConfig& prm) {
   return std::max(prm.ransac_cluster_epsilon, std::sqrt(2.0) * t.size);
 }
 
-// The representatives' normals from their k nearest points of the full cloud (the distinct
-// points `order`): the same neighbourhoods as without thinning. Normals of the thinned cloud
-// itself span several voxels and blur at a corner, where RANSAC then found a diagonal plane
-// through the two walls' edges (topo dev tile, TOPO0014 at 0.1 m: 151 points, 25° off the front wall).
-void estimate_normals_in_full_cloud(PointList& pts, const PointCloud& cloud, const std::vector<int>& order, int k) {
-  using KnnTraits = CGAL::Search_traits_3<Kernel>;
-  using Knn = CGAL::Orthogonal_k_neighbor_search<KnnTraits>;
-  std::vector<Point> all;
-  all.reserve(order.size());
-  for (int i : order) all.emplace_back(cloud.points[i].x(), cloud.points[i].y(), cloud.points[i].z());
-  Knn::Tree tree(all.begin(), all.end());
-  tree.build();
+// The k nearest distinct points of the cloud to `p` (p itself among them), searched ring by ring
+// of voxels around p's, skipping voxels farther than the k-th nearest so far: exact when the k-th
+// lies within the searched block of kMaxRing rings. Beyond them, only while fewer than k are
+// found, up to `max_ring` rings (kFarRing at most: a bounded search per point for voxels much
+// smaller than the point spacing); a point with k others only farther gets the k nearest found.
+constexpr int kMaxRing = 2;
+constexpr int kFarRing = 8;
+void nearest_in_voxels(const PointCloud& cloud, const Thinning& t, const Vec3& p, int k, int max_ring,
+                       std::vector<std::pair<double, int>>& found) {
+  const Eigen::Array3i c = t.cell(p);
+  const Eigen::Array3d in_cell = (p - t.lo).array() / t.size - c.cast<double>();  // in [0, 1)^3
+  // Squared distance from p to the voxel at offset d (in voxels, 0 along an axis of p's voxel).
+  auto gap2 = [&](const Eigen::Array3i& d) {
+    const Eigen::Array3d lo = d.cast<double>() - in_cell, hi = lo + 1.0;
+    return (lo.max(0.0) - hi.min(0.0)).matrix().squaredNorm() * t.size * t.size;
+  };
+  const std::size_t want = std::size_t(k);
+  double kth2 = std::numeric_limits<double>::infinity();
+  found.clear();
+  for (int ring = 0; ring <= std::max(kMaxRing, max_ring); ++ring) {
+    for (int dx = -ring; dx <= ring; ++dx)
+      for (int dy = -ring; dy <= ring; ++dy)
+        for (int dz = -ring; dz <= ring; ++dz) {
+          const Eigen::Array3i d(dx, dy, dz);
+          if (d.abs().maxCoeff() != ring || gap2(d) > kth2) continue;
+          const int v = t.voxel_at(c + d);
+          if (v < 0) continue;
+          for (int m = t.first[v]; m < t.first[v + 1]; ++m)
+            if (!t.copy[m]) found.emplace_back((cloud.points[t.members[m]] - p).squaredNorm(), t.members[m]);
+        }
+    if (found.size() < want) continue;
+    std::nth_element(found.begin(), found.begin() + long(want) - 1, found.end());
+    found.resize(want);
+    kth2 = found.back().first;
+    const double reach = t.size * (ring + std::min(in_cell.minCoeff(), 1.0 - in_cell.maxCoeff()));
+    if (kth2 <= reach * reach || ring >= kMaxRing) break;
+  }
+}
+
+// The representatives' normals from their k nearest points of the full cloud (its distinct
+// points): the same neighbourhoods as without thinning. Normals of the thinned cloud itself
+// span several voxels and blur at a corner, where RANSAC then found a diagonal plane through
+// the two walls' edges (topo dev tile, TOPO0014 at 0.1 m: 151 points, 25° off the front wall).
+void estimate_normals_in_full_cloud(PointList& pts, const PointCloud& cloud, const Thinning& t,
+                                    const PlaneConfig& prm) {
+  // Neighbours are sought up to ransac_cluster_epsilon away, RANSAC's reach of one surface.
+  const int max_ring = int(std::min<double>(kFarRing, std::ceil(prm.ransac_cluster_epsilon / t.size)));
+  std::vector<std::pair<double, int>> found;
   std::vector<Vec3> near;
   for (auto& p : pts) {
-    const Knn search(tree, std::get<0>(p), unsigned(k));
+    nearest_in_voxels(cloud, t, cloud.points[std::get<2>(p)], prm.normal_neighbors, max_ring, found);
+    if (found.size() < 3) continue;  // no normal: the point joins no plane
     near.clear();
-    for (const auto& [q, d2] : search) near.emplace_back(q.x(), q.y(), q.z());
+    for (const auto& [d2, i] : found) near.push_back(cloud.points[i]);
     const Vec3 n = fit_plane(near).n;
     std::get<1>(p) = Vector(n.x(), n.y(), n.z());
   }
@@ -216,7 +281,7 @@ void estimate_normals_in_full_cloud(PointList& pts, const PointCloud& cloud, con
 
 // Efficient RANSAC on the representatives with their PCA normals: each shape's inliers as cloud
 // indices, in CGAL's order of detection.
-std::vector<std::vector<int>> ransac_shapes(const PointCloud& cloud, const Thinning& t, const std::vector<int>& order,
+std::vector<std::vector<int>> ransac_shapes(const PointCloud& cloud, const Thinning& t, std::size_t distinct,
                                             const PlaneConfig& prm) {
   PointList pts;
   pts.reserve(t.reps.size());
@@ -224,7 +289,7 @@ std::vector<std::vector<int>> ransac_shapes(const PointCloud& cloud, const Thinn
     const auto& p = cloud.points[i];
     pts.emplace_back(Point(p.x(), p.y(), p.z()), Vector(0, 0, 0), i);
   }
-  if (t.thinned()) estimate_normals_in_full_cloud(pts, cloud, order, prm.normal_neighbors);
+  if (t.thinned()) estimate_normals_in_full_cloud(pts, cloud, t, prm);
   else
     CGAL::pca_estimate_normals<CGAL::Sequential_tag>(pts, prm.normal_neighbors,
                                                      CGAL::parameters::point_map(PointMap()).normal_map(NormalMap()));
@@ -237,7 +302,7 @@ std::vector<std::vector<int>> ransac_shapes(const PointCloud& cloud, const Thinn
   ransac.add_shape_factory<RansacPlane>();
   Ransac::Parameters rp;
   rp.probability = prm.ransac_probability;
-  rp.min_points = detection_min_points(t, order.size(), prm);
+  rp.min_points = detection_min_points(t, distinct, prm);
   rp.epsilon = prm.ransac_epsilon;
   rp.cluster_epsilon = detection_cluster_epsilon(t, prm);
   rp.normal_threshold = std::cos(radians(prm.ransac_normal_deg));
@@ -267,14 +332,13 @@ std::vector<std::vector<int>> take_back(const PointCloud& cloud, const Thinning&
     std::vector<Vec3> q;
     for (int i : shapes[s]) {
       q.push_back(cloud.points[i]);
-      rep_shape[t.rep_at(t.cell(cloud.points[i]))] = s;
+      rep_shape[t.voxel_of[i]] = s;
     }
     fitted.push_back(fit_plane(q));
   }
   std::vector<std::vector<int>> full(shapes.size());
   for (int i = 0; i < int(cloud.points.size()); ++i) {
-    const int r = t.rep_at(t.cell(cloud.points[i]));
-    const int s = r < 0 ? -1 : rep_shape[r];
+    const int s = rep_shape[t.voxel_of[i]];
     if (s >= 0 && std::abs(fitted[s].distance(cloud.points[i])) <= prm.ransac_epsilon) full[s].push_back(i);
   }
   return full;
@@ -285,11 +349,16 @@ std::vector<std::vector<int>> take_back(const PointCloud& cloud, const Thinning&
 std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const PlaneConfig& prm) {
   std::vector<ScanPlane> result;
   if (cloud.points.size() < min_cloud_points(prm)) return result;
-  const std::vector<int> order = distinct_points(cloud, prm);
-  if (order.empty()) return result;
-  const Thinning thinning = thin_to_voxels(cloud, order, prm);
+  Thinning thinning = thin_to_voxels(cloud, prm.detect_voxel);
+  std::size_t distinct = thinning.distinct;
+  if (!thinning.thinned()) {
+    thinning.reps = distinct_points(cloud, prm);
+    distinct = thinning.reps.size();
+  } else if (!holds_planes(cloud, distinct, prm)) {
+    return result;
+  }
   if (thinning.reps.size() < std::size_t(prm.normal_neighbors) + 1) return result;
-  std::vector<std::vector<int>> shapes = ransac_shapes(cloud, thinning, order, prm);
+  std::vector<std::vector<int>> shapes = ransac_shapes(cloud, thinning, distinct, prm);
   if (thinning.thinned()) shapes = take_back(cloud, thinning, shapes, prm);
   for (auto& inl : shapes) {
     if (inl.size() < std::max<std::size_t>(3, std::size_t(prm.ransac_min_points))) continue;
