@@ -7,6 +7,7 @@
 #include "lodrefine/core/candidates.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <chrono>
 #include <cmath>
 
@@ -63,33 +64,44 @@ std::string SelectionResult::warm_text() const {
 
 namespace {
 
-// The search's work, counted in tableau entries (rows x columns of the problem GLPK works on):
-// each LP solve of the search (a node, or a round of cuts at the root, whose generators scan the
-// tableau; measured 3-5 ns of CPU per entry on the real dev tile's 1,300-5,700 column programs) and each simplex
-// iteration of the relaxation (one row and one column: rows + columns). A count of what GLPK
-// did, not of seconds, so a search that reaches it ends at the same point on any machine load.
+// The search's work, counted in tableau entries: each simplex iteration (of the relaxation and
+// of every node's LP) one row and one column (rows + columns), each round of cuts at the root the
+// whole tableau (rows x columns: its generators scan it; measured 3-5 ns of CPU per entry on the
+// real dev tile's 1,300-5,700 column programs). A count of what GLPK did, not of seconds, so a
+// search that reaches it ends at the same point on any machine load.
 double tableau_size(glp_prob* lp) { return double(glp_get_num_rows(lp)) * double(glp_get_num_cols(lp)); }
+double iteration_size(glp_prob* lp) { return double(glp_get_num_rows(lp)) + double(glp_get_num_cols(lp)); }
+
+// Until the search holds a solution, it may spend this many budgets to find one (no warm start,
+// or GLPK refused it): a building is then kept only when none is found even so.
+constexpr double kFirstSolutionBudgets = 10.0;
 
 // The callback's state: the starting point (GLPK's 1-based column values) and what GLPK made of
-// it; the last relative gap seen; the work done and the budget.
+// it; the last relative gap seen; the work done, the simplex iterations counted in it and the
+// budget.
 struct Search {
   std::vector<double> start;  // empty: no warm start
   bool asked = false, accepted = false;
   double gap = 0.0;
   double work = 0.0, budget = 0.0;
-  int solves = 0;  // LP solves begun in the search
+  int iterations = 0;  // glp_get_it_cnt when work was last brought up to date
 };
 
-// Whether the search has spent its budget: checked before an LP solve (the root's first always
-// runs, so a warm start reaches GLPK) and before a round of cuts (what they cost is like a solve).
+// Brings the work up to date with the iterations GLPK made since, and tells whether the search
+// has spent its budget (checked before each node's LP solve and before a round of cuts).
 bool budget_spent(glp_tree* tree, Search& s, int reason) {
-  const double next = tableau_size(glp_ios_get_prob(tree));
-  if (reason == GLP_IPREPRO) {
-    if (s.solves > 0 && s.work + next > s.budget) return true;
-    s.work += next, ++s.solves;
+  glp_prob* lp = glp_ios_get_prob(tree);
+  const int it = glp_get_it_cnt(lp);
+  s.work += double(it >= s.iterations ? it - s.iterations : it) * iteration_size(lp);
+  s.iterations = it;
+  const bool solved = glp_ios_mip_gap(tree) < DBL_MAX;  // an incumbent exists
+  const double budget = solved ? s.budget : kFirstSolutionBudgets * s.budget;
+  if (reason == GLP_ICUTGEN) {
+    if (s.work + tableau_size(lp) > budget) return true;
+    s.work += tableau_size(lp);
     return false;
   }
-  return reason == GLP_ICUTGEN && s.work + next > s.budget;
+  return reason == GLP_IPREPRO && s.work > budget;
 }
 
 void on_search(glp_tree* tree, void* info) {
@@ -348,11 +360,12 @@ int solve(glp_prob* lp, glp_iocp& parm, Search& search, bool warm) {
     lpp.msg_lev = GLP_MSG_OFF;
     lpp.presolve = GLP_ON;
     lpp.tm_lim = parm.tm_lim;
-    const double per_iteration = double(glp_get_num_rows(lp)) + double(glp_get_num_cols(lp));
+    const double per_iteration = iteration_size(lp);
     lpp.it_lim = int(std::min(2.0e9, std::floor(search.budget / per_iteration)));
     const auto t0 = std::chrono::steady_clock::now();
     ret = glp_simplex(lp, &lpp);
-    search.work += per_iteration * glp_get_it_cnt(lp);
+    search.iterations = glp_get_it_cnt(lp);
+    search.work += per_iteration * search.iterations;
     parm.presolve = GLP_OFF;
     // The relaxation spent part of the budget: the search gets what is left, not all of it again.
     const double spent_ms = 1000.0 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
