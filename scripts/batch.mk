@@ -40,10 +40,10 @@ BINARY := $(if $(findstring /,$(LODREFINE)),$(abspath $(LODREFINE)),$(LODREFINE)
 INNER = $(MAKE) --no-print-directory -C $(call quote,$(RUN)) -f $(call quote,$(BATCH_MK)) \
         LODREFINE_BATCH_DIR=$(call quote,$(RUN)) LODREFINE=$(call quote,$(BINARY))
 all refined todo clean-results:
-	@$(INNER) $@
+	@+$(INNER) $@
 # One building's output, e.g. RUN/<id>/refined.obj.
 .DEFAULT:
-	@$(INNER) $(call quote,$(subst $(RUN)/,,$@))
+	@+$(INNER) $(call quote,$(subst $(RUN)/,,$@))
 
 else
 # Inside RUN: every name below is a checked building folder name or a fixed one.

@@ -139,6 +139,36 @@ TEST_F(Batch, SecondConcurrentRunIsRefusedWithOneLine) {
   fs::remove_all(run);
 }
 
+// `make -j2` refines two buildings at once: batch.mk's outer make hands its job slots to the inner
+// one (a '+' recipe; without it the inner make warned "jobserver unavailable" and ran one at a
+// time). Each refine waits up to 10 s for another to be running beside it.
+TEST_F(Batch, JobsRefineBuildingsAtOnce) {
+  const fs::path run = fresh_dir("batch_jobs");
+  copy_run(*inputs_, run);
+  const fs::path meet = run.parent_path() / (run.filename().string() + "_meet.sh");
+  std::ofstream(meet) << R"sh(#!/bin/sh
+m=../.running.$$
+touch "$m"
+i=0
+while [ $i -lt 200 ]; do
+  [ "$(ls ../.running.* | wc -l)" -ge 2 ] && { touch ../.together; break; }
+  sleep 0.05; i=$((i + 1))
+done
+')sh" << kBinary << R"sh(' "$@"
+rc=$?
+rm -f "$m"
+exit $rc
+)sh";
+  fs::permissions(meet, fs::perms::owner_all);
+  const fs::path log = run.parent_path() / (run.filename().string() + "_jobs.log");
+  EXPECT_EQ(shell(batch_command(run, "LODREFINE=" + shell_quoted(meet)) + " > " + shell_quoted(log) + " 2>&1"), 0);
+  EXPECT_TRUE(fs::exists(run / ".together")) << "no two buildings were refined at once";
+  EXPECT_EQ(read_text(log).find("jobserver unavailable"), std::string::npos) << read_text(log);
+  fs::remove(run / ".together");
+  EXPECT_EQ(outcome_files(run), *reference_);
+  fs::remove_all(run);
+}
+
 TEST_F(Batch, SigkillAnywhereThenRerunEqualsUninterruptedRun) {
   const fs::path run = fresh_dir("batch_kill");
   copy_run(*inputs_, run);

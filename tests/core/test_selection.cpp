@@ -1,15 +1,14 @@
 // Stage 4b: face selection by GLPK over the candidate arrangement.
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <cmath>
 #include <random>
-#include <thread>
 
 #include "lodrefine/core/candidates.h"
 #include "lodrefine/core/confidence.h"
 #include "lodrefine/core/selection.h"
 #include "support/candidate_fixtures.h"
+#include "support/cpu_burners.h"
 
 using namespace lodrefine;
 using namespace lodrefine::fixtures;
@@ -178,19 +177,12 @@ TEST(Selection, TheWorkBudgetEndsTheSearchAtTheSamePointUnderAnyLoad) {
   EXPECT_LE(quiet.work, prm.mip_work_limit);
   EXPECT_TRUE(every_edge_used_0_or_2(cs, quiet_selected));
 
-  std::atomic<bool> stop{false};
-  std::vector<std::thread> burners;
-  for (int t = 0; t < 2; ++t)
-    burners.emplace_back([&stop] {
-      volatile double x = 1.0;
-      while (!stop) x = x * 1.0000001 + 1e-9;
-    });
+  fixtures::CpuBurners burners(2);
   std::vector<SelectionResult> runs;
   std::vector<std::vector<char>> selections;
   for (double limit : {prm.mip_time_limit, 3600.0, 1000.0}) {
     if (limit == 1000.0) {  // and once more on a quiet machine
-      stop = true;
-      for (auto& t : burners) t.join();
+      burners.stop();
     }
     runs.push_back(select_faces(cs, pg, prm, limit));
     selections.push_back(selected_faces(cs));

@@ -5,17 +5,16 @@
 #include <gtest/gtest.h>
 
 #include "support/cli_fixtures.h"
+#include "support/cpu_burners.h"
 #include "support/mesh_fixtures.h"
 #include "support/scan_fixtures.h"
 
-#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
 #include <random>
-#include <thread>
 
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/core/params.h"
@@ -646,13 +645,7 @@ TEST(CityFile, JobsWriteTheSameBytesWhenSelectionsEndAtTheBudget) {
   write_ply(dir + "/cloud.ply", cloud);
   Params prm;
   prm.mip_work_limit = 0.02;
-  std::atomic<bool> stop{false};
-  std::vector<std::thread> burners;
-  for (int t = 0; t < 2; ++t)
-    burners.emplace_back([&stop] {
-      volatile double x = 1.0;
-      while (!stop) x = x * 1.0000001 + 1e-9;
-    });
+  fixtures::CpuBurners burners(2);
   std::map<int, std::string> written;
   int at_budget = 0;
   for (int jobs : {1, 2}) {
@@ -669,8 +662,7 @@ TEST(CityFile, JobsWriteTheSameBytesWhenSelectionsEndAtTheBudget) {
     std::ifstream f(out, std::ios::binary);
     written[jobs].assign(std::istreambuf_iterator<char>(f), {});
   }
-  stop = true;
-  for (auto& t : burners) t.join();
+  burners.stop();
   EXPECT_GE(at_budget, 1) << "no selection reached the budget: the test shows nothing";
   EXPECT_EQ(written[1], written[2]) << "--jobs 2 wrote other bytes than --jobs 1";
 }
