@@ -48,21 +48,21 @@ namespace lodrefine {
   X(double, w_normal, 0.5, 0.0, 1.0, "matching score weight of |S_normal|")                                            \
   X(double, w_coverage, 0.5, 0.0, 1.0, "matching score weight of the OBB IoU C_bbox")
 
-#define LODREFINE_SELECTION_PARAMS(X)                                                                                \
-  X(double, bbox_expand, 0.1, 0.0, 2.0, "relative expansion of the bounding box on each side")                       \
-  X(double, bbox_margin, 1.0, 0.0, 100.0, "absolute expansion of the bounding box on each side (m)")                 \
-  X(double, merge_angle_deg, 5.0, 0.0, 30.0, "planes within this angle (and merge_distance) are merged (deg)")       \
-  X(double, merge_distance, 0.05, 0.0, 5.0, "planes closer than this (and within merge_angle_deg) are merged (m)")   \
-  X(double, tau_cov, 0.3, 0.0, 1.0, "coverage threshold tau_cov: inflection of the sigmoid coverage cost")           \
-  X(double, lambda_coverage, 1.0, 0.0, 1e6, "weight of the coverage term")                                           \
-  X(double, lambda_complexity, 0.2, 0.0, 1e6, "weight of the complexity (sharp edge) term")                          \
-  X(double, mip_work_limit, 60.0, 0.0, 1e9,                                                                          \
-    "GLPK work budget of a face selection (millions of tableau entries: rows + columns per simplex iteration, "      \
-    "rows x columns per round of cuts; 60 is ~0.3 s of CPU; up to 10 budgets until a first selection is found); at " \
-    "the budget the best selection found, at least the starting shell, is taken")                                    \
-  X(double, mip_time_limit, 30.0, 0.001, 86400.0,                                                                    \
-    "wall-clock safety ceiling of a face selection (s), far above what mip_work_limit takes; results that reach "    \
-    "it depend on the machine's load")                                                                               \
+#define LODREFINE_SELECTION_PARAMS(X)                                                                               \
+  X(double, bbox_expand, 0.1, 0.0, 2.0, "relative expansion of the bounding box on each side")                      \
+  X(double, bbox_margin, 1.0, 0.0, 100.0, "absolute expansion of the bounding box on each side (m)")                \
+  X(double, merge_angle_deg, 5.0, 0.0, 30.0, "planes within this angle (and merge_distance) are merged (deg)")      \
+  X(double, merge_distance, 0.05, 0.0, 5.0, "planes closer than this (and within merge_angle_deg) are merged (m)")  \
+  X(double, tau_cov, 0.3, 0.0, 1.0, "coverage threshold tau_cov: inflection of the sigmoid coverage cost")          \
+  X(double, lambda_coverage, 1.0, 0.0, 1e6, "weight of the coverage term")                                          \
+  X(double, lambda_complexity, 0.2, 0.0, 1e6, "weight of the complexity (sharp edge) term")                         \
+  X(double, mip_work_limit, 60.0, 0.0, 1e9,                                                                         \
+    "GLPK work budget of a face selection (millions of tableau entries: rows + columns per simplex iteration, "     \
+    "rows x columns per round of cuts; 60 is ~0.3 s of CPU; up to 4 budgets until a first selection is found); at " \
+    "the budget the best selection found, at least the starting shell, is taken")                                   \
+  X(double, mip_time_limit, 30.0, 0.001, 86400.0,                                                                   \
+    "wall-clock safety ceiling of a face selection (s), far above what mip_work_limit takes; results that reach "   \
+    "it depend on the machine's load")                                                                              \
   X(double, mip_gap, 1e-4, 0.0, 1.0, "GLPK relative MIP gap")
 
 #define LODREFINE_CONFIDENCE_PARAMS(X)                                                                               \
