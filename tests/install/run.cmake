@@ -1,6 +1,7 @@
 # CTest `install`: installs the build tree into a fresh prefix, then configures, builds and runs
-# tests/install/consumer against it with find_package(lodrefine). Catches a package that no
-# longer installs a header, exports a target or finds a dependency.
+# tests/install/consumer against it with find_package(lodrefine), and reads CityGML with the
+# installed app. Catches a package that no longer installs a header, exports a target, finds a
+# dependency or installs the CityGML module where the app looks for it.
 #   cmake -DBUILD=<build dir> -DSOURCE=<source dir> -DWORK=<scratch dir> -P tests/install/run.cmake
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
@@ -28,3 +29,9 @@ run("configure the consumer" ${CMAKE_COMMAND} -S ${SOURCE}/tests/install/consume
 run("build the consumer" ${CMAKE_COMMAND} --build ${WORK}/build)
 run("run the consumer" ${WORK}/build/consumer ${WORK}/box.obj)
 message(STATUS "${last_output}")
+# The installed app finds its CityGML module (<libdir>/lodrefine/, relative to bin/).
+run("convert CityGML with the installed app" ${WORK}/prefix/bin/lodrefine convert
+    --citygml ${SOURCE}/tests/fuzz/corpus/fuzz_citygml/thematic.gml --out-dir ${WORK}/citygml)
+if(NOT EXISTS ${WORK}/citygml/t.obj)
+  message(FATAL_ERROR "install test: the installed app did not convert CityGML:\n${last_output}")
+endif()
