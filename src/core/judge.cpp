@@ -158,6 +158,9 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
   Eigen::AlignedBox3d box = bounding_box(before.vertices);
   box.extend(bounding_box(after.vertices));
   const double ground = box.min().z() + kGroundBand;
+  Eigen::AlignedBox3d within_cap = box;  // beyond it only a facade line's points are judged
+  within_cap.min() -= Vec3::Constant(cap);
+  within_cap.max() += Vec3::Constant(cap);
   box.min() -= Vec3::Constant(reach);
   box.max() += Vec3::Constant(reach);
   const MeshDistance d0(before), d1(after);
@@ -172,7 +175,9 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
   Columns own0(f0.size()), own1(f1.size());
   for (std::size_t i = 0; i < cloud.points.size(); ++i) {
     const Vec3& p = cloud.points[i];
-    if (!box.contains(p) || p.z() < ground || neighbours(p, walls, on_plane)) continue;
+    if (!box.contains(p) || (facade[i] < 0 && !within_cap.contains(p)) || p.z() < ground ||
+        neighbours(p, walls, on_plane))
+      continue;
     const auto a = d0.nearest(p, false), b = d1.nearest(p, false);
     if (reach > cap && a.distance <= cap) own0[std::size_t(a.face)].insert(column_of(p, f0[std::size_t(a.face)]));
     if (reach > cap && b.distance <= cap) own1[std::size_t(b.face)].insert(column_of(p, f1[std::size_t(b.face)]));
