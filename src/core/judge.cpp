@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <set>
 
 #include "lodrefine/core/corners.h"
 #include "lodrefine/core/distance.h"
@@ -105,21 +106,98 @@ bool neighbours(const Vec3& p, const std::vector<JudgedWall>& walls, double on_p
   return false;
 }
 
-// The points near either model with their capped distances.
+// The facade plane each point of the cloud is an inlier of (-1: none).
+std::vector<int> facade_plane_of(const std::vector<ScanPlane>& planes, std::size_t points) {
+  std::vector<int> of(points, -1);
+  for (std::size_t k = 0; k < planes.size(); ++k)
+    if (planes[k].facade)
+      for (int i : planes[k].inliers)
+        if (i >= 0 && std::size_t(i) < points) of[std::size_t(i)] = int(k);
+  return of;
+}
+
+// Whether a facade plane's inlier at `near` (its nearest point on a model) faces that model's
+// face: the face turned from the plane by at most `max_angle_deg`, and the point's foot on the
+// face's plane inside the face (its distance is the plane distance), not beside the model.
+bool faces_the_face(const Vec3& p, const Plane& scan, const MeshDistance::Nearest& near,
+                    const std::vector<Plane>& face_planes, double max_angle_deg, double tolerance) {
+  const Plane& f = face_planes[std::size_t(near.face)];
+  return unoriented_angle_deg(scan.n, f.n) <= max_angle_deg && std::abs(f.distance(p)) >= near.distance - tolerance;
+}
+
+std::vector<Plane> face_planes(const Mesh& m) {
+  std::vector<Plane> out;
+  for (const auto& f : m.faces) out.push_back(polygon_plane(face_points(m, f)));
+  return out;
+}
+
+// Where along each face of a mesh its own points stand: the columns (kColumn wide, along the
+// face's horizontal direction) holding a point within the cap whose nearest face it is. A
+// facade line beyond the cap that stands before a column of the face's own points is another
+// object before the wall (a neighbour across an alley, seen past or over); where the face has
+// no points of its own, it is the building's facade stepping forward (a setback's front line).
+constexpr double kColumn = 0.5;  // m; a column's neighbours count too (window gaps up to ~1 m)
+using Columns = std::vector<std::set<long long>>;
+Vec3 horizontal_along(const Plane& f) { return Vec3(-f.n.y(), f.n.x(), 0.0); }
+long long column_of(const Vec3& p, const Plane& f) {
+  return (long long)std::floor(horizontal_along(f).dot(p) / kColumn);
+}
+bool own_column(const Columns& own, const Vec3& p, int face, const std::vector<Plane>& planes) {
+  const long long c = column_of(p, planes[std::size_t(face)]);
+  const auto& s = own[std::size_t(face)];
+  return s.count(c - 1) || s.count(c) || s.count(c + 1);
+}
+
+// The points near either model with their capped distances: within `cap` of one, or a facade
+// line's within `reach` where it stands before no points of the face it faces (judge.h).
 std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const std::vector<JudgedWall>& walls,
-                                    const PointCloud& cloud, double cap, double on_plane) {
+                                    const PointCloud& cloud, const std::vector<ScanPlane>& planes, double cap,
+                                    double reach, double max_angle_deg, const PlaneConfig& detection) {
+  const double on_plane = on_plane_band(detection);
+  reach = std::max(reach, cap);
   Eigen::AlignedBox3d box = bounding_box(before.vertices);
   box.extend(bounding_box(after.vertices));
   const double ground = box.min().z() + kGroundBand;
-  box.min() -= Vec3::Constant(cap);
-  box.max() += Vec3::Constant(cap);
+  Eigen::AlignedBox3d within_cap = box;  // beyond it only a facade line's points are judged
+  within_cap.min() -= Vec3::Constant(cap);
+  within_cap.max() += Vec3::Constant(cap);
+  box.min() -= Vec3::Constant(reach);
+  box.max() += Vec3::Constant(reach);
   const MeshDistance d0(before), d1(after);
-  std::vector<PointFit> out;
-  for (const auto& p : cloud.points) {
-    if (!box.contains(p) || p.z() < ground || neighbours(p, walls, on_plane)) continue;
+  const std::vector<int> facade = facade_plane_of(planes, cloud.points.size());
+  const std::vector<Plane> f0 = reach > cap ? face_planes(before) : std::vector<Plane>{},
+                           f1 = reach > cap ? face_planes(after) : std::vector<Plane>{};
+  struct Near {
+    std::size_t i;
+    MeshDistance::Nearest a, b;
+  };
+  std::vector<Near> near;
+  Columns own0(f0.size()), own1(f1.size());
+  for (std::size_t i = 0; i < cloud.points.size(); ++i) {
+    const Vec3& p = cloud.points[i];
+    if (!box.contains(p) || (facade[i] < 0 && !within_cap.contains(p)) || p.z() < ground ||
+        neighbours(p, walls, on_plane))
+      continue;
     const auto a = d0.nearest(p, false), b = d1.nearest(p, false);
-    if (a.distance > cap && b.distance > cap) continue;
-    out.push_back({std::min(a.distance, cap), std::min(b.distance, cap), a.face, b.face});
+    if (reach > cap && a.distance <= cap) own0[std::size_t(a.face)].insert(column_of(p, f0[std::size_t(a.face)]));
+    if (reach > cap && b.distance <= cap) own1[std::size_t(b.face)].insert(column_of(p, f1[std::size_t(b.face)]));
+    near.push_back({i, a, b});
+  }
+  std::vector<PointFit> out;
+  for (const auto& [i, a, b] : near) {
+    const Vec3& p = cloud.points[i];
+    double c = cap;
+    if (reach > cap && facade[i] >= 0 && std::min(a.distance, b.distance) > cap) {
+      const Plane& scan = planes[std::size_t(facade[i])].plane;
+      const double tol = detection.ransac_epsilon;
+      if ((a.distance <= reach && faces_the_face(p, scan, a, f0, max_angle_deg, tol) &&
+           !own_column(own0, p, a.face, f0)) ||
+          (b.distance <= reach && faces_the_face(p, scan, b, f1, max_angle_deg, tol) &&
+           !own_column(own1, p, b.face, f1)))
+        c = reach;
+    }
+    if (a.distance > c && b.distance > c) continue;
+    out.push_back({std::min(a.distance, c), std::min(b.distance, c), a.face, b.face});
   }
   return out;
 }
@@ -127,12 +205,13 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
 }  // namespace
 
 Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vector<JudgedWall>& walls,
-                           const PointCloud& cloud, const MatchConfig& prm, const PlaneConfig& detection) {
+                           const PointCloud& cloud, const MatchConfig& prm, const PlaneConfig& detection,
+                           const std::vector<ScanPlane>& planes, double facade_reach) {
   Judgement j;
   const double cap = prm.match_distance, changed = detection.ransac_epsilon;
   std::vector<PointFit> points;
   try {
-    points = judged_points(before, after, walls, cloud, cap, on_plane_band(detection));
+    points = judged_points(before, after, walls, cloud, planes, cap, facade_reach, prm.match_angle_deg, detection);
   } catch (const InputError& e) {
     j.ok = false;
     j.check = "building";

@@ -244,7 +244,8 @@ RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::
   }
   std::vector<JudgedWall> moved;
   for (const auto& f : trace.facades) moved.push_back(f.wall);
-  const Judgement& verdict = trace.judgement.emplace(judge_refinement(kept, chosen.mesh, moved, local, prm, prm));
+  const Judgement& verdict = trace.judgement.emplace(
+      judge_refinement(kept, chosen.mesh, moved, local, prm, prm, planes, prm.match_distance + prm.bbox_margin));
   if (!verdict.ok)
     return run.finish(Outcome::Kept, "not written: never worse, " + verdict.check + " check: " + verdict.detail, kept);
   return run.finish(Outcome::Refined,

@@ -51,9 +51,9 @@ struct Figures {
   double before = 0.0, after = 0.0;  // truth facade RMSE of the coarse model and of the output (m)
 };
 
-// `figures`: also assert the figures (not worse than the coarse model, on the truth when refined);
-// without it only the shell and the selection's status are asserted.
-Figures expect_selection_decided(const Mesh& coarse, const Mesh& truth, const PointCloud& cloud, bool figures = true) {
+// Every building: not worse than the coarse model (never worse). `on_truth`: also on the truth
+// when refined; without it only the shell, the selection's status and never worse are asserted.
+Figures expect_selection_decided(const Mesh& coarse, const Mesh& truth, const PointCloud& cloud, bool on_truth = true) {
   Figures fig;
   const RefineResult r = refine_building(coarse, cloud, Params{});
   SCOPED_TRACE(coarse.id + ": " + outcome_name(r.outcome) + " (" + r.reason + ")");
@@ -77,9 +77,7 @@ Figures expect_selection_decided(const Mesh& coarse, const Mesh& truth, const Po
   const auto samples = sample_faces(local_truth, scanned, 0.25);
   fig.before = rms(cloud_to_mesh(local_coarse, samples)), fig.after = rms(cloud_to_mesh(refined, samples));
   fig.refined = r.refined();
-  if (figures) {
-    EXPECT_LE(fig.after, fig.before + kNotWorse) << "truth facade RMSE " << fig.before << " -> " << fig.after;
-  }
+  EXPECT_LE(fig.after, fig.before + kNotWorse) << "truth facade RMSE " << fig.before << " -> " << fig.after;
   if (!r.refined()) return fig;
 
   EXPECT_TRUE(r.trace.selection.has_value());
@@ -91,7 +89,7 @@ Figures expect_selection_decided(const Mesh& coarse, const Mesh& truth, const Po
       << sel.selection.status_text();
   EXPECT_GT(sel.faces_from_selection, 0);
   EXPECT_EQ(sel.faces_from_selection, int(r.mesh.faces.size()));
-  if (figures) {
+  if (on_truth) {
     EXPECT_LT(fig.after, kOnTruth) << "truth facade RMSE " << fig.before << " -> " << fig.after;
   }
   return fig;
@@ -131,11 +129,11 @@ INSTANTIATE_TEST_SUITE_P(AllTypes, SelectionDecidesType, ::testing::ValuesIn(all
 // within kOnTruth of the truth.
 //
 // KNOWN SHORT (measured 2026-12-02, target_points 20000): the pipeline does not reach the
-// truth on these seeds. They are still checked for a valid, closed, 2-manifold shell and a
-// solved selection, but NOT for being refined, on the truth or not worse; their figures are
+// truth on these seeds. They are still checked for a valid, closed, 2-manifold shell, a solved
+// selection and never worse, but NOT for being refined or on the truth; their figures are
 // printed. Truth facade RMSE coarse -> output (m), "kept" when not refined:
 //   recess 9: 0.402 -> 0.406   bay 1: 0.462 kept          bay 3: 0.896 -> 0.471
-//   bay 7: 0.505 -> 0.386      setback 1: 1.367 -> 0.201  setback 3: 1.378 -> 1.555 (WORSE)
+//   bay 7: 0.505 -> 0.386      setback 1: 1.367 -> 0.201  setback 3: 1.378 kept
 //   setback 4: 1.157 -> 0.585  setback 7: 1.182 kept      setback 8: 1.654 -> 1.237
 // (recess 1 and 2 and setback 9 reach the truth since the generator no longer stands a
 // neighbour's side wall in the recess or before the rear line: the selection had taken it for
@@ -144,18 +142,33 @@ INSTANTIATE_TEST_SUITE_P(AllTypes, SelectionDecidesType, ::testing::ValuesIn(all
 //   bay 3: the bay's front is a supporting plane, but its occupancy confidence is 0.70 (sparse
 //     points), one side is a hypothesised step wall without points, and the roof and ground
 //     pieces over the bay have confidence 0: the program's gain from adding the bay (about -2.4)
-//     does not pay for them and the new sharp edges (about +2.9).
+//     does not pay for them and the new sharp edges (about +2.9). A fully scanned face gains at
+//     most 0.17 per m² (coverage_cost) against 0.05 per m of sharp edge. Measured over the 30
+//     street seeds (--lambda-complexity): at 0.1 bay 3 reaches the truth (0.002 m) and setback
+//     4 gets closer (0.148 m), none worse, but on the dev tiles topo TOPO0005 goes 0.050 ->
+//     0.071 m and the city refuses one more building; at 0.05 recess 1 and bay 5 are lost. Not
+//     adopted: the data term (coverage only, no point-to-plane fit) is what is too weak.
 //   setback 3: the front line is 2.06 m before the coarse wall (beyond match_distance), so the
 //     wall matches only the line 0.27 m behind it and substitution moves the whole wall back;
 //     the front line is then 2.33 m from the start, beyond add_scan_planes' reach
-//     (match_distance + bbox_margin), and no supporting plane. The judge caps distances at
-//     match_distance, so that line's 6241 points weigh the same before and after: it cannot see
-//     the roof and facade getting worse. Judging a facade scan plane's points in front of a
-//     moved wall's outline up to that reach refuses this move, but also refuses a right one:
-//     generated gable 11 (CityFile.GeneratedCityRefinedIntoCityJson2, truth 0.274 -> 0.011 m)
-//     has a neighbour's side wall across an alley before its moved gable end. What tells the
-//     two apart is still to be found (a setback's front line stands where the rear line has no
-//     points; a neighbour across a gap stands before the wall's own points).
+//     (match_distance + bbox_margin), and no supporting plane. The judge now sees that line's
+//     6241 points (a facade line standing before none of the face's own points is judged up to
+//     that reach, judge.h) and refuses the move (written before: 1.378 -> 1.555, worse than
+//     the coarse model). A neighbour's side wall across an alley stands before the wall's own
+//     points and is not judged (generated gable 11, CityFile.GeneratedCityRefinedIntoCityJson2).
+//     With the front line a supporting plane (--bbox-margin 2) the first solve takes the front
+//     line and the step wall, but two things undo or spoil it: the rear-line faces it drops have
+//     corners 2.3 m from every scan point, past kEvidenceReach (2 m), so they are fixed back and
+//     the solve falls back to the start; and it moves the far end wall 2.2 m out onto a
+//     neighbour's side wall (the start's end wall, unscanned, gets confidence 0: a parallel
+//     scanned facade within kSeeThrough stands before it).
+//   setback 7: with 22 supporting planes (8 hypothesised step walls) the program stops at the
+//     work budget (gap 2.4) on its warm start. Solved to optimality (--lambda-complexity 0) it
+//     meets what setback 3 meets: the step is 2.14 m deep, 33 changed faces are fixed back past
+//     kEvidenceReach, then the second solve's shell does not validate and every change is
+//     fixed back.
+//   setback 8 (at --lambda-complexity 0.1): 7 changed faces fixed back past kEvidenceReach,
+//     then the second solve's traced shell has a non-manifold edge; the start is kept.
 // Remove a seed from kKnownShort when the pipeline reaches it (the test prints "now reaches").
 const std::map<BuildingType, std::set<std::uint64_t>> kKnownShort{
     {BuildingType::Recess, {9}}, {BuildingType::Bay, {1, 3, 7}}, {BuildingType::Setback, {1, 3, 4, 7, 8}}};

@@ -2,6 +2,8 @@
 // every scan point near the building and on each moved wall's region.
 #include <gtest/gtest.h>
 
+#include <utility>
+
 #include "lodrefine/core/judge.h"
 #include "lodrefine/core/matching.h"
 #include "support/mesh_fixtures.h"
@@ -174,4 +176,63 @@ TEST(Judge, AFlushNeighboursPointsPastThePartyWallAreNotJudged) {
   EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
   EXPECT_EQ(j.building.worse, 0u);
   EXPECT_LT(j.building.points, refused.building.points);
+}
+
+// A facade line that steps back part-way (the truth of a generated setback): its left half runs
+// 2 m before the model's wall (beyond match_distance), its right half 0.3 m behind it. Moving the
+// whole wall back onto the right half takes it farther from the left half's dense line: the
+// facade lines beyond match_distance are judged too (up to the supports' reach), so the move is
+// refused.
+TEST(Judge, AMoveAwayFromAFacadeLineBeyondMatchDistanceIsRefused) {
+  const Mesh coarse = box({0, 0, 0}, {12, 8, 6}), refined = box({0, 0.3, 0}, {12, 8, 6});
+  PointCloud cloud;
+  const ScanPlane front = fixtures::grid_scan_plane(cloud, wall_patch({0.5, -2.0, 0}, kX, 5.0, 0.5, 5.5), 0.05);
+  const ScanPlane rear = fixtures::grid_scan_plane(cloud, wall_patch({6.5, 0.3, 0}, kX, 5.0, 0.5, 5.5), 0.05);
+  const MatchConfig match;
+  const double reach = match.match_distance + 1.0;
+  const Judgement j =
+      judge_refinement(coarse, refined, {front_wall(0.0, 0.3)}, cloud, match, PlaneConfig{}, {front, rear}, reach);
+  EXPECT_FALSE(j.ok);
+  EXPECT_EQ(j.check, "building");
+  EXPECT_EQ(j.building.points, cloud.points.size());
+  EXPECT_GT(j.building.rms_after, j.building.rms_before + 0.1);
+  EXPECT_GE(j.building.worse, front.inliers.size());
+}
+
+// The same move onto the wall's own scan along its whole length, with a parallel facade line 2 m
+// out from x = `line_x` for `line_length` m, and a tree 2 m before the wall when `tree`: the
+// judgement, and how many of the cloud's points are the wall's own (those first).
+namespace {
+std::pair<Judgement, std::size_t> judge_move_past_a_line(double line_x, double line_length, bool tree) {
+  const Mesh coarse = box({0, 0, 0}, {12, 8, 6}), refined = box({0, 0.3, 0}, {12, 8, 6});
+  PointCloud cloud;
+  const ScanPlane own = fixtures::grid_scan_plane(cloud, wall_patch({0.5, 0.3, 0}, kX, 11.0, 0.5, 5.5), 0.05);
+  const std::size_t facade = cloud.points.size();
+  const ScanPlane line =
+      fixtures::grid_scan_plane(cloud, wall_patch({line_x, -2.0, 0}, kX, line_length, 0.5, 5.5), 0.05);
+  if (tree) add_grid(cloud, {{4, -2.2, 1.0}, kX, Vec3(0, -0.6, 0.8).normalized(), 0.0, 2.0, 0.0, 2.0}, 0.1, 0.15);
+  const MatchConfig match;
+  return {judge_refinement(coarse, refined, {front_wall(0.0, 0.3)}, cloud, match, PlaneConfig{}, {own, line},
+                           match.match_distance + 1.0),
+          facade};
+}
+}  // namespace
+
+// The line 2 m out beside the building (a neighbour's facade standing forward past the corner),
+// and a tree 2 m before the wall: neither is the building's facade line, neither is judged, and
+// the move onto the wall's own scan is written.
+TEST(Judge, AParallelLineBesideTheBuildingAndATreeBeyondMatchDistanceAreNotJudged) {
+  const auto [j, facade] = judge_move_past_a_line(12.5, 6.0, true);
+  EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
+  EXPECT_EQ(j.building.points, facade);
+}
+
+// The line 2 m out standing before the wall's own points (a neighbour's side wall across an
+// alley, before a gable end the scan sees whole): another object, not the building's facade
+// stepping forward. Its points are not judged, and the move onto the wall's own scan is written
+// (a setback's front line stands where the rear line has no points).
+TEST(Judge, AFacadeLineBeforeTheWallsOwnPointsIsNotJudged) {
+  const auto [j, facade] = judge_move_past_a_line(3.0, 5.0, false);
+  EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
+  EXPECT_EQ(j.building.points, facade);
 }

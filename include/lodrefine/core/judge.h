@@ -8,7 +8,13 @@
 // MatchConfig::match_distance of either model (the cap: farther points are another object's) and
 // above the lowest model vertex + kGroundBand (street ground in front of a wall moved inwards
 // would count against a right move), and not a flush neighbour's (JudgedWall::flush_facade). Its
-// distance to each model is capped at match_distance.
+// distance to each model is capped at match_distance. A scanned facade line farther off is the
+// building's, not another object's, where it stands before none of the face's own points: an
+// inlier of a facade scan plane whose nearest point on either model lies inside a face facing
+// like the plane (within match_angle_deg), in a column along that face (0.5 m wide, with its
+// neighbours) holding no point within the cap whose nearest face it is, is judged up to
+// `facade_reach` and capped there. So a move away from a setback's front line 2 m out counts,
+// and a neighbour's side wall across an alley, standing before the wall's own points, does not.
 #pragma once
 #include <cstddef>
 #include <optional>
@@ -17,6 +23,7 @@
 
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/core/params.h"
+#include "lodrefine/core/planes.h"
 #include "lodrefine/core/types.h"
 
 namespace lodrefine {
@@ -46,7 +53,10 @@ struct Judgement {
   std::vector<Fit> walls;  // per JudgedWall, its region
 };
 
-// Whether `after` may replace `before` (both closed meshes, same frame as `cloud`).
+// Whether `after` may replace `before` (both closed meshes, same frame as `cloud`). `planes`:
+// the scan planes detected in `cloud` (indices into it), for the facade lines beyond
+// match_distance, judged up to `facade_reach` (m; refine: match_distance + bbox_margin, the
+// reach of the selection's scan supports); without them every point is capped at match_distance.
 // - building: refused when the capped RMS of every judged point grows by more than kRmsSlack,
 //   or when more than kWorseShare of the points that changed (by more than
 //   PlaneConfig::ransac_epsilon) got farther;
@@ -66,6 +76,7 @@ constexpr double kWorseShare = 0.25;
 constexpr int kMinGain = 50;
 constexpr double kMinRmsGain = 0.001;  // m
 Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vector<JudgedWall>& walls,
-                           const PointCloud& cloud, const MatchConfig& match, const PlaneConfig& detection);
+                           const PointCloud& cloud, const MatchConfig& match, const PlaneConfig& detection,
+                           const std::vector<ScanPlane>& planes = {}, double facade_reach = 0.0);
 
 }  // namespace lodrefine
