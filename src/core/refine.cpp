@@ -137,6 +137,7 @@ class Run {
     trace.output_validation = validate_mesh(local_mesh, planarity_tolerance_, true, single_shell);
     out_.valid = trace.output_validation.valid();
     trace.faces = local_mesh.faces.size();
+    lap("validation");
     trace.seconds.emplace_back("total", seconds_since(t_start_));
     out_.mesh = translated(local_mesh, origin_);
     out_.mesh.id = id_;
@@ -246,6 +247,7 @@ RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::
   for (const auto& f : trace.facades) moved.push_back(f.wall);
   const Judgement& verdict = trace.judgement.emplace(
       judge_refinement(kept, chosen.mesh, moved, local, prm, prm, planes, prm.match_distance + prm.bbox_margin));
+  run.lap("judge");
   if (!verdict.ok)
     return run.finish(Outcome::Kept, "not written: never worse, " + verdict.check + " check: " + verdict.detail, kept);
   return run.finish(Outcome::Refined,

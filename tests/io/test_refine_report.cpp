@@ -59,8 +59,14 @@ TEST(RefineReport, RefinedBuildingHasEveryStage) {
   ASSERT_EQ(j["judgement"]["walls"].size(), 1u);
   EXPECT_EQ(j["output_validation"]["valid"], true);
   EXPECT_EQ(j["faces"], r.trace.faces);
-  for (const char* stage : {"repair", "planes", "matching", "substitution", "selection", "total"})
+  // Every stage has its lap, the judge and the output validation too: the laps add up to the total.
+  double laps = 0.0;
+  for (const char* stage : {"repair", "planes", "matching", "substitution", "selection", "judge", "validation"}) {
     EXPECT_TRUE(j["seconds"].contains(stage)) << stage;
+    laps += j["seconds"].value(stage, 0.0);
+  }
+  EXPECT_EQ(j["seconds"].size(), 8u);  // and the total
+  EXPECT_NEAR(laps, j["seconds"]["total"].get<double>(), 1e-3);
   // The selection chose every output face, starting from the substituted shell.
   const auto& sel = j["selection"];
   EXPECT_EQ(sel["status"], "optimal");
@@ -90,7 +96,7 @@ TEST(RefineReport, ABuildingStoppedAtRepairHasOnlyWhatItReached) {
   for (const char* key :
        {"repair", "cloud", "planes", "matches", "substitution", "replacements", "judgement", "selection"})
     EXPECT_FALSE(j.contains(key)) << key;
-  EXPECT_EQ(j["seconds"].size(), 2u);  // repair, total
+  EXPECT_EQ(j["seconds"].size(), 3u);  // repair, validation, total
   EXPECT_EQ(j["faces"], 2u);
 }
 
