@@ -363,3 +363,36 @@ TEST(CityGmlSecurity, EveryBuildingKeepsItsOwnId) {
   ASSERT_FALSE(f.notes.empty());
   EXPECT_EQ(f.notes[0], "gml:id 'dup' is given to more than one building: one is written as 'dup~3'");
 }
+
+// A building nesting 20,000 BuildingParts overflowed the stack in the CityGML module (libcitygml
+// and the reader walk nested objects and geometries recursively): the nesting is refused before
+// parsing. Real files nest ~15 levels; 40 nested parts (~90 levels) still read.
+TEST(CityGmlSecurity, DeepNestingIsRefusedBeforeParsing) {
+  auto nested_parts = [](int parts) {
+    std::string s = kHeader;
+    s += "<cityObjectMember><bldg:Building gml:id=\"b\">";
+    for (int k = 0; k < parts; ++k)
+      s += "<bldg:consistsOfBuildingPart><bldg:BuildingPart gml:id=\"p" + std::to_string(k) + "\">";
+    s += "<bldg:lod2MultiSurface><gml:MultiSurface>";
+    for (const auto& f : box_faces(Vec3(10, 20, 0), 4, 5, 3))
+      s += "<gml:surfaceMember>" + polygon(f, "") + "</gml:surfaceMember>";
+    s += "</gml:MultiSurface></bldg:lod2MultiSurface>";
+    for (int k = 0; k < parts; ++k) s += "</bldg:BuildingPart></bldg:consistsOfBuildingPart>";
+    return s + "</bldg:Building></cityObjectMember></CityModel>\n";
+  };
+  const CityJsonFile f = read_citygml(write_temp("forty.gml", nested_parts(40)));
+  ASSERT_EQ(f.buildings.size(), 1u);
+  EXPECT_EQ(f.buildings[0].mesh.id, "p39");
+  EXPECT_EQ(f.buildings[0].mesh.faces.size(), 6u);
+
+  const std::string deep = write_temp("deep.gml", nested_parts(20000));
+  EXPECT_EQ(refusal(deep), deep +
+                               ": the XML nests elements more than 256 deep: not accepted, CityGML needs a few "
+                               "dozen levels");
+  // Empty-element tags, processing instructions and comments do not count as levels.
+  std::string flat = nested_parts(1);
+  std::string many;
+  for (int k = 0; k < 1000; ++k) many += "<gen:x/><?pi x?><!-- c -->";
+  flat.replace(flat.find("<bldg:lod2MultiSurface>"), 0, many);
+  EXPECT_EQ(read_citygml(write_temp("flat.gml", flat)).buildings.size(), 1u);
+}
