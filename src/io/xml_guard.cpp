@@ -1,6 +1,7 @@
 // The XML text libcitygml is given (see xml_guard.h).
 #include "xml_guard.h"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <optional>
@@ -225,7 +226,7 @@ std::string safe_citygml_text(std::string text, const std::string& path) {
   for (std::size_t i = 0; i < t.size();) {
     if (t[i] == '<' && !starts_with(t, i, "<!--") && !starts_with(t, i, "<![CDATA[")) {
       const std::size_t end = markup_end(t, i, path);
-      depth += depth_change(t, i, end);
+      depth = std::max(0, depth + depth_change(t, i, end));  // stray end tags bank no levels
       if (depth > kMaxElementDepth)
         io_text::fail(path, "the XML nests elements more than " + std::to_string(kMaxElementDepth) +
                                 " deep: not accepted, CityGML needs a few dozen levels");

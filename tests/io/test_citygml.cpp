@@ -395,4 +395,12 @@ TEST(CityGmlSecurity, DeepNestingIsRefusedBeforeParsing) {
   for (int k = 0; k < 1000; ++k) many += "<gen:x/><?pi x?><!-- c -->";
   flat.replace(flat.find("<bldg:lod2MultiSurface>"), 0, many);
   EXPECT_EQ(read_citygml(write_temp("flat.gml", flat)).buildings.size(), 1u);
+  // End tags before any start tag bank no levels for a deeper nesting after them.
+  std::string stray = nested_parts(200);
+  stray.replace(stray.find("<CityModel"), 0, [] {
+    std::string s;
+    for (int k = 0; k < 1000; ++k) s += "</x>";
+    return s;
+  }());
+  EXPECT_NE(refusal(write_temp("stray.gml", stray)).find("nests elements more than 256 deep"), std::string::npos);
 }
