@@ -6,6 +6,7 @@
 #include <fstream>
 #include <regex>
 #include <string_view>
+#include <unordered_map>
 
 #include "citygml_module.h"
 #include "lodrefine/io/files.h"
@@ -74,12 +75,13 @@ CityJsonFile read_citygml(const std::string& path) {
   f.notes.insert(f.notes.begin(), notes.begin(), notes.end());
   f.format = "CityGML";
   f.version = version;
-  // Attributes travel with each building (CityJSON input keeps them in its own document).
-  const auto& objects = doc["CityObjects"];
-  for (auto& b : f.buildings) {
-    const auto it = objects.find(b.mesh.id);
-    if (it != objects.end() && it->contains("attributes")) b.attributes = (*it)["attributes"];
-  }
+  // Attributes travel with each building (CityJSON input keeps them in its own document). Found
+  // through an index: ordered_json::find searches the objects in order (quadratic over a file).
+  std::unordered_map<std::string_view, const nlohmann::ordered_json*> attributes;
+  for (const auto& [id, object] : doc["CityObjects"].get_ref<const nlohmann::ordered_json::object_t&>())
+    if (const auto it = object.find("attributes"); it != object.end()) attributes.emplace(id, &*it);
+  for (auto& b : f.buildings)
+    if (const auto it = attributes.find(b.mesh.id); it != attributes.end()) b.attributes = *it->second;
   return f;
 }
 

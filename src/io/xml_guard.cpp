@@ -1,6 +1,7 @@
 // The XML text libcitygml is given (see xml_guard.h).
 #include "xml_guard.h"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <optional>
@@ -206,6 +207,14 @@ std::size_t markup_end(std::string_view t, std::size_t i, const std::string& pat
   return t.size();
 }
 
+// How the markup t[i, end) changes the element depth: +1 a start tag, -1 an end tag, 0 an
+// empty-element tag or a processing instruction.
+int depth_change(std::string_view t, std::size_t i, std::size_t end) {
+  if (starts_with(t, i, "<?")) return 0;
+  if (starts_with(t, i, "</")) return -1;
+  return end >= i + 2 && t[end - 1] == '>' && t[end - 2] == '/' ? 0 : 1;
+}
+
 }  // namespace
 
 std::string safe_citygml_text(std::string text, const std::string& path) {
@@ -213,9 +222,15 @@ std::string safe_citygml_text(std::string text, const std::string& path) {
   const std::string_view t = text;
   std::string out;         // filled only once some character data is rewritten
   std::size_t copied = 0;  // t[0, copied) is in out
+  int depth = 0;
   for (std::size_t i = 0; i < t.size();) {
     if (t[i] == '<' && !starts_with(t, i, "<!--") && !starts_with(t, i, "<![CDATA[")) {
-      i = markup_end(t, i, path);
+      const std::size_t end = markup_end(t, i, path);
+      depth = std::max(0, depth + depth_change(t, i, end));  // stray end tags bank no levels
+      if (depth > kMaxElementDepth)
+        io_text::fail(path, "the XML nests elements more than " + std::to_string(kMaxElementDepth) +
+                                " deep: not accepted, CityGML needs a few dozen levels");
+      i = end;
       continue;
     }
     const std::size_t start = i;

@@ -1011,6 +1011,16 @@ TEST(BadInputSecurity, CityFilesRefusedInOneLineNamingTheFile) {
        R"({"type":"CityJSON","version":"2.0","transform":{"scale":[1,1,1],"translate":[0,0,0]},"CityObjects":{},"vertices":[]})"
        "\n{\"type\":5,\"CityObjects\":{},\"vertices\":[]}\n"},
       {"seqheader.city.jsonl", "{\"type\":5}\n{\"type\":\"CityJSONFeature\",\"CityObjects\":{},\"vertices\":[]}\n"},
+      // 20,000 nested BuildingParts overflowed the CityGML module's stack (a crash, no line).
+      {"deep.gml",
+       [] {
+         std::string s =
+             "<?xml version=\"1.0\"?>\n<CityModel xmlns=\"http://www.opengis.net/citygml/2.0\" "
+             "xmlns:bldg=\"http://www.opengis.net/citygml/building/2.0\"><cityObjectMember><bldg:Building>";
+         for (int k = 0; k < 20000; ++k) s += "<bldg:consistsOfBuildingPart><bldg:BuildingPart>";
+         for (int k = 0; k < 20000; ++k) s += "</bldg:BuildingPart></bldg:consistsOfBuildingPart>";
+         return s + "</bldg:Building></cityObjectMember></CityModel>\n";
+       }()},
   };
   for (const auto& [name, text] : files) {
     const std::string model = dir + "/" + name;

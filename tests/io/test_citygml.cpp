@@ -363,3 +363,75 @@ TEST(CityGmlSecurity, EveryBuildingKeepsItsOwnId) {
   ASSERT_FALSE(f.notes.empty());
   EXPECT_EQ(f.notes[0], "gml:id 'dup' is given to more than one building: one is written as 'dup~3'");
 }
+
+// A building nesting 20,000 BuildingParts overflowed the stack in the CityGML module (libcitygml
+// and the reader walk nested objects and geometries recursively): the nesting is refused before
+// parsing. Real files nest ~15 levels; 40 nested parts (~90 levels) still read.
+TEST(CityGmlSecurity, DeepNestingIsRefusedBeforeParsing) {
+  auto nested_parts = [](int parts) {
+    std::string s = kHeader;
+    s += "<cityObjectMember><bldg:Building gml:id=\"b\">";
+    for (int k = 0; k < parts; ++k)
+      s += "<bldg:consistsOfBuildingPart><bldg:BuildingPart gml:id=\"p" + std::to_string(k) + "\">";
+    s += "<bldg:lod2MultiSurface><gml:MultiSurface>";
+    for (const auto& f : box_faces(Vec3(10, 20, 0), 4, 5, 3))
+      s += "<gml:surfaceMember>" + polygon(f, "") + "</gml:surfaceMember>";
+    s += "</gml:MultiSurface></bldg:lod2MultiSurface>";
+    for (int k = 0; k < parts; ++k) s += "</bldg:BuildingPart></bldg:consistsOfBuildingPart>";
+    return s + "</bldg:Building></cityObjectMember></CityModel>\n";
+  };
+  const CityJsonFile f = read_citygml(write_temp("forty.gml", nested_parts(40)));
+  ASSERT_EQ(f.buildings.size(), 1u);
+  EXPECT_EQ(f.buildings[0].mesh.id, "p39");
+  EXPECT_EQ(f.buildings[0].mesh.faces.size(), 6u);
+
+  const std::string deep = write_temp("deep.gml", nested_parts(20000));
+  EXPECT_EQ(refusal(deep), deep +
+                               ": the XML nests elements more than 256 deep: not accepted, CityGML needs a few "
+                               "dozen levels");
+  // Empty-element tags, processing instructions and comments do not count as levels.
+  std::string flat = nested_parts(1);
+  std::string many;
+  for (int k = 0; k < 1000; ++k) many += "<gen:x/><?pi x?><!-- c -->";
+  flat.replace(flat.find("<bldg:lod2MultiSurface>"), 0, many);
+  EXPECT_EQ(read_citygml(write_temp("flat.gml", flat)).buildings.size(), 1u);
+  // End tags before any start tag bank no levels for a deeper nesting after them.
+  std::string stray = nested_parts(200);
+  stray.replace(stray.find("<CityModel"), 0, [] {
+    std::string s;
+    for (int k = 0; k < 1000; ++k) s += "</x>";
+    return s;
+  }());
+  EXPECT_NE(refusal(write_temp("stray.gml", stray)).find("nests elements more than 256 deep"), std::string::npos);
+}
+
+// Renaming searched every "<id>~<k>" (and "building-<k>") from the start: one gml:id given to
+// 20,000 buildings took 27 s (quadratic), 60,000 minutes. The search resumes where the last
+// one for the same name ended; the names are the same as before.
+TEST(CityGmlSecurity, ManyBuildingsSharingAnIdAreNamedInLinearTime) {
+  constexpr int kMany = 60000;
+  std::string s = kHeader;
+  auto box_building = [&](const std::string& id, double x) {
+    s += "<cityObjectMember><bldg:Building" + (id.empty() ? std::string() : " gml:id=\"" + id + "\"") +
+         "><bldg:lod2MultiSurface><gml:MultiSurface>";
+    for (const auto& f : box_faces(Vec3(x, 0, 0), 4, 5, 3))
+      s += "<gml:surfaceMember>" + polygon(f, "") + "</gml:surfaceMember>";
+    s += "</gml:MultiSurface></bldg:lod2MultiSurface></bldg:Building></cityObjectMember>";
+  };
+  // Objects without an id before the ids "building-1" ... "building-30000" they must not take.
+  for (int k = 0; k < kMany / 2; ++k) s += "<cityObjectMember><bldg:Building/></cityObjectMember>";
+  box_building("", 0);
+  for (int k = 1; k <= kMany / 2; ++k)
+    s += "<cityObjectMember><bldg:Building gml:id=\"building-" + std::to_string(k) + "\"/></cityObjectMember>";
+  box_building("dup", 20);
+  for (int k = 0; k < kMany; ++k) s += "<cityObjectMember><bldg:Building gml:id=\"dup\"/></cityObjectMember>";
+  box_building("dup", 40);
+  const std::string path = write_temp("dups.gml", s + "</CityModel>\n");
+  const auto t0 = std::chrono::steady_clock::now();
+  const CityJsonFile f = read_citygml(path);
+  EXPECT_LT(fixtures::seconds_since(t0), fixtures::kHangGuardSeconds);
+  std::vector<std::string> ids;
+  for (const auto& b : f.buildings) ids.push_back(b.mesh.id);
+  EXPECT_EQ(ids, (std::vector<std::string>{"building-" + std::to_string(kMany + 1), "dup",
+                                           "dup~" + std::to_string(kMany + 2)}));
+}
