@@ -23,6 +23,7 @@ constexpr double kOnPlane = kSurfaceDistance;
 struct PointFit {
   double before, after;
   int face_before, face_after;  // the nearest face of each mesh
+  Vec3 p;
 };
 
 // The fit over `points` (those `take` accepts).
@@ -61,13 +62,23 @@ std::string worse_reason(const Judgement::Fit& f, double slack, bool count) {
 }
 
 // The wall's region: the points whose nearest face is the wall's, before the move (a face on
-// its old plane within its outline) or after it (a face on its new plane near that outline).
+// its old plane within its outline) or after it (a face on its new plane near that outline),
+// and which lie on its old or its new plane (within `on_plane`). The points farther from both
+// stand on other surfaces near the wall (a return, a neighbour, clutter): the building check
+// judges them, and they must not decide whether the wall itself is scanned.
 struct Region {
   std::vector<char> before, after;  // per face of each mesh: the wall's
+  const JudgedWall& wall;
+  double on_plane;
 
-  Region(const JudgedWall& w, const Mesh& mb, const Mesh& ma, double margin, double reach) {
+  Region(const JudgedWall& w, const Mesh& mb, const Mesh& ma, double margin, double reach, double band)
+      : wall(w), on_plane(band) {
     before = faces_on(w, w.from, mb, margin);
     after = faces_on(w, w.to, ma, reach);
+  }
+  bool holds(const PointFit& q) const {
+    return (before[std::size_t(q.face_before)] || after[std::size_t(q.face_after)]) &&
+           (std::abs(wall.from.distance(q.p)) <= on_plane || std::abs(wall.to.distance(q.p)) <= on_plane);
   }
   // Faces of `m` on `plane` whose centroid projects into the wall's outline grown by `grow`.
   static std::vector<char> faces_on(const JudgedWall& w, const Plane& plane, const Mesh& m, double grow) {
@@ -197,7 +208,7 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
         c = reach;
     }
     if (a.distance > c && b.distance > c) continue;
-    out.push_back({std::min(a.distance, c), std::min(b.distance, c), a.face, b.face});
+    out.push_back({std::min(a.distance, c), std::min(b.distance, c), a.face, b.face, p});
   }
   return out;
 }
@@ -220,10 +231,8 @@ Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vec
   }
   j.building = fit_of(points, changed, [](const PointFit&) { return true; });
   for (const auto& w : walls) {
-    const Region region(w, before, after, prm.match_margin, cap);
-    j.walls.push_back(fit_of(points, changed, [&](const PointFit& q) {
-      return region.before[std::size_t(q.face_before)] || region.after[std::size_t(q.face_after)];
-    }));
+    const Region region(w, before, after, prm.match_margin, cap, on_plane_band(detection));
+    j.walls.push_back(fit_of(points, changed, [&](const PointFit& q) { return region.holds(q); }));
   }
   if (const std::string why = worse_reason(j.building, kRmsSlack, true); !why.empty()) {
     j.ok = false;

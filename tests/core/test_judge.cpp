@@ -117,6 +117,35 @@ TEST(Judge, AnUnscannedWallMovesOnlyOnCornerEvidence) {
   EXPECT_TRUE(k.ok) << k.check << ": " << k.detail;
 }
 
+// The front moves onto its scan and the side wall (x = 12) 0.7 m in on corner evidence, while a
+// neighbour's wall stands 0.2-1.2 m off the side wall, square to it: its 500 points are nearest
+// the side wall and get farther, but they lie on neither of its planes, so the side wall is still
+// unscanned (the building check judges them). Scanned where it was, it may not move off its points.
+TEST(Judge, OnlyPointsOnAWallsOldOrNewPlaneJudgeTheWall) {
+  const Mesh coarse = box({0, -0.5, 0}, {12, 8, 6}), refined = box({0, 0, 0}, {11.3, 8, 6});
+  PointCloud cloud;
+  scan_front(cloud, 0.0, 0.5, 11.0);
+  add_grid(cloud, wall_patch({12.2, 4, 0}, kX, 1.0, 0.5, 5.5), 0.1);
+  JudgedWall side;
+  side.polygons = {{{12, -0.5, 0}, {12, 8, 0}, {12, 8, 6}, {12, -0.5, 6}}};
+  side.from = Plane(kX, -12.0);
+  side.to = Plane(kX, -11.3);
+  side.corner = true;
+  const std::vector<JudgedWall> walls = {front_wall(-0.5, 0.0), side};
+  const Judgement j = judge_refinement(coarse, refined, walls, cloud, MatchConfig{}, PlaneConfig{});
+  EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
+  ASSERT_EQ(j.walls.size(), 2u);
+  EXPECT_EQ(j.walls[1].points, 0u);
+  EXPECT_GE(j.building.worse, 500u);  // the neighbour's points count for the building
+  // The side wall's own points, where it was: moving it off them is refused.
+  add_grid(cloud, wall_patch({12, 1, 0}, kY, 6.0, 0.5, 5.5), 0.1);
+  const Judgement k = judge_refinement(coarse, refined, walls, cloud, MatchConfig{}, PlaneConfig{});
+  EXPECT_FALSE(k.ok);
+  EXPECT_EQ(k.check, "wall");
+  EXPECT_NE(k.detail.find("moved wall 1: RMS"), std::string::npos) << k.detail;
+  EXPECT_NEAR(k.walls[1].rms_after, 0.7, 0.01);
+}
+
 // The left wall, scanned where it is, moved 1 m inwards (onto nothing): refused.
 TEST(Judge, AWallMovedAwayFromItsPointsIsRefused) {
   const Mesh coarse = box({0, 0, 0}, {12, 8, 6}), refined = box({1.0, 0, 0}, {12, 8, 6});

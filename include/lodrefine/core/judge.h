@@ -61,10 +61,12 @@ struct Judgement {
 //   or when more than kWorseShare of the points that changed (by more than
 //   PlaneConfig::ransac_epsilon) got farther;
 // - wall: each moved wall's region (the judged points whose nearest face is the wall, before
-//   the move or after it) must not grow in RMS by more than kWallRmsSlack (its region also
-//   holds points of whatever stands near the wall, so it is judged on the RMS only); a region
-//   with fewer than PlaneConfig::ransac_min_points points is unscanned and passes only when the
-//   wall moved on corner evidence.
+//   the move or after it, and that lie on its old or its new plane within on_plane_band,
+//   corners.h) must not grow in RMS by more than kWallRmsSlack (window recesses and clutter on
+//   the wall are in it too, so it is judged on the RMS only); a region with fewer than
+//   PlaneConfig::ransac_min_points points is unscanned and passes only when the wall moved on
+//   corner evidence. Points nearest the wall but on neither plane stand on other surfaces (a
+//   neighbour, a return): they count for the building, not for whether the wall is scanned.
 // - gain: fewer than kMinGain points got closer and no moved wall's region RMS dropped by
 //   kMinRmsGain (a move within the scan's noise, e.g. a correct wall refitted a few cm off by
 //   its windows, is no refinement).
