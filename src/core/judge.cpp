@@ -127,15 +127,6 @@ std::vector<int> facade_plane_of(const std::vector<ScanPlane>& planes, std::size
   return of;
 }
 
-// Whether a facade plane's inlier at `near` (its nearest point on a model) faces that model's
-// face: the face turned from the plane by at most `max_angle_deg`, and the point's foot on the
-// face's plane inside the face (its distance is the plane distance), not beside the model.
-bool faces_the_face(const Vec3& p, const Plane& scan, const MeshDistance::Nearest& near,
-                    const std::vector<Plane>& face_planes, double max_angle_deg, double tolerance) {
-  const Plane& f = face_planes[std::size_t(near.face)];
-  return unoriented_angle_deg(scan.n, f.n) <= max_angle_deg && std::abs(f.distance(p)) >= near.distance - tolerance;
-}
-
 std::vector<Plane> face_planes(const Mesh& m) {
   std::vector<Plane> out;
   for (const auto& f : m.faces) out.push_back(polygon_plane(face_points(m, f)));
@@ -148,16 +139,42 @@ std::vector<Plane> face_planes(const Mesh& m) {
 // object before the wall (a neighbour across an alley, seen past or over); where the face has
 // no points of its own, it is the building's facade stepping forward (a setback's front line).
 constexpr double kColumn = 0.5;  // m; a column's neighbours count too (window gaps up to ~1 m)
-using Columns = std::vector<std::set<long long>>;
 Vec3 horizontal_along(const Plane& f) { return Vec3(-f.n.y(), f.n.x(), 0.0); }
 long long column_of(const Vec3& p, const Plane& f) {
   return (long long)std::floor(horizontal_along(f).dot(p) / kColumn);
 }
-bool own_column(const Columns& own, const Vec3& p, int face, const std::vector<Plane>& planes) {
-  const long long c = column_of(p, planes[std::size_t(face)]);
-  const auto& s = own[std::size_t(face)];
-  return s.count(c - 1) || s.count(c) || s.count(c + 1);
-}
+
+// One model as the judge sees it: distances to it and, when facade lines beyond the cap are
+// judged, its faces' planes and the columns of each face's own points.
+struct Side {
+  MeshDistance distance;
+  std::vector<Plane> faces;              // empty: no facade line is judged beyond the cap
+  std::vector<std::set<long long>> own;  // per face, the columns holding its own points
+
+  Side(const Mesh& m, bool facade_lines)
+      : distance(m), faces(facade_lines ? face_planes(m) : std::vector<Plane>{}), own(faces.size()) {}
+
+  // Records `p` (nearest face `near`) as a point of that face's own when within `cap` of it.
+  void note(const Vec3& p, const MeshDistance::Nearest& near, double cap) {
+    if (!faces.empty() && near.distance <= cap)
+      own[std::size_t(near.face)].insert(column_of(p, faces[std::size_t(near.face)]));
+  }
+
+  // Whether the facade plane `scan`'s inlier `p` (nearest face `near`) is judged up to `reach`
+  // here: within it, facing its face (turned from it by at most `max_angle_deg`, its foot on the
+  // face's plane inside the face: its distance is the plane distance, not beside the model), and
+  // standing before no column of that face's own points.
+  bool reaches(const Vec3& p, const Plane& scan, const MeshDistance::Nearest& near, double reach, double max_angle_deg,
+               double tolerance) const {
+    if (near.distance > reach) return false;
+    const Plane& f = faces[std::size_t(near.face)];
+    if (unoriented_angle_deg(scan.n, f.n) > max_angle_deg || std::abs(f.distance(p)) < near.distance - tolerance)
+      return false;
+    const long long c = column_of(p, f);
+    const auto& columns = own[std::size_t(near.face)];
+    return !(columns.count(c - 1) || columns.count(c) || columns.count(c + 1));
+  }
+};
 
 // The points near either model with their capped distances: within `cap` of one, or a facade
 // line's within `reach` where it stands before no points of the face it faces (judge.h).
@@ -166,6 +183,7 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
                                     double reach, double max_angle_deg, const PlaneConfig& detection) {
   const double on_plane = on_plane_band(detection);
   reach = std::max(reach, cap);
+  const bool facade_lines = reach > cap;
   Eigen::AlignedBox3d box = bounding_box(before.vertices);
   box.extend(bounding_box(after.vertices));
   const double ground = box.min().z() + kGroundBand;
@@ -174,37 +192,31 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
   within_cap.max() += Vec3::Constant(cap);
   box.min() -= Vec3::Constant(reach);
   box.max() += Vec3::Constant(reach);
-  const MeshDistance d0(before), d1(after);
+  Side s0(before, facade_lines), s1(after, facade_lines);
   const std::vector<int> facade = facade_plane_of(planes, cloud.points.size());
-  const std::vector<Plane> f0 = reach > cap ? face_planes(before) : std::vector<Plane>{},
-                           f1 = reach > cap ? face_planes(after) : std::vector<Plane>{};
   struct Near {
     std::size_t i;
     MeshDistance::Nearest a, b;
   };
   std::vector<Near> near;
-  Columns own0(f0.size()), own1(f1.size());
   for (std::size_t i = 0; i < cloud.points.size(); ++i) {
     const Vec3& p = cloud.points[i];
     if (!box.contains(p) || (facade[i] < 0 && !within_cap.contains(p)) || p.z() < ground ||
         neighbours(p, walls, on_plane))
       continue;
-    const auto a = d0.nearest(p, false), b = d1.nearest(p, false);
-    if (reach > cap && a.distance <= cap) own0[std::size_t(a.face)].insert(column_of(p, f0[std::size_t(a.face)]));
-    if (reach > cap && b.distance <= cap) own1[std::size_t(b.face)].insert(column_of(p, f1[std::size_t(b.face)]));
+    const auto a = s0.distance.nearest(p, false), b = s1.distance.nearest(p, false);
+    s0.note(p, a, cap);
+    s1.note(p, b, cap);
     near.push_back({i, a, b});
   }
   std::vector<PointFit> out;
   for (const auto& [i, a, b] : near) {
     const Vec3& p = cloud.points[i];
     double c = cap;
-    if (reach > cap && facade[i] >= 0 && std::min(a.distance, b.distance) > cap) {
+    if (facade_lines && facade[i] >= 0 && std::min(a.distance, b.distance) > cap) {
       const Plane& scan = planes[std::size_t(facade[i])].plane;
       const double tol = detection.ransac_epsilon;
-      if ((a.distance <= reach && faces_the_face(p, scan, a, f0, max_angle_deg, tol) &&
-           !own_column(own0, p, a.face, f0)) ||
-          (b.distance <= reach && faces_the_face(p, scan, b, f1, max_angle_deg, tol) &&
-           !own_column(own1, p, b.face, f1)))
+      if (s0.reaches(p, scan, a, reach, max_angle_deg, tol) || s1.reaches(p, scan, b, reach, max_angle_deg, tol))
         c = reach;
     }
     if (a.distance > c && b.distance > c) continue;
