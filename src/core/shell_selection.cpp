@@ -222,7 +222,8 @@ Mesh snapped_to_start(const Mesh& m, const Mesh& start) {
 // m: a changed candidate with a corner farther than this from every scan point the selection
 // used, in plan, is a change the scan did not ask for (a roof re-cut far from every scanned
 // facade): it is fixed back to the starting shell and the program solved again. In plan, as the
-// roof above a moved facade must follow it however high it is.
+// roof above a moved facade must follow it however high it is. A step's facade also reaches the
+// volume between it and the start wall it replaces, however deep (detail::swept_evidence).
 constexpr double kEvidenceReach = 2.0;
 
 // The scan points the selection used, in plan: built once per building, asked whether a point
@@ -405,7 +406,9 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   // is excluded: its changes from the starting shell are fixed back, and the program solved
   // again (at most kRetries times).
   const std::vector<char> base = warm.empty() ? face_flags(cs, "f:in_start") : warm;
-  const EvidenceReach evidence(st.evidence);
+  std::vector<Vec3> reach_of = st.evidence;
+  for (const auto& p : detail::swept_evidence(start, s, prm, kEvidenceReach)) reach_of.push_back(p);
+  const EvidenceReach evidence(reach_of);
   std::string problem;
   int beyond_rounds = 0;  // solves redone for changes beyond the evidence (not counted as attempts)
   for (int attempt = 0;; ++attempt) {

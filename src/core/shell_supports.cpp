@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 #include "lodrefine/core/matching.h"
 
@@ -30,6 +31,50 @@ std::vector<Run> runs_along(const std::vector<Vec3>& pts, const Vec3& u) {
     else out.back().b = x;
   }
   return out;
+}
+
+// Ends within kSideClear (m) of the footprint's ends are the building's own corners; other ends
+// within kStepReach (m) belong to the same step; a plane within kSameStep (m) of the end is there
+// already.
+constexpr double kSideClear = 0.3, kStepReach = 1.0, kSameStep = 0.1;
+
+// The start's span along the horizontal direction u.
+Run span_along(const Mesh& start, const Vec3& u) {
+  Run r{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+  for (const auto& p : start.vertices) r.a = std::min(r.a, u.dot(p)), r.b = std::max(r.b, u.dot(p));
+  return r;
+}
+
+// Whether the parallel facade `pts` continues the facade `facade` across a step (u: their
+// horizontal direction): a run of each ends within kStepReach of the other's, inside the
+// footprint, and their runs overlap along u by no more than that (a facade across the street
+// runs alongside, not on from it).
+bool steps_from(const Mesh& start, const std::vector<Vec3>& pts, const std::vector<Vec3>& facade, const Vec3& u) {
+  const auto [lo, hi] = span_along(start, u);
+  const auto a = runs_along(pts, u), b = runs_along(facade, u);
+  double overlap = 0.0;
+  for (const auto& ra : a)
+    for (const auto& rb : b) overlap += std::max(0.0, std::min(ra.b, rb.b) - std::max(ra.a, rb.a));
+  if (overlap > kStepReach) return false;
+  for (const auto& ra : a)
+    for (double e : {ra.a, ra.b}) {
+      if (e < lo + kSideClear || e > hi - kSideClear) continue;
+      for (const auto& rb : b)
+        if (std::abs(rb.a - e) <= kStepReach || std::abs(rb.b - e) <= kStepReach) return true;
+    }
+  return false;
+}
+
+// Whether the points `pts` on a facade plane with normal `n` continue another parallel scanned
+// facade of `s` (other than plane `self`) across a step.
+bool steps_from_any(const Mesh& start, const Supports& s, const std::vector<Vec3>& pts, const Vec3& n, double angle_deg,
+                    int self = -1) {
+  const Vec3 u = Vec3(-n.y(), n.x(), 0.0).normalized();
+  for (int k = 0; k < int(s.planes.size()); ++k)
+    if (k != self && !s.points[k].empty() && unoriented_angle_deg(s.planes[k].plane.n, n) <= angle_deg &&
+        steps_from(start, pts, s.points[k], u))
+      return true;
+  return false;
 }
 
 }  // namespace
@@ -61,11 +106,38 @@ void add_start_planes(const Mesh& start, Supports& s) {
 }
 
 // The scan's facade planes near the footprint: each one's points within match_distance +
-// bbox_margin of the start's box (in the plane's own horizontal frame), when at least ransac_min_points, go to the
-// supporting plane of the start that they lie on, else to a new one.
+// bbox_margin of the start's box (in the plane's own horizontal frame), when at least
+// ransac_min_points, go to the supporting plane of the start that they lie on, else to a new one.
+// A facade farther before or behind the box (up to the building's depth) counts too where it
+// continues a scanned facade of the building across a step (steps_from): a facade line stepping
+// back or forward farther than the reach.
 void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& scan, const Params& prm,
                      Supports& s) {
   const double reach = prm.match_distance + prm.bbox_margin;  // a wall off by up to match_distance, plus a bay
+  auto attach = [&](int i, const std::vector<Vec3>& pts) {
+    auto mean_distance = [&](const Plane& pl) {
+      double sum = 0.0;
+      for (const auto& p : pts) sum += std::abs(pl.distance(p));
+      return sum / double(pts.size());
+    };
+    int k = -1;
+    double best = prm.merge_distance;
+    for (int j = 0; j < int(s.planes.size()); ++j) {
+      if (!near_vertical(s.planes[j].plane) ||
+          unoriented_angle_deg(s.planes[j].plane.n, scan[i].plane.n) > prm.merge_angle_deg)
+        continue;
+      const double d = mean_distance(s.planes[j].plane);
+      if (d <= best) best = d, k = j;
+    }
+    if (k < 0) {
+      k = int(s.planes.size());
+      s.planes.push_back({scan[i].plane, Semantic::Wall, true, i});
+      s.points.emplace_back();
+      ++s.added;
+    }
+    s.points[k].insert(s.points[k].end(), pts.begin(), pts.end());
+  };
+  std::vector<std::pair<int, std::vector<Vec3>>> deep;  // facades beyond the reach in depth only
   for (int i = 0; i < int(scan.size()); ++i) {
     const ScanPlane& sp = scan[i];
     if (!sp.facade) continue;
@@ -75,35 +147,21 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
     const Vec3 u(-n.y(), n.x(), 0.0);
     Eigen::AlignedBox3d box;  // the start in (u, n, z)
     for (const auto& p : start.vertices) box.extend(Vec3(u.dot(p), n.dot(p), p.z()));
-    std::vector<Vec3> near;
+    std::vector<Vec3> near, beyond;
     for (int idx : sp.inliers) {
       const Vec3& p = cloud.points[idx];
       const Vec3 q(u.dot(p), n.dot(p), p.z());
-      if ((q - box.min()).minCoeff() >= -reach && (box.max() - q).minCoeff() >= -reach) near.push_back(p);
+      const Vec3 below = box.min() - q, above = q - box.max();
+      if (std::max({below.x(), below.z(), above.x(), above.z()}) > reach) continue;
+      const double out = std::max(below.y(), above.y());  // before or behind the box
+      if (out <= reach) near.push_back(p);
+      else if (out <= box.sizes().y()) beyond.push_back(p);
     }
-    if (int(near.size()) < prm.ransac_min_points) continue;
-    auto mean_distance = [&](const Plane& pl) {
-      double sum = 0.0;
-      for (const auto& p : near) sum += std::abs(pl.distance(p));
-      return sum / double(near.size());
-    };
-    int k = -1;
-    double best = prm.merge_distance;
-    for (int j = 0; j < int(s.planes.size()); ++j) {
-      if (!near_vertical(s.planes[j].plane) ||
-          unoriented_angle_deg(s.planes[j].plane.n, sp.plane.n) > prm.merge_angle_deg)
-        continue;
-      const double d = mean_distance(s.planes[j].plane);
-      if (d <= best) best = d, k = j;
-    }
-    if (k < 0) {
-      k = int(s.planes.size());
-      s.planes.push_back({sp.plane, Semantic::Wall, true, i});
-      s.points.emplace_back();
-      ++s.added;
-    }
-    s.points[k].insert(s.points[k].end(), near.begin(), near.end());
+    if (int(near.size()) >= prm.ransac_min_points) attach(i, near);
+    else if (int(beyond.size()) >= prm.ransac_min_points) deep.emplace_back(i, std::move(beyond));
   }
+  for (const auto& [i, pts] : deep)
+    if (steps_from_any(start, s, pts, scan[i].plane.n, prm.merge_angle_deg)) attach(i, pts);
 }
 
 // A facade line that steps, a recess or a bay needs the wall across the step, which the scan
@@ -112,18 +170,13 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
 // a hypothesis, and one at each nearby end of a parallel scanned facade's points (the other side
 // of the step, where the points usually end more sharply). The selection takes such a wall only
 // where it closes what the scan shows.
-// Ends within kSideClear (m) of the footprint's ends are the building's own corners; other ends
-// within kStepReach (m) belong to the same step; a plane within kSameStep (m) of the end is there
-// already.
-constexpr double kSideClear = 0.3, kStepReach = 1.0, kSameStep = 0.1;
 void add_step_walls(const Mesh& start, const Params& prm, Supports& s) {
   const int existing = int(s.planes.size());
   for (int j = s.start_planes; j < existing; ++j) {
     const Plane& pj = s.planes[j].plane;
     if (!s.planes[j].from_scan || s.points[j].empty() || !near_vertical(pj)) continue;
     const Vec3 u = Vec3(-pj.n.y(), pj.n.x(), 0.0).normalized();
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const auto& p : start.vertices) lo = std::min(lo, u.dot(p)), hi = std::max(hi, u.dot(p));
+    const auto [lo, hi] = span_along(start, u);
     std::vector<double> ends;
     for (const auto& r : runs_along(s.points[j], u)) ends.insert(ends.end(), {r.a, r.b});
     std::vector<double> positions;
@@ -152,6 +205,55 @@ void add_step_walls(const Mesh& start, const Params& prm, Supports& s) {
       s.points.emplace_back();
     }
   }
+}
+
+// The evidence a scan-only facade gives for the volume between it and the start's parallel wall
+// it stands before or behind (a step of the facade line, a bay, a recess): the change that
+// replaces that wall's part by the facade is asked for by the scan however deep the step is.
+// Each point of such a facade, swept along the wall's normal onto the nearest parallel start
+// face it stands before, sampled every `step` m (its endpoint included). Only a facade that
+// continues another scanned facade across a step (steps_from): a lone parallel facade before a
+// wall may be a neighbour's across an alley.
+std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const Params& prm, double step) {
+  struct Wall {
+    Plane plane;
+    Vec3 u, v;
+    std::vector<Vec2> poly;  // in (u, v)
+  };
+  std::vector<Wall> walls;
+  for (std::size_t f = 0; f < start.faces.size(); ++f) {
+    const int k = s.face_plane[f];
+    if (k < 0 || !near_vertical(s.planes[k].plane)) continue;
+    Wall w{s.planes[k].plane, {}, {}, {}};
+    std::tie(w.u, w.v) = w.plane.basis();
+    for (int i : start.faces[f].v) w.poly.emplace_back(w.u.dot(start.vertices[i]), w.v.dot(start.vertices[i]));
+    walls.push_back(std::move(w));
+  }
+  std::vector<Vec3> out;
+  for (int k = s.start_planes; k < int(s.planes.size()); ++k) {
+    if (s.points[k].empty() || !near_vertical(s.planes[k].plane) ||
+        !steps_from_any(start, s, s.points[k], s.planes[k].plane.n, prm.merge_angle_deg, k))
+      continue;
+    std::vector<const Wall*> parallel;
+    for (const auto& w : walls)
+      if (unoriented_angle_deg(w.plane.n, s.planes[k].plane.n) <= prm.merge_angle_deg) parallel.push_back(&w);
+    for (const auto& p : s.points[k]) {
+      const Wall* near = nullptr;
+      double best = std::numeric_limits<double>::infinity();
+      for (const Wall* w : parallel) {
+        const double d = w->plane.distance(p);
+        if (std::abs(d) < std::abs(best) && point_in_polygon_2d(Vec2(w->u.dot(p), w->v.dot(p)), w->poly))
+          best = d, near = w;
+      }
+      if (!near) continue;
+      const double depth = std::abs(best);
+      for (double t = std::min(step, depth);; t = std::min(t + step, depth)) {
+        out.push_back(p - std::copysign(t, best) * near->plane.n);
+        if (t >= depth) break;
+      }
+    }
+  }
+  return out;
 }
 
 // The region: the start and the scan evidence, in the axes of the start's largest wall.

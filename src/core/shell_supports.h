@@ -38,6 +38,10 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
                      Supports& s);
 // Hypothesised walls across where a scanned facade's points end inside the footprint.
 void add_step_walls(const Mesh& start, const Params& prm, Supports& s);
+// Where the scan-only facades that step from another scanned facade ask for a change: each point
+// swept along the normal of the nearest parallel start wall it stands before onto that wall (the
+// step, bay or recess between them), sampled every `step` m.
+std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const Params& prm, double step);
 // The region: the start and the scan evidence, in the axes of the start's largest wall, grown by
 // a margin.
 Region building_region(const Mesh& start, const Supports& s);

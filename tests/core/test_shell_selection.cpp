@@ -110,3 +110,56 @@ TEST(ShellSelection, MovesAWallOntoItsScanWithoutAStartingMove) {
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_NEAR(v.volume, 480.0, 1e-6);
 }
+
+namespace {
+
+// The street facade (y = 0 plane family) of a box 10 x 8 x 6 scanned as a line that steps at
+// x = 5: y = `left` for x in [0, 5], y = `right` for x in [5, 10] (no points on the step wall:
+// seen edge-on).
+Scan stepped_facade(double left, double right) {
+  Scan s;
+  s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, left, 0}, Vec3::UnitX(), 5.0, 0.0, 6.0), kStep));
+  s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({5, right, 0}, Vec3::UnitX(), 5.0, 0.0, 6.0), kStep));
+  return s;
+}
+
+// The volume of the selection's shell for `start` and the scan `s`, asserted valid and closed.
+double selected_volume(const Mesh& start, const Scan& s) {
+  Params prm;
+  const ShellSelection r = select_shell(start, s.cloud, s.planes, prm);
+  EXPECT_TRUE(r.ok) << r.reason;
+  const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
+  EXPECT_TRUE(v.valid()) << v.problem;
+  EXPECT_TRUE(every_edge_twice(r.mesh));
+  return v.volume;
+}
+
+}  // namespace
+
+// A facade line stepping forward farther than the evidence's fixed reach (2 m): the rear line's
+// dropped faces and the new roof and ground pieces over the step have corners 2.2 m from every
+// scan point, yet the scan asks for them (they lie between the front line and the wall it
+// replaces): the front part and its step wall are taken.
+TEST(ShellSelection, TakesAFacadeLineSteppingForwardBeyondTwoMetres) {
+  EXPECT_NEAR(selected_volume(box({0, 0, 0}, {10, 8, 6}), stepped_facade(0.0, -2.2)), 480 + 5 * 2.2 * 6, 1e-6);
+}
+
+// The front line 2.4 m before the start's wall: beyond the scan-plane reach (match_distance +
+// bbox_margin) of the start's box, it still counts, as it continues the scanned facade across a
+// step.
+TEST(ShellSelection, TakesAFacadeLineSteppingForwardBeyondTheScanPlaneReach) {
+  EXPECT_NEAR(selected_volume(box({0, 0, 0}, {10, 8, 6}), stepped_facade(0.0, -2.4)), 480 + 5 * 2.4 * 6, 1e-6);
+}
+
+// A neighbour's side wall 2.2 m beyond the start's unscanned end wall (seen down the alley) is
+// no step of the building: the end wall stays.
+TEST(ShellSelection, KeepsAnUnscannedEndWallBeforeANeighboursWall) {
+  Scan s;
+  s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 10.0, 0.0, 6.0), kStep));
+  s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({12.2, 8, 0}, -Vec3::UnitY(), 8.0, 0.0, 6.0), kStep));
+  Params prm;
+  const ShellSelection r = select_shell(box({0, 0, 0}, {10, 8, 6}), s.cloud, s.planes, prm);
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_EQ(r.stats.candidates_changed, 0);
+  EXPECT_NEAR(validate_mesh(r.mesh, prm.planarity_tolerance).volume, 480.0, 1e-6);
+}
