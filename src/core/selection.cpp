@@ -255,13 +255,15 @@ struct Program {
   }
 };
 
-// The data term: each free candidate's column costs lambda_coverage times its coverage cost.
+// The data terms: each free candidate's column costs lambda_coverage times its coverage cost,
+// less lambda_data times the scanned area its points explain.
 void add_coverage_objective(Program& p, const CandidateSet& cs, const Columns& c, const SelectionConfig& prm) {
   if (c.free > 0) glp_add_cols(p.lp, c.free);
   for (int f = 0; f < cs.size(); ++f) {
     if (c.column(f) == 0) continue;
     glp_set_col_kind(p.lp, c.column(f), GLP_BV);
-    glp_set_obj_coef(p.lp, c.column(f), prm.lambda_coverage * c.pg.cost[f]);
+    const double fit = c.pg.fit.empty() ? 0.0 : prm.lambda_data * c.pg.fit[f];
+    glp_set_obj_coef(p.lp, c.column(f), prm.lambda_coverage * c.pg.cost[f] - fit);
     p.start.push_back(c.warm(f) ? 1.0 : 0.0);
   }
 }

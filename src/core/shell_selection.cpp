@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "lodrefine/core/confidence.h"
@@ -56,20 +57,26 @@ void mark(CellSet& cells, const Vec2& q) {
     for (long long dj = -kFill; dj <= kFill; ++dj) cells.insert(cell_key(i + di, j + dj));
 }
 
+// fn(i, j) for every grid cell of a polygon's bounding box.
+template <class Fn>
+void for_box_cells(const std::vector<Vec2>& poly, Fn&& fn) {
+  const Eigen::AlignedBox2d box = bounding_box(poly);
+  const long long i0 = (long long)std::floor(box.min().x() / kCell), i1 = (long long)std::floor(box.max().x() / kCell);
+  const long long j0 = (long long)std::floor(box.min().y() / kCell), j1 = (long long)std::floor(box.max().y() / kCell);
+  for (long long i = i0; i <= i1; ++i)
+    for (long long j = j0; j <= j1; ++j) fn(i, j);
+}
+
 // Share of a convex polygon's grid cells (by centre) that are in `cells`; a polygon holding no
 // cell centre is judged by the cell of its centroid.
 double share(const std::vector<Vec2>& poly, const CellSet& cells) {
   if (cells.empty()) return 0.0;
-  const Eigen::AlignedBox2d box = bounding_box(poly);
-  const long long i0 = (long long)std::floor(box.min().x() / kCell), i1 = (long long)std::floor(box.max().x() / kCell);
-  const long long j0 = (long long)std::floor(box.min().y() / kCell), j1 = (long long)std::floor(box.max().y() / kCell);
   long long total = 0, hit = 0;
-  for (long long i = i0; i <= i1; ++i)
-    for (long long j = j0; j <= j1; ++j) {
-      if (!point_in_polygon_2d(Vec2((i + 0.5) * kCell, (j + 0.5) * kCell), poly)) continue;
-      ++total;
-      hit += cells.count(cell_key(i, j));
-    }
+  for_box_cells(poly, [&](long long i, long long j) {
+    if (!point_in_polygon_2d(Vec2((i + 0.5) * kCell, (j + 0.5) * kCell), poly)) return;
+    ++total;
+    hit += cells.count(cell_key(i, j));
+  });
   if (total > 0) return double(hit) / double(total);
   Vec2 c = Vec2::Zero();
   for (const auto& p : poly) c += p;
@@ -77,10 +84,64 @@ double share(const std::vector<Vec2>& poly, const CellSet& cells) {
   return cells.count(cell_key((long long)std::floor(c.x() / kCell), (long long)std::floor(c.y() / kCell))) ? 1.0 : 0.0;
 }
 
+// PolyFit's data-fitting term (its compute_confidences' supporting points): the scan points of
+// a candidate's supporting plane that lie within it, each weighted by how well it fits that
+// plane, 1 - (d / tol)^2 at distance d (tol: ransac_epsilon, a RANSAC inlier's farthest, plus
+// merge_distance, how far a supporting plane may lie from the points merged onto it). Counted
+// as the area they stand for: the scanned area (kCell cells holding a point, over all planes)
+// over the points, so a candidate explaining its share of an evenly sampled scan is worth about
+// its area, a sparsely sampled one less: PolyFit's share of the points, in the coverage term's
+// units (m²) rather than the box's.
+//
+// Per plane: its points in the plane's frame, their fit weights, and the points in each kCell
+// cell; and the scanned area each point stands for (m²).
+struct FitPoints {
+  std::vector<std::vector<Vec2>> at;
+  std::vector<std::vector<double>> weight;
+  std::vector<std::unordered_map<std::int64_t, std::vector<int>>> cells;
+  double area_per_point = 0.0;
+};
+
+FitPoints fit_points(const Supports& s, const std::vector<Frame2>& frames, const Params& prm) {
+  FitPoints fp;
+  const int np = int(s.planes.size());
+  fp.at.resize(np), fp.weight.resize(np), fp.cells.resize(np);
+  const double tol = prm.ransac_epsilon + prm.merge_distance;
+  long long points = 0, occupied = 0;
+  for (int k = 0; k < np; ++k) {
+    for (const auto& p : s.points[k]) {
+      const Vec2 q = frames[k](p);
+      const double d = s.planes[k].plane.distance(p) / tol;
+      fp.cells[k][cell_key((long long)std::floor(q.x() / kCell), (long long)std::floor(q.y() / kCell))].push_back(
+          int(fp.at[k].size()));
+      fp.at[k].push_back(q);
+      fp.weight[k].push_back(std::max(0.0, 1.0 - d * d));
+    }
+    points += (long long)s.points[k].size();
+    occupied += (long long)fp.cells[k].size();
+  }
+  if (points > 0) fp.area_per_point = double(occupied) * kCell * kCell / double(points);
+  return fp;
+}
+
+// The area (m²) of the points of plane k within the convex polygon `poly` (its frame).
+double fitted_area(const FitPoints& fp, int k, const std::vector<Vec2>& poly) {
+  if (fp.at[k].empty()) return 0.0;
+  double sum = 0.0;
+  for_box_cells(poly, [&](long long i, long long j) {
+    const auto it = fp.cells[k].find(cell_key(i, j));
+    if (it == fp.cells[k].end()) return;
+    for (int idx : it->second)
+      if (point_in_polygon_2d(fp.at[k][idx], poly)) sum += fp.weight[k][idx];
+  });
+  return sum * fp.area_per_point;
+}
+
 // What the program knows of each candidate, as face property maps of the candidate mesh:
 // "f:in_start" (bool: the starting shell has a face there), "f:source" (int: that face's source,
 // -1 without one), "f:confidence" (double: the data term's c), "f:in_zone" (bool: scan evidence
-// reaches it). The selection adds "f:variable" (GLPK column, 0: fixed) and "f:selected".
+// reaches it), "f:fit" (double: the data-fitting term's scanned area it explains, m²). The
+// selection adds "f:variable" (GLPK column, 0: fixed) and "f:selected".
 using FaceIndex = CandidateMesh::Face_index;
 
 void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s, const Params& prm) {
@@ -131,6 +192,8 @@ void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s,
   auto source = cs.mesh.add_property_map<FaceIndex, int>("f:source", -1).first;
   auto confidence = cs.mesh.add_property_map<FaceIndex, double>("f:confidence", 0.0).first;
   auto in_zone = cs.mesh.add_property_map<FaceIndex, bool>("f:in_zone", false).first;
+  auto fit = cs.mesh.add_property_map<FaceIndex, double>("f:fit", 0.0).first;
+  const FitPoints fp = fit_points(s, frames, prm);
   const auto support = cs.supports();
   const auto centroid = cs.centroids();
   for (int f = 0; f < cs.size(); ++f) {
@@ -149,6 +212,9 @@ void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s,
     const double scanned = share(poly, own[k]);
     const double prior = in_start[fi] ? 1.0 - share(poly, other[k]) : 0.0;
     confidence[fi] = std::max(scanned, prior);
+    // On a plane of the starting shell only its own faces are credited: points running on along
+    // it past its outline are no evidence that it runs on (a flush neighbour's facade; corners.h).
+    if (s.planes[k].from_scan || in_start[fi]) fit[fi] = fitted_area(fp, k, poly);
     std::vector<Vec3> pts{centroid[fi]};
     for (int v : corners) pts.push_back(cs.vertices[v]);
     bool reached = false;
@@ -381,6 +447,7 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   carry<int>(all, cs, keep, "f:source");
   carry<double>(all, cs, keep, "f:confidence");
   carry<bool>(all, cs, keep, "f:in_zone");
+  carry<double>(all, cs, keep, "f:fit");
   const std::vector<char> warm = all_warm.empty() ? all_warm : kept(all_warm, keep);
   st.candidates = cs.size();
   st.candidates_pruned = all.size() - st.candidates;
@@ -388,9 +455,12 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
 
   SelectionProgram pg;
   const auto confidence = cs.mesh.property_map<FaceIndex, double>("f:confidence").first;
+  const auto fit = cs.mesh.property_map<FaceIndex, double>("f:fit").first;
   const auto area = cs.areas();
-  for (int f = 0; f < cs.size(); ++f)
+  for (int f = 0; f < cs.size(); ++f) {
     pg.cost.push_back(coverage_cost(area[FaceIndex(f)], confidence[FaceIndex(f)], prm.tau_cov));
+    pg.fit.push_back(fit[FaceIndex(f)]);
+  }
   for (const auto& e : cs.edges) pg.sharp_cost.push_back(prm.lambda_complexity * cs.length(e) * kSharpEdgeWidth);
   if (!warm.empty()) {
     pg.warm = warm;

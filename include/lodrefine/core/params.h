@@ -55,6 +55,9 @@ namespace lodrefine {
   X(double, merge_distance, 0.05, 0.0, 5.0, "planes closer than this (and within merge_angle_deg) are merged (m)")  \
   X(double, tau_cov, 0.3, 0.0, 1.0, "coverage threshold tau_cov: inflection of the sigmoid coverage cost")          \
   X(double, lambda_coverage, 1.0, 0.0, 1e6, "weight of the coverage term")                                          \
+  X(double, lambda_data, 0.1, 0.0, 1e6,                                                                             \
+    "weight of the data-fitting term (the scanned area a face's supporting points explain, each weighted by its "   \
+    "fit to the face's plane)")                                                                                     \
   X(double, lambda_complexity, 0.2, 0.0, 1e6, "weight of the complexity (sharp edge) term")                         \
   X(double, mip_work_limit, 60.0, 0.0, 1e9,                                                                         \
     "GLPK work budget of a face selection (millions of tableau entries: rows + columns per simplex iteration, "     \

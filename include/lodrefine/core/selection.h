@@ -51,6 +51,8 @@ struct SelectionResult {
 
 // A selection program over `CandidateSet` (the paper's Sec. 3.4):
 // - `cost[f]`: coverage cost of candidate f (weighted here by lambda_coverage);
+// - `fit[f]`: the data-fitting credit of candidate f, the scanned area its supporting points
+//   explain (m², weighted here by lambda_data); empty: none;
 // - `outside[e]`: 1 where a kept surface outside the region continues across edge e (counts as a
 //   selected face), else 0; empty: none;
 // - `fixed[f]`: -1 free, 0 or 1 fixed (folded into the edge constraints as constants); empty:
@@ -65,6 +67,7 @@ struct SelectionResult {
 // fixed selected faces) are fixed too before GLPK sees the program (SelectionResult::forced).
 struct SelectionProgram {
   std::vector<double> cost;
+  std::vector<double> fit;
   std::vector<int> outside;
   std::vector<int> fixed;
   std::vector<double> sharp_cost;
