@@ -1362,6 +1362,20 @@ std::string box_citygml(int count) {
   return s + "</CityModel>\n";
 }
 
+// `lodrefine ARGS` with its address space limited to `kb` KB (stdout dropped).
+CliRun run_limited(long kb, const std::string& args, const std::string& dir) {
+  const std::string err = dir + "/.err";
+  const std::string cmd =
+      "timeout -k 5 120 sh -c " +
+      shell_quote("ulimit -v " + std::to_string(kb) + "; exec " + shell_quote(LODREFINE_BINARY) + " " + args) +
+      " >/dev/null 2>" + shell_quote(err);
+  const int st = std::system(cmd.c_str());
+  CliRun r;
+  r.exit = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + (WIFSIGNALED(st) ? WTERMSIG(st) : 0);
+  r.err = read_text(err);
+  return r;
+}
+
 }  // namespace
 
 TEST(BadInputMemory, CityGmlUnderAnAddressSpaceLimitFailsInOneLine) {
@@ -1372,30 +1386,20 @@ TEST(BadInputMemory, CityGmlUnderAnAddressSpaceLimitFailsInOneLine) {
   const std::string model = dir + "/city.gml";
   constexpr int kBuildings = 3;
   write_text(model, box_citygml(kBuildings));
-  auto run_limited = [&](long kb) {
+  auto convert_limited = [&](long kb) {
     fs::remove_all(dir + "/objs");
-    const std::string err = dir + "/.err";
-    const std::string cmd =
-        "timeout -k 5 60 sh -c " +
-        shell_quote("ulimit -v " + std::to_string(kb) + "; exec " + shell_quote(LODREFINE_BINARY) +
-                    " convert --citygml " + shell_quote(model) + " --out-dir " + shell_quote(dir + "/objs")) +
-        " >/dev/null 2>" + shell_quote(err);
-    const int st = std::system(cmd.c_str());
-    CliRun r;
-    r.exit = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + (WIFSIGNALED(st) ? WTERMSIG(st) : 0);
-    r.err = read_text(err);
-    return r;
+    return run_limited(kb, "convert --citygml " + shell_quote(model) + " --out-dir " + shell_quote(dir + "/objs"), dir);
   };
   // The least limit (in KB) that works, to within 64 KB.
   long lo = 16 * 1024, hi = 8 * 1024 * 1024;
-  ASSERT_EQ(run_limited(hi).exit, 0) << "8 GB of address space is not enough?";
+  ASSERT_EQ(convert_limited(hi).exit, 0) << "8 GB of address space is not enough?";
   while (hi - lo > 64) {
     const long mid = (lo + hi) / 2;
-    (run_limited(mid).exit == 0 ? hi : lo) = mid;
+    (convert_limited(mid).exit == 0 ? hi : lo) = mid;
   }
   int failures = 0;
   for (long kb = hi - 4000; kb <= hi + 200; kb += 100) {
-    const CliRun r = run_limited(kb);
+    const CliRun r = convert_limited(kb);
     std::size_t written = 0;
     if (fs::exists(dir + "/objs")) written = files_in(dir + "/objs").size();
     if (r.exit == 0) {
@@ -1440,15 +1444,10 @@ TEST(BadInputMemory, CityJsonUnderAnAddressSpaceLimitFailsInOneLine) {
                         .dump());
   for (long kb : {80000L, 100000L, 120000L, 140000L, 160000L}) {
     fs::remove_all(dir + "/objs");
-    const std::string err = dir + "/.err";
-    const int st = std::system(
-        ("timeout -k 5 120 sh -c " +
-         shell_quote("ulimit -v " + std::to_string(kb) + "; exec " + shell_quote(LODREFINE_BINARY) +
-                     " convert --cityjson " + shell_quote(model) + " --out-dir " + shell_quote(dir + "/objs")) +
-         " >/dev/null 2>" + shell_quote(err))
-            .c_str());
-    const int exit = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + (WIFSIGNALED(st) ? WTERMSIG(st) : 0);
-    const std::string says = read_text(err);
+    const CliRun r =
+        run_limited(kb, "convert --cityjson " + shell_quote(model) + " --out-dir " + shell_quote(dir + "/objs"), dir);
+    const int exit = r.exit;
+    const std::string& says = r.err;
     if (exit == 0) continue;  // enough memory after all
     EXPECT_TRUE(exit >= 1 && exit <= 3) << kb << " KB: exit " << exit << ": " << says;
     EXPECT_EQ(lines(says).size(), 1u) << kb << " KB: " << says;
