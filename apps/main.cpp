@@ -1,5 +1,8 @@
 // lodrefine: refine coarse LoD2 building models with MLS point clouds.
+#include <unistd.h>
+
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <new>
 
@@ -14,8 +17,30 @@ int& exit_code() {
 }
 }  // namespace lodrefine::app
 
+namespace {
+
+// Memory running out can end in std::terminate rather than in main's catch: nlohmann::json's
+// destructor allocates (its stack of children), so a large document destroyed while a
+// bad_alloc unwinds throws again from a noexcept destructor. That is still memory running out:
+// one line and exit 3, as main says it, instead of an abort.
+[[noreturn]] void terminated() {
+  try {
+    if (const std::exception_ptr e = std::current_exception()) std::rethrow_exception(e);
+  } catch (const std::bad_alloc&) {
+    static const char kLine[] = "lodrefine: error: out of memory\n";
+    const ssize_t n = ::write(2, kLine, sizeof kLine - 1);
+    (void)n;
+    ::_exit(3);
+  } catch (...) {
+  }
+  std::abort();
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace lodrefine;
+  std::set_terminate(terminated);
   CLI::App app{"lodrefine: refine coarse LoD2 building models with mobile laser scanning point clouds"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "lodrefine " LODREFINE_VERSION);

@@ -1330,3 +1330,129 @@ TEST(BadInputFiles, EvalFootprintsAreOneFilePerBuilding) {
   EXPECT_TRUE(temp_leftovers(dir).empty());
   add_row("eval --svg-dir: ids `a b`, `a_b`, `a:b`", "three footprint files", r.exit);
 }
+
+// ---------------------------------------------------------------------------------------------
+// Memory running out (ulimit -v) while a CityGML file is read: the module's libraries initialise
+// inside dlopen (an exception there ended in std::terminate, exit 134, with GnuTLS's own line),
+// Xerces-C's panic called exit(-1) (exit 255, "Unknown reason"), and libcitygml / Xerces
+// swallowed bad_alloc as "malformed XML" or a parse error (exit 2, the file blamed). Every
+// limit around the least that works must give exit 0 with every building, or one line naming
+// the file and saying what ran out, and nothing written.
+
+namespace {
+
+// `count` boxes as CityGML 2.0 buildings (lod2MultiSurface), ids b0, b1, ...
+std::string box_citygml(int count) {
+  std::string s =
+      "<?xml version=\"1.0\"?>\n<CityModel xmlns=\"http://www.opengis.net/citygml/2.0\" "
+      "xmlns:bldg=\"http://www.opengis.net/citygml/building/2.0\" xmlns:gml=\"http://www.opengis.net/gml\">\n";
+  for (int b = 0; b < count; ++b) {
+    s += "<cityObjectMember><bldg:Building gml:id=\"b" + std::to_string(b) +
+         "\"><bldg:lod2MultiSurface><gml:MultiSurface>";
+    for (const Quad& q : kQuads) {
+      s += "<gml:surfaceMember><gml:Polygon><gml:exterior><gml:LinearRing><gml:posList>";
+      for (int k = 0; k <= 4; ++k) {
+        const Vec3 v = kBox[q.v[k % 4]] + kOrigin + Vec3(20.0 * b, 0, 0);
+        s += fmt(v.x()) + " " + fmt(v.y()) + " " + fmt(v.z()) + " ";
+      }
+      s += "</gml:posList></gml:LinearRing></gml:exterior></gml:Polygon></gml:surfaceMember>";
+    }
+    s += "</gml:MultiSurface></bldg:lod2MultiSurface></bldg:Building></cityObjectMember>\n";
+  }
+  return s + "</CityModel>\n";
+}
+
+// `lodrefine ARGS` with its address space limited to `kb` KB (stdout dropped).
+CliRun run_limited(long kb, const std::string& args, const std::string& dir) {
+  const std::string err = dir + "/.err";
+  const std::string cmd =
+      "timeout -k 5 120 sh -c " +
+      shell_quote("ulimit -v " + std::to_string(kb) + "; exec " + shell_quote(LODREFINE_BINARY) + " " + args) +
+      " >/dev/null 2>" + shell_quote(err);
+  const int st = std::system(cmd.c_str());
+  CliRun r;
+  r.exit = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + (WIFSIGNALED(st) ? WTERMSIG(st) : 0);
+  r.err = read_text(err);
+  return r;
+}
+
+}  // namespace
+
+TEST(BadInputMemory, CityGmlUnderAnAddressSpaceLimitFailsInOneLine) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "ASan reserves terabytes of address space: ulimit -v does not apply";
+#endif
+  const std::string dir = temp_dir("citygml_ulimit");
+  const std::string model = dir + "/city.gml";
+  constexpr int kBuildings = 3;
+  write_text(model, box_citygml(kBuildings));
+  auto convert_limited = [&](long kb) {
+    fs::remove_all(dir + "/objs");
+    return run_limited(kb, "convert --citygml " + shell_quote(model) + " --out-dir " + shell_quote(dir + "/objs"), dir);
+  };
+  // The least limit (in KB) that works, to within 64 KB.
+  long lo = 16 * 1024, hi = 8 * 1024 * 1024;
+  ASSERT_EQ(convert_limited(hi).exit, 0) << "8 GB of address space is not enough?";
+  while (hi - lo > 64) {
+    const long mid = (lo + hi) / 2;
+    (convert_limited(mid).exit == 0 ? hi : lo) = mid;
+  }
+  int failures = 0;
+  for (long kb = hi - 4000; kb <= hi + 200; kb += 100) {
+    const CliRun r = convert_limited(kb);
+    std::size_t written = 0;
+    if (fs::exists(dir + "/objs")) written = files_in(dir + "/objs").size();
+    if (r.exit == 0) {
+      EXPECT_EQ(written, std::size_t(kBuildings)) << kb << " KB";
+      continue;
+    }
+    ++failures;
+    EXPECT_TRUE(r.exit >= 1 && r.exit <= 3) << kb << " KB: exit " << r.exit << ": " << r.err;
+    EXPECT_EQ(lines(r.err).size(), 1u) << kb << " KB: " << r.err;
+    EXPECT_EQ(r.err.rfind("lodrefine: error: " + model + ": ", 0), 0u) << kb << " KB: " << r.err;
+    EXPECT_TRUE(r.err.find("out of memory") != std::string::npos ||
+                r.err.find("failed to map segment") != std::string::npos ||  // dlopen's words for it
+                r.err.find("Cannot allocate memory") != std::string::npos)
+        << kb << " KB: what ran out is not said: " << r.err;
+    EXPECT_EQ(written, 0u) << kb << " KB";
+    EXPECT_TRUE(temp_leftovers(dir).empty()) << kb << " KB";
+  }
+  EXPECT_GT(failures, 10);  // the scan reached below the least limit
+  add_row("convert: CityGML under ulimit -v (40 limits around the least)",
+          "one line naming the file, or every building", failures > 0 ? 3 : 0);
+}
+
+// A CityJSON file too big for the limit: nlohmann::json's destructor allocates, so a parse
+// running out of memory while an object grows threw again from a noexcept destructor
+// (std::terminate, exit 134). Now one line, exit 3, nothing written.
+TEST(BadInputMemory, CityJsonUnderAnAddressSpaceLimitFailsInOneLine) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "ASan reserves terabytes of address space: ulimit -v does not apply";
+#endif
+  const std::string dir = temp_dir("cityjson_ulimit");
+  const std::string model = dir + "/big.city.json";
+  json faces = json::array(), vertices = json::array();
+  for (int i = 0; i < 300000; ++i) faces.push_back({{0, 1, 2}}), vertices.push_back({i, 2 * i, 3 * i});
+  write_text(model, json{{"type", "CityJSON"},
+                         {"version", "2.0"},
+                         {"transform", {{"scale", {0.001, 0.001, 0.001}}, {"translate", {0, 0, 0}}}},
+                         {"CityObjects",
+                          {{"a",
+                            {{"type", "Building"},
+                             {"geometry", {{{"type", "MultiSurface"}, {"lod", "2.2"}, {"boundaries", faces}}}}}}}},
+                         {"vertices", vertices}}
+                        .dump());
+  for (long kb : {80000L, 100000L, 120000L, 140000L, 160000L}) {
+    fs::remove_all(dir + "/objs");
+    const CliRun r =
+        run_limited(kb, "convert --cityjson " + shell_quote(model) + " --out-dir " + shell_quote(dir + "/objs"), dir);
+    const int exit = r.exit;
+    const std::string& says = r.err;
+    if (exit == 0) continue;  // enough memory after all
+    EXPECT_TRUE(exit >= 1 && exit <= 3) << kb << " KB: exit " << exit << ": " << says;
+    EXPECT_EQ(lines(says).size(), 1u) << kb << " KB: " << says;
+    EXPECT_EQ(says.rfind("lodrefine: error: ", 0), 0u) << kb << " KB: " << says;
+    EXPECT_FALSE(fs::exists(dir + "/objs") && !files_in(dir + "/objs").empty()) << kb << " KB";
+  }
+  add_row("convert: 11 MB CityJSON under ulimit -v 80-160 MB", "one line, exit 3 (was an abort, 134)", 3);
+}

@@ -11,7 +11,9 @@
 #include <citygml/polygon.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <memory>
 #include <mutex>
 #include <new>
 #include <set>
@@ -54,15 +56,28 @@ class Logger : public citygml::CityGMLLogger {
 };
 
 // libcitygml reads a std::istream: this one reads the checked text in place (no copy).
+// It also holds memory in reserve until the text is all read: libcitygml's endDocument then
+// calls gluNewTess and uses its result unchecked (null when malloc fails under a memory limit:
+// a segfault), so the reserve is freed for it.
 class TextBuffer : public std::streambuf {
  public:
-  explicit TextBuffer(std::string& text) { setg(text.data(), text.data(), text.data() + text.size()); }
+  explicit TextBuffer(std::string& text) : reserve_(new char[kEndReserve]) {
+    setg(text.data(), text.data(), text.data() + text.size());
+  }
 
  protected:
+  int_type underflow() override {
+    reserve_.reset();
+    return traits_type::eof();
+  }
   pos_type seekoff(off_type off, std::ios_base::seekdir dir, std::ios_base::openmode) override {
     if (off != 0 || dir != std::ios_base::cur) return pos_type(off_type(-1));
     return pos_type(gptr() - eback());  // tellg(), which Xerces asks for its position
   }
+
+ private:
+  static constexpr std::size_t kEndReserve = std::size_t(1) << 20;  // gluNewTess takes a few KB
+  std::unique_ptr<char[]> reserve_;
 };
 
 const char* semantic_type(Type t) {
@@ -314,24 +329,59 @@ extern "C" __attribute__((visibility("default"))) const char* lodrefine_citygml_
   return lodrefine::io_citygml::kAbiTag;
 }
 
+namespace {
+
+// Set when operator new fails during a conversion. libcitygml catches std::exception around
+// its parse (logging "Unexpected Exception" and returning what it has) and Xerces turns
+// bad_alloc into its own OutOfMemoryException (caught below as "malformed XML"): without this
+// flag memory running out would read as a bad file, or as a model missing buildings.
+std::atomic<bool> out_of_memory{false};
+
+void note_out_of_memory() {
+  out_of_memory = true;
+  throw std::bad_alloc();
+}
+
+// Installs note_out_of_memory for one conversion.
+class OutOfMemoryWatch {
+ public:
+  OutOfMemoryWatch() : before_(std::set_new_handler(note_out_of_memory)) { out_of_memory = false; }
+  ~OutOfMemoryWatch() { std::set_new_handler(before_); }
+  OutOfMemoryWatch(const OutOfMemoryWatch&) = delete;
+  OutOfMemoryWatch& operator=(const OutOfMemoryWatch&) = delete;
+
+ private:
+  std::new_handler before_;
+};
+
+}  // namespace
+
 extern "C" __attribute__((visibility("default"))) int lodrefine_citygml_to_cityjson(
     const char* path, std::string* text, const char* crs_url, nlohmann::ordered_json* doc,
     lodrefine::io_citygml::RenamedIds* renamed, std::string* error) {
   using namespace lodrefine::io_citygml;
+  const OutOfMemoryWatch watch;
+  int status = kOk;
   try {
     *doc = lodrefine::to_cityjson(path, *text, crs_url, *renamed);
-    return kOk;
   } catch (const lodrefine::InputError& e) {
     *error = e.what();
-    return kInputError;
+    status = kInputError;
   } catch (const std::bad_alloc&) {
-    *error = "out of memory";
-    return kFailure;
+    out_of_memory = true;
   } catch (const std::exception& e) {
     *error = e.what();
-    return kFailure;
+    status = kFailure;
   } catch (...) {
     *error = "unknown failure in the CityGML module";
-    return kFailure;
+    status = kFailure;
   }
+  if (!out_of_memory) return status;
+  try {
+    *doc = nlohmann::ordered_json();
+    *error = std::string(path) + ": out of memory reading the CityGML file";
+  } catch (...) {  // no room even for the message: the caller names the file
+    error->clear();
+  }
+  return kOutOfMemory;
 }
