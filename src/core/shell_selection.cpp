@@ -477,7 +477,8 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   // again (at most kRetries times).
   const std::vector<char> base = warm.empty() ? face_flags(cs, "f:in_start") : warm;
   std::vector<Vec3> reach_of = st.evidence;
-  for (const auto& p : detail::swept_evidence(start, s, prm, kEvidenceReach)) reach_of.push_back(p);
+  const std::vector<Vec3> swept = detail::swept_evidence(start, s, prm, kEvidenceReach);
+  reach_of.insert(reach_of.end(), swept.begin(), swept.end());
   const EvidenceReach evidence(reach_of);
   std::string problem;
   int beyond_rounds = 0;  // solves redone for changes beyond the evidence (not counted as attempts)

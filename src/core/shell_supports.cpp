@@ -45,20 +45,19 @@ Run span_along(const Mesh& start, const Vec3& u) {
   return r;
 }
 
-// Whether the parallel facade `pts` continues the facade `facade` across a step (u: their
-// horizontal direction): a run of each ends within kStepReach of the other's, inside the
-// footprint, and their runs overlap along u by no more than that (a facade across the street
-// runs alongside, not on from it).
-bool steps_from(const Mesh& start, const std::vector<Vec3>& pts, const std::vector<Vec3>& facade, const Vec3& u) {
-  const auto [lo, hi] = span_along(start, u);
-  const auto a = runs_along(pts, u), b = runs_along(facade, u);
+// Whether a facade whose runs along their horizontal direction u are `a` continues the parallel
+// facade `facade` across a step (`span`: the start's span along u): a run of each ends within
+// kStepReach of the other's, inside the footprint, and their runs overlap along u by no more
+// than that (a facade across the street runs alongside, not on from it).
+bool steps_from(const std::vector<Run>& a, const Run& span, const std::vector<Vec3>& facade, const Vec3& u) {
+  const auto b = runs_along(facade, u);
   double overlap = 0.0;
   for (const auto& ra : a)
     for (const auto& rb : b) overlap += std::max(0.0, std::min(ra.b, rb.b) - std::max(ra.a, rb.a));
   if (overlap > kStepReach) return false;
   for (const auto& ra : a)
     for (double e : {ra.a, ra.b}) {
-      if (e < lo + kSideClear || e > hi - kSideClear) continue;
+      if (e < span.a + kSideClear || e > span.b - kSideClear) continue;
       for (const auto& rb : b)
         if (std::abs(rb.a - e) <= kStepReach || std::abs(rb.b - e) <= kStepReach) return true;
     }
@@ -66,13 +65,16 @@ bool steps_from(const Mesh& start, const std::vector<Vec3>& pts, const std::vect
 }
 
 // Whether the points `pts` on a facade plane with normal `n` continue another parallel scanned
-// facade of `s` (other than plane `self`) across a step.
+// facade of `s` (other than plane `self`) across a step. Their runs and the start's span are
+// found once, not per facade tried.
 bool steps_from_any(const Mesh& start, const Supports& s, const std::vector<Vec3>& pts, const Vec3& n, double angle_deg,
                     int self = -1) {
   const Vec3 u = Vec3(-n.y(), n.x(), 0.0).normalized();
+  const std::vector<Run> runs = runs_along(pts, u);
+  const Run span = span_along(start, u);
   for (int k = 0; k < int(s.planes.size()); ++k)
     if (k != self && !s.points[k].empty() && unoriented_angle_deg(s.planes[k].plane.n, n) <= angle_deg &&
-        steps_from(start, pts, s.points[k], u))
+        steps_from(runs, span, s.points[k], u))
       return true;
   return false;
 }
