@@ -287,7 +287,7 @@ Mesh snapped_to_start(const Mesh& m, const Mesh& start) {
 
 // m: a changed candidate with a corner farther than this from every scan point the selection
 // used, in plan, is a change the scan did not ask for (a roof re-cut far from every scanned
-// facade): it is fixed back to the starting shell and the program solved again. In plan, as the
+// facade): such candidates keep their starting-shell value. In plan, as the
 // roof above a moved facade must follow it however high it is. A step's facade also reaches the
 // volume between it and the start wall it replaces, however deep (detail::swept_evidence).
 constexpr double kEvidenceReach = 2.0;
@@ -311,18 +311,16 @@ class EvidenceReach {
   PointGrid grid_;
 };
 
-// The changed candidates (selected != base) reaching beyond the evidence.
-std::vector<int> changes_beyond_evidence(const CandidateSet& cs, const std::vector<char>& selected,
-                                         const std::vector<char>& base, const EvidenceReach& evidence) {
+// The candidates with a corner beyond the evidence: a change of one is a change the scan did not
+// ask for, so they keep their starting-shell value.
+std::vector<int> beyond_evidence(const CandidateSet& cs, const EvidenceReach& evidence) {
   std::vector<int> out;
-  for (int f = 0; f < cs.size(); ++f) {
-    if (selected[f] == base[f]) continue;
+  for (int f = 0; f < cs.size(); ++f)
     for (int v : cs.corners(f))
       if (!evidence.reaches(cs.vertices[v])) {
         out.push_back(f);
         break;
       }
-  }
   return out;
 }
 
@@ -472,6 +470,8 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
     st.seconds = seconds_since(t0);
     return out;
   };
+  // A candidate reaching beyond the evidence keeps its starting-shell value from the outset: any
+  // selection changing one would be refused, so the program is the one the scan asks about.
   // A selection whose shell does not validate (two shells touching, faces meeting at a point)
   // is excluded: its changes from the starting shell are fixed back, and the program solved
   // again (at most kRetries times).
@@ -480,21 +480,14 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   const std::vector<Vec3> swept = detail::swept_evidence(start, s, prm, kEvidenceReach);
   reach_of.insert(reach_of.end(), swept.begin(), swept.end());
   const EvidenceReach evidence(reach_of);
+  if (!warm.empty())
+    for (int f : beyond_evidence(cs, evidence)) pg.fixed[f] = int(base[f]);
   std::string problem;
-  int beyond_rounds = 0;  // solves redone for changes beyond the evidence (not counted as attempts)
   for (int attempt = 0;; ++attempt) {
     st.selection = select_faces(cs, pg, prm);
     const auto& sel = st.selection;
     if (!sel.ok) return finish("face selection " + sel.status_text());
     const std::vector<char> selected = selected_faces(cs);
-    if (!warm.empty() && beyond_rounds < kRetries) {
-      const std::vector<int> beyond = changes_beyond_evidence(cs, selected, base, evidence);
-      if (!beyond.empty()) {
-        for (int f : beyond) pg.fixed[f] = int(base[f]);
-        ++beyond_rounds, --attempt;
-        continue;
-      }
-    }
     st.candidates_changed = 0;
     for (int f = 0; f < cs.size(); ++f) st.candidates_changed += selected[f] != base[f];
     out.mesh = traced_shell(cs);
