@@ -139,7 +139,12 @@ std::vector<int> distinct_points(const PointCloud& cloud, const PlaneConfig& prm
   order.erase(std::unique(order.begin(), order.end(), [&](int a, int b) { return cloud.points[a] == cloud.points[b]; }),
               order.end());
   if (!holds_planes(cloud, order.size(), prm)) return {};
-  std::sort(order.begin(), order.end());
+  // Back to file order without a second sort.
+  std::vector<char> kept(cloud.points.size(), 0);
+  for (int i : order) kept[std::size_t(i)] = 1;
+  order.clear();
+  for (std::size_t i = 0; i < kept.size(); ++i)
+    if (kept[i]) order.push_back(int(i));
   return order;
 }
 
