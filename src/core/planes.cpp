@@ -129,20 +129,26 @@ bool holds_planes(const PointCloud& cloud, std::size_t distinct, const PlaneConf
 // point hangs it). The cloud's distinct points in file order (which keeps runs reproducible), or
 // none when they are too few or span too little to hold a plane.
 std::vector<int> distinct_points(const PointCloud& cloud, const PlaneConfig& prm) {
-  std::vector<int> order(cloud.points.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = int(i);
-  auto less = [&](int a, int b) {
-    const auto &p = cloud.points[a], &q = cloud.points[b];
-    return std::tie(p.x(), p.y(), p.z()) < std::tie(q.x(), q.y(), q.z());
+  // Sorted with their indices, not as indices into the cloud: the comparisons read memory in
+  // order. std::sort decides only by the comparisons, so the copies kept are the same as with
+  // an index sort by the same key.
+  struct Indexed {
+    Vec3 p;
+    int i;
   };
-  std::sort(order.begin(), order.end(), less);
-  order.erase(std::unique(order.begin(), order.end(), [&](int a, int b) { return cloud.points[a] == cloud.points[b]; }),
-              order.end());
-  if (!holds_planes(cloud, order.size(), prm)) return {};
+  std::vector<Indexed> sorted(cloud.points.size());
+  for (std::size_t i = 0; i < sorted.size(); ++i) sorted[i] = {cloud.points[i], int(i)};
+  std::sort(sorted.begin(), sorted.end(), [](const Indexed& a, const Indexed& b) {
+    return std::tie(a.p.x(), a.p.y(), a.p.z()) < std::tie(b.p.x(), b.p.y(), b.p.z());
+  });
+  sorted.erase(std::unique(sorted.begin(), sorted.end(), [](const Indexed& a, const Indexed& b) { return a.p == b.p; }),
+               sorted.end());
+  if (!holds_planes(cloud, sorted.size(), prm)) return {};
   // Back to file order without a second sort.
   std::vector<char> kept(cloud.points.size(), 0);
-  for (int i : order) kept[std::size_t(i)] = 1;
-  order.clear();
+  for (const auto& s : sorted) kept[std::size_t(s.i)] = 1;
+  std::vector<int> order;
+  order.reserve(sorted.size());
   for (std::size_t i = 0; i < kept.size(); ++i)
     if (kept[i]) order.push_back(int(i));
   return order;
