@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <limits>
 
 #include "lodrefine/core/geometry.h"
@@ -24,39 +25,60 @@ using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
 // touching it (double rounding in a local frame is ~1e-13 m).
 constexpr double kTieTolerance = 1e-7;
 constexpr double kMinTriangleArea = 1e-12;
+// Slack for the rounding of the bounds that keep a triangle in a search (m, far above it).
+constexpr double kRounding = 1e-9;
+// The cells of a batch of queries (m) and the most a batch's grid holds.
+constexpr double kCell = 1.0;
+constexpr double kMaxCells = 1 << 22;
+// Meshes of at most this many triangles are searched without the tree (faster for so few).
+constexpr std::size_t kFewTriangles = 128;
 
 K::Point_3 to_cgal(const Vec3& p) { return {p.x(), p.y(), p.z()}; }
 
-// Nearest point of a triangle to p (Ericson, Real-Time Collision Detection 5.1.5) and the angle
-// the triangle subtends around it: 2π inside, π on an edge, the corner angle at a vertex.
+// Nearest point of a triangle to p (Ericson, Real-Time Collision Detection 5.1.5) and where it
+// lies: at a corner (0 a, 1 b, 2 c), on an edge or inside.
+enum : int { kOnEdge = 3, kInside = 4 };
 struct Closest {
   Vec3 q;
-  double angle;
+  int at;
 };
+
+Closest closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return {a, 0};
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return {b, 1};
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return {a + ab * (d1 / (d1 - d3)), kOnEdge};
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return {c, 2};
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return {a + ac * (d2 / (d2 - d6)), kOnEdge};
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return {b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))), kOnEdge};
+  const double denom = 1.0 / (va + vb + vc);
+  return {a + ab * (vb * denom) + ac * (vc * denom), kInside};
+}
 
 double corner_angle(const Vec3& at, const Vec3& u, const Vec3& w) {
   const Vec3 e1 = (u - at).normalized(), e2 = (w - at).normalized();
   return std::acos(std::clamp(e1.dot(e2), -1.0, 1.0));
 }
 
-Closest closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return {a, corner_angle(a, b, c)};
-  const Vec3 bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return {b, corner_angle(b, c, a)};
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return {a + ab * (d1 / (d1 - d3)), kPi};
-  const Vec3 cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return {c, corner_angle(c, a, b)};
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return {a + ac * (d2 / (d2 - d6)), kPi};
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return {b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))), kPi};
-  const double denom = 1.0 / (va + vb + vc);
-  return {a + ab * (vb * denom) + ac * (vc * denom), 2 * kPi};
+// The angle the triangle subtends around its nearest point: 2π inside, π on an edge, the
+// corner angle at a vertex.
+double angle_at(const Closest& c, const Vec3& a, const Vec3& b, const Vec3& t) {
+  switch (c.at) {
+    case 0: return corner_angle(a, b, t);
+    case 1: return corner_angle(b, t, a);
+    case 2: return corner_angle(t, a, b);
+    case kOnEdge: return kPi;
+  }
+  return 2 * kPi;
 }
 
 // AABB tree over a mesh's triangles, in a frame shifted to the mesh's first vertex so that
@@ -93,10 +115,114 @@ class SurfaceIndex {
     return {sign_at(p, c, i) * d, tris_[i].face};
   }
 
+  // The nearest distance for many points at once, and on a tie (within kTieTolerance) the
+  // lowest face id: the points fall into cubic cells of kCell, and each cell keeps only the
+  // triangles that can be nearest (or tie) anywhere in it.
+  std::vector<Nearest> nearest_all(const std::vector<Vec3>& world) const {
+    std::vector<Vec3> local;
+    local.reserve(world.size());
+    for (const auto& w : world) local.push_back(w - origin_);
+    CellCandidates cells(*this, local);
+    std::vector<Nearest> out;
+    out.reserve(world.size());
+    std::vector<double> scratch;
+    for (const auto& p : local) {
+      const std::vector<std::size_t>* candidates = cells.of(p);
+      out.push_back(candidates ? nearest_of(p, *candidates, scratch)
+                               : nearest_of(p, within(p, kTieTolerance + kRounding), scratch));
+    }
+    return out;
+  }
+
  private:
   struct Tri {
     Vec3 a, b, c, n;
     int face;
+  };
+
+  double distance_to(const Vec3& p, std::size_t t) const {
+    return (p - closest_on_triangle(p, tris_[t].a, tris_[t].b, tris_[t].c).q).norm();
+  }
+
+  // The triangles within `slack` of the nearest one to p, ascending: on a small mesh all are
+  // measured, else the tree's nearest triangle bounds the nearest distance and those in the box
+  // of that reach are measured (a Sphere_3 query would miss the triangles wholly inside it).
+  std::vector<std::size_t> within(const Vec3& p, double slack) const {
+    std::vector<std::size_t> near;
+    if (tris_.size() <= kFewTriangles) {
+      near.resize(tris_.size());
+      for (std::size_t t = 0; t < near.size(); ++t) near[t] = t;
+    } else {
+      const auto hit = tree_.closest_point_and_primitive(to_cgal(p));
+      const double r = distance_to(p, std::size_t(hit.second - cgal_.cbegin())) + slack + kRounding;
+      std::vector<Primitive::Id> in_box;
+      tree_.all_intersected_primitives(CGAL::Bbox_3(p.x() - r, p.y() - r, p.z() - r, p.x() + r, p.y() + r, p.z() + r),
+                                       std::back_inserter(in_box));
+      for (const auto& id : in_box) near.push_back(std::size_t(id - cgal_.cbegin()));
+      std::sort(near.begin(), near.end());
+    }
+    std::vector<double> d(near.size());
+    for (std::size_t k = 0; k < near.size(); ++k) d[k] = distance_to(p, near[k]);
+    const double reach = *std::min_element(d.begin(), d.end()) + slack;
+    std::vector<std::size_t> out;
+    for (std::size_t k = 0; k < near.size(); ++k)
+      if (d[k] <= reach) out.push_back(near[k]);
+    return out;
+  }
+
+  // The nearest distance among `candidates` (triangles holding every one within kTieTolerance of
+  // the nearest), and as its face the lowest face id of those within kTieTolerance, so that a
+  // point on an edge or vertex gets the same face whichever candidates were searched.
+  Nearest nearest_of(const Vec3& p, const std::vector<std::size_t>& candidates, std::vector<double>& d) const {
+    if (d.size() < candidates.size()) d.resize(candidates.size());
+    double nearest = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < candidates.size(); ++k)
+      nearest = std::min(nearest, d[k] = distance_to(p, candidates[k]));
+    int face = std::numeric_limits<int>::max();
+    for (std::size_t k = 0; k < candidates.size(); ++k)
+      if (d[k] <= nearest + kTieTolerance) face = std::min(face, tris_[candidates[k]].face);
+    return {nearest, face};
+  }
+
+  // Per cell of kCell, the triangles that can lie within kTieTolerance of the nearest one for
+  // some point of the cell: from its centre m (half diagonal h) the nearest triangle is at U,
+  // so every point of the cell has one within U + h, and a triangle farther than U + 2h from m
+  // is farther than that from every point of the cell.
+  class CellCandidates {
+   public:
+    // A grid over the points' bounding box; none when it would hold more than kMaxCells cells.
+    CellCandidates(const SurfaceIndex& index, const std::vector<Vec3>& points) : index_(index) {
+      if (points.empty()) return;
+      const Eigen::AlignedBox3d box = bounding_box(points);
+      if (!box.min().allFinite() || !box.max().allFinite()) return;
+      lo_ = (box.min() / kCell).array().floor().matrix();
+      const Eigen::Array3d n = (box.max() / kCell).array().floor() - lo_.array() + 1.0;
+      if (n.prod() > kMaxCells) return;
+      n_ = n.cast<long long>();
+      slot_.assign(std::size_t(n.prod()), -1);
+    }
+    // Null for a point outside the grid.
+    const std::vector<std::size_t>* of(const Vec3& p) {
+      const Eigen::Array3d c = (p / kCell).array().floor() - lo_.array();
+      if (slot_.empty() || !(c >= 0.0).all() || !(c < n_.cast<double>()).all()) return nullptr;
+      const std::size_t cell = std::size_t((c.z() * double(n_.y()) + c.y()) * double(n_.x()) + c.x());
+      if (slot_[cell] < 0) {
+        slot_[cell] = int(lists_.size());
+        lists_.push_back(candidates((lo_ + c.matrix() + Vec3::Constant(0.5)) * kCell));
+      }
+      return &lists_[std::size_t(slot_[cell])];
+    }
+
+   private:
+    std::vector<std::size_t> candidates(const Vec3& m) const {
+      const double h = 0.5 * std::sqrt(3.0) * kCell + kRounding;
+      return index_.within(m, 2 * h + kTieTolerance + kRounding);
+    }
+    const SurfaceIndex& index_;
+    Vec3 lo_ = Vec3::Zero();  // the grid's first cell (in cells)
+    Eigen::Array<long long, 3, 1> n_ = Eigen::Array<long long, 3, 1>::Zero();
+    std::vector<int> slot_;  // per cell of the grid, its list (-1: not yet found)
+    std::deque<std::vector<std::size_t>> lists_;
   };
 
   // Inside a face the face normal decides. On an edge or vertex, the angle-weighted pseudonormal
@@ -104,7 +230,7 @@ class SurfaceIndex {
   // closed surface whatever the triangulation, where a single adjacent normal can be wrong.
   double sign_at(const Vec3& p, const Closest& c, std::size_t i) const {
     const double own = tris_[i].n.dot(p - c.q);
-    if (c.angle == 2 * kPi) return own >= 0 ? 1.0 : -1.0;
+    if (c.at == kInside) return own >= 0 ? 1.0 : -1.0;
     const double r = (p - c.q).norm() + kTieTolerance;
     std::vector<Primitive::Id> touching;
     tree_.all_intersected_primitives(K::Sphere_3(to_cgal(p), r * r), std::back_inserter(touching));
@@ -112,7 +238,7 @@ class SurfaceIndex {
     for (const auto& id : touching) {
       const Tri& t = tris_[std::size_t(id - cgal_.cbegin())];
       const Closest ct = closest_on_triangle(p, t.a, t.b, t.c);
-      if ((p - ct.q).norm() <= r) s += ct.angle * t.n.dot(p - ct.q);
+      if ((p - ct.q).norm() <= r) s += angle_at(ct, t.a, t.b, t.c) * t.n.dot(p - ct.q);
     }
     if (s == 0.0) s = own;
     return s >= 0 ? 1.0 : -1.0;
@@ -135,6 +261,10 @@ MeshDistance::~MeshDistance() = default;
 
 MeshDistance::Nearest MeshDistance::nearest(const Vec3& point, bool signed_distance) const {
   return index_->nearest(point, signed_distance);
+}
+
+std::vector<MeshDistance::Nearest> MeshDistance::nearest_all(const std::vector<Vec3>& points) const {
+  return index_->nearest_all(points);
 }
 
 namespace {

@@ -194,24 +194,26 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
   box.max() += Vec3::Constant(reach);
   Side s0(before, facade_lines), s1(after, facade_lines);
   const std::vector<int> facade = facade_plane_of(planes, cloud.points.size());
-  struct Near {
-    std::size_t i;
-    MeshDistance::Nearest a, b;
-  };
-  std::vector<Near> near;
+  std::vector<std::size_t> judged;  // the cloud's points near enough to be judged
+  std::vector<Vec3> at;
   for (std::size_t i = 0; i < cloud.points.size(); ++i) {
     const Vec3& p = cloud.points[i];
     if (!box.contains(p) || (facade[i] < 0 && !within_cap.contains(p)) || p.z() < ground ||
         neighbours(p, walls, on_plane))
       continue;
-    const auto a = s0.distance.nearest(p, false), b = s1.distance.nearest(p, false);
-    s0.note(p, a, cap);
-    s1.note(p, b, cap);
-    near.push_back({i, a, b});
+    judged.push_back(i);
+    at.push_back(p);
+  }
+  const auto near0 = s0.distance.nearest_all(at), near1 = s1.distance.nearest_all(at);
+  for (std::size_t k = 0; k < at.size(); ++k) {
+    s0.note(at[k], near0[k], cap);
+    s1.note(at[k], near1[k], cap);
   }
   std::vector<PointFit> out;
-  for (const auto& [i, a, b] : near) {
-    const Vec3& p = cloud.points[i];
+  for (std::size_t k = 0; k < at.size(); ++k) {
+    const std::size_t i = judged[k];
+    const Vec3& p = at[k];
+    const MeshDistance::Nearest &a = near0[k], &b = near1[k];
     double c = cap;
     if (facade_lines && facade[i] >= 0 && std::min(a.distance, b.distance) > cap) {
       const Plane& scan = planes[std::size_t(facade[i])].plane;

@@ -2,7 +2,9 @@
 // pseudonormal sign on edges and vertices, precision in georeferenced frames, face sampling.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "lodrefine/core/distance.h"
 #include "support/mesh_fixtures.h"
@@ -16,6 +18,17 @@ Mesh unit_cube() { return box(Vec3::Zero(), Vec3::Ones()); }
 
 // 10 × 10 m footprint without the 6 × 6 m square x > 4, y > 4: a reflex vertical edge at (4, 4).
 Mesh l_shape() { return extrusion({{0, 0}, {10, 0}, {10, 4}, {4, 4}, {4, 10}, {0, 10}}, 0.0, 6.0); }
+
+// The 10 × 8 × 6 m box with a wall every 0.5 m (coplanar neighbours): 284 triangles, enough for
+// the distance to search its tree.
+Mesh tiled_box() {
+  std::vector<Vec2> footprint;
+  for (int i = 0; i < 20; ++i) footprint.emplace_back(0.5 * i, 0.0);
+  for (int i = 0; i < 16; ++i) footprint.emplace_back(10.0, 0.5 * i);
+  for (int i = 0; i < 20; ++i) footprint.emplace_back(10.0 - 0.5 * i, 8.0);
+  for (int i = 0; i < 16; ++i) footprint.emplace_back(0.0, 8.0 - 0.5 * i);
+  return extrusion(footprint, 0.0, 6.0);
+}
 
 // A point, its signed distance to the mesh and the face of its nearest point.
 struct Probe {
@@ -113,6 +126,66 @@ TEST(MeshDistance, EdgeAndVertexTakeTheSignOfThePseudonormal) {
   EXPECT_NEAR(reflex[0], -std::sqrt(0.5), 1e-12);
   EXPECT_NEAR(reflex[1], -std::hypot(0.1, 0.4), 1e-12);
   EXPECT_NEAR(reflex[2], 0.5, 1e-12);
+}
+
+// A point nearest an edge or vertex ties between the faces that meet there: the batch reports
+// the lowest face id.
+TEST(MeshDistance, TheBatchGivesATieToTheLowestFace) {
+  const MeshDistance index(box({0, 0, 0}, {10, 8, 6}));
+  const std::vector<std::pair<Vec3, int>> probes = {{{11, -1, 3}, 2},  // outside the edge of walls 2 and 3
+                                                    {{11, -1, 7}, 1},  // beyond the vertex of the roof and walls 2, 3
+                                                    {{10, 0, 3}, 2},   // on that edge
+                                                    {{5, 4, 3}, 0},    // inside, 3 m from both ground and roof
+                                                    {{9, 1, 5}, 1}};   // inside, 1 m from the roof and walls 2, 3
+  for (const auto& [p, face] : probes) {
+    const auto batch = index.nearest_all({p}).front();
+    EXPECT_EQ(batch.face, face) << p.transpose();
+    EXPECT_NEAR(batch.distance, index.nearest(p, false).distance, 1e-12) << p.transpose();
+  }
+}
+
+// The batch search (cells of candidate triangles; measured directly on a small mesh, found in
+// the tree on a large one) equals the plain search on a lattice full of ties (edges, vertices,
+// medial planes, cell boundaries): nearest()'s distance, the distance to each face alone, and the
+// lowest face of those within 1e-7 m; bit for bit the same when every point is searched alone.
+TEST(MeshDistance, TheBatchSearchEqualsThePlainOneOnTies) {
+  const Vec3 shift(85000.0, 447000.0, 12.0);
+  Mesh far = l_shape();
+  for (auto& v : far.vertices) v += shift;
+  for (const Mesh& mesh : {l_shape(), gable_house(), as_soup(box({0, 0, 0}, {10, 8, 6})), far, tiled_box()}) {
+    const Vec3 o = mesh.vertices.front().array().floor().matrix();
+    std::vector<Vec3> points;
+    for (double x = -3; x <= 13; x += 0.5)
+      for (double y = -3; y <= 13; y += 0.5)
+        for (double z = -3; z <= 12; z += 0.5) points.push_back(o + Vec3(x, y, z));
+    std::vector<std::unique_ptr<MeshDistance>> each;  // the distance to each face alone
+    for (const auto& f : mesh.faces) {
+      Mesh one = mesh;
+      one.faces = {f};
+      each.push_back(std::make_unique<MeshDistance>(one));
+    }
+    const MeshDistance index(mesh);
+    const auto batch = index.nearest_all(points);
+    ASSERT_EQ(batch.size(), points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      std::vector<double> d;
+      for (const auto& e : each) d.push_back(e->nearest(points[i], false).distance);
+      const double nearest = *std::min_element(d.begin(), d.end());
+      const int lowest =
+          int(std::find_if(d.begin(), d.end(), [&](double x) { return x <= nearest + 1e-7; }) - d.begin());
+      EXPECT_NEAR(batch[i].distance, index.nearest(points[i], false).distance, 1e-12) << points[i].transpose();
+      EXPECT_NEAR(batch[i].distance, nearest, 1e-12) << points[i].transpose();
+      EXPECT_EQ(batch[i].face, lowest) << points[i].transpose();
+    }
+    // A far outlier makes the batch's grid too large: every point is then searched alone.
+    points.push_back(o + Vec3(3e6, -2e6, 5));
+    const auto alone = index.nearest_all(points);
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+      EXPECT_EQ(alone[i].distance, batch[i].distance);
+      EXPECT_EQ(alone[i].face, batch[i].face);
+    }
+    EXPECT_NEAR(alone.back().distance, index.nearest(points.back(), false).distance, 1e-9);
+  }
 }
 
 // A 7-digit northing (UTM): squared distances in the file's frame would lose the millimetres.

@@ -26,6 +26,11 @@ class MeshDistance {
   // pseudonormal of all triangles touching it (found geometrically, so it also works on polygon
   // soups with T-junctions).
   Nearest nearest(const Vec3& point, bool signed_distance) const;
+  // Unsigned, for many points close together (a scan near the mesh), faster than one nearest()
+  // each: the same distances (up to rounding where faces tie) and, where several faces are
+  // nearest (within 1e-7 m: an edge, a vertex), the lowest face id; nearest() reports
+  // whichever of them its tree finds first.
+  std::vector<Nearest> nearest_all(const std::vector<Vec3>& points) const;
 
  private:
   struct Index;
