@@ -129,25 +129,26 @@ TEST(MeshDistance, EdgeAndVertexTakeTheSignOfThePseudonormal) {
 }
 
 // A point nearest an edge or vertex ties between the faces that meet there: the batch reports
-// the lowest face id.
-TEST(MeshDistance, TheBatchGivesATieToTheLowestFace) {
+// what nearest() reports, the face included (the judge's wall regions take their points by it).
+TEST(MeshDistance, TheBatchGivesATieThePlainSearchsFace) {
   const MeshDistance index(box({0, 0, 0}, {10, 8, 6}));
-  const std::vector<std::pair<Vec3, int>> probes = {{{11, -1, 3}, 2},  // outside the edge of walls 2 and 3
-                                                    {{11, -1, 7}, 1},  // beyond the vertex of the roof and walls 2, 3
-                                                    {{10, 0, 3}, 2},   // on that edge
-                                                    {{5, 4, 3}, 0},    // inside, 3 m from both ground and roof
-                                                    {{9, 1, 5}, 1}};   // inside, 1 m from the roof and walls 2, 3
-  for (const auto& [p, face] : probes) {
-    const auto batch = index.nearest_all({p}).front();
-    EXPECT_EQ(batch.face, face) << p.transpose();
-    EXPECT_NEAR(batch.distance, index.nearest(p, false).distance, 1e-12) << p.transpose();
+  const std::vector<Vec3> probes = {{11, -1, 3},  // outside the edge of walls 2 and 3
+                                    {11, -1, 7},  // beyond the vertex of the roof and walls 2, 3
+                                    {10, 0, 3},   // on that edge
+                                    {5, 4, 3},    // inside, 3 m from both ground and roof
+                                    {9, 1, 5}};   // inside, 1 m from the roof and walls 2, 3
+  const auto batch = index.nearest_all(probes);
+  for (std::size_t i = 0; i < probes.size(); ++i) {
+    const auto plain = index.nearest(probes[i], false);
+    EXPECT_EQ(batch[i].face, plain.face) << probes[i].transpose();
+    EXPECT_EQ(batch[i].distance, plain.distance) << probes[i].transpose();
   }
 }
 
 // The batch search (cells of candidate triangles; measured directly on a small mesh, found in
 // the tree on a large one) equals the plain search on a lattice full of ties (edges, vertices,
-// medial planes, cell boundaries): nearest()'s distance, the distance to each face alone, and the
-// lowest face of those within 1e-7 m; bit for bit the same when every point is searched alone.
+// medial planes, cell boundaries): nearest()'s distance and face bit for bit, the distance to
+// each face alone; bit for bit the same when every point is searched alone.
 TEST(MeshDistance, TheBatchSearchEqualsThePlainOneOnTies) {
   const Vec3 shift(85000.0, 447000.0, 12.0);
   Mesh far = l_shape();
@@ -170,12 +171,10 @@ TEST(MeshDistance, TheBatchSearchEqualsThePlainOneOnTies) {
     for (std::size_t i = 0; i < points.size(); ++i) {
       std::vector<double> d;
       for (const auto& e : each) d.push_back(e->nearest(points[i], false).distance);
-      const double nearest = *std::min_element(d.begin(), d.end());
-      const int lowest =
-          int(std::find_if(d.begin(), d.end(), [&](double x) { return x <= nearest + 1e-7; }) - d.begin());
-      EXPECT_NEAR(batch[i].distance, index.nearest(points[i], false).distance, 1e-12) << points[i].transpose();
-      EXPECT_NEAR(batch[i].distance, nearest, 1e-12) << points[i].transpose();
-      EXPECT_EQ(batch[i].face, lowest) << points[i].transpose();
+      const auto plain = index.nearest(points[i], false);
+      EXPECT_EQ(batch[i].distance, plain.distance) << points[i].transpose();
+      EXPECT_EQ(batch[i].face, plain.face) << points[i].transpose();
+      EXPECT_NEAR(batch[i].distance, *std::min_element(d.begin(), d.end()), 1e-12) << points[i].transpose();
     }
     // A far outlier makes the batch's grid too large: every point is then searched alone.
     points.push_back(o + Vec3(3e6, -2e6, 5));

@@ -27,9 +27,8 @@ class MeshDistance {
   // soups with T-junctions).
   Nearest nearest(const Vec3& point, bool signed_distance) const;
   // Unsigned, for many points close together (a scan near the mesh), faster than one nearest()
-  // each: the same distances (up to rounding where faces tie) and, where several faces are
-  // nearest (within 1e-7 m: an edge, a vertex), the lowest face id; nearest() reports
-  // whichever of them its tree finds first.
+  // each, with the same answers bit for bit, the face included where several faces are nearest
+  // (within 1e-7 m: an edge, a vertex; there nearest() reports the one its tree finds first).
   std::vector<Nearest> nearest_all(const std::vector<Vec3>& points) const;
 
  private:
