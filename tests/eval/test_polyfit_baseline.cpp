@@ -125,7 +125,9 @@ TEST(PolyfitBaseline, IsolatedChildStopsAtItsCpuLimit) {
   EXPECT_EQ(r.status, PolyfitStatus::TimeLimit) << polyfit_status_name(r.status) << ": " << r.reason;
   EXPECT_NE(r.reason.find("1 s CPU"), std::string::npos) << r.reason;
   EXPECT_TRUE(r.mesh.faces.empty());
-  EXPECT_GE(r.seconds, 1.0);
+  // The kernel checks RLIMIT_CPU against its tick-based accounting, which may run ahead of the
+  // parent's clock: a fresh checkout's run read 0.99995 s of wall clock.
+  EXPECT_GE(r.seconds, 0.95);
   EXPECT_DOUBLE_EQ(r.cpu_seconds, 1.0);
 }
 
