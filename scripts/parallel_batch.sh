@@ -15,7 +15,9 @@ shift
 command -v parallel > /dev/null || { echo "lodrefine: error: GNU Parallel not found (Debian: parallel)" >&2; exit 2; }
 
 exec 9>> "$run/.batch.lock"
-flock -n 9 || { echo "lodrefine: error: $run is in use by another batch run; wait for it to end" >&2; exit 1; }
+# A short wait, as batch_lock.sh's: the holder of a make run that just ended (`make clean-results`
+# too) needs up to 0.05 s, more on a loaded machine, to let go.
+flock -w 1 9 || { echo "lodrefine: error: $run is in use by another batch run; wait for it to end" >&2; exit 1; }
 export LODREFINE_BATCH_LOCKED=1
 todo=$(mktemp)
 trap 'rm -f "$todo"' EXIT

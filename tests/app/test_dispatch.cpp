@@ -87,6 +87,25 @@ TEST_F(Dispatch, GnuParallelOverSshLoginFileEqualsLocalBatch) {
   if (!HasFailure()) fs::remove_all(run), fs::remove(hosts), fs::remove(log);
 }
 
+// A lock let go a moment ago (a make run that just ended, whose holder is still on its way out) is
+// waited for, not taken as another batch run: `make clean-results` then the dispatcher at once
+// failed so on CI.
+TEST_F(Dispatch, GnuParallelWaitsForALockJustLetGo) {
+  if (!installed("parallel")) GTEST_SKIP() << "GNU Parallel not installed (Debian: parallel)";
+  const fs::path run = fresh_run("dispatch_lock");
+  const fs::path held = run.parent_path() / (run.filename().string() + "_held");
+  const fs::path log = run.parent_path() / (run.filename().string() + ".log");
+  ASSERT_EQ(shell("(exec 9>> " + shell_quoted(run / ".batch.lock") + "; flock 9; touch " + shell_quoted(held) +
+                  "; sleep 0.4) & while [ ! -e " + shell_quoted(held) + " ]; do sleep 0.01; done; LODREFINE=" +
+                  shell_quoted(kBinary) + " HOME=" + shell_quoted(run.parent_path()) + " " +
+                  shell_quoted(kSource / "scripts" / "parallel_batch.sh") + " " + shell_quoted(run) +
+                  " --sshlogin : > " + shell_quoted(log) + " 2>&1"),
+            0)
+      << read_text(log);
+  expect_same_as_local(run);
+  if (!HasFailure()) fs::remove_all(run), fs::remove(held), fs::remove(log);
+}
+
 TEST_F(Dispatch, SlurmJobArrayEqualsLocalBatch) {
   if (!installed("slurmctld slurmd munged mungekey sbatch sinfo squeue"))
     GTEST_SKIP() << "Slurm/munge not installed (Debian: slurm-wlm munge)";
