@@ -3,9 +3,10 @@
 #include "lodrefine/core/planes.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Orthogonal_k_neighbor_search.h>
 #include <CGAL/Random.h>
+#include <CGAL/Search_traits_3.h>
 #include <CGAL/Shape_detection/Efficient_RANSAC.h>
-#include <CGAL/pca_estimate_normals.h>
 #include <CGAL/property_map.h>
 
 #include <Eigen/Eigenvalues>
@@ -36,6 +37,8 @@ using NormalMap = CGAL::Nth_of_tuple_property_map<1, PointWithNormal>;
 using Traits = CGAL::Shape_detection::Efficient_RANSAC_traits<Kernel, PointList, PointMap, NormalMap>;
 using Ransac = CGAL::Shape_detection::Efficient_RANSAC<Traits>;
 using RansacPlane = CGAL::Shape_detection::Plane<Traits>;
+using KnnSearch = CGAL::Orthogonal_k_neighbor_search<CGAL::Search_traits_3<Kernel>>;
+using KdTree = KnnSearch::Tree;
 
 // RANSAC pieces of one facade are merged when their normals are within kMergeAngleDeg and each
 // one's points lie on average within kMergeEpsilons RANSAC epsilons of the other's plane (one
@@ -156,31 +159,39 @@ std::vector<int> distinct_points(const PointCloud& cloud, const PlaneConfig& prm
 
 // The cloud grouped by voxel, one representative point per voxel: detection's cost grows with
 // the points, not with the facade area, so a dense scan is thinned to the voxel size before
-// detection. The groups serve the representatives' normals and the take-back without a tree.
+// detection. The groups serve the take-back without a second hashing.
 struct Thinning {
   Vec3 lo = Vec3::Zero();
-  double size = 0.0;                                // voxel edge (m); 0: no thinning
-  std::vector<int> reps;                            // cloud indices: each voxel's first point, voxels in file order
-  std::vector<int> voxel_of;                        // per cloud point, its voxel (position in reps)
-  std::vector<int> first;                           // voxel v holds members[first[v] .. first[v + 1])
-  std::vector<int> members;                         // cloud indices by voxel, copies of a point adjacent
-  std::vector<char> copy;                           // per member: an exact copy of the member before it
-  std::unordered_map<std::uint64_t, int> voxel_id;  // voxel key -> position in reps
-  std::size_t distinct = 0;                         // points that are not copies
+  double size = 0.0;          // voxel edge (m); 0: no thinning
+  std::vector<int> reps;      // cloud indices: each voxel's first point, voxels in file order
+  std::vector<int> voxel_of;  // per cloud point, its voxel (position in reps)
+  std::vector<int> first;     // voxel v holds members[first[v] .. first[v + 1])
+  std::vector<int> members;   // cloud indices by voxel, copies of a point adjacent
+  std::vector<char> copy;     // per member: an exact copy of the member before it
+  std::size_t distinct = 0;   // points that are not copies
 
   bool thinned() const { return size > 0.0; }
+  // The cloud indices of the points that are not copies, voxel by voxel.
+  std::vector<int> non_copies() const {
+    std::vector<int> out;
+    out.reserve(distinct);
+    for (std::size_t m = 0; m < members.size(); ++m)
+      if (!copy[m]) out.push_back(members[m]);
+    return out;
+  }
   Eigen::Array3i cell(const Vec3& p) const { return ((p - lo) / size).array().floor().cast<int>(); }
   static std::uint64_t key(const Eigen::Array3i& c) {
     return (std::uint64_t(c.x()) << (2 * kVoxelKeyBits)) | (std::uint64_t(c.y()) << kVoxelKeyBits) |
            std::uint64_t(c.z());
   }
-  // The voxel at `c`, or -1 (none there, or outside the grid).
-  int voxel_at(const Eigen::Array3i& c) const {
-    if ((c < 0).any() || (c >= (1 << kVoxelKeyBits)).any()) return -1;
-    const auto it = voxel_id.find(key(c));
-    return it == voxel_id.end() ? -1 : it->second;
-  }
 };
+
+// The voxel edge detection thins to: detect_voxel when set, none when 0, else (negative) the
+// largest voxel whose neighbouring representatives on a plane, a voxel diagonal apart, stay
+// within ransac_cluster_epsilon: RANSAC's connectivity is then that of the full cloud.
+double detection_voxel(const PlaneConfig& prm) {
+  return prm.detect_voxel >= 0.0 ? prm.detect_voxel : prm.ransac_cluster_epsilon / std::sqrt(2.0);
+}
 
 // The cloud grouped by voxels of `voxel` (no thinning when 0 or when the grid would not fit the
 // key). Copies of a point are found within their voxel, by sorting it.
@@ -192,8 +203,9 @@ Thinning thin_to_voxels(const PointCloud& cloud, double voxel) {
   t.size = voxel;
   const int n = int(cloud.points.size());
   t.voxel_of.resize(std::size_t(n));
+  std::unordered_map<std::uint64_t, int> voxel_id;  // voxel key -> position in reps
   for (int i = 0; i < n; ++i) {
-    const auto [it, added] = t.voxel_id.emplace(Thinning::key(t.cell(cloud.points[i])), int(t.reps.size()));
+    const auto [it, added] = voxel_id.emplace(Thinning::key(t.cell(cloud.points[i])), int(t.reps.size()));
     if (added) t.reps.push_back(i);
     t.voxel_of[i] = it->second;
   }
@@ -231,60 +243,22 @@ double detection_cluster_epsilon(const Thinning& t, const PlaneConfig& prm) {
   return std::max(prm.ransac_cluster_epsilon, std::sqrt(2.0) * t.size);
 }
 
-// The k nearest distinct points of the cloud to `p` (p itself among them), searched ring by ring
-// of voxels around p's, skipping voxels farther than the k-th nearest so far: exact when the k-th
-// lies within the searched block of kMaxRing rings. Beyond them, only while fewer than k are
-// found, up to `max_ring` rings (kFarRing at most: a bounded search per point for voxels much
-// smaller than the point spacing); a point with k others only farther gets the k nearest found.
-constexpr int kMaxRing = 2;
-constexpr int kFarRing = 8;
-void nearest_in_voxels(const PointCloud& cloud, const Thinning& t, const Vec3& p, int k, int max_ring,
-                       std::vector<std::pair<double, int>>& found) {
-  const Eigen::Array3i c = t.cell(p);
-  const Eigen::Array3d in_cell = (p - t.lo).array() / t.size - c.cast<double>();  // in [0, 1)^3
-  // Squared distance from p to the voxel at offset d (in voxels, 0 along an axis of p's voxel).
-  auto gap2 = [&](const Eigen::Array3i& d) {
-    const Eigen::Array3d lo = d.cast<double>() - in_cell, hi = lo + 1.0;
-    return (lo.max(0.0) - hi.min(0.0)).matrix().squaredNorm() * t.size * t.size;
-  };
-  const std::size_t want = std::size_t(k);
-  double kth2 = std::numeric_limits<double>::infinity();
-  found.clear();
-  for (int ring = 0; ring <= std::max(kMaxRing, max_ring); ++ring) {
-    for (int dx = -ring; dx <= ring; ++dx)
-      for (int dy = -ring; dy <= ring; ++dy)
-        for (int dz = -ring; dz <= ring; ++dz) {
-          const Eigen::Array3i d(dx, dy, dz);
-          if (d.abs().maxCoeff() != ring || gap2(d) > kth2) continue;
-          const int v = t.voxel_at(c + d);
-          if (v < 0) continue;
-          for (int m = t.first[v]; m < t.first[v + 1]; ++m)
-            if (!t.copy[m]) found.emplace_back((cloud.points[t.members[m]] - p).squaredNorm(), t.members[m]);
-        }
-    if (found.size() < want) continue;
-    std::nth_element(found.begin(), found.begin() + long(want) - 1, found.end());
-    found.resize(want);
-    kth2 = found.back().first;
-    const double reach = t.size * (ring + std::min(in_cell.minCoeff(), 1.0 - in_cell.maxCoeff()));
-    if (kth2 <= reach * reach || ring >= kMaxRing) break;
-  }
-}
-
-// The representatives' normals from their k nearest points of the full cloud (its distinct
-// points): the same neighbourhoods as without thinning. Normals of the thinned cloud itself
-// span several voxels and blur at a corner, where RANSAC then found a diagonal plane through
-// the two walls' edges (topo dev tile, TOPO0014 at 0.1 m: 151 points, 25° off the front wall).
-void estimate_normals_in_full_cloud(PointList& pts, const PointCloud& cloud, const Thinning& t,
-                                    const PlaneConfig& prm) {
-  // Neighbours are sought up to ransac_cluster_epsilon away, RANSAC's reach of one surface.
-  const int max_ring = int(std::min<double>(kFarRing, std::ceil(prm.ransac_cluster_epsilon / t.size)));
-  std::vector<std::pair<double, int>> found;
+// The representatives' normals, PCA of their k nearest distinct points of the full cloud (a
+// CGAL kd-tree over those): the same neighbourhoods as without thinning. Normals of the thinned
+// cloud itself span several voxels and blur at a corner, where RANSAC then found a diagonal plane
+// through the two walls' edges (topo dev tile, TOPO0014 at 0.1 m: 151 points, 25° off the front
+// wall).
+void estimate_normals(PointList& pts, const PointCloud& cloud, const std::vector<int>& distinct,
+                      const PlaneConfig& prm) {
+  std::vector<Point> all;
+  all.reserve(distinct.size());
+  for (int i : distinct) all.emplace_back(cloud.points[i].x(), cloud.points[i].y(), cloud.points[i].z());
+  const KdTree tree(all.begin(), all.end());
   std::vector<Vec3> near;
   for (auto& p : pts) {
-    nearest_in_voxels(cloud, t, cloud.points[std::get<2>(p)], prm.normal_neighbors, max_ring, found);
-    if (found.size() < 3) continue;  // no normal: the point joins no plane
     near.clear();
-    for (const auto& [d2, i] : found) near.push_back(cloud.points[i]);
+    const KnnSearch search(tree, std::get<0>(p), unsigned(prm.normal_neighbors));
+    for (const auto& [q, d2] : search) near.emplace_back(q.x(), q.y(), q.z());
     const Vec3 n = fit_plane(near).n;
     std::get<1>(p) = Vector(n.x(), n.y(), n.z());
   }
@@ -300,10 +274,7 @@ std::vector<std::vector<int>> ransac_shapes(const PointCloud& cloud, const Thinn
     const auto& p = cloud.points[i];
     pts.emplace_back(Point(p.x(), p.y(), p.z()), Vector(0, 0, 0), i);
   }
-  if (t.thinned()) estimate_normals_in_full_cloud(pts, cloud, t, prm);
-  else
-    CGAL::pca_estimate_normals<CGAL::Sequential_tag>(pts, prm.normal_neighbors,
-                                                     CGAL::parameters::point_map(PointMap()).normal_map(NormalMap()));
+  estimate_normals(pts, cloud, t.thinned() ? t.non_copies() : t.reps, prm);
 
   // Efficient RANSAC draws from CGAL's default generator: seed it for reproducible runs. The
   // generator is thread-local (CGAL_HAS_THREADS), so buildings refined at once do not share it.
@@ -360,7 +331,7 @@ std::vector<std::vector<int>> take_back(const PointCloud& cloud, const Thinning&
 std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const PlaneConfig& prm) {
   std::vector<ScanPlane> result;
   if (cloud.points.size() < min_cloud_points(prm)) return result;
-  Thinning thinning = thin_to_voxels(cloud, prm.detect_voxel);
+  Thinning thinning = thin_to_voxels(cloud, detection_voxel(prm));
   std::size_t distinct = thinning.distinct;
   if (!thinning.thinned()) {
     thinning.reps = distinct_points(cloud, prm);

@@ -102,10 +102,11 @@ TEST(Planes, BoxCornerGivesItsThreePlanes) {
     const Truth& t = c.truth[k];
     const ScanPlane* sp = expect_found(planes, t.plane);
     if (!sp) continue;
-    // Nearly all its points (3-sigma noise and some border points with skewed normals may
-    // go), and hardly any from elsewhere.
+    // Nearly all its points (3-sigma noise, some border points with skewed normals and, with
+    // the default thinning, those of a corner voxel whose point went to the other wall may go),
+    // and hardly any from elsewhere.
     const std::size_t own = count_of(sp->inliers, t.points);
-    EXPECT_GE(own, std::size_t(0.97 * double(t.points.size())));
+    EXPECT_GE(own, std::size_t(0.95 * double(t.points.size())));
     EXPECT_LE(sp->inliers.size() - own, t.points.size() / 100);
     for (int i : sp->inliers) {
       EXPECT_TRUE(seen.insert(i).second) << "point " << i << " in two planes";

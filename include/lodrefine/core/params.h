@@ -20,9 +20,9 @@ namespace lodrefine {
   X(double, ransac_normal_deg, 25.0, 1.0, 90.0, "RANSAC: max angle between point normal and plane (deg)")           \
   X(int, ransac_min_points, 150, 3, 100000000, "RANSAC: min inliers of a plane")                                    \
   X(double, ransac_probability, 0.01, 1e-6, 1.0, "RANSAC: probability to miss the largest shape")                   \
-  X(double, detect_voxel, 0.0, 0.0, 1.0,                                                                            \
+  X(double, detect_voxel, -1.0, -1.0, 1.0,                                                                          \
     "plane detection runs on one point per voxel of this size, then takes back every point near its planes (m; 0: " \
-    "all points)")                                                                                                  \
+    "all points; negative: ransac_cluster_epsilon / sqrt 2, the largest voxel that keeps RANSAC's connectivity)")   \
   X(int, normal_neighbors, 12, 3, 200, "neighbours for PCA normal estimation")                                      \
   X(double, min_plane_area, 1.0, 0.0, 1e6, "scan planes whose inlier hull is smaller are ignored (m^2)")            \
   X(double, facade_max_tilt_deg, 10.0, 0.0, 45.0,                                                                   \
