@@ -2,11 +2,13 @@
 // slowest to compile.
 #include "lodrefine/core/planes.h"
 
+#include <CGAL/Eigen_diagonalize_traits.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Orthogonal_k_neighbor_search.h>
 #include <CGAL/Random.h>
 #include <CGAL/Search_traits_3.h>
 #include <CGAL/Shape_detection/Efficient_RANSAC.h>
+#include <CGAL/linear_least_squares_fitting_3.h>
 #include <CGAL/property_map.h>
 
 #include <Eigen/Eigenvalues>
@@ -254,13 +256,18 @@ void estimate_normals(PointList& pts, const PointCloud& cloud, const std::vector
   all.reserve(distinct.size());
   for (int i : distinct) all.emplace_back(cloud.points[i].x(), cloud.points[i].y(), cloud.points[i].z());
   const KdTree tree(all.begin(), all.end());
-  std::vector<Vec3> near;
+  std::vector<Point> near;
+  Kernel::Plane_3 fitted;
+  Point centroid;
   for (auto& p : pts) {
     near.clear();
-    const KnnSearch search(tree, std::get<0>(p), unsigned(prm.normal_neighbors));
-    for (const auto& [q, d2] : search) near.emplace_back(q.x(), q.y(), q.z());
-    const Vec3 n = fit_plane(near).n;
-    std::get<1>(p) = Vector(n.x(), n.y(), n.z());
+    const KnnSearch search(tree, std::get<0>(p), unsigned(prm.normal_neighbors), 0.0, true, KnnSearch::Distance(),
+                           false);  // unsorted: the fit needs no order
+    for (const auto& [q, d2] : search) near.push_back(q);
+    // As CGAL::pca_estimate_normals fits each neighbourhood.
+    CGAL::linear_least_squares_fitting_3(near.begin(), near.end(), fitted, centroid, CGAL::Dimension_tag<0>(), Kernel(),
+                                         CGAL::Eigen_diagonalize_traits<double, 3>());
+    std::get<1>(p) = fitted.orthogonal_vector();
   }
 }
 

@@ -49,12 +49,18 @@ std::int64_t cell_key(long long i, long long j) {
 
 // A point marks its cell and those within kFill cells: a facade's windows and the gaps of its
 // scan lines (up to about a metre) count as scanned, so that a scanned facade's coverage is near
-// 1 and the coverage of a face it does not reach near 0.
+// 1 and the coverage of a face it does not reach near 0. Each cell holding points is filled
+// around once, not once per point.
 constexpr int kFill = 2;
-void mark(CellSet& cells, const Vec2& q) {
-  const long long i = (long long)std::floor(q.x() / kCell), j = (long long)std::floor(q.y() / kCell);
-  for (long long di = -kFill; di <= kFill; ++di)
-    for (long long dj = -kFill; dj <= kFill; ++dj) cells.insert(cell_key(i + di, j + dj));
+void mark(CellSet& cells, const std::vector<Vec3>& pts, const Frame2& frame) {
+  CellSet occupied;
+  for (const auto& p : pts) {
+    const Vec2 q = frame(p);
+    const long long i = (long long)std::floor(q.x() / kCell), j = (long long)std::floor(q.y() / kCell);
+    if (!occupied.insert(cell_key(i, j)).second) continue;
+    for (long long di = -kFill; di <= kFill; ++di)
+      for (long long dj = -kFill; dj <= kFill; ++dj) cells.insert(cell_key(i + di, j + dj));
+  }
 }
 
 // fn(i, j) for every grid cell of a polygon's bounding box.
@@ -150,8 +156,7 @@ void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s,
   for (const auto& sp : s.planes) frames.push_back(frame_of(sp.plane, cs.region.center));
   // Own occupancy and the cells where another parallel scanned facade lies near.
   std::vector<CellSet> own(np), other(np);
-  for (int k = 0; k < np; ++k)
-    for (const auto& p : s.points[k]) mark(own[k], frames[k](p));
+  for (int k = 0; k < np; ++k) mark(own[k], s.points[k], frames[k]);
   for (int k = 0; k < np; ++k) {
     if (!near_vertical(s.planes[k].plane)) continue;
     for (int j = 0; j < np; ++j) {
@@ -162,7 +167,7 @@ void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s,
       for (const auto& p : s.points[j]) sum += std::abs(s.planes[k].plane.distance(p));
       const double d = sum / double(s.points[j].size());
       if (d <= prm.merge_distance || d > kSeeThrough) continue;
-      for (const auto& p : s.points[j]) mark(other[k], frames[k](p));
+      mark(other[k], s.points[j], frames[k]);
     }
   }
   // The start's faces per plane, in that plane's frame.
