@@ -1,7 +1,7 @@
 // Stage 1, detect_planes: synthetic scans with 1 cm range noise give back their planes (normal,
 // offset, inliers, RMS, hull area, facade flag, vertical snap), the same ones for a fixed seed,
-// also through the voxel option; too small or degenerate clouds give none, without
-// hanging. Clouds are in a local frame, as the pipeline passes them.
+// through the default voxel thinning and without it; too small or degenerate clouds give none,
+// without hanging. Clouds are in a local frame, as the pipeline passes them.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -203,11 +203,12 @@ TEST(Planes, VoxelDetectionKeepsTheMinimumOfPointsOfTheFullCloud) {
   EXPECT_EQ(detect_planes(cloud, prm).size(), 2u);
 }
 
-// Detection thinned to voxels of ransac_cluster_epsilon / sqrt 2 (the largest that keeps RANSAC's
-// connectivity) finds the planes that detection on every point finds: a corner scanned every
-// 3 cm (61 000 points) gives the same three planes, normals within 0.2°, offsets within 5 mm,
-// inlier counts within 3 % (the take-back leaves out the other wall's points in a corner voxel).
-TEST(Planes, ThinnedDetectionOfADenseScanFindsThePlanesOfFullDetection) {
+// By default detection is thinned to voxels of ransac_cluster_epsilon / sqrt 2 (the largest that
+// keeps RANSAC's connectivity), and finds the planes that detection on every point finds: a
+// corner scanned every 3 cm (61 000 points) gives the same three planes, normals within 0.2°,
+// offsets within 5 mm, inlier counts within 3 % (the take-back leaves out the other wall's points
+// in a corner voxel).
+TEST(Planes, DefaultDetectionIsThinnedAndFindsThePlanesOfFullDetection) {
   PointCloud cloud;
   std::vector<Truth> truth;
   auto dense = [&](const Patch& p, unsigned seed) {
@@ -219,10 +220,13 @@ TEST(Planes, ThinnedDetectionOfADenseScanFindsThePlanesOfFullDetection) {
   Params thin, all;
   thin.detect_voxel = thin.ransac_cluster_epsilon / std::sqrt(2.0);
   all.detect_voxel = 0.0;
-  const auto thinned = detect_planes(cloud, thin);
+  const auto thinned = detect_planes(cloud, Params{});
   const auto full = detect_planes(cloud, all);
   ASSERT_EQ(full.size(), 3u);
   ASSERT_EQ(thinned.size(), 3u);
+  const auto explicit_voxel = detect_planes(cloud, thin);
+  ASSERT_EQ(explicit_voxel.size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(thinned[k].inliers, explicit_voxel[k].inliers) << "the default voxel";
   for (std::size_t k = 0; k < truth.size(); ++k) {
     SCOPED_TRACE("truth plane " + std::to_string(k));
     const ScanPlane* a = find_plane(thinned, truth[k].plane);
@@ -238,9 +242,9 @@ TEST(Planes, ThinnedDetectionOfADenseScanFindsThePlanesOfFullDetection) {
 }
 
 // The side wall of a 0.6 m jog in a dense facade (like a bay's side: 0.6 × 2.5 m, 1.5 m², about
-// 40 voxels of ransac_cluster_epsilon / sqrt 2) is not lost by thinning: found, with its points
-// and extent.
-TEST(Planes, ThinnedDetectionKeepsASmallSideWall) {
+// 40 voxels of ransac_cluster_epsilon / sqrt 2) is not lost by the default thinning: found, with
+// its points and extent.
+TEST(Planes, DefaultDetectionKeepsASmallSideWall) {
   PointCloud cloud;
   const double step = 0.03;
   auto dense = [&](const Patch& p, unsigned seed) {
@@ -251,9 +255,7 @@ TEST(Planes, ThinnedDetectionKeepsASmallSideWall) {
   // The side x = 8.02, from the facade (y = 0) out to the front (y = -0.62).
   const Truth side = dense({{8.02, 0, 0}, -Vec3::UnitY(), Vec3::UnitZ(), 0.03, 0.6, 0.0, 2.5}, 2);
   const Truth front = dense(wall_patch({8.02, -0.62, 0}, Vec3::UnitX(), 3.0, 0.0, 2.5), 3);
-  Params prm;
-  prm.detect_voxel = prm.ransac_cluster_epsilon / std::sqrt(2.0);
-  const auto planes = detect_planes(cloud, prm);
+  const auto planes = detect_planes(cloud, Params{});
   ASSERT_EQ(planes.size(), 3u);
   // The facade and the front are parallel: each is the plane holding most of its points.
   for (const Truth* t : {&facade, &front})
