@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -403,15 +404,18 @@ std::string shell_problem(const Mesh& m, const Params& prm) {
   return "";
 }
 
-}  // namespace
-
-ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
-                            const Params& prm) {
+// The selection with the start's slivers on the planes they lie on within `sliver_tolerance`
+// (negative: none); nothing when some are and the starting shell then cannot be expressed in the
+// candidates (its pieces cannot be mended to close): select_shell then gives each sliver a plane
+// of its own, as it is.
+std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointCloud& cloud,
+                                              const std::vector<ScanPlane>& planes, const Params& prm,
+                                              double sliver_tolerance) {
   const auto t0 = Clock::now();
   ShellSelection out;
   auto& st = out.stats;
   Supports s;
-  detail::add_start_planes(start, s);
+  detail::add_start_planes(start, sliver_tolerance, s);
   detail::add_scan_planes(start, cloud, planes, prm, s);
   const int before_steps = int(s.planes.size());
   detail::add_step_walls(start, prm, s);
@@ -441,6 +445,7 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   }
   describe_candidates(all, start, s, prm);
   const std::vector<char> all_warm = mended_start(all, face_flags(all, "f:in_start"), prm);
+  if (all_warm.empty() && s.slivers > 0) return std::nullopt;
   const auto all_in_zone = all.mesh.property_map<FaceIndex, bool>("f:in_zone").first;
   std::vector<char> keep(all.size(), 1);
   if (!all_warm.empty())
@@ -521,6 +526,14 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
   if (!problem.empty()) return finish("selected shell invalid: " + problem);
   out.ok = true;
   return finish("");
+}
+
+}  // namespace
+
+ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
+                            const Params& prm) {
+  if (auto joined = select_shell_on(start, cloud, planes, prm, prm.planarity_tolerance)) return *joined;
+  return *select_shell_on(start, cloud, planes, prm, -1.0);  // no slivers: always a selection
 }
 
 }  // namespace lodrefine

@@ -81,7 +81,7 @@ bool steps_from_any(const Mesh& start, const Supports& s, const std::vector<Vec3
 
 }  // namespace
 
-void add_start_planes(const Mesh& start, Supports& s) {
+void add_start_planes(const Mesh& start, double planarity_tolerance, Supports& s) {
   const auto surfaces = model_surfaces(start);
   std::vector<int> order(surfaces.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = int(i);
@@ -89,14 +89,22 @@ void add_start_planes(const Mesh& start, Supports& s) {
   s.face_plane.assign(start.faces.size(), -1);
   for (int si : order) {
     const ModelSurface& surf = surfaces[si];
-    int k = -1;
+    // The first (largest) plane the surface lies on within kSurfaceDistance and kSurfaceAngleDeg;
+    // else the one nearest in angle of those its vertices lie within the planarity tolerance of,
+    // whatever its own normal: a sliver's normal is noise (a hole filled between a roof's
+    // jittered edge and its wall's top, 1 cm wide and 2° off the roof, was a plane of its own and
+    // held the roof's edge where the model had it, so no wall under it could move).
+    int k = -1, sliver_of = -1;
+    double sliver_angle = 180.0;
     for (int j = 0; j < int(s.planes.size()) && k < 0; ++j) {
-      if (unoriented_angle_deg(s.planes[j].plane.n, surf.plane.n) > kSurfaceAngleDeg) continue;
       double worst = 0.0;
       for (int f : surf.faces)
         for (int v : start.faces[f].v) worst = std::max(worst, std::abs(s.planes[j].plane.distance(start.vertices[v])));
-      if (worst <= kSurfaceDistance) k = j;
+      const double angle = unoriented_angle_deg(s.planes[j].plane.n, surf.plane.n);
+      if (worst <= kSurfaceDistance && angle <= kSurfaceAngleDeg) k = j;
+      else if (worst <= planarity_tolerance && angle < sliver_angle) sliver_of = j, sliver_angle = angle;
     }
+    if (k < 0 && sliver_of >= 0) k = sliver_of, ++s.slivers;
     if (k < 0) {
       k = int(s.planes.size());
       s.planes.push_back({surf.plane, surf.sem, false, si});

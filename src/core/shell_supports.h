@@ -22,6 +22,7 @@ struct Supports {
   std::vector<int> face_plane;            // start face -> supporting plane
   std::vector<std::vector<Vec3>> points;  // per supporting plane: its scan points
   int added = 0;
+  int slivers = 0;  // start surfaces on a plane by the planarity tolerance alone (add_start_planes)
 };
 
 // A plane whose normal is within this of horizontal is a wall's (deg): the contradiction and the
@@ -30,8 +31,9 @@ constexpr double kVerticalTiltDeg = 10.0;
 inline bool near_vertical(const Plane& pl) { return std::abs(pl.n.z()) < std::sin(radians(kVerticalTiltDeg)); }
 
 // The start's planes, one per set of its surfaces within kSurfaceAngleDeg / kSurfaceDistance
-// (matching.h), largest first.
-void add_start_planes(const Mesh& start, Supports& s);
+// (matching.h), largest first; a surface on none of them goes to the one nearest in angle of
+// those its vertices all lie within `planarity_tolerance` (m) of (a sliver: counted in slivers).
+void add_start_planes(const Mesh& start, double planarity_tolerance, Supports& s);
 // The scan's facade planes near the footprint (within match_distance + bbox_margin), each on the
 // supporting plane it lies on, else a new one; ransac_min_points such points at least.
 void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& scan, const Params& prm,

@@ -53,8 +53,10 @@ struct ShellSelection {
 // faces on added scan planes are WallSurface (source -1). A selection whose shell does not
 // validate is excluded and the program solved again (its changes fixed back, twice at most);
 // when the program chose the starting shell unchanged but its pieces do not validate, the result
-// is `start` itself (ok, with that said in `reason`). Never throws for geometry; !ok with the
-// reason when the program has no solution or no valid shell.
+// is `start` itself (ok, with that said in `reason`). A start face whose vertices all lie within
+// planarity_tolerance of a larger face's plane, though its own normal is off (a sliver), is a
+// piece of that plane, unless the start then cannot be expressed in the candidates. Never throws
+// for geometry; !ok with the reason when the program has no solution or no valid shell.
 ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
                             const Params& params);
 
