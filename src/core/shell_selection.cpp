@@ -10,6 +10,7 @@
 #include <unordered_set>
 
 #include "lodrefine/core/confidence.h"
+#include "lodrefine/core/distance.h"
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/core/matching.h"
 #include "lodrefine/core/shell_trace.h"
@@ -343,6 +344,73 @@ bool moves_beyond_evidence(const Mesh& m, const Mesh& start, const EvidenceReach
   return false;
 }
 
+// A selection that puts solid where the scan saw through: points of the supporting planes
+// (surfaces the scanner saw from outside) that end up deeper than kEnclosedDepth inside the
+// shell, though not inside the start, would have been hidden by it. A neighbour's wall across a
+// gap beyond the building's end became the front of a box filling the gap (the front wall's
+// points behind it then inside): a change made of those. Deeper than a window recess or a
+// moved wall's noise; as many as a plane needs (ransac_min_points).
+constexpr double kEnclosedDepth = 0.5;
+
+// The changed candidates in connected pieces (sharing an edge): each piece alone leaves every
+// edge used 0 or 2 times, as the whole selection does.
+std::vector<std::vector<int>> changed_pieces(const CandidateSet& cs, const std::vector<char>& changed) {
+  DisjointSets sets(std::size_t(cs.size()));
+  for (const auto& e : cs.edges) {
+    int first = -1;
+    for (auto h : e) {
+      const int f = cs.face(h);
+      if (!changed[f]) continue;
+      if (first < 0) first = f;
+      else sets.unite(f, first);
+    }
+  }
+  std::unordered_map<int, int> piece_of_root;
+  std::vector<std::vector<int>> pieces;
+  for (int f = 0; f < cs.size(); ++f) {
+    if (!changed[f]) continue;
+    const auto [it, added] = piece_of_root.emplace(sets.find(f), int(pieces.size()));
+    if (added) pieces.emplace_back();
+    pieces[std::size_t(it->second)].push_back(f);
+  }
+  return pieces;
+}
+
+// The changed candidates of the pieces that enclose scan points (see kEnclosedDepth): each
+// newly enclosed point counts for the piece with the changed candidate nearest to it.
+std::vector<int> enclosing_changes(const CandidateSet& cs, const std::vector<char>& changed, const Mesh& start,
+                                   const Mesh& shell, const std::vector<Vec3>& evidence, const Params& prm) {
+  const auto pieces = changed_pieces(cs, changed);
+  if (pieces.empty()) return {};
+  Mesh changes;  // the changed candidates as one polygon soup, face i of piece piece_of[i]
+  std::vector<int> piece_of;
+  Eigen::AlignedBox3d box;
+  for (int k = 0; k < int(pieces.size()); ++k)
+    for (int f : pieces[k]) {
+      Face face;
+      for (const Vec3& p : cs.polygon(f)) {
+        face.v.push_back(int(changes.vertices.size()));
+        changes.vertices.push_back(p);
+        box.extend(p);
+      }
+      changes.faces.push_back(std::move(face));
+      piece_of.push_back(k);
+    }
+  std::vector<Vec3> enclosed;
+  const MeshDistance to_shell(shell), to_start(start);
+  for (const Vec3& p : evidence)
+    if (box.contains(p) && to_shell.nearest(p, true).distance < -kEnclosedDepth &&
+        to_start.nearest(p, true).distance >= -kEnclosedDepth)
+      enclosed.push_back(p);
+  if (int(enclosed.size()) < prm.ransac_min_points) return {};
+  std::vector<int> count(pieces.size(), 0);
+  for (const auto& n : MeshDistance(changes).nearest_all(enclosed)) ++count[piece_of[n.face]];
+  std::vector<int> out;
+  for (int k = 0; k < int(pieces.size()); ++k)
+    if (count[k] >= prm.ransac_min_points) out.insert(out.end(), pieces[k].begin(), pieces[k].end());
+  return out;
+}
+
 // The starting shell as a selection of candidates: its faces are unions of candidates up to
 // where its vertices sit off the planes' meets (a model within tolerance of its planes, planes
 // merged within kSurfaceDistance), which leaves some edges used once or thrice. Those are
@@ -504,15 +572,24 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
     out.mesh.id = start.id;
     st.faces_from_selection = int(out.mesh.faces.size());
     problem = shell_problem(out.mesh, prm);
+    std::vector<int> refused;  // the changes to fix back (all of them, unless said)
     if (problem.empty()) {
       Mesh snapped = snapped_to_start(out.mesh, start);
       if (shell_problem(snapped, prm).empty()) out.mesh = std::move(snapped);
       if (st.candidates_changed > 0 && moves_beyond_evidence(out.mesh, start, evidence))
         problem = "it moves the model where the scan shows nothing";
     }
+    if (problem.empty() && st.candidates_changed > 0 && !warm.empty()) {
+      std::vector<char> changed(cs.size());
+      for (int f = 0; f < cs.size(); ++f) changed[f] = selected[f] != base[f];
+      refused = enclosing_changes(cs, changed, start, out.mesh, st.evidence, prm);
+      if (!refused.empty()) problem = "it encloses scan points (a surface seen through it)";
+    }
     if (problem.empty() || st.candidates_changed == 0 || warm.empty() || attempt == kRetries) break;
-    for (int f = 0; f < cs.size(); ++f)
-      if (selected[f] != base[f]) pg.fixed[f] = int(base[f]);
+    if (refused.empty())
+      for (int f = 0; f < cs.size(); ++f)
+        if (selected[f] != base[f]) refused.push_back(f);
+    for (int f : refused) pg.fixed[f] = int(base[f]);
   }
   if (st.candidates_changed == 0) {
     // The program chose its starting shell: it is written with the start's own faces, whose

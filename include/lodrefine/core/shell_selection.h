@@ -51,7 +51,9 @@ struct ShellSelection {
 // Selects the building's faces. `start`: a valid closed shell (local frame); `cloud`: the local
 // cloud `planes` were detected in. Faces on the start's planes keep its semantic and source;
 // faces on added scan planes are WallSurface (source -1). A selection whose shell does not
-// validate is excluded and the program solved again (its changes fixed back, twice at most);
+// validate is excluded and the program solved again (its changes fixed back, twice at most), as
+// is a connected piece of changes leaving ransac_min_points or more of the supporting planes'
+// points over 0.5 m inside the shell but not inside `start` (solid where the scan saw through);
 // when the program chose the starting shell unchanged but its pieces do not validate, the result
 // is `start` itself (ok, with that said in `reason`). A start face whose vertices all lie within
 // planarity_tolerance of a larger face's plane, though its own normal is off (a sliver), is a
