@@ -396,6 +396,10 @@ std::vector<int> enclosing_changes(const CandidateSet& cs, const std::vector<cha
       changes.faces.push_back(std::move(face));
       piece_of.push_back(k);
     }
+  // A point newly enclosed lies inside the changed candidates' box or within kEnclosedDepth of
+  // a removed one (the start's surface, by which it was less deep).
+  box.extend(box.min() - Vec3::Constant(kEnclosedDepth + kSurfaceDistance));
+  box.extend(box.max() + Vec3::Constant(kEnclosedDepth + kSurfaceDistance));
   std::vector<Vec3> enclosed;
   const MeshDistance to_shell(shell), to_start(start);
   for (const Vec3& p : evidence)
