@@ -266,6 +266,7 @@ Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vec
     if (!why.empty()) {
       j.ok = false;
       j.check = "wall";
+      j.wall = int(k);
       j.detail = "moved wall " + std::to_string(k) + ": " + why;
       return j;
     }

@@ -1,6 +1,7 @@
 // The pipeline (paper Sec. 3), as orchestration only: each stage's logic lives in its module.
 #include "lodrefine/core/refine.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -206,8 +207,14 @@ std::optional<Mesh> starting_shell(const Mesh& current, const std::vector<ModelS
   std::optional<Mesh> refined;
   if (!all.empty())
     refined = substitute_valid(current, surfaces, all, prm, trace.substitution.emplace(RefineTrace::Substitution{}));
+  auto describe_scan_moves = [&] {
+    for (const auto& mv : moves) {
+      trace.facades.push_back(describe_move(current, surfaces, mv, "scan"));
+      trace.facades.back().surface = mv.surface;
+    }
+  };
   if (refined) {
-    for (const auto& mv : moves) trace.facades.push_back(describe_move(current, surfaces, mv, "scan"));
+    describe_scan_moves();
     for (const auto& c : corners) {
       trace.facades.push_back(describe_move(current, surfaces, c.move, "corner"));
       trace.facades.back().wall.flush_facade = c.flush_facade;
@@ -215,8 +222,7 @@ std::optional<Mesh> starting_shell(const Mesh& current, const std::vector<ModelS
   } else if (!corners.empty() && !moves.empty()) {
     refined = substitute_valid(current, surfaces, moves, prm,
                                trace.substitution_without_corners.emplace(RefineTrace::Substitution{}));
-    if (refined)
-      for (const auto& mv : moves) trace.facades.push_back(describe_move(current, surfaces, mv, "scan"));
+    if (refined) describe_scan_moves();
   }
   trace.replacements.emplace();
   if (!refined && !all.empty()) refined = one_wall_at_a_time(current, local, planes, prm, trace);
@@ -325,11 +331,29 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const R
     return select_and_judge(kept, current, refined, !mr.matches.empty(), local, planes, prm, run);
   };
   RefineResult result = attempt(corners);
-  if (!corners.empty() && trace.judgement && !trace.judgement->ok) {
-    trace.corners_refused = trace.judgement->check + " check: " + trace.judgement->detail;
+  auto refused = [&] { return trace.judgement && !trace.judgement->ok; };
+  auto again = [&](const std::vector<CornerMove>& with_corners) {
     trace.judgement.reset();
-    trace.seconds.pop_back();  // the first attempt's total; its other laps add up in the report
-    result = attempt({});
+    trace.seconds.pop_back();  // the last attempt's total; its other laps add up in the report
+    return attempt(with_corners);
+  };
+  std::vector<CornerMove> kept_corners = corners;
+  if (!corners.empty() && refused()) {
+    trace.corners_refused = trace.judgement->check + " check: " + trace.judgement->detail;
+    kept_corners.clear();
+    result = again(kept_corners);
+  }
+  // A scan move whose own wall the judge refuses (its points got farther, or it has none: a
+  // plane matched that is not the wall's) says nothing of the other walls: it is dropped and the
+  // building refined again on theirs.
+  while (refused() && trace.judgement->check == "wall") {
+    const RefineTrace::FacadeMove& wall = trace.facades[std::size_t(trace.judgement->wall)];
+    const auto dropped =
+        std::remove_if(moves.begin(), moves.end(), [&](const WallMove& m) { return m.surface == wall.surface; });
+    if (wall.surface < 0 || dropped == moves.end()) break;
+    moves.erase(dropped, moves.end());
+    trace.walls_refused.push_back(trace.judgement->check + " check: " + trace.judgement->detail);
+    result = again(kept_corners);
   }
   return result;
 }

@@ -153,6 +153,7 @@ json refine_report(const RefineResult& r) {
                         {"building", fit(t.judgement->building)},
                         {"walls", walls}};
     if (t.corners_refused) rep["judgement"]["corners_refused"] = *t.corners_refused;
+    if (!t.walls_refused.empty()) rep["judgement"]["walls_refused"] = t.walls_refused;
   }
   if (t.selection) rep["selection"] = selection_json(*t.selection, t.selection_reason);
   return rep;

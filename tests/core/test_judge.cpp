@@ -46,6 +46,7 @@ TEST(Judge, AWallMovedOntoItsScanIsBetter) {
   scan_front(cloud, 0.0, 0.5, 11.5);
   const Judgement j = judge_refinement(coarse, refined, {front_wall(-0.5, 0.0)}, cloud, MatchConfig{}, PlaneConfig{});
   EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
+  EXPECT_EQ(j.wall, -1);
   EXPECT_EQ(j.building.points, cloud.points.size());
   EXPECT_NEAR(j.building.rms_before, 0.5, 0.01);
   EXPECT_LT(j.building.rms_after, 0.01);
@@ -107,6 +108,7 @@ TEST(Judge, AnUnscannedWallMovesOnlyOnCornerEvidence) {
   const Judgement j = judge_refinement(coarse, refined, {side}, cloud, MatchConfig{}, PlaneConfig{});
   EXPECT_FALSE(j.ok);
   EXPECT_EQ(j.check, "wall");
+  EXPECT_EQ(j.wall, 0);
   EXPECT_NE(j.detail.find("no corner evidence"), std::string::npos) << j.detail;
   side.corner = true;
   EXPECT_EQ(judge_refinement(coarse, refined, {side}, cloud, MatchConfig{}, PlaneConfig{}).check,
@@ -143,6 +145,7 @@ TEST(Judge, OnlyPointsOnAWallsOldOrNewPlaneJudgeTheWall) {
   EXPECT_FALSE(k.ok);
   EXPECT_EQ(k.check, "wall");
   EXPECT_NE(k.detail.find("moved wall 1: RMS"), std::string::npos) << k.detail;
+  EXPECT_EQ(k.wall, 1);  // which one, for refine to drop its move
   EXPECT_NEAR(k.walls[1].rms_after, 0.7, 0.01);
 }
 

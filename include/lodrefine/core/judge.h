@@ -49,6 +49,7 @@ struct Judgement {
   bool ok = true;
   std::string check;       // the check that refused: "building", "wall" or "gain"; empty when ok
   std::string detail;      // one line with the figures of the refusal; empty when ok
+  int wall = -1;           // the refused wall (index into the JudgedWalls) when check == "wall"
   Fit building;            // every judged point
   std::vector<Fit> walls;  // per JudgedWall, its region
 };

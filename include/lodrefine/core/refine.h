@@ -58,7 +58,8 @@ struct RefineTrace {
     std::set<int> input_faces;  // Face::source of its faces
     std::string evidence;       // "scan" or "corner"
     double max_move = 0.0, mean_move = 0.0;
-    JudgedWall wall;  // the wall before the move and its new plane, for the judge
+    JudgedWall wall;   // the wall before the move and its new plane, for the judge
+    int surface = -1;  // the moved model surface of the merged input (-1: moved one wall at a time)
   };
 
   std::string id;
@@ -78,6 +79,9 @@ struct RefineTrace {
   // The judge's refusal of the refinement with the corner moves, when it was tried again
   // without them (the judgement above is then the second attempt's).
   std::optional<std::string> corners_refused;
+  // The judge's refusals of single scan moves (the wall check), each dropped in turn and the
+  // building refined again on the other walls' moves.
+  std::vector<std::string> walls_refused;
   std::optional<ShellSelectionStats> selection;  // the program that chose the output's faces
   std::string selection_reason;                  // why it gave no shell, when it did not
 
@@ -98,7 +102,9 @@ struct RefineResult {
 };
 
 // Every model gets an output: the refined building, the repaired input, or the input as read,
-// with the outcome and its reason. Never throws for a bad model (only for parameters out of
+// with the outcome and its reason. A refinement the judge refuses with corner moves is made again
+// without them; one it refuses on a scan move's own wall, again without that move (in turn, while
+// any is left). Never throws for a bad model (only for parameters out of
 // range).
 RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const RefineConfig& config);
 
