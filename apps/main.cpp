@@ -1,6 +1,7 @@
 // lodrefine: refine coarse LoD2 building models with MLS point clouds.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -8,6 +9,7 @@
 
 #include "commands.h"
 #include "lodrefine/core/types.h"
+#include "lodrefine/io/files.h"
 #include "lodrefine/version.h"
 
 namespace lodrefine::app {
@@ -22,14 +24,19 @@ namespace {
 // Memory running out can end in std::terminate rather than in main's catch: nlohmann::json's
 // destructor allocates (its stack of children), so a large document destroyed while a
 // bad_alloc unwinds throws again from a noexcept destructor. That is still memory running out:
-// one line and exit 3, as main says it, instead of an abort.
+// one line and exit 3, as main says it, instead of an abort, naming the file being read.
 [[noreturn]] void terminated() {
   try {
     if (const std::exception_ptr e = std::current_exception()) std::rethrow_exception(e);
   } catch (const std::bad_alloc&) {
-    static const char kLine[] = "lodrefine: error: out of memory\n";
-    const ssize_t n = ::write(2, kLine, sizeof kLine - 1);
-    (void)n;
+    // Formatted into a static buffer: nothing to allocate.
+    static char line[1024];
+    const char* file = lodrefine::ReadingFile::name();
+    const int n = *file
+                      ? std::snprintf(line, sizeof line, "lodrefine: error: %s: out of memory reading the file\n", file)
+                      : std::snprintf(line, sizeof line, "lodrefine: error: out of memory\n");
+    const ssize_t w = ::write(2, line, std::size_t(std::clamp(n, 0, int(sizeof line) - 1)));
+    (void)w;
     ::_exit(3);
   } catch (...) {
   }
@@ -65,6 +72,9 @@ int main(int argc, char** argv) {
   } catch (const InputError& e) {
     std::fprintf(stderr, "lodrefine: error: %s\n", e.what());
     return 2;
+  } catch (const OutOfMemory& e) {  // names the file
+    std::fprintf(stderr, "lodrefine: error: %s\n", e.what());
+    return 3;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "lodrefine: error: out of memory\n");
     return 3;

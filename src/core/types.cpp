@@ -2,8 +2,15 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstring>
 
 namespace lodrefine {
+
+OutOfMemory::OutOfMemory(const std::string& message) noexcept {
+  const std::size_t n = std::min(message.size(), sizeof what_ - 1);
+  std::memcpy(what_, message.data(), n);
+  what_[n] = '\0';
+}
 
 const char* semantic_name(Semantic s) {
   switch (s) {

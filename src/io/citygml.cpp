@@ -67,7 +67,8 @@ nlohmann::ordered_json citygml_to_cityjson(const std::string& path, std::string*
   return doc;
 }
 
-CityJsonFile read_citygml(const std::string& path) {
+namespace {
+CityJsonFile citygml_file(const std::string& path) {
   std::string version;
   std::vector<std::string> notes;
   const auto doc = citygml_to_cityjson(path, &version, &notes);
@@ -83,6 +84,11 @@ CityJsonFile read_citygml(const std::string& path) {
   for (auto& b : f.buildings)
     if (const auto it = attributes.find(b.mesh.id); it != attributes.end()) b.attributes = *it->second;
   return f;
+}
+}  // namespace
+
+CityJsonFile read_citygml(const std::string& path) {
+  return read_naming_memory(path, [&] { return citygml_file(path); });
 }
 
 CityJsonFile read_city_file(const std::string& path) {

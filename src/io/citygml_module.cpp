@@ -133,8 +133,8 @@ void to_cityjson(const std::string& path, std::string& text, const std::string& 
     status = module.convert(path.c_str(), &text, crs_url.c_str(), &doc, &renamed, &error);
   }
   if (status == kInputError) throw InputError(error);
-  if (status == kOutOfMemory)  // main's bad_alloc line cannot name the file
-    throw std::runtime_error(error.empty() ? path + ": out of memory reading the CityGML file" : error);
+  if (status == kOutOfMemory)
+    throw OutOfMemory(error.empty() ? path + ": out of memory reading the CityGML file" : error);
   if (status != kOk) throw std::runtime_error(error);
 }
 

@@ -479,12 +479,14 @@ CityJsonFile read_cityjson(const std::string& path, const std::string& lod) {
   const FileKind kind = sniff_file(path);
   if (kind != FileKind::Json && kind != FileKind::Other)
     throw InputError(path + ": not a CityJSON file: the file is " + file_kind_text(kind));
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open the file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw InputError(path + ": cannot read the file");
-  return parse_cityjson(ss.str(), path, lod);
+  return read_naming_memory(path, [&] {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path + ": cannot open the file");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    if (in.bad()) throw InputError(path + ": cannot read the file");
+    return parse_cityjson(ss.str(), path, lod);
+  });
 }
 
 }  // namespace lodrefine

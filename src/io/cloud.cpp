@@ -47,7 +47,7 @@ PointCloud read_cloud(const std::string& path, const CloudOptions& options) {
       cloud.points.reserve(ply_vertex_count(path));
     }
   }
-  stream_cloud(path, options, [&](const Vec3& p) { cloud.points.push_back(p); });
+  read_naming_memory(path, [&] { stream_cloud(path, options, [&](const Vec3& p) { cloud.points.push_back(p); }); });
   return cloud;
 }
 

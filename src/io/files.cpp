@@ -210,6 +210,25 @@ std::string SafeNames::add(const std::string& id) {
     if (take(hashed + "-" + std::to_string(k))) return hashed + "-" + std::to_string(k);
 }
 
+namespace {
+thread_local char reading_name[512] = "";
+
+void copy_name(char (&to)[512], const char* from) noexcept {
+  const std::size_t n = strnlen(from, sizeof to - 1);
+  std::memmove(to, from, n);
+  to[n] = '\0';
+}
+}  // namespace
+
+ReadingFile::ReadingFile(const std::string& path) noexcept {
+  copy_name(previous_, reading_name);
+  copy_name(reading_name, path.c_str());
+}
+
+ReadingFile::~ReadingFile() { copy_name(reading_name, previous_); }
+
+const char* ReadingFile::name() noexcept { return reading_name; }
+
 std::string read_file(const std::string& path) { return io_text::read_whole_file(path); }
 
 }  // namespace lodrefine

@@ -30,6 +30,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "lodrefine/io/files.h"
 #include "text.h"
 
 #ifndef TINYOBJLOADER_USE_DOUBLE
@@ -299,7 +300,8 @@ std::string obj_text(const Mesh& mesh, const Vec3& origin, AtomicFile& file) {
 Mesh read_obj(const std::string& path, int* skipped_faces) {
   const FileKind kind = sniff_file(path);
   if (kind != FileKind::Other) fail(path, "not an OBJ model: the file is " + file_kind_text(kind));
-  return ObjBuild(path, ObjCheck(path).run(read_whole_file(path))).run(skipped_faces);
+  return read_naming_memory(
+      path, [&] { return ObjBuild(path, ObjCheck(path).run(read_whole_file(path))).run(skipped_faces); });
 }
 
 Mesh read_obj(const std::string& path) { return read_obj(path, nullptr); }

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross products on Vec3 everywhere
 #include <chrono>
+#include <new>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -44,6 +45,18 @@ inline double seconds_since(Clock::time_point t0) { return std::chrono::duration
 // Input that cannot be used; what() is a one-line message naming the file and the fault.
 struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
+};
+
+// Memory ran out reading a named input: a bad_alloc (main's exit 3) whose what() is the one-line
+// message naming the file. The message is copied into a fixed buffer (cut to fit): throwing it
+// allocates nothing.
+class OutOfMemory : public std::bad_alloc {
+ public:
+  explicit OutOfMemory(const std::string& message) noexcept;
+  const char* what() const noexcept override { return what_; }
+
+ private:
+  char what_[512];
 };
 
 }  // namespace lodrefine

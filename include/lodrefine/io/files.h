@@ -2,6 +2,7 @@
 // and atomic writes (a temporary beside the target, renamed over it), so no partial file is left.
 #pragma once
 #include <cstddef>
+#include <new>
 #include <set>
 #include <string>
 #include <vector>
@@ -60,6 +61,36 @@ class AtomicFile {
 // The whole file as bytes (small inputs: a baseline, a gates file); throws InputError, one line
 // naming `path`, for a directory or a file that cannot be read.
 std::string read_file(const std::string& path);
+
+// The input file this thread is reading, for the out-of-memory line. Memory running out while a
+// model or cloud is read ends in the reader's catch, or in std::terminate when a destructor
+// allocates while the bad_alloc unwinds (nlohmann::json's does), where only this is known; the
+// name is kept in a fixed buffer, so reading it allocates nothing.
+class ReadingFile {
+ public:
+  explicit ReadingFile(const std::string& path) noexcept;  // names `path` for this thread
+  ~ReadingFile();                                          // names the file read before, if any
+  ReadingFile(const ReadingFile&) = delete;
+  ReadingFile& operator=(const ReadingFile&) = delete;
+  static const char* name() noexcept;  // "" when no reader runs on this thread
+
+ private:
+  char previous_[512];
+};
+
+// read() under ReadingFile(path); memory running out in it throws OutOfMemory "<path>: out of
+// memory reading the file" once what read() held is freed.
+template <class Read>
+auto read_naming_memory(const std::string& path, Read&& read) -> decltype(read()) {
+  const ReadingFile reading(path);
+  try {
+    return read();
+  } catch (const OutOfMemory&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw OutOfMemory(path + ": out of memory reading the file");
+  }
+}
 
 // Writes `content` to `path` atomically (temp file in the same directory + rename).
 void write_file_atomic(const std::string& path, const std::string& content);
