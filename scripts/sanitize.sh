@@ -9,8 +9,9 @@
 #   scripts/sanitize.sh --unit          the unit tests only (labels core, io, eval, synth), building
 #                                       only their binaries and the app (the io tests run it)
 #   scripts/sanitize.sh -R BadInput     extra arguments go to ctest (after --unit too)
-# CI (.ci/run) runs every label but the Batch and Dispatch suites (shell orchestration of the
-# same refine; slow under ASan, they run unsanitized in scripts/test.sh).
+# CI (.ci/run) runs every label but the suites that drive the same refine through make, Slurm or
+# GNU Parallel and the sweeps over real data, seeds and types (.ci/run says which and why; they
+# run unsanitized in scripts/test.sh).
 # Optimisation: -O1 -g1 (LODREFINE_SANITIZE_OPT in CMakeLists.txt; README, Tests, has the figures).
 set -euo pipefail
 cd "$(dirname "$0")/.."
