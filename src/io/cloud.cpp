@@ -34,21 +34,24 @@ void stream_cloud(const std::string& path, const CloudOptions& options,
 }
 
 PointCloud read_cloud(const std::string& path, const CloudOptions& options) {
-  PointCloud cloud;
-  // A LAS count is bounded by the file size (checked in the header), a LAZ count only by what
-  // its chunks decode to, so beyond a few million points the vector grows as points arrive.
-  // With a class filter most points may be dropped, so the vector grows too.
-  constexpr std::uint64_t kReserveLimit = std::uint64_t(1) << 22;
-  if (options.classes.empty()) {
-    if (cloud_format(path) == CloudFormat::Las) {
-      const LasHeader h = read_las_header(path);
-      cloud.points.reserve(h.compressed ? std::min(h.point_count, kReserveLimit) : h.point_count);
-    } else {
-      cloud.points.reserve(ply_vertex_count(path));
+  // Under read_naming_memory whole: the reservation is most of the memory a cloud takes.
+  return read_naming_memory(path, [&] {
+    PointCloud cloud;
+    // A LAS count is bounded by the file size (checked in the header), a LAZ count only by what
+    // its chunks decode to, so beyond a few million points the vector grows as points arrive.
+    // With a class filter most points may be dropped, so the vector grows too.
+    constexpr std::uint64_t kReserveLimit = std::uint64_t(1) << 22;
+    if (options.classes.empty()) {
+      if (cloud_format(path) == CloudFormat::Las) {
+        const LasHeader h = read_las_header(path);
+        cloud.points.reserve(h.compressed ? std::min(h.point_count, kReserveLimit) : h.point_count);
+      } else {
+        cloud.points.reserve(ply_vertex_count(path));
+      }
     }
-  }
-  read_naming_memory(path, [&] { stream_cloud(path, options, [&](const Vec3& p) { cloud.points.push_back(p); }); });
-  return cloud;
+    stream_cloud(path, options, [&](const Vec3& p) { cloud.points.push_back(p); });
+    return cloud;
+  });
 }
 
 std::string overlap_problem(const Eigen::AlignedBox3d& cloud, const Eigen::AlignedBox3d& model, const std::string& what,
