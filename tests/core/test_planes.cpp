@@ -203,11 +203,11 @@ TEST(Planes, VoxelDetectionKeepsTheMinimumOfPointsOfTheFullCloud) {
   EXPECT_EQ(detect_planes(cloud, prm).size(), 2u);
 }
 
-// By default detection is thinned to voxels of ransac_cluster_epsilon / sqrt 2 (the largest that
-// keeps RANSAC's connectivity), and finds the planes that detection on every point finds: a
-// corner scanned every 3 cm (61 000 points) gives the same three planes, normals within 0.2°,
-// offsets within 5 mm, inlier counts within 3 % (the take-back leaves out the other wall's points
-// in a corner voxel).
+// By default detection is thinned to voxels of sqrt(min_plane_area / (normal_neighbors + 1)),
+// and finds the planes that detection on every point finds: a corner scanned every 3 cm (61 000
+// points) gives the same three planes, normals within 0.2°, offsets within 5 mm, inlier counts
+// within 3 % (the ground lost 4 % before a corner voxel's points off its representative's wall
+// went to the neighbouring wall's plane).
 TEST(Planes, DefaultDetectionIsThinnedAndFindsThePlanesOfFullDetection) {
   PointCloud cloud;
   std::vector<Truth> truth;
@@ -218,7 +218,7 @@ TEST(Planes, DefaultDetectionIsThinnedAndFindsThePlanesOfFullDetection) {
   dense({{6, 0, 0}, Vec3::UnitY(), Vec3::UnitZ(), 0.1, 5.0, 0.1, 4.0}, 2);
   dense({{0, 0, 0}, Vec3::UnitX(), Vec3::UnitY(), 0.0, 6.0, -3.0, -0.1}, 3);
   Params thin, all;
-  thin.detect_voxel = thin.ransac_cluster_epsilon / std::sqrt(2.0);
+  thin.detect_voxel = std::sqrt(thin.min_plane_area / double(thin.normal_neighbors + 1));
   all.detect_voxel = 0.0;
   const auto thinned = detect_planes(cloud, Params{});
   const auto full = detect_planes(cloud, all);
@@ -242,7 +242,7 @@ TEST(Planes, DefaultDetectionIsThinnedAndFindsThePlanesOfFullDetection) {
 }
 
 // The side wall of a 0.6 m jog in a dense facade (like a bay's side: 0.6 × 2.5 m, 1.5 m², about
-// 40 voxels of ransac_cluster_epsilon / sqrt 2) is not lost by the default thinning: found, with
+// 20 voxels of the default 0.28 m) is not lost by the default thinning: found, with
 // its points and extent.
 TEST(Planes, DefaultDetectionKeepsASmallSideWall) {
   PointCloud cloud;

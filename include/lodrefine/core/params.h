@@ -22,7 +22,9 @@ namespace lodrefine {
   X(double, ransac_probability, 0.01, 1e-6, 1.0, "RANSAC: probability to miss the largest shape")                   \
   X(double, detect_voxel, -1.0, -1.0, 1.0,                                                                          \
     "plane detection runs on one point per voxel of this size, then takes back every point near its planes (m; 0: " \
-    "all points; negative: ransac_cluster_epsilon / sqrt 2, the largest voxel that keeps RANSAC's connectivity)")   \
+    "all points; negative: sqrt(min_plane_area / (normal_neighbors + 1)), the largest voxel at which the smallest " \
+    "plane "                                                                                                        \
+    "kept still holds a neighbourhood of representatives)")                                                         \
   X(int, normal_neighbors, 12, 3, 200, "neighbours for PCA normal estimation")                                      \
   X(double, min_plane_area, 1.0, 0.0, 1e6, "scan planes whose inlier hull is smaller are ignored (m^2)")            \
   X(double, facade_max_tilt_deg, 10.0, 0.0, 45.0,                                                                   \

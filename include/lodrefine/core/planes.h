@@ -21,10 +21,11 @@ struct ScanPlane {
 // ransac_*, normal_neighbors, detect_voxel, min_plane_area, facade_max_tilt_deg and
 // vertical_snap_deg parameters. Returns planes of at least ransac_min_points inliers and
 // min_plane_area hull, largest first; a point is the inlier of one plane at most. RANSAC runs on
-// one point per voxel (detect_voxel; by default, negative, ransac_cluster_epsilon / sqrt 2), with
-// normals from the k nearest points of the full cloud, and each point of the cloud goes back to
-// the plane that took its voxel's point, if within ransac_epsilon of it; detect_voxel = 0 runs it
-// on every point. Too few, repeated or nearly coincident points give no plane.
+// one point per voxel (detect_voxel; by default, negative, sqrt(min_plane_area /
+// (normal_neighbors + 1)), 0.28 m), with normals from the k nearest points of the full cloud, and
+// each point of the cloud goes back to the plane that took its voxel's point, if within
+// ransac_epsilon of it; detect_voxel = 0 runs it on every point. Too few, repeated or nearly
+// coincident points give no plane.
 std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const PlaneConfig& config);
 
 }  // namespace lodrefine
