@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <tuple>
 #include <unordered_map>
 
@@ -326,7 +327,7 @@ int neighbouring_shape(const Vec3& p, int own, const Thinning& t, const std::vec
                        const std::vector<Plane>& fitted, const PlaneConfig& prm) {
   const Eigen::Array3i c = t.cell(p);
   int best = -1;
-  double best_distance = prm.ransac_epsilon;
+  double best_distance = std::numeric_limits<double>::infinity();
   for (int dx = -1; dx <= 1; ++dx)
     for (int dy = -1; dy <= 1; ++dy)
       for (int dz = -1; dz <= 1; ++dz) {
@@ -334,7 +335,8 @@ int neighbouring_shape(const Vec3& p, int own, const Thinning& t, const std::vec
         const int s = v < 0 ? -1 : rep_shape[std::size_t(v)];
         if (s < 0 || s == own) continue;
         const double d = std::abs(fitted[std::size_t(s)].distance(p));
-        if (d < best_distance || (d == best_distance && s < best)) best = s, best_distance = d;
+        if (d <= prm.ransac_epsilon && (d < best_distance || (d == best_distance && s < best)))
+          best = s, best_distance = d;
       }
   return best;
 }
