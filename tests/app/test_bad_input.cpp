@@ -1377,6 +1377,25 @@ CliRun run_limited(long kb, const std::string& args, const std::string& dir) {
   return r;
 }
 
+// Runs `lodrefine ARGS` under each address-space limit (KB). Where it fails for want of memory,
+// it says one line, the file's name and that memory ran out reading it, exits 3 and leaves
+// nothing at `out` (a file, or a folder with files). Returns how many limits failed.
+int expect_named_out_of_memory(const std::vector<long>& limits_kb, const std::string& args, const std::string& file,
+                               const std::string& out, const std::string& dir) {
+  int failures = 0;
+  for (long kb : limits_kb) {
+    fs::remove_all(out);
+    const CliRun r = run_limited(kb, args, dir);
+    if (r.exit == 0) continue;  // enough memory after all
+    ++failures;
+    EXPECT_EQ(r.exit, 3) << kb << " KB: " << r.err;
+    EXPECT_EQ(lines(r.err).size(), 1u) << kb << " KB: " << r.err;
+    EXPECT_EQ(r.err, "lodrefine: error: " + file + ": out of memory reading the file\n") << kb << " KB";
+    EXPECT_FALSE(fs::exists(out) && (!fs::is_directory(out) || !files_in(out).empty())) << kb << " KB";
+  }
+  return failures;
+}
+
 }  // namespace
 
 TEST(BadInputMemory, CityGmlUnderAnAddressSpaceLimitFailsInOneLine) {
@@ -1443,18 +1462,9 @@ TEST(BadInputMemory, CityJsonUnderAnAddressSpaceLimitFailsInOneLine) {
                              {"geometry", {{{"type", "MultiSurface"}, {"lod", "2.2"}, {"boundaries", faces}}}}}}}},
                          {"vertices", vertices}}
                         .dump());
-  for (long kb : {80000L, 100000L, 120000L, 140000L, 160000L}) {
-    fs::remove_all(dir + "/objs");
-    const CliRun r =
-        run_limited(kb, "convert --cityjson " + shell_quote(model) + " --out-dir " + shell_quote(dir + "/objs"), dir);
-    const int exit = r.exit;
-    const std::string& says = r.err;
-    if (exit == 0) continue;  // enough memory after all
-    EXPECT_EQ(exit, 3) << kb << " KB: " << says;
-    EXPECT_EQ(lines(says).size(), 1u) << kb << " KB: " << says;
-    EXPECT_EQ(says, "lodrefine: error: " + model + ": out of memory reading the file\n") << kb << " KB";
-    EXPECT_FALSE(fs::exists(dir + "/objs") && !files_in(dir + "/objs").empty()) << kb << " KB";
-  }
+  expect_named_out_of_memory({80000, 100000, 120000, 140000, 160000},
+                             "convert --cityjson " + shell_quote(model) + " --out-dir " + shell_quote(dir + "/objs"),
+                             model, dir + "/objs", dir);
   add_row("convert: 11 MB CityJSON under ulimit -v 80-160 MB", "one line naming the file, exit 3 (was an abort, 134)",
           3);
 }
@@ -1474,19 +1484,12 @@ TEST(BadInputMemory, CloudUnderAnAddressSpaceLimitIsNamed) {
   write_ply(cloud, big);
   big = PointCloud();
   const std::string model = std::string(LODREFINE_SOURCE_DIR) + "/data/samples/synth_gable_0001/coarse.obj";
-  int failures = 0;
-  for (long kb = 90000; kb <= 200000; kb += 10000) {
-    fs::remove(dir + "/r.obj");
-    const CliRun r = run_limited(kb,
-                                 "refine --model " + shell_quote(model) + " --cloud " + shell_quote(cloud) + " --out " +
-                                     shell_quote(dir + "/r.obj"),
-                                 dir);
-    if (r.exit == 0) continue;  // enough memory after all
-    ++failures;
-    EXPECT_EQ(r.exit, 3) << kb << " KB: " << r.err;
-    EXPECT_EQ(r.err, "lodrefine: error: " + cloud + ": out of memory reading the file\n") << kb << " KB";
-    EXPECT_FALSE(fs::exists(dir + "/r.obj")) << kb << " KB";
-  }
+  std::vector<long> limits;
+  for (long kb = 90000; kb <= 200000; kb += 10000) limits.push_back(kb);
+  const int failures = expect_named_out_of_memory(limits,
+                                                  "refine --model " + shell_quote(model) + " --cloud " +
+                                                      shell_quote(cloud) + " --out " + shell_quote(dir + "/r.obj"),
+                                                  cloud, dir + "/r.obj", dir);
   EXPECT_GT(failures, 0);  // the scan reached below what the cloud needs
   fs::remove(cloud);
   add_row("refine: 144 MB PLY under ulimit -v 90-200 MB", "one line naming the cloud, exit 3", 3);
