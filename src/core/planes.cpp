@@ -321,23 +321,33 @@ std::vector<std::vector<int>> ransac_shapes(const PointCloud& cloud, const Thinn
   return shapes;
 }
 
-// The shape other than `own` whose plane lies nearest p, within ransac_epsilon, among those that
-// took the representative of a voxel next to p's; -1 when none.
-int neighbouring_shape(const Vec3& p, int own, const Thinning& t, const std::vector<int>& rep_shape,
-                       const std::vector<Plane>& fitted, const PlaneConfig& prm) {
-  const Eigen::Array3i c = t.cell(p);
-  int best = -1;
-  double best_distance = std::numeric_limits<double>::infinity();
+// The shapes other than `own` that took the representative of a voxel next to cell c (sorted,
+// unique): where a corner voxel's points off its own plane may go.
+std::vector<int> neighbouring_shapes(const Eigen::Array3i& c, int own, const Thinning& t,
+                                     const std::vector<int>& rep_shape) {
+  std::vector<int> out;
   for (int dx = -1; dx <= 1; ++dx)
     for (int dy = -1; dy <= 1; ++dy)
       for (int dz = -1; dz <= 1; ++dz) {
         const int v = t.voxel_at(c + Eigen::Array3i(dx, dy, dz));
         const int s = v < 0 ? -1 : rep_shape[std::size_t(v)];
-        if (s < 0 || s == own) continue;
-        const double d = std::abs(fitted[std::size_t(s)].distance(p));
-        if (d <= prm.ransac_epsilon && (d < best_distance || (d == best_distance && s < best)))
-          best = s, best_distance = d;
+        if (s >= 0 && s != own) out.push_back(s);
       }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+// Of `shapes`, the one whose plane lies nearest p within ransac_epsilon (ties: the lower); -1
+// when none.
+int nearest_shape(const Vec3& p, const std::vector<int>& shapes, const std::vector<Plane>& fitted,
+                  const PlaneConfig& prm) {
+  int best = -1;
+  double best_distance = std::numeric_limits<double>::infinity();
+  for (int s : shapes) {  // ascending: a tie keeps the lower
+    const double d = std::abs(fitted[std::size_t(s)].distance(p));
+    if (d <= prm.ransac_epsilon && d < best_distance) best = s, best_distance = d;
+  }
   return best;
 }
 
@@ -363,12 +373,19 @@ std::vector<std::vector<int>> take_back(const PointCloud& cloud, const Thinning&
     fitted.push_back(fit_plane(q));
   }
   std::vector<std::vector<int>> full(shapes.size());
+  // Per voxel, its neighbours' shapes, looked up for its first point off its own plane.
+  std::unordered_map<int, std::vector<int>> around;
   for (int i = 0; i < int(cloud.points.size()); ++i) {
     const Vec3& p = cloud.points[i];
-    const int s = rep_shape[t.voxel_of[i]];
+    const int v = t.voxel_of[i], s = rep_shape[v];
     if (s < 0) continue;
-    const int to =
-        std::abs(fitted[s].distance(p)) <= prm.ransac_epsilon ? s : neighbouring_shape(p, s, t, rep_shape, fitted, prm);
+    if (std::abs(fitted[s].distance(p)) <= prm.ransac_epsilon) {
+      full[std::size_t(s)].push_back(i);
+      continue;
+    }
+    auto it = around.find(v);
+    if (it == around.end()) it = around.emplace(v, neighbouring_shapes(t.cell(p), s, t, rep_shape)).first;
+    const int to = nearest_shape(p, it->second, fitted, prm);
     if (to >= 0) full[std::size_t(to)].push_back(i);
   }
   return full;
