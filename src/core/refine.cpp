@@ -126,8 +126,8 @@ class Run {
   const Vec3& origin() const { return origin_; }
   RefineTrace& trace() { return out_.trace; }
   // Records the time since the last lap as `stage`'s.
-  void lap(const char* stage) {
-    out_.trace.seconds.emplace_back(stage, seconds_since(t_));
+  void lap(RefineStage stage) {
+    out_.trace.seconds.emplace_back(stage_name(stage), seconds_since(t_));
     t_ = Clock::now();
   }
   // The result: `local_mesh` validated and written back in the input frame.
@@ -138,7 +138,7 @@ class Run {
     trace.output_validation = validate_mesh(local_mesh, planarity_tolerance_, true, single_shell);
     out_.valid = trace.output_validation.valid();
     trace.faces = local_mesh.faces.size();
-    lap("validation");
+    lap(RefineStage::Validation);
     trace.seconds.emplace_back("total", seconds_since(t_start_));
     out_.mesh = translated(local_mesh, origin_);
     out_.mesh.id = id_;
@@ -161,14 +161,14 @@ std::optional<RefineResult> repair_or_stop(const Mesh& local_model, const Repair
   try {
     kept = repair_input(local_model, cfg, rr);
   } catch (const InputError& e) {
-    run.lap("repair");
+    run.lap(RefineStage::Repair);
     return run.finish(Outcome::KeptInvalid, e.what(), local_model);
   }
   kept.id = local_model.id;
   run.trace().repair = rr;
   const Validation v0 = validate_mesh(kept, cfg.planarity_tolerance);
   run.trace().input_validation = v0;
-  run.lap("repair");
+  run.lap(RefineStage::Repair);
   if (!v0.valid() && v0.components > 1 && validate_mesh(kept, cfg.planarity_tolerance, true, false).valid())
     return run.finish(Outcome::Kept, std::to_string(v0.components) + " separate closed shells: kept whole", kept,
                       false);
@@ -240,7 +240,7 @@ RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::
   const ShellSelection chosen = select_shell(refined ? *refined : current, local, planes, prm);
   trace.selection = chosen.stats;
   trace.selection_reason = chosen.reason;
-  run.lap("selection");
+  run.lap(RefineStage::Selection);
   if (!chosen.ok) return run.finish(Outcome::Kept, "the selection found no valid shell: " + chosen.reason, kept);
   if (!refined && chosen.stats.candidates_changed == 0) {
     trace.facades.clear();
@@ -253,7 +253,7 @@ RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::
   for (const auto& f : trace.facades) moved.push_back(f.wall);
   const Judgement& verdict = trace.judgement.emplace(
       judge_refinement(kept, chosen.mesh, moved, local, prm, prm, planes, prm.match_distance + prm.bbox_margin));
-  run.lap("judge");
+  run.lap(RefineStage::Judge);
   if (!verdict.ok)
     return run.finish(Outcome::Kept, "not written: never worse, " + verdict.check + " check: " + verdict.detail, kept);
   return run.finish(Outcome::Refined,
@@ -304,7 +304,7 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const R
   const PointCloud local = cloud_near(current, cloud, run.origin(), prm);
   trace.cloud = {cloud.points.size(), local.points.size()};
   const auto planes = detect_planes(local, prm);
-  run.lap("planes");
+  run.lap(RefineStage::Planes);
   trace.planes = planes;
   if (planes.empty()) return run.finish(Outcome::Kept, "no planes found in the cloud near the model", kept);
 
@@ -317,7 +317,7 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const R
   std::vector<ScannedWall> scanned;
   outdated_walls(current, surfaces, mr, planes, local, prm, trace, moves, scanned);
   const auto corners = corner_moves(current, surfaces, scanned, local, planes, prm, prm);
-  run.lap("matching");
+  run.lap(RefineStage::Matching);
 
   // The corners are the least certain evidence: a refinement the judge refuses with them is
   // tried once more on the walls' own points alone.
@@ -327,7 +327,7 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const R
     trace.substitution_without_corners.reset();
     const std::optional<Mesh> refined =
         starting_shell(current, surfaces, moves, with_corners, local, planes, prm, trace);
-    run.lap("substitution");
+    run.lap(RefineStage::Substitution);
     return select_and_judge(kept, current, refined, !mr.matches.empty(), local, planes, prm, run);
   };
   RefineResult result = attempt(corners);

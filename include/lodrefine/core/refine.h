@@ -2,6 +2,7 @@
 // walls, move the outdated walls (substitution), let the candidate selection decide the faces
 // (shell_selection.h), validate, and keep the input unless the result fits the scan better.
 #pragma once
+#include <array>
 #include <optional>
 #include <set>
 #include <string>
@@ -25,6 +26,13 @@ namespace lodrefine {
 // "kept-invalid": the input cannot be made a valid solid and the output is it as read.
 enum class Outcome { Refined, Kept, KeptInvalid };
 const char* outcome_name(Outcome outcome);
+
+// The stages a refinement times (RefineTrace::seconds), in pipeline order; "total" follows
+// them. A building's run stops after any of them (a refusal, nothing to change).
+enum class RefineStage { Repair, Planes, Matching, Substitution, Selection, Judge, Validation };
+inline constexpr std::array<const char*, 7> kRefineStageNames = {"repair",    "planes", "matching",  "substitution",
+                                                                 "selection", "judge",  "validation"};
+inline const char* stage_name(RefineStage stage) { return kRefineStageNames[std::size_t(stage)]; }
 
 // What each stage found, kept for the report (built outside the core: io/refine_report.h).
 // A stage the building did not reach leaves its member empty.
@@ -85,10 +93,13 @@ struct RefineTrace {
   std::optional<ShellSelectionStats> selection;  // the program that chose the output's faces
   std::string selection_reason;                  // why it gave no shell, when it did not
 
-  double stage_seconds(const std::string& stage) const {  // 0 for a stage not reached
+  // The seconds of `stage` (kRefineStageNames, or "total"); a retry's laps add up; 0 for a
+  // stage not reached.
+  double stage_seconds(const std::string& stage) const {
+    double sum = 0.0;
     for (const auto& [name, s] : seconds)
-      if (name == stage) return s;
-    return 0.0;
+      if (name == stage) sum += s;
+    return sum;
   }
 };
 
