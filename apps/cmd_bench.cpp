@@ -16,7 +16,6 @@
 #include <vector>
 
 #include "commands.h"
-#include "lodrefine/core/geometry.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/eval/eval.h"
 #include "lodrefine/eval/polyfit_bench.h"
@@ -116,12 +115,9 @@ const double kNotReached = std::numeric_limits<double>::quiet_NaN();
 // Seconds per stage (kRefineStageNames, then "total") of one refinement; kNotReached for a stage
 // it did not reach (a building kept early), which no median or maximum counts.
 std::vector<double> stage_times(const RefineTrace& t) {
-  auto reached = [&](const char* name) {
-    return std::any_of(t.seconds.begin(), t.seconds.end(), [&](const auto& lap) { return lap.first == name; });
-  };
   std::vector<double> s;
-  for (const char* name : kRefineStageNames) s.push_back(reached(name) ? t.stage_seconds(name) : kNotReached);
-  s.push_back(t.stage_seconds("total"));
+  for (const char* name : kRefineStageNames) s.push_back(t.stage_seconds(name).value_or(kNotReached));
+  s.push_back(t.stage_seconds("total").value_or(kNotReached));
   return s;
 }
 
@@ -199,14 +195,7 @@ void run(const BenchArgs& a) {
   const int skipped = for_each_building(a, start, [&](const BenchBuilding& b) {
     const auto [r, best] = refine_best_of(b, a.params, a.repeat);
     const RefineTrace& t = r.trace;
-    // Accuracy in the coarse model's local frame: points on the truth's scanned walls to each model.
-    const Vec3 o = local_origin(b.coarse);
-    PointCloud local_cloud = b.cloud;
-    for (auto& p : local_cloud.points) p -= o;
-    const Mesh truth = translated(b.truth, -o);
-    const BuildingEval ev = evaluate_building(translated(b.coarse, -o), translated(r.mesh, -o), local_cloud,
-                                              truth.faces.empty() ? nullptr : &truth, a.params,
-                                              b.scanned_truth_faces ? &*b.scanned_truth_faces : nullptr);
+    const BuildingEval ev = evaluate_against_truth(b, r.mesh, a.params);
     const double f0 = ev.truth_facade_before ? ev.truth_facade_before->rmse : -1;
     const double f1 = ev.truth_facade_after ? ev.truth_facade_after->rmse : -1;
     if (ev.truth_facade_after && ev.truth_facade_before) {

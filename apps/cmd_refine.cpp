@@ -229,7 +229,8 @@ void run(const RefineArgs& a) {
   if (!a.report.empty())
     write_file_atomic(a.report, report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   std::printf("%s: %s (%s) -> %s (%.2f s)%s\n", model.id.c_str(), outcome_name(r.outcome), r.reason.c_str(),
-              a.out.c_str(), r.trace.stage_seconds("total"), overlap.empty() ? "" : ("; warning: " + overlap).c_str());
+              a.out.c_str(), r.trace.stage_seconds("total").value_or(0.0),
+              overlap.empty() ? "" : ("; warning: " + overlap).c_str());
 }
 
 }  // namespace

@@ -100,6 +100,16 @@ BenchBuilding read_bench_building(const BuildingFiles& f) {
   return b;
 }
 
+BuildingEval evaluate_against_truth(const BenchBuilding& b, const Mesh& output, const Params& params) {
+  const Vec3 o = local_origin(b.coarse);
+  PointCloud cloud = b.cloud;
+  for (auto& p : cloud.points) p -= o;
+  const Mesh truth = translated(b.truth, -o);
+  return evaluate_building(translated(b.coarse, -o), translated(output, -o), cloud,
+                           truth.faces.empty() ? nullptr : &truth, params,
+                           b.scanned_truth_faces ? &*b.scanned_truth_faces : nullptr);
+}
+
 PolyfitComparisonRow compare_with_polyfit(const BenchBuilding& b, const Params& params, const PolyfitOptions& options) {
   PolyfitComparisonRow row;
   row.id = b.id, row.points = b.cloud.points.size();
@@ -115,19 +125,11 @@ PolyfitComparisonRow compare_with_polyfit(const BenchBuilding& b, const Params& 
   row.polyfit.cpu_seconds = row.baseline.cpu_seconds;
   row.polyfit.produced = row.baseline.closed();
 
-  // Both measured in the coarse model's local frame, on the same facade points and truth samples.
-  const Vec3 o = local_origin(b.coarse);
-  PointCloud cloud = b.cloud;
-  for (auto& p : cloud.points) p -= o;
-  const Mesh coarse = translated(b.coarse, -o), truth = translated(b.truth, -o);
-  const Mesh* truth_ptr = truth.faces.empty() ? nullptr : &truth;
-  const std::vector<int>* scanned = b.scanned_truth_faces ? &*b.scanned_truth_faces : nullptr;
-  const BuildingEval ev = evaluate_building(coarse, translated(refined.mesh, -o), cloud, truth_ptr, params, scanned);
+  // Both measured the same way, on the same facade points and truth samples.
+  const BuildingEval ev = evaluate_against_truth(b, refined.mesh, params);
   row.coarse_facade = ev.truth_facade_before, row.coarse_roof = ev.truth_roof_before;
   measure(row.lodrefine, ev);
-  if (row.polyfit.produced)
-    measure(row.polyfit,
-            evaluate_building(coarse, translated(row.baseline.mesh, -o), cloud, truth_ptr, params, scanned));
+  if (row.polyfit.produced) measure(row.polyfit, evaluate_against_truth(b, row.baseline.mesh, params));
   row.baseline.mesh = Mesh{};
   return row;
 }

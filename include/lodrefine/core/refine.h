@@ -93,12 +93,12 @@ struct RefineTrace {
   std::optional<ShellSelectionStats> selection;  // the program that chose the output's faces
   std::string selection_reason;                  // why it gave no shell, when it did not
 
-  // The seconds of `stage` (kRefineStageNames, or "total"); a retry's laps add up; 0 for a
-  // stage not reached.
-  double stage_seconds(const std::string& stage) const {
-    double sum = 0.0;
+  // The seconds of `stage` (kRefineStageNames, or "total"); a retry's laps add up; none for a
+  // stage the building did not reach.
+  std::optional<double> stage_seconds(const std::string& stage) const {
+    std::optional<double> sum;
     for (const auto& [name, s] : seconds)
-      if (name == stage) sum += s;
+      if (name == stage) sum = sum.value_or(0.0) + s;
     return sum;
   }
 };

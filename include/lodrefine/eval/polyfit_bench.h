@@ -31,6 +31,10 @@ struct BenchBuilding {
 std::vector<BuildingFiles> discover_bench(const std::string& dir);
 // Reads one building (truth when its file is set). Throws InputError on unreadable input.
 BenchBuilding read_bench_building(const BuildingFiles& files);
+// A method's output for `b` (input frame) against its coarse model and truth, measured in the
+// coarse model's local frame: evaluate_building with the scan, the truth when it has faces and
+// the scanned truth faces when known.
+BuildingEval evaluate_against_truth(const BenchBuilding& b, const Mesh& output, const Params& params);
 
 // What one method gave for a building.
 struct MethodRun {
