@@ -106,6 +106,7 @@ class SurfaceIndex {
   using Nearest = MeshDistance::Nearest;
 
   Nearest nearest(const Vec3& world, bool want_sign) const { return nearest_local(world - origin_, want_sign); }
+  double distance(const Vec3& world, bool want_sign) const { return distance_local(world - origin_, want_sign); }
 
   // The nearest distance for many points at once, and the face nearest() reports: the points
   // fall into cubic cells of kCell, and each cell keeps only the triangles that can be nearest
@@ -131,14 +132,27 @@ class SurfaceIndex {
     int face;
   };
 
-  // nearest() in the index's frame: the tree's nearest triangle.
+  // nearest() in the index's frame: the distance to the tree's nearest triangle (signed by the
+  // pseudonormal there), the face by nearest_of's rule among the triangles tied with it.
   Nearest nearest_local(const Vec3& p, bool want_sign) const {
+    const auto hit = tree_.closest_point_and_primitive(to_cgal(p));
+    const std::size_t i = std::size_t(hit.second - cgal_.cbegin());
+    std::vector<double> scratch;
+    Nearest n = nearest_of(p, within(p, i, kTieTolerance), scratch);
+    if (want_sign && n.distance != 0.0) {
+      const Closest c = closest_on_triangle(p, tris_[i].a, tris_[i].b, tris_[i].c);
+      n.distance *= sign_at(p, c, i);
+    }
+    return n;
+  }
+
+  // The distance alone, without the face's tie search.
+  double distance_local(const Vec3& p, bool want_sign) const {
     const auto hit = tree_.closest_point_and_primitive(to_cgal(p));
     const std::size_t i = std::size_t(hit.second - cgal_.cbegin());
     const Closest c = closest_on_triangle(p, tris_[i].a, tris_[i].b, tris_[i].c);
     const double d = (p - c.q).norm();
-    if (!want_sign || d == 0.0) return {d, tris_[i].face};
-    return {sign_at(p, c, i) * d, tris_[i].face};
+    return !want_sign || d == 0.0 ? d : sign_at(p, c, i) * d;
   }
 
   double distance_to(const Vec3& p, std::size_t t) const {
@@ -149,13 +163,16 @@ class SurfaceIndex {
   // measured, else the tree's nearest triangle bounds the nearest distance and those in the box
   // of that reach are measured (a Sphere_3 query would miss the triangles wholly inside it).
   std::vector<std::size_t> within(const Vec3& p, double slack) const {
+    return within(p, std::size_t(tree_.closest_point_and_primitive(to_cgal(p)).second - cgal_.cbegin()), slack);
+  }
+  // The same, with the tree's nearest triangle to p already found.
+  std::vector<std::size_t> within(const Vec3& p, std::size_t nearest, double slack) const {
     std::vector<std::size_t> near;
     if (tris_.size() <= kFewTriangles) {
       near.resize(tris_.size());
       for (std::size_t t = 0; t < near.size(); ++t) near[t] = t;
     } else {
-      const auto hit = tree_.closest_point_and_primitive(to_cgal(p));
-      const double r = distance_to(p, std::size_t(hit.second - cgal_.cbegin())) + slack + kRounding;
+      const double r = distance_to(p, nearest) + slack + kRounding;
       std::vector<Primitive::Id> in_box;
       tree_.all_intersected_primitives(CGAL::Bbox_3(p.x() - r, p.y() - r, p.z() - r, p.x() + r, p.y() + r, p.z() + r),
                                        std::back_inserter(in_box));
@@ -173,20 +190,25 @@ class SurfaceIndex {
 
   // The nearest distance among `candidates` (triangles holding every one within kTieTolerance of
   // the nearest) and its face. Where several triangles lie within kTieTolerance (a point nearest
-  // to an edge or a vertex), the tree's answer: the face the judge's wall regions have always
-  // been given there, which decides points at a wall's edges (a lowest-id rule instead refused 13
-  // more Delfshaven buildings' moved walls).
+  // an edge or a vertex), the one whose plane lies nearest the point: a street point beyond a
+  // wall's foot goes to the ground, a point of a flush neighbour's facade beyond a wall's end
+  // to that wall. Ties of that go to the first candidate (the lowest triangle).
   Nearest nearest_of(const Vec3& p, const std::vector<std::size_t>& candidates, std::vector<double>& d) const {
     if (d.size() < candidates.size()) d.resize(candidates.size());
-    std::size_t best = 0;
+    double nearest = std::numeric_limits<double>::infinity();
     for (std::size_t k = 0; k < candidates.size(); ++k) {
       d[k] = distance_to(p, candidates[k]);
-      if (d[k] < d[best]) best = k;
+      nearest = std::min(nearest, d[k]);
     }
-    const auto tied = std::count_if(d.begin(), d.begin() + long(candidates.size()),
-                                    [&](double x) { return x <= d[best] + kTieTolerance; });
-    if (tied > 1) return nearest_local(p, false);
-    return {d[best], tris_[candidates[best]].face};
+    std::size_t best = 0;
+    double off_plane = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < candidates.size(); ++k) {
+      if (!(d[k] <= nearest + kTieTolerance)) continue;
+      const Tri& t = tris_[candidates[k]];
+      const double off = std::abs(t.n.dot(p - t.a));
+      if (off < off_plane) off_plane = off, best = k;
+    }
+    return {nearest, tris_[candidates[best]].face};
   }
 
   // Per cell of kCell, the triangles that can lie within kTieTolerance of the nearest one for
@@ -268,6 +290,10 @@ MeshDistance::Nearest MeshDistance::nearest(const Vec3& point, bool signed_dista
   return index_->nearest(point, signed_distance);
 }
 
+double MeshDistance::distance(const Vec3& point, bool signed_distance) const {
+  return index_->distance(point, signed_distance);
+}
+
 std::vector<MeshDistance::Nearest> MeshDistance::nearest_all(const std::vector<Vec3>& points) const {
   return index_->nearest_all(points);
 }
@@ -277,7 +303,7 @@ namespace {
 std::vector<double> distances(const Mesh& mesh, const std::vector<Vec3>& points, bool want_sign) {
   const MeshDistance index(mesh);
   std::vector<double> d(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) d[i] = index.nearest(points[i], want_sign).distance;
+  for (std::size_t i = 0; i < points.size(); ++i) d[i] = index.distance(points[i], want_sign);
   return d;
 }
 

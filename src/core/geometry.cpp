@@ -161,7 +161,41 @@ bool point_in_polygon_2d(const Vec2& p, const std::vector<Vec2>& poly) {
   return in;
 }
 
+namespace {
+// Points below this many go straight to the monotone chain.
+constexpr std::size_t kHullFilterMin = 64;
+
+// Akl–Toussaint: the points extreme in eight directions span a convex polygon inside the hull;
+// a point inside it by a margin can be no hull vertex, so dropping it leaves the hull (and the
+// chain's output, vertex for vertex) as it was, and the sort runs on the few points left.
+std::vector<Vec2> outside_extremes(std::vector<Vec2> pts) {
+  static const Vec2 kDirections[8] = {{1, 0}, {1, 1}, {0, 1}, {-1, 1}, {-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
+  std::vector<Vec2> poly;
+  for (const Vec2& d : kDirections) {
+    const Vec2& e =
+        *std::max_element(pts.begin(), pts.end(), [&](const Vec2& a, const Vec2& b) { return d.dot(a) < d.dot(b); });
+    if (poly.empty() || (e != poly.back() && e != poly.front())) poly.push_back(e);
+  }
+  Eigen::AlignedBox2d box;
+  for (const Vec2& v : poly) box.extend(v);
+  if (poly.size() < 3 || !box.diagonal().allFinite()) return pts;
+  // Far above the cross products' rounding (~1e-16 of the box's squared size): a point this close
+  // to the polygon's boundary stays.
+  const double margin = 1e-9 * box.diagonal().squaredNorm();
+  auto inside = [&](const Vec2& p) {
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+      const Vec2 &a = poly[i], &b = poly[(i + 1) % poly.size()];
+      if ((b.x() - a.x()) * (p.y() - a.y()) - (b.y() - a.y()) * (p.x() - a.x()) <= margin) return false;
+    }
+    return true;
+  };
+  pts.erase(std::remove_if(pts.begin(), pts.end(), inside), pts.end());
+  return pts;
+}
+}  // namespace
+
 std::vector<Vec2> convex_hull_2d(std::vector<Vec2> pts) {
+  if (pts.size() >= kHullFilterMin) pts = outside_extremes(std::move(pts));
   std::sort(pts.begin(), pts.end(),
             [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
   pts.erase(std::unique(pts.begin(), pts.end()), pts.end());

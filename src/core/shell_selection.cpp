@@ -403,8 +403,8 @@ std::vector<int> enclosing_changes(const CandidateSet& cs, const std::vector<cha
   std::vector<Vec3> enclosed;
   const MeshDistance to_shell(shell), to_start(start);
   for (const Vec3& p : evidence)
-    if (box.contains(p) && to_shell.nearest(p, true).distance < -kEnclosedDepth &&
-        to_start.nearest(p, true).distance >= -kEnclosedDepth)
+    if (box.contains(p) && to_shell.distance(p, true) < -kEnclosedDepth &&
+        to_start.distance(p, true) >= -kEnclosedDepth)
       enclosed.push_back(p);
   if (int(enclosed.size()) < prm.ransac_min_points) return {};
   std::vector<int> count(pieces.size(), 0);

@@ -209,10 +209,8 @@ std::vector<int> scanned_walls(const Mesh& truth, const std::vector<Vec3>& point
   if (points.empty()) return {};
   const MeshDistance index(truth);
   std::vector<int> count(truth.faces.size(), 0);
-  for (const auto& p : points) {
-    const auto hit = index.nearest(p, false);
+  for (const auto& hit : index.nearest_all(points))
     if (hit.distance <= distance) ++count[std::size_t(hit.face)];
-  }
   std::vector<int> out;
   for (std::size_t f = 0; f < truth.faces.size(); ++f)
     if (truth.faces[f].sem == Semantic::Wall && count[f] >= min_points) out.push_back(int(f));

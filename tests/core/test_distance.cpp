@@ -145,6 +145,33 @@ TEST(MeshDistance, TheBatchGivesATieThePlainSearchsFace) {
   }
 }
 
+// A point nearest an edge ties between the faces meeting there: it goes to the face whose plane
+// lies nearest it, in both searches (the tree's own pick was arbitrary: the first it visited).
+TEST(MeshDistance, ATieGoesToTheFaceWhosePlaneIsNearest) {
+  struct Tie {
+    Vec3 p;
+    int box_face, tiled_face;  // tiled_box: ground 0, roof 1, wall tile i (footprint edge i) 2 + i
+  };
+  const std::vector<Tie> ties = {
+      {{5.25, -1, 0}, 0, 0},      // street ground beyond the wall's foot: the ground
+      {{11, 0, 3}, 2, 21},        // the wall y = 0 running on beyond its end: that wall
+      {{10.2, -0.5, 3}, 3, 22},   // nearer the plane x = 10 than y = 0: the wall x = 10
+      {{5.25, -0.5, 6.2}, 1, 1},  // above the eaves, nearer the roof's plane
+      {{5.0, -1, 3}, 2, 11},      // before the joint of two coplanar tiles: the lower face
+  };
+  const MeshDistance plain(box({0, 0, 0}, {10, 8, 6})), tiled(tiled_box());
+  std::vector<Vec3> points;
+  for (const auto& t : ties) points.push_back(t.p);
+  const auto plain_all = plain.nearest_all(points), tiled_all = tiled.nearest_all(points);
+  for (std::size_t i = 0; i < ties.size(); ++i) {
+    EXPECT_EQ(plain.nearest(ties[i].p, false).face, ties[i].box_face) << ties[i].p.transpose();
+    EXPECT_EQ(plain_all[i].face, ties[i].box_face) << ties[i].p.transpose();
+    EXPECT_EQ(tiled.nearest(ties[i].p, true).face, ties[i].tiled_face) << ties[i].p.transpose();
+    EXPECT_EQ(tiled_all[i].face, ties[i].tiled_face) << ties[i].p.transpose();
+    EXPECT_EQ(tiled.distance(ties[i].p, false), tiled_all[i].distance) << ties[i].p.transpose();
+  }
+}
+
 // The batch search (cells of candidate triangles; measured directly on a small mesh, found in
 // the tree on a large one) equals the plain search on a lattice full of ties (edges, vertices,
 // medial planes, cell boundaries): nearest()'s distance and face bit for bit, the distance to

@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <random>
+
 #include "lodrefine/core/geometry.h"
 
 using namespace lodrefine;
@@ -42,4 +46,46 @@ TEST(Geometry, ConvexClipAreas) {
   EXPECT_NEAR(polygon_convex_intersection_area(l, b), 0.0, 1e-12);
   EXPECT_NEAR(polygon_convex_intersection_area(l, a), 3.0, 1e-12);
   EXPECT_EQ(convex_hull_2d({{0, 0}, {1, 0}, {1, 1}, {0, 1}, {0.5, 0.5}}).size(), 4u);
+}
+
+// Many points take a filtered path (the points inside the eight extremes' polygon are dropped
+// before the sort): its hull must be the few points' hull vertex for vertex, bit for bit.
+TEST(Geometry, ConvexHullOfManyPointsIsTheHullOfItsCorners) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const Vec2 o(485123.25, 5801234.75);  // georeferenced magnitudes
+  for (int shape = 0; shape < 50; ++shape) {
+    // A random convex polygon's corners.
+    std::vector<Vec2> few;
+    for (int i = 0; i < 3 + shape % 9; ++i) {
+      const double a = 2 * kPi * u(rng);
+      few.push_back(o + Vec2(std::cos(a) * (5 + 3 * u(rng)), std::sin(a) * (2 + u(rng))));
+    }
+    const std::vector<Vec2> corners = convex_hull_2d(few);
+    ASSERT_GE(corners.size(), 3u);
+    std::vector<Vec2> boundary = corners;  // and the edges' midpoints: (nearly) collinear
+    for (std::size_t i = 0; i < corners.size(); ++i)
+      boundary.push_back(0.5 * (corners[i] + corners[(i + 1) % corners.size()]));
+    const std::vector<Vec2> expected = convex_hull_2d(boundary);  // under 64 points: the plain path
+    Vec2 centre = Vec2::Zero();
+    for (const auto& c : corners) centre += c - o;
+    centre = o + centre / double(corners.size());
+    std::vector<Vec2> many = boundary;
+    while (many.size() < 2000) {  // convex combinations of three corners, pulled in: inside
+      const Vec2 &a = corners[rng() % corners.size()], &b = corners[rng() % corners.size()],
+                 &c = corners[rng() % corners.size()];
+      const double s = u(rng), t = u(rng) * (1 - s);
+      many.push_back(centre + 0.99 * (a + s * (b - a) + t * (c - a) - centre));
+    }
+    std::shuffle(many.begin(), many.end(), rng);
+    const std::vector<Vec2> hull = convex_hull_2d(many);
+    ASSERT_EQ(hull.size(), expected.size()) << shape;
+    for (std::size_t i = 0; i < hull.size(); ++i) EXPECT_EQ(hull[i], expected[i]) << shape;
+  }
+  // A grid (many collinear points, ties in every direction) keeps its four corners.
+  std::vector<Vec2> grid;
+  for (int i = 0; i < 30; ++i)
+    for (int j = 0; j < 20; ++j) grid.push_back(Vec2(0.1 * i, 0.1 * j));
+  EXPECT_EQ(convex_hull_2d(grid).size(), 4u);
+  EXPECT_NEAR(std::abs(signed_area_2d(convex_hull_2d(grid))), 2.9 * 1.9, 1e-12);
 }
