@@ -301,12 +301,28 @@ void build_fans(CandidateSet& cs, const std::vector<CandidateHalfedge>& first) {
   for (auto& [appears, e] : fans) cs.edges.push_back(std::move(e));
 }
 
-// Per support plane, the vertices within kPlaneReach of it, by index.
-std::vector<std::vector<int>> vertices_on_planes(const std::vector<Vec3>& V, const std::vector<SupportPlane>& planes) {
-  std::vector<std::vector<int>> on(planes.size());
-  for (int w = 0; w < int(V.size()); ++w)
-    for (std::size_t i = 0; i < planes.size(); ++i)
-      if (std::abs(planes[i].plane.distance(V[w])) <= kPlaneReach) on[i].push_back(w);
+// Per support plane, the vertices within kPlaneReach of it, by x: an edge's inside vertices
+// are among those within its x range (a plane of a large building holds thousands of vertices).
+struct PlaneVertices {
+  std::vector<int> ids;   // ascending x
+  std::vector<double> x;  // their x
+
+  // The vertices whose x lies within `tol` of segment a-b's x range.
+  std::vector<int> near_segment(const Vec3& a, const Vec3& b, double tol) const {
+    const auto lo = std::lower_bound(x.begin(), x.end(), std::min(a.x(), b.x()) - tol);
+    const auto hi = std::upper_bound(lo, x.end(), std::max(a.x(), b.x()) + tol);
+    return {ids.begin() + (lo - x.begin()), ids.begin() + (hi - x.begin())};
+  }
+};
+
+std::vector<PlaneVertices> vertices_on_planes(const std::vector<Vec3>& V, const std::vector<SupportPlane>& planes) {
+  std::vector<PlaneVertices> on(planes.size());
+  for (std::size_t i = 0; i < planes.size(); ++i) {
+    for (int w = 0; w < int(V.size()); ++w)
+      if (std::abs(planes[i].plane.distance(V[w])) <= kPlaneReach) on[i].ids.push_back(w);
+    std::sort(on[i].ids.begin(), on[i].ids.end(), [&](int u, int w) { return V[u].x() < V[w].x(); });
+    for (int w : on[i].ids) on[i].x.push_back(V[w].x());
+  }
   return on;
 }
 
@@ -389,8 +405,8 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
     for (std::size_t k = 0; k < v.size(); ++k) {
       const int a = v[k], b = v[(k + 1) % v.size()];
       out.push_back(a);
-      for (int x : vertices_on_segment(cs.vertices, a, b, SegmentRule{kVertexWeld, false, kEdgeEndShare},
-                                       &on_plane[kept[f].plane]))
+      const std::vector<int> near = on_plane[kept[f].plane].near_segment(cs.vertices[a], cs.vertices[b], kVertexWeld);
+      for (int x : vertices_on_segment(cs.vertices, a, b, SegmentRule{kVertexWeld, false, kEdgeEndShare}, &near))
         out.push_back(x);
     }
     v = out;

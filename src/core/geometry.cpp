@@ -170,12 +170,13 @@ constexpr std::size_t kHullFilterMin = 64;
 // chain's output, vertex for vertex) as it was, and the sort runs on the few points left.
 std::vector<Vec2> outside_extremes(std::vector<Vec2> pts) {
   static const Vec2 kDirections[8] = {{1, 0}, {1, 1}, {0, 1}, {-1, 1}, {-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
+  std::size_t extreme[8] = {};  // per direction, the first point farthest along it
+  for (std::size_t i = 1; i < pts.size(); ++i)
+    for (int k = 0; k < 8; ++k)
+      if (kDirections[k].dot(pts[i]) > kDirections[k].dot(pts[extreme[k]])) extreme[k] = i;
   std::vector<Vec2> poly;
-  for (const Vec2& d : kDirections) {
-    const Vec2& e =
-        *std::max_element(pts.begin(), pts.end(), [&](const Vec2& a, const Vec2& b) { return d.dot(a) < d.dot(b); });
-    if (poly.empty() || (e != poly.back() && e != poly.front())) poly.push_back(e);
-  }
+  for (std::size_t i : extreme)
+    if (poly.empty() || (pts[i] != poly.back() && pts[i] != poly.front())) poly.push_back(pts[i]);
   Eigen::AlignedBox2d box;
   for (const Vec2& v : poly) box.extend(v);
   if (poly.size() < 3 || !box.diagonal().allFinite()) return pts;
