@@ -114,12 +114,36 @@ double max_planarity_error(const Mesh& m) {
   return err;
 }
 
+// Whether two edges of the outline that share no vertex touch or cross, or come within a
+// billionth of its size of each other, in the plane of the two coordinates its normal leaves
+// (dropping one is exact, and the segment test is CGAL's exact predicate).
+bool touches_itself(const std::vector<Vec3>& pts) {
+  const Vec3 n = newell_normal(pts).cwiseAbs();
+  const int drop = n.x() >= n.y() && n.x() >= n.z() ? 0 : n.y() >= n.z() ? 1 : 2;
+  const int a = drop == 0 ? 1 : 0, b = drop == 2 ? 1 : 2;
+  std::vector<Kernel::Point_2> q;
+  Eigen::AlignedBox3d box;
+  for (const Vec3& p : pts) q.emplace_back(p[a], p[b]), box.extend(p);
+  const double tol = 1e-9 * box.diagonal().norm();
+  const std::size_t m = q.size();
+  for (std::size_t i = 0; i < m; ++i)
+    for (std::size_t j = i + 2; j < m; ++j) {
+      if (i == 0 && j == m - 1) continue;  // adjacent through the closing edge
+      const Kernel::Segment_2 e(q[i], q[(i + 1) % m]), f(q[j], q[(j + 1) % m]);
+      if (CGAL::do_intersect(e, f) || CGAL::squared_distance(e, f) <= tol * tol) return true;
+    }
+  return false;
+}
+
 // Triangles of one face as indices into it. CGAL's constrained Delaunay triangulation in the
 // face's plane is used first: geometry.h's ear clipper accepts ears whose diagonal runs through
 // a reflex vertex (an L-shaped roof then gets overlapping triangles that would read as a
-// self-intersection). Faces CGAL rejects (self-overlapping outlines) fall back to the clipper.
+// self-intersection). Outlines that touch or cross themselves go to the clipper: CGAL rejects
+// some, and on one (a ground face with a vertex on its closing edge, a Delfshaven building with
+// region-grown planes) its triangulation never returned.
 std::vector<std::array<int, 3>> face_triangles(const std::vector<Vec3>& pts) {
   if (pts.size() == 3) return {{0, 1, 2}};
+  if (touches_itself(pts)) return triangulate_polygon(pts);
   SurfaceMesh one;
   std::vector<SmVertex> loop;
   for (const Vec3& p : pts) loop.push_back(one.add_vertex(Kernel::Point_3(p.x(), p.y(), p.z())));

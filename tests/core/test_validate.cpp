@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <map>
@@ -207,4 +208,52 @@ TEST(Validate, EdgeUsesRecordDirection) {
     ASSERT_EQ(u.size(), 2u);
     EXPECT_NE(u[0].forward, u[1].forward) << e.first << "-" << e.second;
   }
+}
+
+// A shell the selection once proposed for a Delfshaven building (region-grown planes): its ground
+// face has a vertex on its own closing edge, where CGAL's face triangulation never returned.
+// Validation ends, in a child process so that a hang fails the test, and finds the shell invalid.
+TEST(Validate, AFaceTouchingItselfIsTriangulatedWithoutHanging) {
+  Mesh shell;
+  shell.vertices = {{59.429000000003725, 79.798999999999069, 0},
+                    {59.429000000003725, 79.798999999999069, 12.929},
+                    {47.456000000005588, 80.76500000001397, 12.929},
+                    {47.456000000005588, 80.76500000001397, 3.548},
+                    {43.307000000000698, 81.097999999998137, 3.548},
+                    {43.307000000000698, 81.097999999998137, 0},
+                    {47.957999999998719, 85.961000000010245, 3.548},
+                    {47.957999999998719, 85.961000000010245, 12.907999999999999},
+                    {59.679000000003725, 85.020000000018626, 12.904},
+                    {59.677973582579988, 85.020096972624657, 3.5480000000000005},
+                    {59.679000000003725, 85.020000000018626, 0},
+                    {43.369000000006054, 86.35899999999674, 0},
+                    {43.369000000006054, 86.35899999999674, 3.548},
+                    {59.680051398728416, 85.960988345818208, 0},
+                    {59.724053206978645, 85.960891174486491, 0},
+                    {59.724053206978645, 85.960891174486491, 3.5480000000000005},
+                    {59.677923731856168, 84.997523216024931, 3.5480000000000005},
+                    {47.706000000005588, 83.353999999992084, 16.173999999999999},
+                    {56.320000000006985, 82.661000000021886, 16.173999999999999},
+                    {59.680051398728416, 85.960988345818208, 3.5480000000000005}};
+  for (const std::vector<int>& f : std::vector<std::vector<int>>{{0, 1, 2, 3, 4, 5},
+                                                                 {6, 7, 8, 9, 10, 11, 12},
+                                                                 {0, 5, 11, 10, 13, 14},
+                                                                 {0, 14, 15, 16, 8, 1},
+                                                                 {3, 2, 17, 7, 6},
+                                                                 {1, 18, 17, 2},
+                                                                 {7, 17, 18, 8},
+                                                                 {9, 16, 15, 19},
+                                                                 {3, 6, 12, 4},
+                                                                 {4, 12, 11, 5},
+                                                                 {1, 8, 18},
+                                                                 {16, 9, 8},
+                                                                 {9, 19, 13, 10},
+                                                                 {14, 13, 19, 15}})
+    shell.faces.push_back({f, Semantic::Wall});
+  EXPECT_EXIT(
+      {
+        ::alarm(20);
+        std::exit(validate_mesh(shell, kPlanarity).valid() ? 1 : 0);
+      },
+      testing::ExitedWithCode(0), "");
 }
