@@ -1,4 +1,5 @@
-// Stage 1, detect_planes: synthetic scans with 1 cm range noise give back their planes (normal,
+// Stage 1, detect_planes, with both detectors (Efficient RANSAC, region growing): synthetic scans
+// with 1 cm range noise give back their planes (normal,
 // offset, inliers, RMS, hull area, facade flag, vertical snap), the same ones for a fixed seed,
 // through the default voxel thinning and without it; too small or degenerate clouds give none,
 // without hanging. Clouds are in a local frame, as the pipeline passes them.
@@ -81,20 +82,33 @@ std::size_t count_of(const std::vector<int>& inliers, const std::vector<int>& po
 
 // detect_planes finishes within `seconds` and finds no plane: run in a child process, so a hang
 // fails the test instead of stalling the suite.
-void expect_no_plane_and_no_hang(const PointCloud& cloud, unsigned seconds) {
+void expect_no_plane_and_no_hang(const PointCloud& cloud, const Params& prm, unsigned seconds) {
   EXPECT_EXIT(
       {
         ::alarm(seconds);
-        std::exit(detect_planes(cloud, Params{}).empty() ? 0 : 1);
+        std::exit(detect_planes(cloud, prm).empty() ? 0 : 1);
       },
       testing::ExitedWithCode(0), "");
 }
 
 }  // namespace
 
-TEST(Planes, BoxCornerGivesItsThreePlanes) {
+// Every test runs with both detectors: Efficient RANSAC (the default, the paper's) and region
+// growing (--ransac 0).
+class Planes : public testing::TestWithParam<int> {
+ protected:
+  Params params() const {
+    Params p;
+    p.ransac = GetParam();
+    return p;
+  }
+};
+INSTANTIATE_TEST_SUITE_P(Detector, Planes, testing::Values(1, 0),
+                         [](const testing::TestParamInfo<int>& info) { return info.param ? "Ransac" : "Growing"; });
+
+TEST_P(Planes, BoxCornerGivesItsThreePlanes) {
   const Corner c = box_corner();
-  const auto planes = detect_planes(c.cloud, Params{});
+  const auto planes = detect_planes(c.cloud, params());
   ASSERT_EQ(planes.size(), 3u);
   std::set<int> seen;
   for (std::size_t k = 0; k < c.truth.size(); ++k) {
@@ -110,7 +124,7 @@ TEST(Planes, BoxCornerGivesItsThreePlanes) {
     EXPECT_LE(sp->inliers.size() - own, t.points.size() / 100);
     for (int i : sp->inliers) {
       EXPECT_TRUE(seen.insert(i).second) << "point " << i << " in two planes";
-      EXPECT_LE(std::abs(t.plane.distance(c.cloud.points[i])), 2 * Params{}.ransac_epsilon);
+      EXPECT_LE(std::abs(t.plane.distance(c.cloud.points[i])), 2 * params().ransac_epsilon);
     }
     EXPECT_NEAR(sp->rms, kNoise, 0.0015);
     EXPECT_NEAR(sp->hull_area, t.area, 0.03 * t.area);
@@ -129,9 +143,9 @@ TEST(Planes, BoxCornerGivesItsThreePlanes) {
   for (std::size_t k = 1; k < planes.size(); ++k) EXPECT_GE(planes[k - 1].inliers.size(), planes[k].inliers.size());
 }
 
-TEST(Planes, SameSeedSameResult) {
+TEST_P(Planes, SameSeedSameResult) {
   const Corner c = box_corner();
-  Params prm;
+  Params prm = params();
   prm.seed = 7;
   const auto a = detect_planes(c.cloud, prm);
   const auto b = detect_planes(c.cloud, prm);
@@ -153,10 +167,10 @@ TEST(Planes, SameSeedSameResult) {
 
 // Detection on one point per 0.2 m voxel (about a quarter of the points) still gives every
 // point near its plane back as an inlier.
-TEST(Planes, VoxelDetectionOfOneFacadeTakesBackItsPoints) {
+TEST_P(Planes, VoxelDetectionOfOneFacadeTakesBackItsPoints) {
   PointCloud cloud;
   const Truth wall = add_patch(cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 6.0, 0.0, 4.0), 1);
-  Params prm;
+  Params prm = params();
   prm.detect_voxel = 0.2;
   const auto planes = detect_planes(cloud, prm);
   ASSERT_EQ(planes.size(), 1u);
@@ -171,9 +185,9 @@ TEST(Planes, VoxelDetectionOfOneFacadeTakesBackItsPoints) {
 // was once recorded by its position in the reordered list and read by its position in the
 // original one, and each plane got back about half of its points (front 1175 of 2400, side 657
 // of 2000, ground 859 of 1830; the ground's hull 8.6 instead of 17.4 m²).
-TEST(Planes, VoxelDetectionTakesBackEveryPointOfItsPlanes) {
+TEST_P(Planes, VoxelDetectionTakesBackEveryPointOfItsPlanes) {
   const Corner c = box_corner();
-  Params prm;
+  Params prm = params();
   prm.detect_voxel = 0.2;
   const auto planes = detect_planes(c.cloud, prm);
   ASSERT_EQ(planes.size(), 3u);
@@ -188,13 +202,16 @@ TEST(Planes, VoxelDetectionTakesBackEveryPointOfItsPlanes) {
 // A plane the thinned detection finds with fewer than ransac_min_points points of the full cloud
 // is dropped, as full detection would never have found it. Two walls, 10 000 and 120 points: the
 // small one's representatives pass the scaled minimum, its points do not pass the real one.
-TEST(Planes, VoxelDetectionKeepsTheMinimumOfPointsOfTheFullCloud) {
+TEST_P(Planes, VoxelDetectionKeepsTheMinimumOfPointsOfTheFullCloud) {
   PointCloud cloud;
   const Truth big = add_patch(cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 9.9, 0.0, 9.9), 1);
-  PointCloud sparse;  // 12 × 10 points, 0.3 m apart: 3.3 × 2.7 m, one point per voxel
-  const auto small = add_grid(sparse, {{20, 0, 0}, Vec3::UnitY(), Vec3::UnitZ(), 0.0, 3.3, 0.0, 2.7}, 0.3, kNoise, 2);
+  // 12 × 10 points, 0.25 m apart (within the 0.28 m a shape may span at 0.2 m voxels): 2.75 ×
+  // 2.25 m, one point per voxel.
+  PointCloud sparse;
+  const auto small =
+      add_grid(sparse, {{20, 0, 0}, Vec3::UnitY(), Vec3::UnitZ(), 0.0, 2.75, 0.0, 2.25}, 0.25, kNoise, 2);
   for (int i : small) cloud.points.push_back(sparse.points[i]);
-  Params prm;
+  Params prm = params();
   prm.detect_voxel = 0.2;
   const auto planes = detect_planes(cloud, prm);
   ASSERT_EQ(planes.size(), 1u);
@@ -208,7 +225,7 @@ TEST(Planes, VoxelDetectionKeepsTheMinimumOfPointsOfTheFullCloud) {
 // points) gives the same three planes, normals within 0.2°, offsets within 5 mm, inlier counts
 // within 3 % (the ground lost 4 % before a corner voxel's points off its representative's wall
 // went to the neighbouring wall's plane).
-TEST(Planes, DefaultDetectionIsThinnedAndFindsThePlanesOfFullDetection) {
+TEST_P(Planes, DefaultDetectionIsThinnedAndFindsThePlanesOfFullDetection) {
   PointCloud cloud;
   std::vector<Truth> truth;
   auto dense = [&](const Patch& p, unsigned seed) {
@@ -217,10 +234,10 @@ TEST(Planes, DefaultDetectionIsThinnedAndFindsThePlanesOfFullDetection) {
   dense(wall_patch({0, 0, 0}, Vec3::UnitX(), 5.9, 0.1, 4.0), 1);
   dense({{6, 0, 0}, Vec3::UnitY(), Vec3::UnitZ(), 0.1, 5.0, 0.1, 4.0}, 2);
   dense({{0, 0, 0}, Vec3::UnitX(), Vec3::UnitY(), 0.0, 6.0, -3.0, -0.1}, 3);
-  Params thin, all;
+  Params thin = params(), all = params();
   thin.detect_voxel = std::sqrt(thin.min_plane_area / double(thin.normal_neighbors + 1));
   all.detect_voxel = 0.0;
-  const auto thinned = detect_planes(cloud, Params{});
+  const auto thinned = detect_planes(cloud, params());
   const auto full = detect_planes(cloud, all);
   ASSERT_EQ(full.size(), 3u);
   ASSERT_EQ(thinned.size(), 3u);
@@ -244,7 +261,7 @@ TEST(Planes, DefaultDetectionIsThinnedAndFindsThePlanesOfFullDetection) {
 // The side wall of a 0.6 m jog in a dense facade (like a bay's side: 0.6 × 2.5 m, 1.5 m², about
 // 20 voxels of the default 0.28 m) is not lost by the default thinning: found, with
 // its points and extent.
-TEST(Planes, DefaultDetectionKeepsASmallSideWall) {
+TEST_P(Planes, DefaultDetectionKeepsASmallSideWall) {
   PointCloud cloud;
   const double step = 0.03;
   auto dense = [&](const Patch& p, unsigned seed) {
@@ -255,7 +272,7 @@ TEST(Planes, DefaultDetectionKeepsASmallSideWall) {
   // The side x = 8.02, from the facade (y = 0) out to the front (y = -0.62).
   const Truth side = dense({{8.02, 0, 0}, -Vec3::UnitY(), Vec3::UnitZ(), 0.03, 0.6, 0.0, 2.5}, 2);
   const Truth front = dense(wall_patch({8.02, -0.62, 0}, Vec3::UnitX(), 3.0, 0.0, 2.5), 3);
-  const auto planes = detect_planes(cloud, Params{});
+  const auto planes = detect_planes(cloud, params());
   ASSERT_EQ(planes.size(), 3u);
   // The facade and the front are parallel: each is the plane holding most of its points.
   for (const Truth* t : {&facade, &front})
@@ -274,14 +291,14 @@ TEST(Planes, DefaultDetectionKeepsASmallSideWall) {
 }
 
 // facade_max_tilt_deg (10°) decides the facade flag; vertical_snap_deg (1.5°) the refit.
-TEST(Planes, FacadeFlagAndVerticalSnapFollowTheTilt) {
+TEST_P(Planes, FacadeFlagAndVerticalSnapFollowTheTilt) {
   PointCloud cloud;
   auto leaning = [&](double y, double tilt_deg, unsigned seed) {
     const double t = radians(tilt_deg);
     return add_patch(cloud, {{0, y, 0}, Vec3::UnitX(), Vec3(0, std::sin(t), std::cos(t)), 0.0, 6.0, 0.0, 4.0}, seed);
   };
   const Truth snapped = leaning(0.0, 1.0, 1), leaning5 = leaning(20.0, 5.0, 2), roof = leaning(40.0, 60.0, 3);
-  const auto planes = detect_planes(cloud, Params{});
+  const auto planes = detect_planes(cloud, params());
   ASSERT_EQ(planes.size(), 3u);
 
   const ScanPlane* a = find_plane(planes, snapped.plane, 1.5);
@@ -302,11 +319,11 @@ TEST(Planes, FacadeFlagAndVerticalSnapFollowTheTilt) {
 
 // RANSAC's connectivity splits a facade at a gap wider than the cluster epsilon (a 1 m window
 // column): the pieces are merged back into one plane.
-TEST(Planes, PiecesOfOneFacadeAcrossAGapAreOnePlane) {
+TEST_P(Planes, PiecesOfOneFacadeAcrossAGapAreOnePlane) {
   PointCloud cloud;
   const Truth left = add_patch(cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 3.0, 0.0, 4.0), 1);
   const Truth right = add_patch(cloud, wall_patch({4, 0, 0}, Vec3::UnitX(), 3.0, 0.0, 4.0), 2);
-  const auto planes = detect_planes(cloud, Params{});
+  const auto planes = detect_planes(cloud, params());
   ASSERT_EQ(planes.size(), 1u);
   expect_same_plane(planes[0], left.plane);
   EXPECT_GE(count_of(planes[0].inliers, left.points), std::size_t(0.97 * double(left.points.size())));
@@ -314,12 +331,12 @@ TEST(Planes, PiecesOfOneFacadeAcrossAGapAreOnePlane) {
   EXPECT_NEAR(planes[0].hull_area, 7.0 * 4.0, 0.03 * 28.0);  // the hull spans the gap
 }
 
-TEST(Planes, FewerPointsThanRansacMinPointsGiveNoPlane) {
+TEST_P(Planes, FewerPointsThanRansacMinPointsGiveNoPlane) {
   PointCloud cloud;
   add_grid(cloud, {{0, 0, 0}, Vec3::UnitX(), Vec3::UnitZ(), 0.0, 1.4, 0.0, 0.9}, kStep);  // 15 × 10
   cloud.points.pop_back();
   ASSERT_EQ(cloud.points.size(), 149u);
-  Params prm;
+  Params prm = params();
   EXPECT_TRUE(detect_planes(cloud, prm).empty());  // ransac_min_points = 150
   // Copies of points do not count: 149 distinct points stay too few.
   PointCloud doubled = cloud;
@@ -335,20 +352,20 @@ TEST(Planes, FewerPointsThanRansacMinPointsGiveNoPlane) {
 
 // Fuzz regressions (tests/fuzz/README.md): repeated points and a subset smaller than the
 // cluster epsilon sent CGAL's octree into an endless loop.
-TEST(Planes, RepeatedIdenticalPointsGiveNoPlaneAndDoNotHang) {
+TEST_P(Planes, RepeatedIdenticalPointsGiveNoPlaneAndDoNotHang) {
   PointCloud copies;
   copies.points.assign(300, Vec3(1.5, -2.25, 3.0));
-  expect_no_plane_and_no_hang(copies, 20);
+  expect_no_plane_and_no_hang(copies, params(), 20);
   PointCloud tiny;  // 300 distinct points within a millimetre
   for (int i = 0; i < 300; ++i) tiny.points.emplace_back(1e-5 * (i % 7), 1e-5 * (i % 11), 1e-5 * (i % 13));
-  expect_no_plane_and_no_hang(tiny, 20);
+  expect_no_plane_and_no_hang(tiny, params(), 20);
 }
 
-TEST(Planes, RepeatedPointsBesideAFacadeLeaveItsPlane) {
+TEST_P(Planes, RepeatedPointsBesideAFacadeLeaveItsPlane) {
   PointCloud cloud;
   const Truth wall = add_patch(cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 6.0, 0.0, 4.0), 1);
   cloud.points.insert(cloud.points.end(), 300, Vec3(20.0, -5.0, 1.0));
-  const auto planes = detect_planes(cloud, Params{});
+  const auto planes = detect_planes(cloud, params());
   ASSERT_EQ(planes.size(), 1u);
   expect_same_plane(planes[0], wall.plane);
   EXPECT_EQ(count_of(planes[0].inliers, wall.points), planes[0].inliers.size());

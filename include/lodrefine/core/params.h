@@ -14,6 +14,9 @@ namespace lodrefine {
   X(double, planarity_tolerance, 0.01, 0.0, 1.0, "validation: max vertex distance from its face plane (m)")
 
 #define LODREFINE_PLANE_PARAMS(X)                                                                                   \
+  X(int, ransac, 1, 0, 1,                                                                                           \
+    "1: planes by CGAL's Efficient RANSAC (the paper's); 0: by region growing on the same points, normals and "     \
+    "thresholds (the same planes on the dev tiles, faster)")                                                        \
   X(int, seed, 42, 0, 2147483647, "RANSAC random seed (runs are reproducible)")                                     \
   X(double, ransac_epsilon, 0.03, 0.001, 1.0, "RANSAC: max point-to-plane distance of an inlier (m)")               \
   X(double, ransac_cluster_epsilon, 0.25, 0.01, 10.0, "RANSAC: max gap between connected inliers (m)")              \
