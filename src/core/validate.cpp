@@ -130,6 +130,12 @@ bool touches_itself(const std::vector<Vec3>& pts) {
     for (std::size_t j = i + 2; j < m; ++j) {
       if (i == 0 && j == m - 1) continue;  // adjacent through the closing edge
       const Kernel::Segment_2 e(q[i], q[(i + 1) % m]), f(q[j], q[(j + 1) % m]);
+      // Boxes farther apart than tol on an axis hold segments farther apart: the quadratic pass
+      // over a large face's edges then costs a box test per pair.
+      const CGAL::Bbox_2 be = e.bbox(), bf = f.bbox();
+      if (be.xmin() - bf.xmax() > tol || bf.xmin() - be.xmax() > tol || be.ymin() - bf.ymax() > tol ||
+          bf.ymin() - be.ymax() > tol)
+        continue;
       if (CGAL::do_intersect(e, f) || CGAL::squared_distance(e, f) <= tol * tol) return true;
     }
   return false;
