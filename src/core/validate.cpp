@@ -14,6 +14,7 @@
 #include <cmath>
 #include <iterator>
 #include <map>
+#include <numeric>
 #include <set>
 #include <sstream>
 
@@ -116,28 +117,37 @@ double max_planarity_error(const Mesh& m) {
 
 // Whether two edges of the outline that share no vertex touch or cross, or come within a
 // billionth of its size of each other, in the plane of the two coordinates its normal leaves
-// (dropping one is exact, and the segment test is CGAL's exact predicate).
+// (dropping one is exact, and the segment test is CGAL's exact predicate). Edges are swept by
+// their boxes' x: only pairs whose boxes come within that tolerance are tested, so an outline of
+// many vertices costs about a sort, not a test per pair.
 bool touches_itself(const std::vector<Vec3>& pts) {
   const Vec3 n = newell_normal(pts).cwiseAbs();
   const int drop = n.x() >= n.y() && n.x() >= n.z() ? 0 : n.y() >= n.z() ? 1 : 2;
   const int a = drop == 0 ? 1 : 0, b = drop == 2 ? 1 : 2;
-  std::vector<Kernel::Point_2> q;
   Eigen::AlignedBox3d box;
-  for (const Vec3& p : pts) q.emplace_back(p[a], p[b]), box.extend(p);
+  for (const Vec3& p : pts) box.extend(p);
   const double tol = 1e-9 * box.diagonal().norm();
-  const std::size_t m = q.size();
-  for (std::size_t i = 0; i < m; ++i)
-    for (std::size_t j = i + 2; j < m; ++j) {
-      if (i == 0 && j == m - 1) continue;  // adjacent through the closing edge
-      const Kernel::Segment_2 e(q[i], q[(i + 1) % m]), f(q[j], q[(j + 1) % m]);
-      // Boxes farther apart than tol on an axis hold segments farther apart: the quadratic pass
-      // over a large face's edges then costs a box test per pair.
-      const CGAL::Bbox_2 be = e.bbox(), bf = f.bbox();
-      if (be.xmin() - bf.xmax() > tol || bf.xmin() - be.xmax() > tol || be.ymin() - bf.ymax() > tol ||
-          bf.ymin() - be.ymax() > tol)
-        continue;
-      if (CGAL::do_intersect(e, f) || CGAL::squared_distance(e, f) <= tol * tol) return true;
+  const std::size_t m = pts.size();
+  std::vector<Kernel::Segment_2> edge;
+  for (std::size_t i = 0; i < m; ++i) {
+    const Vec3 &p = pts[i], &q = pts[(i + 1) % m];
+    edge.emplace_back(Kernel::Point_2(p[a], p[b]), Kernel::Point_2(q[a], q[b]));
+  }
+  std::vector<std::size_t> by_x(m);
+  std::iota(by_x.begin(), by_x.end(), 0);
+  std::sort(by_x.begin(), by_x.end(),
+            [&](std::size_t i, std::size_t j) { return edge[i].bbox().xmin() < edge[j].bbox().xmin(); });
+  auto adjacent = [&](std::size_t i, std::size_t j) { return (i + 1) % m == j || (j + 1) % m == i; };
+  for (std::size_t k = 0; k < m; ++k) {
+    const std::size_t i = by_x[k];
+    const CGAL::Bbox_2 bi = edge[i].bbox();
+    for (std::size_t l = k + 1; l < m && edge[by_x[l]].bbox().xmin() - bi.xmax() <= tol; ++l) {
+      const std::size_t j = by_x[l];
+      const CGAL::Bbox_2 bj = edge[j].bbox();
+      if (adjacent(i, j) || bi.ymin() - bj.ymax() > tol || bj.ymin() - bi.ymax() > tol) continue;
+      if (CGAL::do_intersect(edge[i], edge[j]) || CGAL::squared_distance(edge[i], edge[j]) <= tol * tol) return true;
     }
+  }
   return false;
 }
 
