@@ -11,7 +11,7 @@ SUDO=""
 LAZPERF=0
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 PKGS="build-essential cmake ccache pkgconf clang-format-14 libcgal-dev libeigen3-dev libglpk-dev libtinyobjloader-dev
-      libcli11-dev nlohmann-json3-dev libtbb-dev libgtest-dev libboost-dev zlib1g-dev libcitygml-dev
+      libcli11-dev nlohmann-json3-dev libtbb-dev libjemalloc-dev libgtest-dev libboost-dev zlib1g-dev libcitygml-dev
       python3-jsonschema python3-numpy python3-scipy"
 for flag in "$@"; do
   case "$flag" in

@@ -1410,15 +1410,19 @@ TEST(BadInputMemory, CityGmlUnderAnAddressSpaceLimitFailsInOneLine) {
     fs::remove_all(dir + "/objs");
     return run_limited(kb, "convert --citygml " + shell_quote(model) + " --out-dir " + shell_quote(dir + "/objs"), dir);
   };
-  // The least limit (in KB) that works, to within 64 KB.
+  // The least limit (in KB) that works, to within 64 KB. The address space jemalloc needs varies
+  // by a few MB from run to run with where the kernel places its aligned mappings (measured: at
+  // 2-6 MB above the least limit 1 run in 8 fails, none with address randomisation off), so a
+  // limit is too small only when it fails twice, and the scan starts 8 MB below.
+  auto works = [&](long kb) { return convert_limited(kb).exit == 0 || convert_limited(kb).exit == 0; };
   long lo = 16 * 1024, hi = 8 * 1024 * 1024;
-  ASSERT_EQ(convert_limited(hi).exit, 0) << "8 GB of address space is not enough?";
+  ASSERT_TRUE(works(hi)) << "8 GB of address space is not enough?";
   while (hi - lo > 64) {
     const long mid = (lo + hi) / 2;
-    (convert_limited(mid).exit == 0 ? hi : lo) = mid;
+    (works(mid) ? hi : lo) = mid;
   }
   int failures = 0;
-  for (long kb = hi - 4000; kb <= hi + 200; kb += 100) {
+  for (long kb = hi - 8000; kb <= hi + 200; kb += 200) {
     const CliRun r = convert_limited(kb);
     std::size_t written = 0;
     if (fs::exists(dir + "/objs")) written = files_in(dir + "/objs").size();
@@ -1438,7 +1442,7 @@ TEST(BadInputMemory, CityGmlUnderAnAddressSpaceLimitFailsInOneLine) {
     EXPECT_TRUE(temp_leftovers(dir).empty()) << kb << " KB";
   }
   EXPECT_GT(failures, 10);  // the scan reached below the least limit
-  add_row("convert: CityGML under ulimit -v (40 limits around the least)",
+  add_row("convert: CityGML under ulimit -v (42 limits around the least)",
           "one line naming the file, or every building", failures > 0 ? 3 : 0);
 }
 

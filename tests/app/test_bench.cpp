@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <numeric>
@@ -175,4 +176,17 @@ TEST(Bench, RepeatWithPolyfitIsRefused) {
   const auto r = run_cli("bench --polyfit --repeat 2 --count 1 --type flat", dir);
   EXPECT_NE(r.exit, 0);
   EXPECT_NE(r.err.find("--repeat"), std::string::npos) << r.err;
+}
+
+// The app allocates with jemalloc (CMakeLists.txt, LODREFINE_JEMALLOC): asked through its
+// MALLOC_CONF, jemalloc prints its statistics at exit. glibc's malloc ignores the variable.
+TEST(Bench, TheAppAllocatesWithJemalloc) {
+  if (!LODREFINE_APP_JEMALLOC) GTEST_SKIP() << "built without jemalloc (LODREFINE_JEMALLOC off, or the sanitizers)";
+  const std::string dir = test_dir("bench");
+  ASSERT_EQ(::setenv("MALLOC_CONF", "stats_print:true", 1), 0);
+  const auto r = run_cli("--version", dir);
+  ::unsetenv("MALLOC_CONF");
+  EXPECT_EQ(r.exit, 0);
+  EXPECT_NE(r.out.find("lodrefine"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("jemalloc statistics"), std::string::npos) << r.err.substr(0, 300);
 }
