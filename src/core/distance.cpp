@@ -132,11 +132,15 @@ class SurfaceIndex {
     int face;
   };
 
+  // The AABB tree's nearest triangle to p (an index into tris_).
+  std::size_t tree_nearest(const Vec3& p) const {
+    return std::size_t(tree_.closest_point_and_primitive(to_cgal(p)).second - cgal_.cbegin());
+  }
+
   // nearest() in the index's frame: the distance to the tree's nearest triangle (signed by the
   // pseudonormal there), the face by nearest_of's rule among the triangles tied with it.
   Nearest nearest_local(const Vec3& p, bool want_sign) const {
-    const auto hit = tree_.closest_point_and_primitive(to_cgal(p));
-    const std::size_t i = std::size_t(hit.second - cgal_.cbegin());
+    const std::size_t i = tree_nearest(p);
     std::vector<double> scratch;
     Nearest n = nearest_of(p, within(p, i, kTieTolerance), scratch);
     if (want_sign && n.distance != 0.0) {
@@ -148,8 +152,7 @@ class SurfaceIndex {
 
   // The distance alone, without the face's tie search.
   double distance_local(const Vec3& p, bool want_sign) const {
-    const auto hit = tree_.closest_point_and_primitive(to_cgal(p));
-    const std::size_t i = std::size_t(hit.second - cgal_.cbegin());
+    const std::size_t i = tree_nearest(p);
     const Closest c = closest_on_triangle(p, tris_[i].a, tris_[i].b, tris_[i].c);
     const double d = (p - c.q).norm();
     return !want_sign || d == 0.0 ? d : sign_at(p, c, i) * d;
@@ -162,9 +165,7 @@ class SurfaceIndex {
   // The triangles within `slack` of the nearest one to p, ascending: on a small mesh all are
   // measured, else the tree's nearest triangle bounds the nearest distance and those in the box
   // of that reach are measured (a Sphere_3 query would miss the triangles wholly inside it).
-  std::vector<std::size_t> within(const Vec3& p, double slack) const {
-    return within(p, std::size_t(tree_.closest_point_and_primitive(to_cgal(p)).second - cgal_.cbegin()), slack);
-  }
+  std::vector<std::size_t> within(const Vec3& p, double slack) const { return within(p, tree_nearest(p), slack); }
   // The same, with the tree's nearest triangle to p already found.
   std::vector<std::size_t> within(const Vec3& p, std::size_t nearest, double slack) const {
     std::vector<std::size_t> near;
