@@ -87,6 +87,13 @@ struct Created {
   void dir(const fs::path& d) {
     if (fs::create_directories(d)) paths.push_back(d);
   }
+  // A building's folder inside --out: a symbolic link there (a run folder from elsewhere, used as
+  // --models and --out) would take the building's files wherever it points.
+  void building_dir(const fs::path& d) {
+    if (fs::is_symlink(fs::symlink_status(d)))
+      throw InputError(d.string() + ": is a symbolic link; crop writes only inside --out");
+    dir(d);
+  }
   void file(const fs::path& f) {
     if (!fs::exists(fs::symlink_status(f))) paths.push_back(f);
   }
@@ -110,7 +117,7 @@ void run(const CropArgs& a) {
       kept.push_back(m);
       if (model.id != m.path.stem().string()) kept.back().own_id = model.id;
     } catch (const InputError& e) {  // one broken model must not stop the tile
-      std::fprintf(stderr, "lodrefine: warning: skipping %s: %s\n", shown_id(m.id).c_str(), e.what());
+      std::fprintf(stderr, "lodrefine: warning: skipping %s: %s\n", shown_id(m.id).c_str(), one_line(e.what()).c_str());
       ++skipped;
     }
   }
@@ -122,7 +129,7 @@ void run(const CropArgs& a) {
     created.dir(a.out);
     std::vector<std::string> clouds;
     for (const auto& m : kept) {
-      created.dir(fs::path(a.out) / m.folder);
+      created.building_dir(fs::path(a.out) / m.folder);
       clouds.push_back((fs::path(a.out) / m.folder / "cloud.ply").string());
       created.file(clouds.back());
       created.file(fs::path(a.out) / m.folder / "coarse.obj");

@@ -22,13 +22,13 @@ namespace {
 
 struct RefineArgs {
   std::string model, cloud, out, report;
-  std::uint64_t max_points = 20000000;
   Params params;
   CloudOptions cloud_options;
   std::string building, lod;  // city files only
   std::string html;           // city files only: the review page
   int jobs = default_jobs();  // city files only
   bool quiet = false;
+  std::uint64_t max_crop_points = kDefaultMaxCropPoints;  // city files only
 };
 
 // Scan points per refined building on the review page: enough to see each facade, and what
@@ -119,6 +119,7 @@ void run_city(const RefineArgs& a) {
   o.building = a.building;
   o.lod = a.lod;
   o.cloud = a.cloud_options;
+  o.max_crop_points = a.max_crop_points;
   o.jobs = a.jobs;
   ReviewCollector review;
   if (!a.html.empty()) o.on_building = std::ref(review);
@@ -207,9 +208,6 @@ void run(const RefineArgs& a) {
                      ": --building and --lod pick buildings of a city file (CityJSON, CityGML), not of an OBJ");
   const Mesh model = read_obj(a.model);
   const std::uint64_t declared = cloud_point_count(a.cloud);
-  if (declared > a.max_points)
-    throw InputError(a.cloud + ": " + std::to_string(declared) + " points, more than --max-points " +
-                     std::to_string(a.max_points) + "; cut a crop per building first (lodrefine crop)");
   const PointCloud cloud = read_cloud(a.cloud, a.cloud_options);
   if (cloud.points.empty())
     throw InputError(a.cloud + ": the cloud has no points" +
@@ -259,7 +257,11 @@ void add_refine_command(CLI::App& app) {
                     1, 1024);
   cmd->add_flag("--quiet", args.quiet, "City file: no progress line on stderr");
   cmd->add_option("--report", args.report, "JSON report: matches, planes, candidates, MIP, timings, validation");
-  cmd->add_option("--max-points", args.max_points, "Refuse clouds with more points (a tile, not a crop)")
+  cmd->add_option("--max-points", args.cloud_options.max_points, "Refuse clouds with more points (a tile, not a crop)")
+      ->capture_default_str();
+  cmd->add_option("--max-crop-points", args.max_crop_points,
+                  "City file: refuse the run when the buildings' crop boxes hold more points together (each "
+                  "is held in memory, 24 bytes); refine the district in parts")
       ->capture_default_str();
   add_cloud_options(cmd, args.cloud_options);
   add_param_options(cmd, args.params);

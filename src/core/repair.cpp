@@ -546,6 +546,8 @@ Mesh merge_coplanar_faces(const Mesh& mesh, double angle_deg, double distance) {
 }
 
 Mesh repair_input(const Mesh& local_model, const RepairConfig& prm, RepairReport& rr) {
+  // Before any weld: each step validates, and validation's time grows with the model's size.
+  if (const std::string too_large = size_problem(local_model); !too_large.empty()) throw InputError(too_large);
   // Welds tried in turn, relative to weld_tolerance: the tolerance itself; gaps between faces
   // up to 1.5x and 2x it (corners jittered a little more than the tolerance); then 10x and 100x
   // finer for detailed models whose features are shorter than it.

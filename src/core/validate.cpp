@@ -267,10 +267,26 @@ double signed_volume(const std::vector<Vec3>& vertices, const std::vector<Face>&
   return volume;
 }
 
+std::string size_problem(const Mesh& mesh) {
+  std::size_t corners = 0;
+  for (std::size_t k = 0; k < mesh.faces.size(); ++k) {
+    const std::size_t n = mesh.faces[k].v.size();
+    if (n > kMaxFaceVertices)
+      return "face " + std::to_string(k) + " has " + std::to_string(n) + " vertices, more than " +
+             std::to_string(kMaxFaceVertices) + " (LoD2 faces have tens)";
+    corners += n;
+  }
+  if (corners > kMaxFaceCorners)
+    return "the faces have " + std::to_string(corners) + " corners in all, more than " +
+           std::to_string(kMaxFaceCorners) + " (LoD2 buildings have hundreds)";
+  return {};
+}
+
 Validation validate_mesh(const Mesh& mesh, double planarity_tolerance, bool check_self_intersections,
                          bool single_component) {
   Validation v;
-  v.problem = mesh.faces.empty() ? "no faces" : malformed(mesh);
+  v.problem = mesh.faces.empty() ? "no faces" : size_problem(mesh);
+  if (v.problem.empty()) v.problem = malformed(mesh);
   if (!v.problem.empty()) return v;
   const EdgeUses uses = edge_uses(mesh.faces);
   count_edge_defects(uses, v);

@@ -8,6 +8,8 @@
 #include <nlohmann/json.hpp>
 
 #include "lodrefine/core/types.h"
+#include "lodrefine/io/cityjson.h"
+#include "lodrefine/io/files.h"
 
 namespace lodrefine {
 namespace {
@@ -237,13 +239,17 @@ RunFigures read_baseline(const std::string& text, const std::string& source) {
 }
 
 namespace {
+// Baselines and gates may come from other people: parsed as every untrusted JSON file (one line
+// on malformed text, nesting bounded: a value 100,000 arrays deep overflowed the stack).
+json parse_untrusted(const std::string& text, const std::string& source) { return json(parse_city_json(text, source)); }
+
 RunFigures parse_baseline(const std::string& text, const std::string& source) {
-  const json doc = json::parse(text, nullptr, false);
+  const json doc = parse_untrusted(text, source);
   if (!doc.is_object() || doc.value("format", json()) != "lodrefine-baseline")
     throw InputError(source + ": not a lodrefine baseline (write one with eval --dir RUN --write-baseline FILE)");
   if (doc.value("version", json()) != kBaselineVersion)
-    throw InputError(source + ": baseline version " + doc.value("version", json()).dump() + ", this lodrefine reads " +
-                     std::to_string(kBaselineVersion) + "; write it again");
+    throw InputError(source + ": baseline version " + shown_id(doc.value("version", json()).dump()).substr(0, 40) +
+                     ", this lodrefine reads " + std::to_string(kBaselineVersion) + "; write it again");
   RunFigures run;
   const json pooled = doc.value("pooled", json::object());
   if (!pooled.is_object()) throw InputError(source + ": \"pooled\" is not an object");
@@ -259,8 +265,8 @@ RunFigures parse_baseline(const std::string& text, const std::string& source) {
     if (!j.is_object() || !j.value("id", json()).is_string()) throw InputError(source + ": a building without an id");
     BuildingFigures b;
     b.id = j["id"].get<std::string>();
-    if (!ids.insert(b.id).second) throw InputError(source + ": building '" + b.id + "' listed twice");
-    const std::string where = source + ": building '" + b.id + "'";
+    if (!ids.insert(b.id).second) throw InputError(source + ": building " + shown_id(b.id) + " listed twice");
+    const std::string where = source + ": building " + shown_id(b.id);
     b.outcome = j.value("outcome", json()).is_string() ? j["outcome"].get<std::string>() : std::string("failed");
     b.reason = j.value("reason", json()).is_string() ? j["reason"].get<std::string>() : std::string();
     b.watertight = j.value("watertight", json()).is_boolean() && j["watertight"].get<bool>();
@@ -291,7 +297,7 @@ const std::map<std::string, std::string>& gate_names() {
 }
 
 Gates read_gates(const std::string& text, const std::string& source) {
-  const json doc = json::parse(text, nullptr, false);
+  const json doc = parse_untrusted(text, source);
   if (!doc.is_object()) throw InputError(source + ": gates must be a JSON object of gate name -> limit");
   Gates gates;
   for (const auto& [key, value] : doc.items()) {
@@ -299,10 +305,10 @@ Gates read_gates(const std::string& text, const std::string& source) {
     if (!gate_names().count(key)) {
       std::string known;
       for (const auto& [name, what] : gate_names()) known += (known.empty() ? "" : ", ") + name;
-      throw InputError(source + ": unknown gate '" + key + "' (known: " + known + ")");
+      throw InputError(source + ": unknown gate " + shown_id(key) + " (known: " + known + ")");
     }
     if (!value.is_number() || !std::isfinite(value.get<double>()))
-      throw InputError(source + ": gate '" + key + "' is not a finite number");
+      throw InputError(source + ": gate " + shown_id(key) + " is not a finite number");
     gates[key] = value.get<double>();
   }
   return gates;

@@ -3,6 +3,7 @@
 #include "lodrefine/eval/run.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -16,7 +17,9 @@
 
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/core/refine.h"
+#include "lodrefine/core/validate.h"
 #include "lodrefine/eval/plots.h"
+#include "lodrefine/io/cityjson.h"
 #include "lodrefine/io/files.h"
 #include "lodrefine/io/obj.h"
 #include "lodrefine/io/refine_report.h"
@@ -30,18 +33,29 @@ using nlohmann::json;
 // Points drawn in a footprint file (svg_footprint's default): dense enough to see each facade.
 constexpr std::size_t kFootprintFilePoints = 5000;
 
+// A run folder's JSON file, or null when absent or unreadable. Read as every untrusted file: a
+// FIFO or device is not read (it hung eval), the nesting is bounded.
 json read_json_or_null(const std::string& path) {
   if (path.empty() || !fs::exists(path)) return nullptr;
-  std::ifstream in(path);
-  return json::parse(in, nullptr, false);  // discarded (null-like) on a parse error
+  try {
+    return json(parse_city_json(read_file(path), path));
+  } catch (const InputError&) {
+    return nullptr;
+  }
 }
 
 // Scanned truth faces listed by the generator, if present and plausible (walls of this truth).
 std::optional<std::vector<int>> meta_scanned_faces(const std::string& meta_path, const Mesh& truth) {
   const json meta = read_json_or_null(meta_path);
-  if (!meta.is_object() || !meta.contains("scanned_truth_faces")) return std::nullopt;
+  if (!meta.is_object() || !meta.contains("scanned_truth_faces") || !meta["scanned_truth_faces"].is_array())
+    return std::nullopt;
   std::vector<int> faces;
   for (const auto& f : meta["scanned_truth_faces"]) {
+    if (!f.is_number_integer() || f.get<long long>() < INT_MIN || f.get<long long>() > INT_MAX) {
+      std::fprintf(stderr, "lodrefine: warning: %s: a scanned face is not a face index; detecting instead\n",
+                   meta_path.c_str());
+      return std::nullopt;
+    }
     const int i = f.get<int>();
     if (i < 0 || std::size_t(i) >= truth.faces.size() || truth.faces[std::size_t(i)].sem != Semantic::Wall) {
       std::fprintf(stderr, "lodrefine: warning: %s: scanned face %d is not a wall of the truth; detecting instead\n",
@@ -53,6 +67,14 @@ std::optional<std::vector<int>> meta_scanned_faces(const std::string& meta_path,
   return faces;
 }
 
+// An OBJ model within validation's size bounds: the distances' AABB tree degrades on a face of
+// thousands of collinear vertices as validation does (minutes for one building).
+Mesh read_model(const std::string& path) {
+  Mesh m = read_obj(path);
+  if (const std::string too_large = size_problem(m); !too_large.empty()) throw InputError(path + ": " + too_large);
+  return m;
+}
+
 // A missing or unreadable refined model is a failure row, never an abort.
 Mesh read_refined(const std::string& path, std::string& error) {
   if (path.empty() || !fs::exists(path)) {
@@ -60,18 +82,26 @@ Mesh read_refined(const std::string& path, std::string& error) {
     return {};
   }
   try {
-    return read_obj(path);
+    return read_model(path);
   } catch (const InputError& e) {
     error = e.what();
     return {};
   }
 }
 
+// The reason a FAILED marker records: its first line, at most kMaxReason bytes, control
+// characters escaped; a FIFO or device is not read.
 std::string first_line(const std::string& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  return line.empty() ? "failed (no reason recorded)" : line;
+  constexpr std::size_t kMaxReason = 500;
+  if (!fs::is_regular_file(path)) return "failed (the FAILED marker is not a regular file)";
+  std::ifstream in(path, std::ios::binary);
+  std::string line(kMaxReason, '\0');
+  in.read(line.data(), std::streamsize(line.size()));
+  line.resize(std::size_t(in.gcount()));
+  line = line.substr(0, line.find_first_of("\r\n"));
+  if (line.empty()) return "failed (no reason recorded)";
+  const std::string shown = shown_id(line);  // JSON-quoted: no control character reaches a terminal
+  return shown.substr(1, shown.size() - 2);
 }
 
 // Refuses a report written by a newer refine than this eval reads (absent: version 1).
@@ -136,7 +166,7 @@ std::string building_footprint_svg(const BuildingEval& e, const LocalBuilding& b
 LocalBuilding read_local(const BuildingFiles& f, const std::optional<Vec3>& origin, std::string& refined_error,
                          const CloudOptions& cloud_options) {
   LocalBuilding b;
-  b.original = read_obj(f.original);
+  b.original = read_model(f.original);
   b.origin = origin ? *origin : local_origin(b.original);
   b.original = translated(std::move(b.original), -b.origin);
   b.cloud = read_cloud(f.cloud, cloud_options);
@@ -155,7 +185,7 @@ RunRow evaluate_building_files(const BuildingFiles& f, const Params& params, con
   std::optional<Mesh> truth;
   std::optional<std::vector<int>> scanned;
   if (!f.truth.empty()) {
-    truth = translated(read_obj(f.truth), -row.origin);
+    truth = translated(read_model(f.truth), -row.origin);
     scanned = meta_scanned_faces(f.meta, *truth);
     row.truth_faces_source = scanned ? "meta.json" : "detected";
   }

@@ -395,7 +395,8 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
 
   t = Clock::now();
   Eigen::AlignedBox3d cloud_box;
-  sum.cloud_points = crop_tile(cloud_path, targets, options.cloud, &cloud_box, options.crop_progress);
+  sum.cloud_points =
+      crop_tile(cloud_path, targets, options.cloud, &cloud_box, options.crop_progress, options.max_crop_points);
   sum.cropped_points = check_cloud_reaches(targets, cloud_box, city_box, cloud_path);
   sum.seconds_crop = seconds_since(t);
 
@@ -519,7 +520,8 @@ CityRefineSummary refine_city(const std::string& model_path, const std::string& 
 
   t = Clock::now();
   Eigen::AlignedBox3d cloud_box;
-  sum.cloud_points = crop_tile(cloud_path, targets, options.cloud, &cloud_box, options.crop_progress);
+  sum.cloud_points =
+      crop_tile(cloud_path, targets, options.cloud, &cloud_box, options.crop_progress, options.max_crop_points);
   sum.cropped_points = check_cloud_reaches(targets, cloud_box, model_box(file.buildings), cloud_path);
   sum.seconds_crop = seconds_since(t);
 

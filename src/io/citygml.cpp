@@ -33,6 +33,9 @@ void scan_text(std::string_view text, std::string& version, std::string& srs) {
 }  // namespace
 
 std::string crs_url(const std::string& srs_name) {
+  // std::regex recurses once per character matched: a name of 50,000 digits overflowed the
+  // stack. No CRS name is that long; such a name is kept as it is.
+  if (srs_name.size() > kMaxCrsName) return srs_name;
   static const std::regex epsg("EPSG(?::[0-9.]*)?:+([0-9]+)|EPSG/[0-9]+/([0-9]+)", std::regex::icase);
   std::smatch m;
   if (!std::regex_search(srs_name, m, epsg)) return srs_name;
@@ -41,6 +44,7 @@ std::string crs_url(const std::string& srs_name) {
 
 nlohmann::ordered_json citygml_to_cityjson(const std::string& path, std::string* citygml_version,
                                            std::vector<std::string>* notes) {
+  require_regular_file(path);  // a FIFO would block the probe below, /dev/zero be read without end
   const FileKind kind = sniff_file(path);
   if (kind != FileKind::Xml) {
     std::ifstream probe(path);

@@ -110,6 +110,12 @@ class Reader {
       out.translate = vec3(member(t, "translate"), "transform.translate");
       if ((out.scale.array() <= 0.0).any())
         fail("transform.scale has a zero or negative factor (every vertex would collapse)");
+      // The refined vertices are written back as (p - translate) / scale in 64-bit integers:
+      // with both within kMaxCoordinate and the scale at least kMinScale they fit (2e18 < 9.2e18).
+      // A scale of 1e-15 wrapped them to -9.2e18 without a word.
+      if ((out.scale.array() < kMinScale).any())
+        fail("transform.scale has a factor below 1e-9 m (the vertices written back would overflow 64-bit integers)");
+      if (out.translate.cwiseAbs().maxCoeff() > kMaxCoordinate) fail("transform.translate is beyond 1e9 m");
     }
     const json& rs = member(member(root, "metadata"), "referenceSystem");
     if (rs.is_string()) out.crs = rs.get<std::string>();
@@ -476,6 +482,7 @@ CityJsonFile read_cityjson_document(const nlohmann::ordered_json& doc, const std
 }
 
 CityJsonFile read_cityjson(const std::string& path, const std::string& lod) {
+  require_regular_file(path);  // a FIFO would block, /dev/zero be read without end
   const FileKind kind = sniff_file(path);
   if (kind != FileKind::Json && kind != FileKind::Other)
     throw InputError(path + ": not a CityJSON file: the file is " + file_kind_text(kind));

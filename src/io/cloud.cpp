@@ -35,6 +35,10 @@ void stream_cloud(const std::string& path, const CloudOptions& options,
 
 PointCloud read_cloud(const std::string& path, const CloudOptions& options) {
   // Under read_naming_memory whole: the reservation is most of the memory a cloud takes.
+  const std::uint64_t declared = cloud_point_count(path);
+  if (declared > options.max_points)
+    throw InputError(path + ": " + std::to_string(declared) + " points, more than --max-points " +
+                     std::to_string(options.max_points) + "; cut a crop per building first (lodrefine crop)");
   return read_naming_memory(path, [&] {
     PointCloud cloud;
     // A LAS count is bounded by the file size (checked in the header), a LAZ count only by what

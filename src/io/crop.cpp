@@ -136,9 +136,17 @@ std::vector<Vec3> unspill(const std::string& path) {
 }  // namespace
 
 std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets, const CloudOptions& options,
-                      Eigen::AlignedBox3d* bounds, const std::function<void(std::uint64_t)>& on_read) {
+                      Eigen::AlignedBox3d* bounds, const std::function<void(std::uint64_t)>& on_read,
+                      std::uint64_t max_held) {
+  std::uint64_t held = 0;
   return for_each_hit(
-      tile, targets, options, bounds, [&](std::size_t i, const Vec3& p) { targets[i].cloud.points.push_back(p); },
+      tile, targets, options, bounds,
+      [&](std::size_t i, const Vec3& p) {
+        if (++held > max_held)
+          throw InputError(tile + ": the buildings' crop boxes hold more than " + std::to_string(max_held) +
+                           " points (--max-crop-points); refine the district in parts");
+        targets[i].cloud.points.push_back(p);
+      },
       on_read);
 }
 

@@ -1498,3 +1498,155 @@ TEST(BadInputMemory, CloudUnderAnAddressSpaceLimitIsNamed) {
   fs::remove(cloud);
   add_row("refine: 144 MB PLY under ulimit -v 90-200 MB", "one line naming the cloud, exit 3", 3);
 }
+
+// Found by an attacker's review (2026-12-03): before its fix each input below crashed, hung,
+// wrote outside --out, filled the memory, or was written back as garbage.
+
+// std::regex recursed once per digit of a CityJSON 1.x CRS name: 50,000 digits overflowed the
+// stack (SIGSEGV). Such a name is kept as it is.
+TEST(BadInputAttack, HugeCrsNameIsKeptNotACrash) {
+  const std::string dir = temp_dir("attack_crs");
+  const std::string crs = "EPSG:" + std::string(50000, '1');
+  json doc = json::parse(box_city({"a"}));
+  doc["version"] = "1.1";
+  doc["metadata"] = {{"referenceSystem", crs}};
+  write_text(dir + "/city.json", doc.dump());
+  write_text(dir + "/cloud.ply", valid_cloud());
+  const CliRun r = run_cli(
+      "refine --quiet --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir + "/out.city.json", dir,
+      60);
+  ASSERT_EQ(r.exit, 0) << r.err;
+  EXPECT_EQ(json::parse(read_text(dir + "/out.city.json"))["metadata"]["referenceSystem"], crs);
+  add_row("CityJSON 1.1, CRS name of 50,000 digits", "refined; the name kept as it is", r.exit);
+}
+
+// convert opened its input without asking what it was: a FIFO blocked it, /dev/zero was read
+// until the memory ran out. eval --dir did the same with a run folder's meta.json, report.json
+// and FAILED marker.
+TEST(BadInputAttack, FifosAndDevicesAreNeverRead) {
+  const std::string dir = temp_dir("attack_fifo");
+  ASSERT_EQ(::mkfifo((dir + "/fifo").c_str(), 0600), 0);
+  for (const std::string& args :
+       {"--cityjson " + dir + "/fifo", "--citygml " + dir + "/fifo", std::string("--cityjson /dev/zero")}) {
+    const CliRun r = run_cli("convert " + args + " --out-dir " + dir + "/objs", dir, 30);
+    expect_one_error_line(r, "not a regular file");
+    EXPECT_LT(r.seconds, 5.0) << args;
+  }
+  const std::string b = dir + "/run/a";
+  fs::create_directories(b);
+  write_text(b + "/coarse.obj", valid_model());
+  write_text(b + "/refined.obj", valid_model());
+  write_text(b + "/cloud.ply", valid_cloud());
+  for (const char* name : {"meta.json", "report.json"}) ASSERT_EQ(::mkfifo((b + "/" + name).c_str(), 0600), 0);
+  fs::create_symlink("/dev/zero", b + "/FAILED");
+  const CliRun r = run_cli("eval --quiet --dir " + dir + "/run --json " + dir + "/eval.json", dir, 30);
+  EXPECT_LT(r.seconds, 10.0);
+  EXPECT_NE(r.out.find("failed 1"), std::string::npos) << r.out << r.err;
+  const json figures = json::parse(read_text(dir + "/eval.json"));
+  EXPECT_EQ(figures["buildings"][0]["reason"], "failed (the FAILED marker is not a regular file)") << figures.dump();
+  add_row("convert / eval --dir: FIFO or /dev/zero as an input file", "not read: refused, or the building failed", 2);
+}
+
+// With --out the --models folder, a building folder that is a symbolic link took crop's files
+// wherever it pointed.
+TEST(BadInputAttack, CropDoesNotWriteThroughASymlinkedBuildingFolder) {
+  const std::string dir = temp_dir("attack_symlink");
+  fs::create_directories(dir + "/run");
+  fs::create_directories(dir + "/outside");
+  write_text(dir + "/run/Y.obj", valid_model());
+  fs::create_directory_symlink(dir + "/outside", dir + "/run/Y");
+  write_text(dir + "/tile.ply", valid_cloud());
+  const CliRun r =
+      run_cli("crop --quiet --tile " + dir + "/tile.ply --models " + dir + "/run --out " + dir + "/run", dir);
+  expect_one_error_line(r, "is a symbolic link");
+  EXPECT_TRUE(files_in(dir + "/outside").empty());
+  add_row("crop: a building folder in --out is a symlink", "refused; nothing written through it", r.exit);
+}
+
+// A transform.scale of 1e-15 wrapped the refined vertices to -9.2e18 (64-bit overflow) and the
+// file was written with exit 0.
+TEST(BadInputAttack, TransformScaleFinerThanANanometreIsRefused) {
+  const std::string dir = temp_dir("attack_scale");
+  json doc = json::parse(box_city({"a"}));
+  doc["transform"]["scale"] = {1e-15, 1e-15, 1e-15};
+  write_text(dir + "/city.json", doc.dump());
+  write_text(dir + "/cloud.ply", valid_cloud());
+  const CliRun r = run_cli(
+      "refine --quiet --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir + "/out.city.json",
+      dir);
+  expect_one_error_line(r, "transform.scale has a factor below 1e-9 m");
+  EXPECT_FALSE(fs::exists(dir + "/out.city.json"));
+  add_row("CityJSON transform.scale 1e-15", "refused: the vertices written back would overflow", r.exit);
+}
+
+// A LAZ file of 150 KB announced 1e8 identical points: eval read them all and the city refine
+// held them in its crops, until the memory ran out. Both are bounded now (--max-points,
+// --max-crop-points), as the OBJ refine was.
+TEST(BadInputAttack, PointLimitsBoundEvalAndTheCityRefine) {
+  const std::string dir = temp_dir("attack_points");
+  write_text(dir + "/model.obj", valid_model());
+  write_text(dir + "/city.json", box_city({"a"}));
+  write_text(dir + "/cloud.ply", valid_cloud());
+  const std::string m = dir + "/model.obj", c = dir + "/cloud.ply";
+  const CliRun e = run_cli("eval --original " + m + " --refined " + m + " --cloud " + c + " --max-points 10", dir);
+  expect_one_error_line(e, "more than --max-points 10");
+  const CliRun r = run_cli("refine --quiet --model " + dir + "/city.json --cloud " + c + " --out " + dir +
+                               "/out.city.json --max-crop-points 10",
+                           dir);
+  expect_one_error_line(r, "hold more than 10 points (--max-crop-points)");
+  EXPECT_FALSE(fs::exists(dir + "/out.city.json"));
+  add_row("eval / city refine: more points than --max-points / --max-crop-points", "refused in one line", r.exit);
+}
+
+// The box with every edge cut into `pieces` collinear pieces (faces of 4 * pieces vertices).
+std::string box_obj_with_collinear_vertices(int pieces) {
+  std::string s = "o bldg_0001\n";
+  int n = 0;
+  for (const Quad& q : kQuads) {
+    s += std::string("g ") + q.group + "\n";
+    std::string face = "f";
+    for (int e = 0; e < 4; ++e)
+      for (int j = 0; j < pieces; ++j) {
+        const Vec3 p = kOrigin + kBox[q.v[e]] + (kBox[q.v[(e + 1) % 4]] - kBox[q.v[e]]) * (double(j) / pieces);
+        s += "v " + fmt(p.x()) + " " + fmt(p.y()) + " " + fmt(p.z()) + "\n";
+        face += " " + std::to_string(++n);
+      }
+    s += face + "\n";
+  }
+  return s;
+}
+
+// A 1 MB OBJ whose faces hold thousands of collinear vertices made validation's
+// self-intersection test (and eval's distances) run for minutes: such a model is no LoD2 building.
+TEST(BadInputAttack, FacesOfThousandsOfVerticesAreRefusedAtOnce) {
+  const std::string dir = temp_dir("attack_collinear");
+  write_text(dir + "/model.obj", box_obj_with_collinear_vertices(300));
+  write_text(dir + "/cloud.ply", valid_cloud());
+  const std::string m = dir + "/model.obj";
+  const CliRun r =
+      run_cli("refine --model " + m + " --cloud " + dir + "/cloud.ply --out " + dir + "/out.obj", dir, 120);
+  EXPECT_EQ(r.exit, 0) << r.err;
+  EXPECT_NE(r.out.find("kept-invalid (face 0 has 1200 vertices, more than 1000"), std::string::npos) << r.out;
+  EXPECT_LT(r.seconds, 10.0);
+  const CliRun e = run_cli("eval --original " + m + " --refined " + m + " --cloud " + dir + "/cloud.ply", dir, 120);
+  expect_one_error_line(e, "face 0 has 1200 vertices, more than 1000");
+  EXPECT_LT(e.seconds, 10.0);
+  add_row("OBJ whose faces hold 1,200 collinear vertices", "kept-invalid at once (eval: refused)", r.exit);
+}
+
+// Every error is one line whatever the input's bytes: a path, id or key quoted in a message with
+// a newline or an escape code in it is shown escaped.
+TEST(BadInputAttack, ErrorsQuotingControlCharactersStayOneLine) {
+  const std::string dir = temp_dir("attack_lines");
+  const std::string bad = dir + "/a\nlodrefine: error: injected\x1b[31m.obj";
+  write_text(bad, "v 0 0 0\nnot obj\n");
+  write_text(dir + "/cloud.ply", valid_cloud());
+  for (const std::string& model : {bad, dir + "/missing\nline.obj"}) {
+    const CliRun r = run_cli(
+        "refine --model " + shell_quote(model) + " --cloud " + dir + "/cloud.ply --out " + dir + "/out.obj", dir);
+    EXPECT_NE(r.exit, 0);
+    EXPECT_EQ(lines(r.err).size(), 1u) << r.err;
+    EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << r.err;
+  }
+  add_row("a path holding a newline and an escape code", "one error line, escaped", 2);
+}

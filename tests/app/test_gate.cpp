@@ -130,8 +130,8 @@ TEST(EvalGate, BaselineThenAModelMovedFailsWithItsLine) {
   std::ofstream(dir / "bad.json") << R"({"max_c2m": 0.1})";
   const EvalRun bad = eval(run, "--gates " + shell_quoted(dir / "bad.json"));
   EXPECT_EQ(bad.exit, 2);
-  EXPECT_EQ(bad.err.rfind("lodrefine: error: " + (dir / "bad.json").string() + ": unknown gate 'max_c2m' (known: ", 0),
-            0u)
+  EXPECT_EQ(
+      bad.err.rfind("lodrefine: error: " + (dir / "bad.json").string() + ": unknown gate \"max_c2m\" (known: ", 0), 0u)
       << bad.err;
   EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1);
   if (!HasFailure()) fs::remove_all(dir);

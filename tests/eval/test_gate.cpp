@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <functional>
 
 #include "lodrefine/core/types.h"
 #include "lodrefine/eval/gate.h"
@@ -165,7 +166,7 @@ TEST(Gate, BadGateAndBaselineFilesAreOneLineErrors) {
     FAIL() << "an unknown gate was accepted";
   } catch (const InputError& e) {
     const std::string m = e.what();
-    EXPECT_EQ(m.rfind("gates.json: unknown gate 'max_c2m_rmse' (known: ", 0), 0u) << m;
+    EXPECT_EQ(m.rfind("gates.json: unknown gate \"max_c2m_rmse\" (known: ", 0), 0u) << m;
     EXPECT_EQ(m.find('\n'), std::string::npos);
   }
   EXPECT_THROW(read_gates(R"({"max_failed_buildings": "0"})", "g"), InputError);
@@ -217,4 +218,33 @@ TEST(Gate, JunitHasOneTestcasePerBuildingAndParsesWithHostileIds) {
   EXPECT_NE(parsed.find("'</testcase><script>alert(\"x\")</script>\\'\\ufffd\\ufffd\\n]]>' True"), std::string::npos)
       << parsed;
   EXPECT_NE(parsed.find("'max_failed_buildings' False"), std::string::npos) << parsed;
+}
+
+// Baselines and gates may come from other people. A value nested 100,000 arrays deep crashed
+// eval (the parse kept it, the error message dumped it recursively); ids and keys holding a
+// newline or an escape code broke the one error line.
+TEST(GateFiles, DeepNestingAndControlCharactersFailInOneLine) {
+  auto refusal = [](const std::function<void()>& read) {
+    try {
+      read();
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(accepted)");
+  };
+  const std::string deep =
+      R"({"format":"lodrefine-baseline","version":)" + std::string(100000, '[') + std::string(100000, ']') + "}";
+  const std::string nested = refusal([&] { read_baseline(deep, "deep.json"); });
+  EXPECT_NE(nested.find("nested deeper than"), std::string::npos) << nested.substr(0, 200);
+
+  RunFigures run;
+  run.buildings = {building("a\nlodrefine: error: injected", "refined", 0.1)};
+  run.buildings.push_back(run.buildings.front());
+  const std::string twice = refusal([&] { read_baseline(baseline_json(run), "twice.json"); });
+  EXPECT_NE(twice.find("listed twice"), std::string::npos) << twice;
+  EXPECT_EQ(twice.find('\n'), std::string::npos) << twice;
+
+  const std::string gate = refusal([] { read_gates("{\"bad\\ngate\\u001b[31m\": 1}", "gates.json"); });
+  EXPECT_NE(gate.find("unknown gate"), std::string::npos) << gate;
+  EXPECT_EQ(gate.find_first_of("\n\x1b"), std::string::npos) << gate;
 }

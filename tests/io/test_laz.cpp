@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <map>
 #include <vector>
 
@@ -302,8 +303,11 @@ TEST(Laz, HugeDeclaredCountsAllocateLittle) {
   poke<std::uint32_t>(b, 107, 0xffffff00u);
   const std::string path = write_bytes("huge.laz", b);
   EXPECT_EQ(read_las_header(path).point_count, 0xffffff00u);
+  EXPECT_THROW(read_cloud(path), InputError);  // beyond the default --max-points, before decoding
+  CloudOptions unbounded;                      // the decoder itself, without that limit
+  unbounded.max_points = std::numeric_limits<std::uint64_t>::max();
   try {
-    read_cloud(path);
+    read_cloud(path, unbounded);
     ADD_FAILURE() << "4 billion points from 500 bytes";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("truncated or corrupt"), std::string::npos) << e.what();

@@ -23,11 +23,23 @@ struct Validation {
   bool valid() const { return problem.empty(); }
 };
 
+// The largest building model validated and refined: faces of at most kMaxFaceVertices
+// vertices, at most kMaxFaceCorners face corners in all. The self-intersection test's time grows
+// with the square of a face's vertices where they lie on one line (8 faces of 6,000 collinear
+// vertices took minutes); Delfshaven's largest LoD2 face has 251 vertices, its largest building
+// 1,916 face corners.
+inline constexpr std::size_t kMaxFaceVertices = 1000;
+inline constexpr std::size_t kMaxFaceCorners = 20000;
+
+// Why `mesh` exceeds those bounds, one line ("face 3 has 6000 vertices, more than 1000 ..."), or
+// empty when it does not.
+std::string size_problem(const Mesh& mesh);
+
 // Checks closed, 2-manifold (edges and vertices), consistently and outward oriented, planar
 // faces within `planarity_tolerance` (Params::planarity_tolerance; no default here, the
 // parameter table holds it), one component, no self-intersections (CGAL PMP on the triangulated
-// faces). Expects shared vertices. `single_component` false accepts a building of several closed
-// shells (a multi-part export).
+// faces). Expects shared vertices. A mesh beyond size_problem's bounds is invalid unchecked. `single_component` false
+// accepts a building of several closed shells (a multi-part export).
 Validation validate_mesh(const Mesh& mesh, double planarity_tolerance, bool check_self_intersections = true,
                          bool single_component = true);
 

@@ -38,7 +38,8 @@ nlohmann::ordered_json citygml_to_cityjson(const std::string& path, std::string*
 CityJsonFile read_city_file(const std::string& path);
 
 // "urn:ogc:def:crs:EPSG::28992", "EPSG:28992", ... -> "https://www.opengis.net/def/crs/EPSG/0/28992";
-// other names are returned unchanged.
+// other names, and names longer than kMaxCrsName bytes, are returned unchanged.
+inline constexpr std::size_t kMaxCrsName = 200;
 std::string crs_url(const std::string& srs_name);
 
 }  // namespace lodrefine

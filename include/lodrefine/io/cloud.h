@@ -14,10 +14,15 @@ namespace lodrefine {
 
 enum class CloudFormat { Ply, Las };
 
+inline constexpr std::uint64_t kDefaultMaxPoints = 20000000;
+
 struct CloudOptions {
   // Classification codes to keep (LAS only; empty: every point). Formats 0–5 carry 5-bit
   // classes (0–31), 6–10 the full byte. A PLY has no classification: a filter is an error.
   std::vector<int> classes;
+  // The most points read_cloud holds (a building's crop, not a tile): a LAZ file of a few
+  // hundred kilobytes can announce 1e9 points, which would fill the memory. Beyond: InputError.
+  std::uint64_t max_points = kDefaultMaxPoints;
 };
 
 // The format of a cloud file by its first bytes; throws InputError for anything else.
@@ -31,7 +36,8 @@ std::uint64_t cloud_point_count(const std::string& path);
 void stream_cloud(const std::string& path, const CloudOptions& options,
                   const std::function<void(const Vec3&)>& on_point);
 
-// Reads the whole cloud.
+// Reads the whole cloud. Throws InputError when its header announces more than
+// options.max_points points, before reading them.
 PointCloud read_cloud(const std::string& path, const CloudOptions& options = {});
 
 // CRS / tile sanity: one line "cloud x a..b y c..d does not overlap <what> x e..f y g..h: wrong

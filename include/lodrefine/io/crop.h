@@ -28,9 +28,11 @@ CropTarget crop_target(const Mesh& model, double relative, double absolute);
 // to every target whose box holds it (2D grids over the targets keep this O(points), their memory O(targets)).
 // Returns the number of points read (after the class filter); `bounds` (optional) gets the
 // bounding box of every point read. `on_read` (optional) is called with the points read so far
-// every 65,536 points (for a progress line).
+// every 65,536 points (for a progress line). Throws InputError when the targets would hold more
+// than `max_held` points together.
 std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets, const CloudOptions& options = {},
-                      Eigen::AlignedBox3d* bounds = nullptr, const std::function<void(std::uint64_t)>& on_read = {});
+                      Eigen::AlignedBox3d* bounds = nullptr, const std::function<void(std::uint64_t)>& on_read = {},
+                      std::uint64_t max_held = UINT64_MAX);
 
 // The same pass for a whole city tile, with memory bounded by `buffer_points`, not by the tile:
 // each target's points go to `out_paths[i]` (a PLY, written atomically), and points held beyond

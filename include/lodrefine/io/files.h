@@ -15,6 +15,9 @@ namespace lodrefine {
 // broken file, and would overflow the integer grids of welding and hashing downstream. Every
 // reader refuses such coordinates.
 constexpr double kMaxCoordinate = 1e9;
+// The finest CityJSON transform.scale accepted (m): coordinates within kMaxCoordinate then fit
+// 64-bit integers when written back.
+constexpr double kMinScale = 1e-9;
 
 // What a file holds, judged by its first bytes (not its name): lets each reader say what a
 // file given in the wrong place is, and lets commands that take several formats pick one.
