@@ -76,13 +76,14 @@ void run(const ConvertArgs& a) {
   // Every building by name: the ones written (file <- id), then what the reader dropped or changed.
   for (std::size_t i = 0; i < chosen.size(); ++i)
     std::printf("%s <- %s\n", paths[i].filename().string().c_str(), shown_id(chosen[i]->mesh.id).c_str());
-  for (const auto& note : file.notes) std::fprintf(stderr, "lodrefine: note: %s: %s\n", path.c_str(), note.c_str());
+  for (const auto& note : file.notes)
+    std::fprintf(stderr, "lodrefine: note: %s: %s\n", escaped_line(path).c_str(), escaped_line(note).c_str());
   for (const auto& id : file.ids_without_lod2)
     std::fprintf(stderr, "lodrefine: note: %s: %s has no LoD %s geometry, skipped\n", path.c_str(),
                  shown_id(id).c_str(), a.lod.empty() ? "2.x" : a.lod.c_str());
   std::printf("%zu building(s) written to %s (%s %s%s, %s; %d object(s) without LoD %s skipped)\n", chosen.size(),
               a.out_dir.c_str(), file.format.c_str(), file.version.c_str(), file.sequence ? " sequence" : "",
-              file.crs.empty() ? "no CRS" : file.crs.c_str(), file.objects_without_lod2,
+              file.crs.empty() ? "no CRS" : escaped_line(file.crs).c_str(), file.objects_without_lod2,
               a.lod.empty() ? "2.x" : a.lod.c_str());
 }
 

@@ -117,7 +117,8 @@ void run(const CropArgs& a) {
       kept.push_back(m);
       if (model.id != m.path.stem().string()) kept.back().own_id = model.id;
     } catch (const InputError& e) {  // one broken model must not stop the tile
-      std::fprintf(stderr, "lodrefine: warning: skipping %s: %s\n", shown_id(m.id).c_str(), one_line(e.what()).c_str());
+      std::fprintf(stderr, "lodrefine: warning: skipping %s: %s\n", shown_id(m.id).c_str(),
+                   escaped_line(e.what()).c_str());
       ++skipped;
     }
   }

@@ -73,8 +73,6 @@ void add_eval_command(CLI::App& app) {
   dir->excludes(orig);
   add_gate_options(cmd, a, dir);
   add_cloud_options(cmd, a.cloud_options);
-  cmd->add_option("--max-points", a.cloud_options.max_points, "Refuse clouds with more points (a tile, not a crop)")
-      ->capture_default_str();
   add_param_options(cmd, a.params);
   cmd->callback([] {
     a.params_json = params_json(a.params);

@@ -257,8 +257,6 @@ void add_refine_command(CLI::App& app) {
                     1, 1024);
   cmd->add_flag("--quiet", args.quiet, "City file: no progress line on stderr");
   cmd->add_option("--report", args.report, "JSON report: matches, planes, candidates, MIP, timings, validation");
-  cmd->add_option("--max-points", args.cloud_options.max_points, "Refuse clouds with more points (a tile, not a crop)")
-      ->capture_default_str();
   cmd->add_option("--max-crop-points", args.max_crop_points,
                   "City file: refuse the run when the buildings' crop boxes hold more points together (each "
                   "is held in memory, 24 bytes); refine the district in parts")

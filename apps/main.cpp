@@ -67,19 +67,19 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {  // one line, like every other error (batch logs keep the last line)
-    std::fprintf(stderr, "lodrefine: error: %s (see --help)\n", app::one_line(e.what()).c_str());
+    std::fprintf(stderr, "lodrefine: error: %s (see --help)\n", escaped_line(e.what()).c_str());
     return 2;
   } catch (const InputError& e) {
-    std::fprintf(stderr, "lodrefine: error: %s\n", app::one_line(e.what()).c_str());
+    std::fprintf(stderr, "lodrefine: error: %s\n", escaped_line(e.what()).c_str());
     return 2;
   } catch (const OutOfMemory& e) {  // names the file
-    std::fprintf(stderr, "lodrefine: error: %s\n", app::one_line(e.what()).c_str());
+    std::fprintf(stderr, "lodrefine: error: %s\n", escaped_line(e.what()).c_str());
     return 3;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "lodrefine: error: out of memory\n");
     return 3;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "lodrefine: error: %s\n", app::one_line(e.what()).c_str());
+    std::fprintf(stderr, "lodrefine: error: %s\n", escaped_line(e.what()).c_str());
     return 1;
   }
   return app::exit_code();

@@ -42,6 +42,10 @@ inline void add_cloud_options(CLI::App* cmd, CloudOptions& options) {
                   "formats 0-5: 0-31, 6-10: 0-255)")
       ->delimiter(',')
       ->check(CLI::Range(0, 255));
+  cmd->add_option("--max-points", options.max_points,
+                  "The most points of one building's cloud or crop (a LAZ file of kilobytes can announce "
+                  "billions); a cloud read whole, or a crop, with more is refused")
+      ->capture_default_str();
 }
 
 }  // namespace lodrefine::app

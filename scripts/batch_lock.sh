@@ -20,6 +20,12 @@ for model in "$run"/*/coarse.obj; do
     printf 'lodrefine: error: %s: building folder %q is not a safe name ([A-Za-z0-9._-], not starting with - or .); rename it\n' "$run" "$name"
     exit 0
   fi
+  # A planted link (Y -> /elsewhere) would take the building's outputs, and the cleaning of
+  # temporaries, outside the run folder.
+  if [[ -L $run/$name ]]; then
+    printf 'lodrefine: error: %s: building folder %q is a symbolic link; the batch writes only inside the run folder\n' "$run" "$name"
+    exit 0
+  fi
 done
 # A dispatcher (parallel_batch.sh) that holds the lock itself runs make for the summary.
 if [[ -n ${LODREFINE_BATCH_LOCKED:-} ]]; then

@@ -23,6 +23,10 @@ if ! safe_name "$id"; then
   printf 'lodrefine: error: %s: building folder %q is not a safe name ([A-Za-z0-9._-], not starting with - or .)\n' "$run" "$id" >&2
   exit 2
 fi
+if [[ -L $run/$id ]]; then
+  printf 'lodrefine: error: %s: building folder %q is a symbolic link; refine writes only inside the run folder\n' "$run" "$id" >&2
+  exit 2
+fi
 bin=${LODREFINE:-}
 [[ -z $bin && -x $(dirname "$0")/../build/lodrefine ]] && bin=$(dirname "$0")/../build/lodrefine
 bin=${bin:-lodrefine}

@@ -83,7 +83,8 @@ struct Checker {
   GateVerdict& verdict;
 
   void fail(const std::string& building, const std::string& check, const std::string& figure, const std::string& text) {
-    verdict.failures.push_back({building, check, figure, (building.empty() ? "pooled: " : building + ": ") + text});
+    verdict.failures.push_back(
+        {building, check, figure, (building.empty() ? "pooled: " : escaped_line(building) + ": ") + text});
   }
 
   // A distance that grew beyond the tolerance, or is no longer measured.
@@ -239,16 +240,12 @@ RunFigures read_baseline(const std::string& text, const std::string& source) {
 }
 
 namespace {
-// Baselines and gates may come from other people: parsed as every untrusted JSON file (one line
-// on malformed text, nesting bounded: a value 100,000 arrays deep overflowed the stack).
-json parse_untrusted(const std::string& text, const std::string& source) { return json(parse_city_json(text, source)); }
-
 RunFigures parse_baseline(const std::string& text, const std::string& source) {
-  const json doc = parse_untrusted(text, source);
+  const json doc = parse_json(text, source);  // nesting bounded: 100,000 levels crashed eval
   if (!doc.is_object() || doc.value("format", json()) != "lodrefine-baseline")
     throw InputError(source + ": not a lodrefine baseline (write one with eval --dir RUN --write-baseline FILE)");
   if (doc.value("version", json()) != kBaselineVersion)
-    throw InputError(source + ": baseline version " + shown_id(doc.value("version", json()).dump()).substr(0, 40) +
+    throw InputError(source + ": baseline version " + escaped_line(doc.value("version", json()).dump().substr(0, 40)) +
                      ", this lodrefine reads " + std::to_string(kBaselineVersion) + "; write it again");
   RunFigures run;
   const json pooled = doc.value("pooled", json::object());
@@ -297,7 +294,7 @@ const std::map<std::string, std::string>& gate_names() {
 }
 
 Gates read_gates(const std::string& text, const std::string& source) {
-  const json doc = parse_untrusted(text, source);
+  const json doc = parse_json(text, source);  // nesting bounded: 100,000 levels crashed eval
   if (!doc.is_object()) throw InputError(source + ": gates must be a JSON object of gate name -> limit");
   Gates gates;
   for (const auto& [key, value] : doc.items()) {

@@ -11,6 +11,7 @@
 
 #include "lodrefine/core/geometry.h"
 #include "lodrefine/core/refine.h"
+#include "lodrefine/eval/run.h"
 #include "lodrefine/io/cloud.h"
 #include "lodrefine/io/obj.h"
 
@@ -94,9 +95,9 @@ std::vector<BuildingFiles> discover_bench(const std::string& dir) {
 BenchBuilding read_bench_building(const BuildingFiles& f) {
   BenchBuilding b;
   b.id = f.id;
-  b.coarse = read_obj(f.original);
+  b.coarse = read_eval_model(f.original);
   b.cloud = read_cloud(f.cloud);
-  if (!f.truth.empty()) b.truth = read_obj(f.truth);
+  if (!f.truth.empty()) b.truth = read_eval_model(f.truth);
   return b;
 }
 

@@ -38,7 +38,7 @@ constexpr std::size_t kFootprintFilePoints = 5000;
 json read_json_or_null(const std::string& path) {
   if (path.empty() || !fs::exists(path)) return nullptr;
   try {
-    return json(parse_city_json(read_file(path), path));
+    return parse_json(read_file(path), path);
   } catch (const InputError&) {
     return nullptr;
   }
@@ -53,26 +53,18 @@ std::optional<std::vector<int>> meta_scanned_faces(const std::string& meta_path,
   for (const auto& f : meta["scanned_truth_faces"]) {
     if (!f.is_number_integer() || f.get<long long>() < INT_MIN || f.get<long long>() > INT_MAX) {
       std::fprintf(stderr, "lodrefine: warning: %s: a scanned face is not a face index; detecting instead\n",
-                   meta_path.c_str());
+                   escaped_line(meta_path).c_str());
       return std::nullopt;
     }
     const int i = f.get<int>();
     if (i < 0 || std::size_t(i) >= truth.faces.size() || truth.faces[std::size_t(i)].sem != Semantic::Wall) {
       std::fprintf(stderr, "lodrefine: warning: %s: scanned face %d is not a wall of the truth; detecting instead\n",
-                   meta_path.c_str(), i);
+                   escaped_line(meta_path).c_str(), i);
       return std::nullopt;
     }
     faces.push_back(i);
   }
   return faces;
-}
-
-// An OBJ model within validation's size bounds: the distances' AABB tree degrades on a face of
-// thousands of collinear vertices as validation does (minutes for one building).
-Mesh read_model(const std::string& path) {
-  Mesh m = read_obj(path);
-  if (const std::string too_large = size_problem(m); !too_large.empty()) throw InputError(path + ": " + too_large);
-  return m;
 }
 
 // A missing or unreadable refined model is a failure row, never an abort.
@@ -82,7 +74,7 @@ Mesh read_refined(const std::string& path, std::string& error) {
     return {};
   }
   try {
-    return read_model(path);
+    return read_eval_model(path);
   } catch (const InputError& e) {
     error = e.what();
     return {};
@@ -90,7 +82,7 @@ Mesh read_refined(const std::string& path, std::string& error) {
 }
 
 // The reason a FAILED marker records: its first line, at most kMaxReason bytes, control
-// characters escaped; a FIFO or device is not read.
+// characters escaped (escaped_line); a FIFO or device is not read.
 std::string first_line(const std::string& path) {
   constexpr std::size_t kMaxReason = 500;
   if (!fs::is_regular_file(path)) return "failed (the FAILED marker is not a regular file)";
@@ -99,9 +91,7 @@ std::string first_line(const std::string& path) {
   in.read(line.data(), std::streamsize(line.size()));
   line.resize(std::size_t(in.gcount()));
   line = line.substr(0, line.find_first_of("\r\n"));
-  if (line.empty()) return "failed (no reason recorded)";
-  const std::string shown = shown_id(line);  // JSON-quoted: no control character reaches a terminal
-  return shown.substr(1, shown.size() - 2);
+  return line.empty() ? "failed (no reason recorded)" : escaped_line(line);
 }
 
 // Refuses a report written by a newer refine than this eval reads (absent: version 1).
@@ -163,10 +153,16 @@ std::string building_footprint_svg(const BuildingEval& e, const LocalBuilding& b
                        e.id + ": original vs refined, facade points (XY)", max_points);
 }
 
+Mesh read_eval_model(const std::string& path) {
+  Mesh m = read_obj(path);
+  if (const std::string too_large = size_problem(m); !too_large.empty()) throw InputError(path + ": " + too_large);
+  return m;
+}
+
 LocalBuilding read_local(const BuildingFiles& f, const std::optional<Vec3>& origin, std::string& refined_error,
                          const CloudOptions& cloud_options) {
   LocalBuilding b;
-  b.original = read_model(f.original);
+  b.original = read_eval_model(f.original);
   b.origin = origin ? *origin : local_origin(b.original);
   b.original = translated(std::move(b.original), -b.origin);
   b.cloud = read_cloud(f.cloud, cloud_options);
@@ -185,7 +181,7 @@ RunRow evaluate_building_files(const BuildingFiles& f, const Params& params, con
   std::optional<Mesh> truth;
   std::optional<std::vector<int>> scanned;
   if (!f.truth.empty()) {
-    truth = translated(read_model(f.truth), -row.origin);
+    truth = translated(read_eval_model(f.truth), -row.origin);
     scanned = meta_scanned_faces(f.meta, *truth);
     row.truth_faces_source = scanned ? "meta.json" : "detected";
   }
@@ -234,7 +230,8 @@ RunRow failure_row(const std::string& id, const std::string& error) {
 }
 
 std::vector<RunRow> evaluate_run(const std::string& dir, const Params& params, const std::string& svg_dir, int jobs,
-                                 PooledSeries& series, Progress::Mode progress_mode) {
+                                 PooledSeries& series, Progress::Mode progress_mode,
+                                 const CloudOptions& cloud_options) {
   const auto buildings = discover_run(dir);
   std::vector<RunRow> rows(buildings.size());
   std::size_t finished = 0, failed = 0;
@@ -244,7 +241,7 @@ std::vector<RunRow> evaluate_run(const std::string& dir, const Params& params, c
     const BuildingFiles& f = buildings[k];
     RunRow& row = rows[k];
     try {
-      row = evaluate_building_files(f, params, svg_dir);
+      row = evaluate_building_files(f, params, svg_dir, cloud_options);
     } catch (const InputError& e) {
       row = failure_row(f.id, e.what());
     }

@@ -92,7 +92,8 @@ bool apply_gate(const EvalOptions& a, const GateInputs& in, const RunFigures& ru
   if (!a.junit_out.empty()) write_file_atomic(a.junit_out, junit_xml(v, "lodrefine eval " + a.dir));
   std::fprintf(out, "\ngate: %zu building(s), %zu new, %zu pooled check(s): %s\n", v.buildings.size(),
                v.new_buildings.size(), v.pooled_checks.size(), v.failed() ? "FAILED" : "passed");
-  for (const std::string& id : v.new_buildings) std::fprintf(out, "new: %s (not in the baseline)\n", id.c_str());
+  for (const std::string& id : v.new_buildings)
+    std::fprintf(out, "new: %s (not in the baseline)\n", shown_id(id).c_str());
   for (const GateLine& l : v.failures)
     std::fprintf(out, "%s: %s\n", l.check == "baseline" ? "regression" : "breach", l.text.c_str());
   return v.failed();
@@ -124,7 +125,7 @@ void check_options(const EvalOptions& a) {
 RunRow evaluate_single(const EvalOptions& a, PooledSeries& series) {
   RunRow row = evaluate_building_files({"", a.original, a.refined, a.cloud, a.truth, a.meta, "", ""}, a.params,
                                        a.svg_dir, a.cloud_options);
-  if (!row.eval.ok()) std::fprintf(stderr, "lodrefine: warning: %s\n", row.eval.error.c_str());
+  if (!row.eval.ok()) std::fprintf(stderr, "lodrefine: warning: %s\n", escaped_line(row.eval.error).c_str());
   series.add(row.eval);
   return row;
 }
@@ -138,7 +139,9 @@ int run_eval(const EvalOptions& a, std::FILE* out) {
   if (!a.svg_dir.empty()) fs::create_directories(a.svg_dir);
   std::vector<RunRow> rows;
   PooledSeries series;
-  if (batch) rows = evaluate_run(a.dir, a.params, a.svg_dir, a.jobs, series, Progress::mode_for_stderr(a.quiet));
+  if (batch)
+    rows =
+        evaluate_run(a.dir, a.params, a.svg_dir, a.jobs, series, Progress::mode_for_stderr(a.quiet), a.cloud_options);
   else rows.push_back(evaluate_single(a, series));
   std::vector<BuildingEval> evals;
   for (const RunRow& r : rows) evals.push_back(r.eval);

@@ -452,16 +452,33 @@ bool is_cityjson_sequence(const std::string& text) {
   }
 }
 
+// nlohmann's message without its tag ("[json.exception.parse_error.101] parse error at ...").
+[[noreturn]] void refuse_json(const nlohmann::json::exception& e, const std::string& name) {
+  std::string msg = e.what();
+  const auto p = msg.find("] ");
+  if (p != std::string::npos) msg = msg.substr(p + 2);
+  throw InputError(name + ": not valid JSON: " + one_line(msg));
+}
+
 nlohmann::ordered_json parse_city_json(std::string_view text, const std::string& name) {
   ParseGuard guard(name);
   try {
     return json::parse(text, std::ref(guard));
   } catch (const json::exception& e) {
-    // "[json.exception.parse_error.101] parse error at ...": the message without its tag.
-    std::string msg = e.what();
-    const auto p = msg.find("] ");
-    if (p != std::string::npos) msg = msg.substr(p + 2);
-    throw InputError(name + ": not valid JSON: " + one_line(msg));
+    refuse_json(e, name);
+  }
+}
+
+nlohmann::json parse_json(std::string_view text, const std::string& name) {
+  using E = nlohmann::detail::parse_event_t;
+  try {
+    return nlohmann::json::parse(text, [&](int depth, E event, nlohmann::json&) {
+      if ((event == E::object_start || event == E::array_start) && depth >= kMaxJsonDepth)
+        throw InputError(name + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+      return true;
+    });
+  } catch (const nlohmann::json::exception& e) {
+    refuse_json(e, name);
   }
 }
 

@@ -169,8 +169,11 @@ std::size_t crop_tile_to_files(const std::string& tile, const std::vector<CropTa
     n = for_each_hit(
         tile, targets, options, nullptr,
         [&](std::size_t i, const Vec3& p) {
+          // Each crop is read back whole to be written: bounded as a cloud read whole is.
+          if (++counts[i] > options.max_points)
+            throw InputError(tile + ": the crop of " + shown_id(targets[i].id) + " holds more than " +
+                             std::to_string(options.max_points) + " points (--max-points)");
           held[i].push_back(p);
-          ++counts[i];
           if (++in_memory > buffer_points) flush_all();
         },
         on_read);

@@ -182,6 +182,23 @@ std::string lower(std::string s) {
 
 }  // namespace
 
+std::string escaped_line(const std::string& text) {
+  static const char* const kHex = "0123456789abcdef";
+  auto hex = [](unsigned char u) { return std::string("\\x") + kHex[u >> 4] + kHex[u & 15]; };
+  std::string out;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const auto u = static_cast<unsigned char>(text[i]);
+    const auto next = i + 1 < text.size() ? static_cast<unsigned char>(text[i + 1]) : 0;
+    if (text[i] == '\n') out += "\\n";
+    else if (text[i] == '\r') out += "\\r";
+    else if (text[i] == '\t') out += "\\t";
+    else if (u < 0x20 || u == 0x7f) out += hex(u);
+    else if (u == 0xc2 && next >= 0x80 && next <= 0x9f) out += hex(u) + hex(next), ++i;  // C1, e.g. CSI
+    else out += text[i];
+  }
+  return out;
+}
+
 std::string shown_id(const std::string& id) {
   return nlohmann::json(id).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }

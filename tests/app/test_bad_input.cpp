@@ -1536,6 +1536,7 @@ TEST(BadInputAttack, FifosAndDevicesAreNeverRead) {
   fs::create_directories(b);
   write_text(b + "/coarse.obj", valid_model());
   write_text(b + "/refined.obj", valid_model());
+  write_text(b + "/truth.obj", valid_model());  // meta.json is read beside a truth
   write_text(b + "/cloud.ply", valid_cloud());
   for (const char* name : {"meta.json", "report.json"}) ASSERT_EQ(::mkfifo((b + "/" + name).c_str(), 0600), 0);
   fs::create_symlink("/dev/zero", b + "/FAILED");
@@ -1590,6 +1591,17 @@ TEST(BadInputAttack, PointLimitsBoundEvalAndTheCityRefine) {
   const std::string m = dir + "/model.obj", c = dir + "/cloud.ply";
   const CliRun e = run_cli("eval --original " + m + " --refined " + m + " --cloud " + c + " --max-points 10", dir);
   expect_one_error_line(e, "more than --max-points 10");
+  const std::string b = dir + "/run/a";  // a run folder's clouds too
+  fs::create_directories(b);
+  for (const char* name : {"/coarse.obj", "/refined.obj"}) write_text(b + name, valid_model());
+  write_text(b + "/cloud.ply", valid_cloud());
+  const CliRun d = run_cli("eval --quiet --dir " + dir + "/run --max-points 10 --json " + dir + "/eval.json", dir);
+  EXPECT_NE(d.out.find("failed 1"), std::string::npos) << d.out << d.err;
+  EXPECT_NE(read_text(dir + "/eval.json").find("more than --max-points 10"), std::string::npos);
+  const CliRun k =
+      run_cli("crop --quiet --tile " + c + " --models " + dir + "/run --out " + dir + "/crops --max-points 10", dir);
+  expect_one_error_line(k, "holds more than 10 points (--max-points)");
+  EXPECT_FALSE(fs::exists(dir + "/crops"));
   const CliRun r = run_cli("refine --quiet --model " + dir + "/city.json --cloud " + c + " --out " + dir +
                                "/out.city.json --max-crop-points 10",
                            dir);

@@ -412,6 +412,32 @@ TEST(BatchIds, UnsafeFolderNamesAreRefusedBeforeAnythingRuns) {
   fs::remove_all(base);
 }
 
+// A building folder that is a symbolic link (planted: Y -> /elsewhere) would take the building's
+// outputs, and the batch's cleaning of temporaries, outside the run folder: refused with one
+// line before anything runs, and by refine_one.sh itself.
+TEST(BatchIds, SymlinkedBuildingFoldersAreRefusedBeforeAnythingRuns) {
+  const fs::path base = fresh_dir("batch_symlink");
+  const fs::path run = base / "run";
+  make_tile(run, 1);
+  const fs::path good = fs::directory_iterator(run)->path();
+  const fs::path outside = base / "outside";
+  fs::create_directories(outside);
+  fs::copy_file(good / "coarse.obj", outside / "coarse.obj");
+  fs::copy_file(good / "cloud.ply", outside / "cloud.ply");
+  fs::create_directory_symlink(outside, run / "Y");
+  const fs::path err = base / "err.txt";
+  EXPECT_EQ(shell("cd " + shell_quoted(base) + " && " + batch_command(run) + " > /dev/null 2> " + shell_quoted(err)),
+            2);
+  const std::string message = read_text(err);
+  EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
+  EXPECT_NE(message.find("is a symbolic link"), std::string::npos) << message;
+  EXPECT_EQ(shell(shell_quoted(kSource / "scripts" / "refine_one.sh") + " " + shell_quoted(run) + " Y 2> /dev/null"),
+            2);
+  EXPECT_EQ(std::distance(fs::directory_iterator(outside), fs::directory_iterator()), 2) << "nothing written there";
+  EXPECT_FALSE(fs::exists(good / "refined.obj")) << "nothing runs when a folder is refused";
+  fs::remove_all(base);
+}
+
 // The run folder's own name reaches make's command line from the dispatchers: "$(shell ...)"
 // in it ran the command (make expands "$" in a command-line variable).
 TEST(BatchIds, RunFolderNamedWithMakeSyntaxRunsNothing) {

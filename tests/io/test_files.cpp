@@ -217,3 +217,15 @@ TEST(IoWrite, NonRegularFilesAreRefusedAndSameFilesRecognised) {
   EXPECT_FALSE(same_file((dir / "new.obj").string(), (dir / "sub" / "new.obj").string()));
   fs::remove_all(dir);
 }
+
+// A message line quoting untrusted text: control characters escaped (C0, DEL, C1 as its UTF-8
+// bytes: U+009B is a CSI on some terminals), everything else, UTF-8 included, as it is.
+TEST(EscapedLine, ControlCharactersEscapedTextKept) {
+  EXPECT_EQ(escaped_line("a\nb\rc\td"), "a\\nb\\rc\\td");
+  EXPECT_EQ(escaped_line("x\x1b[31my\x7f"), "x\\x1b[31my\\x7f");
+  EXPECT_EQ(escaped_line("csi \xc2\x9b"
+                         "2J"),
+            "csi \\xc2\\x9b2J");
+  EXPECT_EQ(escaped_line("Größe 東京 \xc2\xa0nbsp"), "Größe 東京 \xc2\xa0nbsp");
+  EXPECT_EQ(escaped_line(std::string("nul\0end", 7)), "nul\\x00end");
+}

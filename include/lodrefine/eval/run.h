@@ -92,7 +92,13 @@ RunRow failure_row(const std::string& id, const std::string& error);
 // the run and is rethrown. Each building's per-point series go into `series` as it finishes and
 // are then dropped (memory: the bins, not the run's points); a progress line counts the
 // buildings (`progress_mode`).
+// An OBJ model to evaluate (read_obj), refused with InputError beyond validation's size bounds
+// (size_problem): the distances' AABB tree degrades on faces of thousands of collinear vertices
+// as validation does (minutes for one building).
+Mesh read_eval_model(const std::string& path);
+
 std::vector<RunRow> evaluate_run(const std::string& dir, const Params& params, const std::string& svg_dir, int jobs,
-                                 PooledSeries& series, Progress::Mode progress_mode);
+                                 PooledSeries& series, Progress::Mode progress_mode,
+                                 const CloudOptions& cloud_options = {});
 
 }  // namespace lodrefine

@@ -71,6 +71,12 @@ constexpr int kMaxJsonDepth = 256;
 // (JSON parsers silently keep one of the two).
 nlohmann::ordered_json parse_city_json(std::string_view text, const std::string& name);
 
+// Parses the JSON text of any other untrusted file (a run folder's report, a baseline, gates)
+// into plain nlohmann::json (hashed keys: ordered_json's search in order is quadratic in the keys
+// of an object), nesting bounded by kMaxJsonDepth; a key given twice keeps the last. Throws
+// InputError with one line "<name>: <fault>".
+nlohmann::json parse_json(std::string_view text, const std::string& name);
+
 // True when `text` is a CityJSONSeq: a first line holding a complete "CityJSON" object, then
 // more lines (the CityJSONFeatures).
 bool is_cityjson_sequence(const std::string& text);

@@ -37,8 +37,9 @@ std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets,
 // The same pass for a whole city tile, with memory bounded by `buffer_points`, not by the tile:
 // each target's points go to `out_paths[i]` (a PLY, written atomically), and points held beyond
 // the bound are spilled to per-target temporary files beside them. Only one target's crop is
-// in memory at a time when the PLYs are written. Returns the number of points read and sets
-// `counts[i]` to each crop's size.
+// in memory at a time when the PLYs are written, so a crop of more than options.max_points points
+// is refused (InputError). Returns the number of points read and sets `counts[i]` to each crop's
+// size.
 std::size_t crop_tile_to_files(const std::string& tile, const std::vector<CropTarget>& targets,
                                const std::vector<std::string>& out_paths, std::size_t buffer_points,
                                std::vector<std::size_t>& counts, const CloudOptions& options = {},

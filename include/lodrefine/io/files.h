@@ -133,6 +133,10 @@ inline constexpr std::size_t kMaxSafeName = 100;
 // An untrusted id for a message line: in double quotes, JSON-escaped (control characters as
 // \u00XX, invalid UTF-8 as U+FFFD), so it can neither break the line nor the terminal.
 std::string shown_id(const std::string& id);
+// Untrusted text for a message line as it is, but for its control characters (C0, DEL, C1):
+// \n, \r, \t or \xHH (a C1 character as its UTF-8 bytes), so a newline or an escape code in a
+// path, key or file's text can neither break the line nor reach the terminal.
+std::string escaped_line(const std::string& text);
 std::string safe_name(const std::string& id);
 bool is_safe_name(const std::string& name);
 
