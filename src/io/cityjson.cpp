@@ -383,6 +383,14 @@ class Reader {
   }
 };
 
+// Refuses nesting deeper than kMaxJsonDepth at an object's or array's start (every untrusted
+// JSON file: copying, writing or freeing deeper values recurses past the stack).
+void check_depth(int depth, nlohmann::detail::parse_event_t event, const std::string& name) {
+  using E = nlohmann::detail::parse_event_t;
+  if ((event == E::object_start || event == E::array_start) && depth >= kMaxJsonDepth)
+    throw InputError(name + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+}
+
 // Refuses what the DOM parser would take silently or with a raw message: nesting deeper than
 // kMaxJsonDepth, and a key given twice in one object (the parser keeps the last one: a second
 // "CityObjects" or "vertices" would replace the first without a word, a CityObjects id given
@@ -393,8 +401,7 @@ class ParseGuard {
   explicit ParseGuard(const std::string& name) : name_(name) {}
   bool operator()(int depth, nlohmann::detail::parse_event_t event, json& parsed) {
     using E = nlohmann::detail::parse_event_t;
-    if ((event == E::object_start || event == E::array_start) && depth >= kMaxJsonDepth)
-      throw InputError(name_ + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+    check_depth(depth, event, name_);
     if (event == E::object_start || event == E::array_start) open(event == E::object_start);
     else if ((event == E::object_end || event == E::array_end) && !frames_.empty()) frames_.pop_back();
     else if (event == E::key && !frames_.empty()) key(parsed.get<std::string>());
@@ -470,11 +477,9 @@ nlohmann::ordered_json parse_city_json(std::string_view text, const std::string&
 }
 
 nlohmann::json parse_json(std::string_view text, const std::string& name) {
-  using E = nlohmann::detail::parse_event_t;
   try {
-    return nlohmann::json::parse(text, [&](int depth, E event, nlohmann::json&) {
-      if ((event == E::object_start || event == E::array_start) && depth >= kMaxJsonDepth)
-        throw InputError(name + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+    return nlohmann::json::parse(text, [&](int depth, nlohmann::detail::parse_event_t event, nlohmann::json&) {
+      check_depth(depth, event, name);
       return true;
     });
   } catch (const nlohmann::json::exception& e) {

@@ -38,8 +38,8 @@ std::string size_problem(const Mesh& mesh);
 // Checks closed, 2-manifold (edges and vertices), consistently and outward oriented, planar
 // faces within `planarity_tolerance` (Params::planarity_tolerance; no default here, the
 // parameter table holds it), one component, no self-intersections (CGAL PMP on the triangulated
-// faces). Expects shared vertices. A mesh beyond size_problem's bounds is invalid unchecked. `single_component` false
-// accepts a building of several closed shells (a multi-part export).
+// faces). Expects shared vertices. A mesh beyond size_problem's bounds is invalid unchecked.
+// `single_component` false accepts a building of several closed shells (a multi-part export).
 Validation validate_mesh(const Mesh& mesh, double planarity_tolerance, bool check_self_intersections = true,
                          bool single_component = true);
 

@@ -87,16 +87,16 @@ void add_refine_record(RunRow& row, const nlohmann::json& report, const std::str
 // The row of a building whose inputs cannot be read: failed, with `error`.
 RunRow failure_row(const std::string& id, const std::string& error);
 
-// Evaluates every building of `dir` (discover_run), `jobs` at once, rows in id order, each with
-// its refine record. A building with unreadable inputs is a failed row; any other error stops
-// the run and is rethrown. Each building's per-point series go into `series` as it finishes and
-// are then dropped (memory: the bins, not the run's points); a progress line counts the
-// buildings (`progress_mode`).
 // An OBJ model to evaluate (read_obj), refused with InputError beyond validation's size bounds
 // (size_problem): the distances' AABB tree degrades on faces of thousands of collinear vertices
 // as validation does (minutes for one building).
 Mesh read_eval_model(const std::string& path);
 
+// Evaluates every building of `dir` (discover_run), `jobs` at once, rows in id order, each with
+// its refine record. A building with unreadable inputs is a failed row; any other error stops
+// the run and is rethrown. Each building's per-point series go into `series` as it finishes and
+// are then dropped (memory: the bins, not the run's points); a progress line counts the
+// buildings (`progress_mode`). Each building's cloud is read with `cloud_options` (max_points).
 std::vector<RunRow> evaluate_run(const std::string& dir, const Params& params, const std::string& svg_dir, int jobs,
                                  PooledSeries& series, Progress::Mode progress_mode,
                                  const CloudOptions& cloud_options = {});
