@@ -19,6 +19,7 @@
 #include "lodrefine/core/refine.h"
 #include "lodrefine/eval/eval.h"
 #include "lodrefine/eval/polyfit_bench.h"
+#include "lodrefine/io/files.h"
 #include "lodrefine/synth/synth.h"
 #include "options.h"
 
@@ -76,7 +77,7 @@ int for_each_building(const BenchArgs& a, Start start, Each each) {
       try {
         b = read_bench_building(f);
       } catch (const InputError& e) {
-        std::printf("  %s: skipped: %s\n", f.id.c_str(), e.what());
+        std::printf("  %s: skipped: %s\n", escaped_line(f.id).c_str(), escaped_line(e.what()).c_str());
         ++skipped;
         continue;
       }
@@ -203,7 +204,7 @@ void run(const BenchArgs& a) {
       sum_sq_before += f0 * f0 * double(ev.truth_facade_before->count);
       n_after += ev.truth_facade_after->count;
     }
-    std::printf("%-*s %7zu %6zu %5d %6d |", table.id_width, b.id.c_str(), b.cloud.points.size(),
+    std::printf("%-*s %7zu %6zu %5d %6d |", table.id_width, escaped_line(b.id).c_str(), b.cloud.points.size(),
                 t.planes ? t.planes->size() : std::size_t(0), t.selection ? t.selection->candidates : 0,
                 t.selection ? t.selection->selection.variables : 0);
     StageTable::cells(best);

@@ -9,6 +9,7 @@
 #include "lodrefine/io/citygml.h"
 #include "lodrefine/io/files.h"
 #include "lodrefine/io/obj.h"
+#include "options.h"
 
 namespace lodrefine::app {
 namespace {
@@ -79,12 +80,12 @@ void run(const ConvertArgs& a) {
   for (const auto& note : file.notes)
     std::fprintf(stderr, "lodrefine: note: %s: %s\n", escaped_line(path).c_str(), escaped_line(note).c_str());
   for (const auto& id : file.ids_without_lod2)
-    std::fprintf(stderr, "lodrefine: note: %s: %s has no LoD %s geometry, skipped\n", path.c_str(),
+    std::fprintf(stderr, "lodrefine: note: %s: %s has no LoD %s geometry, skipped\n", escaped_line(path).c_str(),
                  shown_id(id).c_str(), a.lod.empty() ? "2.x" : a.lod.c_str());
   std::printf("%zu building(s) written to %s (%s %s%s, %s; %d object(s) without LoD %s skipped)\n", chosen.size(),
-              a.out_dir.c_str(), file.format.c_str(), file.version.c_str(), file.sequence ? " sequence" : "",
-              file.crs.empty() ? "no CRS" : escaped_line(file.crs).c_str(), file.objects_without_lod2,
-              a.lod.empty() ? "2.x" : a.lod.c_str());
+              escaped_line(a.out_dir).c_str(), file.format.c_str(), escaped_line(file.version).c_str(),
+              file.sequence ? " sequence" : "", file.crs.empty() ? "no CRS" : escaped_line(file.crs).c_str(),
+              file.objects_without_lod2, a.lod.empty() ? "2.x" : a.lod.c_str());
 }
 
 }  // namespace
@@ -98,7 +99,8 @@ void add_convert_command(CLI::App& app) {
   cmd->add_option("--citygml", args.citygml, "CityGML 1.0/2.0 file (Building, BuildingPart)")
       ->check(CLI::ExistingFile)
       ->excludes(json_in);
-  cmd->add_option("--lod", args.lod, "The LoD geometry to write, e.g. 2.2 or 1.2 (default: the highest 2.x)");
+  cmd->add_option("--lod", args.lod, "The LoD geometry to write, e.g. 2.2 or 1.2 (default: the highest 2.x)")
+      ->check(lod_validator());
   cmd->add_option("--id", args.ids, "Only these CityObject ids (repeatable; default: every building)");
   cmd->add_option("--out-dir", args.out_dir,
                   "Directory for <name>.obj (created if missing; existing files are never overwritten). <name> is the "

@@ -11,6 +11,7 @@
 #include "lodrefine/core/types.h"
 #include "lodrefine/io/files.h"
 #include "lodrefine/version.h"
+#include "options.h"
 
 namespace lodrefine::app {
 int& exit_code() {
@@ -58,6 +59,7 @@ int main(int argc, char** argv) {
   app::add_params_command(app);
   app::add_bench_command(app);
   app::add_convert_command(app);
+  app::require_finite_numbers(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

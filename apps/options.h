@@ -1,12 +1,14 @@
 // Method parameters as CLI options, generated from the one table in params.h.
 #pragma once
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <thread>
 
 #include <CLI/CLI.hpp>
 
 #include "lodrefine/core/params.h"
+#include "lodrefine/io/cityjson.h"
 #include "lodrefine/io/cloud.h"
 
 namespace lodrefine::app {
@@ -46,6 +48,28 @@ inline void add_cloud_options(CLI::App* cmd, CloudOptions& options) {
                   "The most points of one building's cloud or crop (a LAZ file of kilobytes can announce "
                   "billions); a cloud read whole, or a crop, with more is refused")
       ->capture_default_str();
+}
+
+// `--lod 2.2`: the value must be an LoD as city files write it (lod_number), as is each file's.
+inline CLI::Validator lod_validator() {
+  return CLI::Validator(
+      [](std::string& s) { return lod_number(s) ? std::string() : "must be an LoD such as 2.2, not " + s; }, "LOD");
+}
+
+// Checks every floating option of `app` and its subcommands for a finite value: "nan" and "inf"
+// parse as doubles, and CLI::Range lets NaN through (no comparison with it is true), so
+// `--tolerance nan` passed every regression. Called once, after every command is declared.
+inline void require_finite_numbers(CLI::App& app) {
+  const CLI::Validator finite(
+      [](std::string& s) {
+        double v = 0;
+        if (CLI::detail::lexical_cast(s, v) && !std::isfinite(v)) return "must be a finite number, not " + s;
+        return std::string();
+      },
+      "");
+  for (CLI::Option* o : app.get_options())
+    if (o->get_type_name().rfind("FLOAT", 0) == 0) o->check(finite);
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) require_finite_numbers(*sub);
 }
 
 }  // namespace lodrefine::app

@@ -40,10 +40,23 @@ std::string metres(const std::optional<double>& v) { return v ? num(*v) + " m" :
 
 json optional_json(const std::optional<double>& v) { return v && std::isfinite(*v) ? json(*v) : json(nullptr); }
 
+// A value of the wrong kind refuses the file, naming the key and what it holds.
+[[noreturn]] void wrong_value(const std::string& where, const char* key, const char* expected, const json& v) {
+  throw InputError(where + ": \"" + key + "\" must be " + expected + ", not " +
+                   escaped_line(v.dump(-1, ' ', false, json::error_handler_t::replace).substr(0, 40)));
+}
+
 std::optional<double> optional_number(const json& j, const char* key, const std::string& where) {
   if (!j.contains(key) || j[key].is_null()) return std::nullopt;
-  if (!j[key].is_number()) throw InputError(where + ": \"" + key + "\" is not a number");
+  if (!j[key].is_number() || !std::isfinite(j[key].get<double>())) wrong_value(where, key, "a finite number", j[key]);
   return j[key].get<double>();
+}
+
+// A count (absent: 0): a non-negative integer. Read unchecked, -1 became 2^64 - 1.
+std::size_t count_field(const json& j, const char* key, const std::string& where) {
+  if (!j.contains(key)) return 0;
+  if (!j[key].is_number_unsigned()) wrong_value(where, key, "a non-negative integer", j[key]);
+  return j[key].get<std::size_t>();
 }
 
 // --- XML ---------------------------------------------------------------------------------
@@ -234,8 +247,8 @@ std::string baseline_json(const RunFigures& run) {
 RunFigures read_baseline(const std::string& text, const std::string& source) {
   try {
     return parse_baseline(text, source);
-  } catch (const json::exception& e) {  // a value of the wrong type
-    throw InputError(source + ": not a baseline this lodrefine reads: " + e.what());
+  } catch (const json::exception&) {  // every value is checked by kind; this is a last net
+    throw InputError(source + ": not a baseline this lodrefine reads (a value of the wrong kind)");
   }
 }
 
@@ -245,14 +258,18 @@ RunFigures parse_baseline(const std::string& text, const std::string& source) {
   if (!doc.is_object() || doc.value("format", json()) != "lodrefine-baseline")
     throw InputError(source + ": not a lodrefine baseline (write one with eval --dir RUN --write-baseline FILE)");
   if (doc.value("version", json()) != kBaselineVersion)
-    throw InputError(source + ": baseline version " + escaped_line(doc.value("version", json()).dump().substr(0, 40)) +
-                     ", this lodrefine reads " + std::to_string(kBaselineVersion) + "; write it again");
+    throw InputError(
+        source + ": baseline version " +
+        escaped_line(doc.value("version", json()).dump(-1, ' ', false, json::error_handler_t::replace).substr(0, 40)) +
+        ", this lodrefine reads " + std::to_string(kBaselineVersion) + "; write it again");
   RunFigures run;
   const json pooled = doc.value("pooled", json::object());
   if (!pooled.is_object()) throw InputError(source + ": \"pooled\" is not an object");
-  run.failed = pooled.value("failed", std::size_t(0));
-  run.refined = pooled.value("refined", std::size_t(0));
-  run.watertight_rate = pooled.value("watertight_rate", 0.0);
+  run.failed = count_field(pooled, "failed", source);
+  run.refined = count_field(pooled, "refined", source);
+  run.watertight_rate = optional_number(pooled, "watertight_rate", source).value_or(0.0);
+  if (run.watertight_rate < 0 || run.watertight_rate > 1)
+    wrong_value(source, "watertight_rate", "a share from 0 to 1", pooled["watertight_rate"]);
   run.c2m_rmse_original = optional_number(pooled, "c2m_rmse_original", source);
   for (const auto& [name, field] : kPooledDistances) run.*field = optional_number(pooled, name, source);
   const json buildings = doc.value("buildings", json::array());
@@ -267,7 +284,7 @@ RunFigures parse_baseline(const std::string& text, const std::string& source) {
     b.outcome = j.value("outcome", json()).is_string() ? j["outcome"].get<std::string>() : std::string("failed");
     b.reason = j.value("reason", json()).is_string() ? j["reason"].get<std::string>() : std::string();
     b.watertight = j.value("watertight", json()).is_boolean() && j["watertight"].get<bool>();
-    b.facades_moved = j.value("facades_moved", json()).is_number_unsigned() ? j["facades_moved"].get<std::size_t>() : 0;
+    b.facades_moved = count_field(j, "facades_moved", where);
     b.moved_max = optional_number(j, "moved_max", where);
     for (const auto& [name, field] : kBuildingDistances) b.*field = optional_number(j, name, where);
     run.buildings.push_back(std::move(b));

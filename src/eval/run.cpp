@@ -189,9 +189,16 @@ RunRow evaluate_building_files(const BuildingFiles& f, const Params& params, con
                                scanned ? &*scanned : nullptr);
   if (!f.id.empty()) row.eval.id = f.id;
   if (!refined_error.empty()) row.eval.error = refined_error;
-  if (!svg_dir.empty())
-    write_file_atomic((fs::path(svg_dir) / ("footprint_" + safe_name(row.eval.id) + ".svg")).string(),
-                      building_footprint_svg(row.eval, b, kFootprintFilePoints));
+  if (!svg_dir.empty()) {
+    const std::string svg = (fs::path(svg_dir) / ("footprint_" + safe_name(row.eval.id) + ".svg")).string();
+    refuse_overwrites({{"--original", f.original},
+                       {"--refined", f.refined},
+                       {"--cloud", f.cloud},
+                       {"--truth", f.truth},
+                       {"--meta", f.meta}},
+                      {{"--svg-dir", svg}});
+    write_file_atomic(svg, building_footprint_svg(row.eval, b, kFootprintFilePoints));
+  }
   return row;
 }
 

@@ -99,21 +99,31 @@ bool apply_gate(const EvalOptions& a, const GateInputs& in, const RunFigures& ru
   return v.failed();
 }
 
+// Every file the evaluation reads: the options' and, with --dir, each building's of the run.
+std::vector<FileOption> eval_inputs(const EvalOptions& a) {
+  std::vector<FileOption> in = {{"--original", a.original}, {"--refined", a.refined}, {"--cloud", a.cloud},
+                                {"--truth", a.truth},       {"--meta", a.meta},       {"--baseline", a.baseline_in},
+                                {"--gates", a.gates}};
+  if (a.dir.empty() || !fs::is_directory(a.dir)) return in;
+  for (const BuildingFiles& f : discover_run(a.dir))
+    for (const std::string* path : {&f.original, &f.refined, &f.cloud, &f.truth, &f.meta, &f.report, &f.failed})
+      in.push_back({"run's", *path});
+  return in;
+}
+
 void check_options(const EvalOptions& a) {
   a.params.validate();
-  // An output given as an input (--json r.obj --refined r.obj) replaced it without a word.
-  refuse_overwrites({{"--original", a.original},
-                     {"--refined", a.refined},
-                     {"--cloud", a.cloud},
-                     {"--truth", a.truth},
-                     {"--meta", a.meta},
-                     {"--baseline", a.baseline_in},
-                     {"--gates", a.gates}},
-                    {{"--json", a.json_out},
-                     {"--csv", a.csv_out},
-                     {"--html", a.html_out},
-                     {"--write-baseline", a.baseline_out},
-                     {"--junit", a.junit_out}});
+  // An output given as an input (--json r.obj --refined r.obj, or --json RUN/<id>/coarse.obj)
+  // replaced it without a word.
+  std::vector<FileOption> outputs = {{"--json", a.json_out},
+                                     {"--csv", a.csv_out},
+                                     {"--html", a.html_out},
+                                     {"--write-baseline", a.baseline_out},
+                                     {"--junit", a.junit_out}};
+  if (!a.svg_dir.empty())
+    for (const char* name : {"c2m_histogram.svg", "c2m_boxplot.svg"})
+      outputs.push_back({"--svg-dir", (fs::path(a.svg_dir) / name).string()});
+  refuse_overwrites(eval_inputs(a), outputs);
   if (!a.dir.empty() && !a.cloud_options.classes.empty())
     throw InputError(a.dir + ": --classes applies to --cloud; a run folder holds cropped PLY clouds");
   if (a.dir.empty() && (a.original.empty() || a.refined.empty() || a.cloud.empty()))

@@ -124,12 +124,13 @@ BuildingJob take_job(std::size_t i, std::vector<CropTarget>& targets, const std:
 }
 
 // Writes a finished job into the document (in input order: new vertices are appended).
-// `hook` (may be empty) sees the building, its outcome, result and crop; the crop is freed after.
-void apply_job(json& doc, const CityJsonTransform& tf, const CityJsonBuilding& b, BuildingJob&& job,
+// `hook` (may be empty) sees the building (`index` over the file), its outcome, result and crop;
+// the crop is freed after.
+void apply_job(json& doc, const CityJsonTransform& tf, const CityJsonBuilding& b, std::size_t index, BuildingJob&& job,
                const CityBuildingHook& hook, CityRefineSummary& sum) {
   if (!job.has_points) {
     ++sum.untouched;
-    if (hook) hook(b.mesh, nullptr, nullptr, nullptr);
+    if (hook) hook(index, b.mesh, nullptr, nullptr, nullptr);
     return;
   }
   CityBuildingOutcome& o = job.outcome;
@@ -149,7 +150,7 @@ void apply_job(json& doc, const CityJsonTransform& tf, const CityJsonBuilding& b
   obj["attributes"]["lodrefine_outcome"] = o.outcome;
   obj["attributes"]["lodrefine_reason"] = o.reason;
   obj["attributes"]["lodrefine_facades_moved"] = o.facades_moved;
-  if (hook) hook(b.mesh, &o, job.returned ? &job.result : nullptr, &job.cloud);
+  if (hook) hook(index, b.mesh, &o, job.returned ? &job.result : nullptr, &job.cloud);
   job.cloud = PointCloud();  // the crop is no longer needed: free it now
   sum.outcomes.push_back(std::move(o));
 }
@@ -216,7 +217,7 @@ void refine_document(json& doc, const CityJsonTransform& tf, const std::vector<C
       },
       [&](BuildingJob& job) { run_job(job, buildings[job.index], params); },
       [&](BuildingJob& job) {
-        apply_job(doc, tf, buildings[job.index], std::move(job), hook, sum);
+        apply_job(doc, tf, buildings[job.index], first + job.index, std::move(job), hook, sum);
         if (progress) progress(sum);
       });
 }
@@ -380,7 +381,9 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
       f(n, parse_feature(line, model_path + ": line " + std::to_string(n)));
     }
   };
+  std::unordered_set<std::string> ids;
   for_each_feature([&](int n, json&& feature) {
+    add_feature_ids(feature, ids, model_path + ": line " + std::to_string(n));
     const CityJsonFile f = read_cityjson_document(feature_document(header, std::move(feature)),
                                                   model_path + ": line " + std::to_string(n), options.lod);
     sum.buildings += int(f.buildings.size());

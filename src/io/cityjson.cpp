@@ -1,9 +1,11 @@
 // CityJSON / CityJSONSeq reader: LoD 2.x Buildings and BuildingParts as polygon soups.
 #include "lodrefine/io/cityjson.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string_view>
 #include <unordered_map>
@@ -15,6 +17,26 @@
 #include "lodrefine/io/files.h"
 
 namespace lodrefine {
+
+// strtod alone took "2.2\0<script>" as 2.2 (it stops at the NUL) and "0x2.8p0" as 2.5.
+std::optional<double> lod_number(const std::string& s) {
+  constexpr std::size_t kMaxLodText = 8;
+  if (s.empty() || s.size() > kMaxLodText || s.front() == '.' || s.back() == '.') return std::nullopt;
+  if (std::count(s.begin(), s.end(), '.') > 1) return std::nullopt;
+  for (char c : s)
+    if (c != '.' && (c < '0' || c > '9')) return std::nullopt;
+  return std::strtod(s.c_str(), nullptr);
+}
+
+void add_feature_ids(const nlohmann::ordered_json& feature, std::unordered_set<std::string>& seen,
+                     const std::string& where) {
+  const auto objects = feature.find("CityObjects");
+  if (objects == feature.end() || !objects->is_object()) return;  // the reader says what is wrong
+  for (const auto& [id, obj] : objects->items())
+    if (!seen.insert(id).second)
+      throw InputError(where + ": CityObject " + shown_id(id) + " is in an earlier feature too");
+}
+
 namespace {
 
 // ordered_json keeps the CityObjects in file order (nlohmann::json would sort them by id).
@@ -65,6 +87,7 @@ class Reader {
   std::string lod_;    // the LoD asked for ("" = the highest 2.x)
   std::string where_;  // "line N" / "object ID" context for error messages
   int degenerate_rings_ = 0, degenerate_objects_ = 0;
+  std::unordered_set<std::string> ids_;  // a sequence's CityObjects so far
 
   void finish(CityJsonFile& out) const {
     if (degenerate_rings_ > 0)
@@ -89,6 +112,7 @@ class Reader {
       const json feature = parse_city_json(line, name_ + ": " + where_);
       if (!feature.is_object() || member(feature, "type") != "CityJSONFeature")
         fail("expected a CityJSONFeature object");
+      add_feature_ids(feature, ids_, name_ + ": " + where_);
       const std::vector<Vec3> vertices = read_vertices(feature, out);
       read_objects(feature, vertices, out);
     }
@@ -154,6 +178,9 @@ class Reader {
       const json& type = member(obj, "type");
       if (!type.is_null() && !type.is_string()) fail("\"type\" is not a string");
       if (type != "Building" && type != "BuildingPart") continue;
+      // The outcome is written into a building's attributes: any other value there would be lost.
+      const json& attributes = member(obj, "attributes");
+      if (!attributes.is_null() && !attributes.is_object()) fail("\"attributes\" is not a JSON object");
       const json* geom = best_lod2(obj);
       if (geom == nullptr) {
         ++out.objects_without_lod2;
@@ -205,16 +232,16 @@ class Reader {
       if (lod.is_number()) {
         value = lod.get<double>();
       } else if (lod.is_string()) {
-        const std::string s = lod.get<std::string>();
-        char* end = nullptr;
-        value = std::strtod(s.c_str(), &end);
-        if (s.empty() || *end != '\0') fail("geometry lod \"" + one_line(s, 20) + "\" is not a number");
+        const std::optional<double> v = lod_number(lod.get<std::string>());
+        if (!v)
+          fail("geometry lod " + shown_id(lod.get<std::string>().substr(0, 20)) +
+               " is not an LoD (a decimal such as 2.2)");
+        value = *v;
       } else {
         fail("a geometry has no \"lod\"");
       }
       if (!lod_.empty()) {  // an exact LoD asked for: "2.2" matches "2.2" and 2.2
-        char* end = nullptr;
-        if (best == nullptr && std::strtod(lod_.c_str(), &end) == value && *end == '\0') best = &g;
+        if (best == nullptr && lod_number(lod_) == value) best = &g;
         continue;
       }
       if (value >= 2.0 && value < 3.0 && value > best_lod) {

@@ -187,6 +187,9 @@ void stream_records(const std::string& path, std::ifstream& in, std::uint64_t fi
     } catch (const OutOfData&) {
       fail(path, "LAZ chunk " + std::to_string(i) + " ends after " + std::to_string(done) + " of " +
                      std::to_string(h.point_count) + " points (truncated or corrupt)");
+    } catch (const Corrupt& e) {
+      fail(path, "LAZ chunk " + std::to_string(i) + " is corrupt after " + std::to_string(done) + " of " +
+                     std::to_string(h.point_count) + " points: " + e.what);
     }
   }
 }

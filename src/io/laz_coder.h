@@ -17,6 +17,11 @@ namespace lodrefine::laz {
 
 // The decoder ran past the bytes its chunk (or table) holds: the data is truncated or corrupt.
 struct OutOfData {};
+// The chunk's data codes something no LASzip encoder writes and that would cost unbounded time or
+// memory to follow; `what` says what, for the error line.
+struct Corrupt {
+  const char* what;
+};
 
 // Bytes of one chunk (or the chunk table) in memory, read front to back.
 class ByteReader {

@@ -74,10 +74,12 @@ class GpsTimeCoder {
   explicit GpsTimeCoder(bool v3 = false)
       : v3_(v3), multi_(v3 ? kMultiTotal - 1 : kMultiTotal), zero_diff_(v3 ? 5 : 6) {}
   void next(ArithmeticDecoder& dec, unsigned char* out) {
-    // A switch to another sequence is followed by that sequence's own code: a loop, as the
-    // switches could otherwise nest as deep as a corrupt stream likes.
-    while (!decode_one(dec)) {
-    }
+    // A switch to another sequence is followed by that sequence's own code. An encoder switches
+    // once, to a sequence the time fits; a corrupt stream could switch on without end, consuming
+    // no bytes.
+    int switches = 0;
+    while (!decode_one(dec))
+      if (++switches > kMaxSwitches) throw Corrupt{"GPS time switches sequence without end"};
     for (int i = 0; i < 8; ++i) out[i] = (unsigned char)(time_[last_] >> (8 * i));
   }
   std::uint64_t last() const { return time_[last_]; }
@@ -89,6 +91,7 @@ class GpsTimeCoder {
   }
 
  private:
+  static constexpr int kMaxSwitches = 3;  // a switch to each other sequence
   static constexpr int kMulti = 500, kMultiMinus = -10, kMultiUnchanged = kMulti - kMultiMinus + 1,
                        kMultiCodeFull = kMulti - kMultiMinus + 2, kMultiTotal = kMulti - kMultiMinus + 6;
 

@@ -168,7 +168,10 @@ class WavePacket14Decoder : WavePacket14State {
   Layer layer_;
 };
 
-// BYTE14: each extra byte its own layer, a difference to its last value.
+// BYTE14: each extra byte its own layer, a difference to its last value. A byte's model is made
+// when its layer first codes a change in a channel: a record may carry 65,535 extra bytes in four
+// channels, 2 KB a model, and a chunk of a few hundred KB may switch through all four. The models
+// of one chunk are bounded by kMaxByteModels.
 class Byte14Decoder {
  public:
   explicit Byte14Decoder(std::size_t n) : layers_(n) {}
@@ -183,17 +186,28 @@ class Byte14Decoder {
     const std::size_t n = layers_.size();
     std::vector<unsigned char>& last = state_.select(channel, [n] { return make(n); });
     for (std::size_t i = 0; i < n; ++i) {
-      if (layers_[i].present()) last[i] = (unsigned char)(last[i] + layers_[i]->symbol(state_.models()[i]));
+      if (layers_[i].present()) last[i] = (unsigned char)(last[i] + layers_[i]->symbol(model(i)));
       out[i] = last[i];
     }
   }
 
  private:
-  using Models = std::vector<SymbolModel>;
-  static std::unique_ptr<Models> make(std::size_t n) { return std::make_unique<Models>(n, SymbolModel(256)); }
+  // 16,384 models, 32 MB: 4,096 extra bytes changing in every channel.
+  static constexpr std::size_t kMaxByteModels = 16384;
+  using Models = std::vector<std::unique_ptr<SymbolModel>>;
+  static std::unique_ptr<Models> make(std::size_t n) { return std::make_unique<Models>(n); }
+  SymbolModel& model(std::size_t i) {
+    std::unique_ptr<SymbolModel>& m = state_.models()[i];
+    if (!m) {
+      if (++made_ > kMaxByteModels) throw Corrupt{"more than 16384 extra-byte models in one chunk"};
+      m = std::make_unique<SymbolModel>(256);
+    }
+    return *m;
+  }
 
   std::vector<Layer> layers_;
   ChannelState<std::vector<unsigned char>, Models> state_;
+  std::size_t made_ = 0;
 };
 
 // One chunk of a layered (compressor 3) file.

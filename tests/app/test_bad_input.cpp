@@ -31,6 +31,7 @@
 #include <random>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
@@ -1661,4 +1662,108 @@ TEST(BadInputAttack, ErrorsQuotingControlCharactersStayOneLine) {
     EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << r.err;
   }
   add_row("a path holding a newline and an escape code", "one error line, escaped", 2);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Third pass (issue 36): gates that waved regressions through, outputs over a run's files, a CR
+// in an outcome line.
+
+namespace {
+
+// A run folder of one building (the box, refined as itself) with its baseline written.
+std::string run_with_baseline(const std::string& dir) {
+  fs::create_directories(dir + "/run/a");
+  for (const char* name : {"/coarse.obj", "/refined.obj"}) write_text(dir + "/run/a" + name, valid_model());
+  write_text(dir + "/run/a/cloud.ply", valid_cloud());
+  const CliRun w = run_cli("eval --quiet --dir " + dir + "/run --write-baseline " + dir + "/b.json", dir);
+  EXPECT_EQ(w.exit, 0) << w.err;
+  return dir + "/b.json";
+}
+
+}  // namespace
+
+// CLI::Range lets NaN through (no comparison with it is true): `--tolerance nan` passed every
+// regression. Every floating option of every command must be finite.
+TEST(BadInputAttack, FloatingOptionsMustBeFinite) {
+  const std::string dir = temp_dir("attack_nan");
+  const std::string baseline = run_with_baseline(dir);
+  for (const std::string value : {"nan", "NaN", "inf", "-inf", "1e400"}) {
+    const CliRun r =
+        run_cli("eval --quiet --dir " + dir + "/run --baseline " + baseline + " --tolerance " + value, dir);
+    expect_one_error_line(r, "--tolerance");
+    if (value.find_first_of("nN") == 0) {
+      EXPECT_NE(r.err.find("must be a finite number"), std::string::npos) << r.err;
+    }
+  }
+  write_text(dir + "/model.obj", valid_model());
+  write_text(dir + "/cloud.ply", valid_cloud());
+  const CliRun p = run_cli("refine --model " + dir + "/model.obj --cloud " + dir + "/cloud.ply --out " + dir +
+                               "/out.obj --ransac-epsilon nan",
+                           dir);
+  expect_one_error_line(p, "--ransac-epsilon: must be a finite number, not nan");
+  EXPECT_FALSE(fs::exists(dir + "/out.obj"));
+  add_row("--tolerance nan, --ransac-epsilon nan (any floating option)", "refused in one line", p.exit);
+}
+
+// A baseline's counts are non-negative integers: -1 was read as 2^64 - 1, so a newly failed
+// building passed. A value of the wrong kind is named in our words, not the JSON library's.
+TEST(BadInputAttack, BaselineValuesOfTheWrongKindAreNamed) {
+  const std::string dir = temp_dir("attack_baseline");
+  const std::string baseline = run_with_baseline(dir);
+  const json good = json::parse(read_text(baseline));
+  const std::vector<std::tuple<std::string, json, std::string>> lies = {
+      {"failed", -1, "\"failed\" must be a non-negative integer, not -1"},
+      {"refined", -3, "\"refined\" must be a non-negative integer, not -3"},
+      {"failed", "none", "\"failed\" must be a non-negative integer, not \"none\""},
+      {"failed", 1.5, "\"failed\" must be a non-negative integer"},
+      {"watertight_rate", json::array({1}), "\"watertight_rate\" must be a finite number, not [1]"},
+      {"watertight_rate", 7, "\"watertight_rate\" must be a share from 0 to 1"},
+      {"c2m_rmse", "x", "\"c2m_rmse\" must be a finite number"}};
+  for (const auto& [key, value, says] : lies) {
+    json b = good;
+    b["pooled"][key] = value;
+    write_text(dir + "/bad.json", b.dump());
+    const CliRun r = run_cli("eval --quiet --dir " + dir + "/run --baseline " + dir + "/bad.json", dir);
+    expect_one_error_line(r, says);
+    EXPECT_EQ(r.err.find("json.exception"), std::string::npos) << r.err;
+  }
+  json b = good;
+  b["buildings"][0]["facades_moved"] = -2;
+  write_text(dir + "/bad.json", b.dump());
+  expect_one_error_line(run_cli("eval --quiet --dir " + dir + "/run --baseline " + dir + "/bad.json", dir),
+                        "building \"a\": \"facades_moved\" must be a non-negative integer");
+  add_row("baseline with \"failed\": -1, \"none\", [1] ...", "refused, naming the key", 2);
+}
+
+// No output of `eval --dir` may be a file the run reads: `--json RUN/<id>/coarse.obj` replaced
+// that building's model.
+TEST(BadInputAttack, EvalOutputsNeverReplaceTheRunsFiles) {
+  const std::string dir = temp_dir("attack_eval_run");
+  run_with_baseline(dir);
+  write_text(dir + "/run/a/report.json", "{}");
+  for (const std::string option : {"--json", "--csv", "--html", "--junit", "--write-baseline"})
+    for (const char* file : {"coarse.obj", "cloud.ply", "refined.obj", "report.json"}) {
+      const std::string target = dir + "/run/a/" + file;
+      const std::string before = read_text(target);
+      const CliRun r = run_cli("eval --quiet --dir " + dir + "/run " + option + " " + target, dir);
+      expect_one_error_line(r, option + " is the run's file; it would be overwritten");
+      EXPECT_EQ(read_text(target), before) << option << " " << file;
+    }
+  add_row("eval --dir RUN --json RUN/<id>/coarse.obj (any output)", "refused before reading", 2);
+}
+
+// An outcome line is one line whatever the model's name holds: `o ok\rFAKE: refined` printed over
+// the outcome in a terminal, and batch logs keep that line.
+TEST(BadInputAttack, OutcomeLineEscapesCarriageReturns) {
+  const std::string dir = temp_dir("attack_cr");
+  std::string model = valid_model();
+  model.replace(model.find("o bldg_0001"), 11, "o ok\rFAKE: refined (all good)");
+  write_text(dir + "/model.obj", model);
+  write_text(dir + "/cloud.ply", valid_cloud());
+  const CliRun r =
+      run_cli("refine --model " + dir + "/model.obj --cloud " + dir + "/cloud.ply --out " + dir + "/out.obj", dir);
+  EXPECT_EQ(r.exit, 0) << r.err;
+  EXPECT_EQ(r.out.find('\r'), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.rfind("ok\\rFAKE: refined (all good): ", 0), 0u) << r.out;
+  add_row("OBJ name with a CR (`o ok\\rFAKE: refined`)", "escaped in the outcome line", r.exit);
 }

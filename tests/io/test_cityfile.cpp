@@ -14,6 +14,7 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <mutex>
 #include <random>
 
 #include "lodrefine/core/geometry.h"
@@ -651,7 +652,8 @@ TEST(CityFile, JobsWriteTheSameBytesWhenSelectionsEndAtTheBudget) {
   for (int jobs : {1, 2}) {
     CityRefineOptions o;
     o.jobs = jobs;
-    o.on_building = [&](const Mesh&, const CityBuildingOutcome*, const RefineResult* r, const PointCloud*) {
+    o.on_building = [&](std::size_t, const Mesh&, const CityBuildingOutcome*, const RefineResult* r,
+                        const PointCloud*) {
       if (jobs == 1 && r != nullptr && r->trace.selection &&
           r->trace.selection->selection.status == SolveStatus::FeasibleBudget)
         ++at_budget;
@@ -726,4 +728,145 @@ TEST(CityFileSecurity, FlatAndStrayBuildingsAreKeptInvalidTheRunGoesOn) {
       << s.outcomes[2].reason;
   EXPECT_EQ(s.outcomes[2].points, 0u);
   check_city_output(in, dir + "/out.city.json", s);
+}
+
+namespace {
+
+// A CityJSONSeq of one feature per building, as cjseq writes them.
+std::string synth_sequence(const std::vector<SynthBuilding>& bs, const Vec3& translate) {
+  std::string text = synth_city({}, translate).dump() + "\n";
+  for (const auto& b : bs) {
+    const json one = synth_city({b}, translate);
+    text += json({{"type", "CityJSONFeature"},
+                  {"id", b.id},
+                  {"CityObjects", one["CityObjects"]},
+                  {"vertices", one["vertices"]}})
+                .dump() +
+            "\n";
+  }
+  return text;
+}
+
+}  // namespace
+
+// The review page of a CityJSONSeq: its features are refined on the pool and finish in any
+// order; the page lists them in file order, its map in the first building's frame, so runs with
+// any --jobs write the same bytes (the page followed whichever building finished first).
+TEST(CityFile, ReviewPageIsTheSameWhateverFinishesFirst) {
+  const std::string dir = test_dir();
+  PointCloud cloud;
+  const std::vector<SynthBuilding> bs = synth_street({BuildingType::Gable, BuildingType::LShape, BuildingType::Hip,
+                                                      BuildingType::Shed, BuildingType::TShape, BuildingType::Flat},
+                                                     71, 4000, 6, cloud);
+  write_file_atomic(dir + "/city.city.jsonl", synth_sequence(bs, Vec3(93000, 436000, 0)));
+  write_ply(dir + "/cloud.ply", cloud);
+  std::vector<std::string> pages;
+  for (const int jobs : {1, 4, 4, 3}) {
+    const std::string page = dir + "/review" + std::to_string(pages.size()) + ".html";
+    const Cli r = run_cli("refine --quiet --model " + dir + "/city.city.jsonl --cloud " + dir + "/cloud.ply --out " +
+                              dir + "/out" + std::to_string(pages.size()) + ".city.jsonl --jobs " +
+                              std::to_string(jobs) + " --html " + page,
+                          dir);
+    ASSERT_EQ(r.exit, 0) << r.err;
+    pages.push_back(cli_fixtures::slurp(page));
+    EXPECT_TRUE(pages.back() == pages.front()) << "--jobs " << jobs << " wrote another page";
+  }
+  // In file order: each id's first mention follows the previous one's.
+  std::size_t at = 0;
+  for (const auto& b : bs) {
+    const std::size_t found = pages.front().find(b.id, at);
+    ASSERT_NE(found, std::string::npos) << b.id;
+    at = found;
+  }
+}
+
+// The hook is told each building's place in the file, once for each, whatever the threads.
+TEST(CityFile, HookSeesEveryBuildingOnceWithItsIndex) {
+  const std::string dir = test_dir();
+  PointCloud cloud;
+  const std::vector<SynthBuilding> bs = synth_street(
+      {BuildingType::Gable, BuildingType::Shed, BuildingType::Hip, BuildingType::Gable}, 33, 3000, 3, cloud);
+  write_file_atomic(dir + "/city.city.jsonl", synth_sequence(bs, Vec3(93000, 436000, 0)));
+  write_ply(dir + "/cloud.ply", cloud);
+  std::mutex m;
+  std::map<std::size_t, std::string> seen;
+  CityRefineOptions o;
+  o.jobs = 3;
+  o.on_building = [&](std::size_t index, const Mesh& model, const CityBuildingOutcome*, const RefineResult*,
+                      const PointCloud*) {
+    const std::lock_guard<std::mutex> lock(m);
+    EXPECT_TRUE(seen.emplace(index, model.id).second) << index;
+  };
+  refine_city(dir + "/city.city.jsonl", dir + "/cloud.ply", dir + "/out.city.jsonl", Params{}, o);
+  ASSERT_EQ(seen.size(), bs.size());
+  for (std::size_t i = 0; i < bs.size(); ++i) EXPECT_EQ(seen[i], bs[i].id);
+}
+
+// Ids are unique in a CityJSONSeq as in a document: a second feature with an id already seen is
+// refused in one line naming both, by the reader and by the city refine (both copies were
+// refined and written).
+TEST(CityFile, SequenceWithAnIdTwiceIsRefused) {
+  const std::string dir = test_dir();
+  PointCloud cloud;
+  std::vector<SynthBuilding> bs = synth_street({BuildingType::Gable, BuildingType::Shed}, 35, 3000, 2, cloud);
+  bs[1].id = bs[0].id;
+  write_file_atomic(dir + "/city.city.jsonl", synth_sequence(bs, Vec3(93000, 436000, 0)));
+  write_ply(dir + "/cloud.ply", cloud);
+  const std::string says = "line 3: CityObject \"" + bs[0].id + "\" is in an earlier feature too";
+  try {
+    read_cityjson(dir + "/city.city.jsonl");
+    ADD_FAILURE() << "read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+  }
+  try {
+    refine_city(dir + "/city.city.jsonl", dir + "/cloud.ply", dir + "/out.city.jsonl", Params{}, {});
+    ADD_FAILURE() << "refined";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir + "/out.city.jsonl"));
+}
+
+// A building's "attributes" hold the owner's data and receive the outcome: a value that is no
+// object (CityJSON requires one) is refused rather than replaced by the outcome's object.
+TEST(CityFile, AttributesThatAreNoObjectAreRefusedNotReplaced) {
+  const std::string dir = test_dir();
+  PointCloud cloud;
+  const std::vector<SynthBuilding> bs = synth_street({BuildingType::Gable}, 37, 3000, 1, cloud);
+  json doc = synth_city(bs, Vec3(93000, 436000, 0));
+  doc["CityObjects"][bs[0].id]["attributes"] = "owner-notes: keep me";
+  write_file_atomic(dir + "/city.json", doc.dump());
+  write_ply(dir + "/cloud.ply", cloud);
+  try {
+    refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/out.city.json", Params{}, {});
+    ADD_FAILURE() << "refined";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("object " + bs[0].id + ": \"attributes\" is not a JSON object"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir + "/out.city.json"));
+}
+
+// An LoD is a plain decimal that is the whole string: strtod read "2.2\0<script>…" as 2.2 (and
+// the string went to the output) and "0x2.8p0" as 2.5.
+TEST(CityFile, LodIsAPlainDecimal) {
+  for (const std::string& bad : {std::string("2.2\0<script>", 12), std::string("0x2.8p0"), std::string("2."),
+                                 std::string(" 2.2"), std::string("2.2e0"), std::string("")}) {
+    EXPECT_FALSE(lod_number(bad)) << bad;
+    PointCloud cloud;
+    const std::vector<SynthBuilding> bs = synth_street({BuildingType::Gable}, 39, 500, 1, cloud);
+    json doc = synth_city(bs, Vec3(93000, 436000, 0));
+    doc["CityObjects"][bs[0].id]["geometry"][1]["lod"] = bad;
+    try {
+      parse_cityjson(doc.dump(), "city.json");
+      ADD_FAILURE() << "accepted lod " << bad;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("is not an LoD"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(lod_number("2.2"), 2.2);
+  EXPECT_EQ(lod_number("2"), 2.0);
+  EXPECT_EQ(lod_number("1.3"), 1.3);
 }

@@ -29,10 +29,11 @@ struct RefineResult;
 
 // Called once per building of the file when set (e.g. to collect a review page): in file order on
 // the caller's thread for a CityJSON file; for a CityJSONSeq by the thread that refines the
-// feature, so concurrently when jobs > 1 (the hook must then be thread-safe).
+// feature, so concurrently and in any order when jobs > 1 (the hook must then be thread-safe,
+// and order what it collects by `index`, the building's place among the file's buildings).
 // `outcome` and `crop` are null for a building the cloud does not reach, `result` is null unless
 // refine_building returned. All in the input frame.
-using CityBuildingHook = std::function<void(const Mesh& model, const CityBuildingOutcome* outcome,
+using CityBuildingHook = std::function<void(std::size_t index, const Mesh& model, const CityBuildingOutcome* outcome,
                                             const RefineResult* result, const PointCloud* crop)>;
 struct CityRefineSummary;
 

@@ -9,8 +9,10 @@
 // in the geometry (running over all shells), Face::sem comes from the semantics
 // (WallSurface / RoofSurface / GroundSurface, anything else -> Other).
 #pragma once
+#include <optional>
 #include <string>
 #include <string_view>
+#include <unordered_set>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -83,5 +85,15 @@ bool is_cityjson_sequence(const std::string& text);
 
 // Semantic of a CityJSON semantic surface type ("WallSurface" -> Wall, ...; others -> Other).
 Semantic semantic_from_cityjson(const std::string& type);
+
+// Adds the ids of a CityJSONSeq feature's "CityObjects" to `seen`; throws InputError "<where>:
+// CityObject <id> is in an earlier feature too" for one already there: ids are unique in a
+// sequence as in one document (--building and the review page name a building by its id).
+void add_feature_ids(const nlohmann::ordered_json& feature, std::unordered_set<std::string>& seen,
+                     const std::string& where);
+
+// An LoD as CityJSON writes it, a plain decimal that is the whole string ("2", "2.2", at most 8
+// characters); nullopt for anything else ("2.2\0…", "0x2.8p0", "2.", "").
+std::optional<double> lod_number(const std::string& text);
 
 }  // namespace lodrefine
