@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <tuple>
@@ -58,13 +59,23 @@ std::vector<Model> find_models(const fs::path& dir) {
   return found;
 }
 
-// The outputs of the kept models, refused before anything is written when one is the tile.
-void check_outputs(const std::vector<Model>& kept, const CropArgs& a) {
+// The outputs of the kept models, refused before anything is written when one is the tile or
+// another model (with --out the --models folder, `a b.obj`'s hashed folder can be where a model
+// `a_b--<hash>/coarse.obj` lies, renamed itself: its model was replaced without a word).
+void check_outputs(const std::vector<Model>& models, const std::vector<Model>& kept, const CropArgs& a) {
+  std::map<std::string, const Model*> inputs;  // by path with its folders' links resolved
+  for (const auto& m : models) inputs[fs::weakly_canonical(m.path).string()] = &m;
   for (const auto& m : kept)
-    for (const char* name : {"cloud.ply", "coarse.obj"})
-      if (same_file((fs::path(a.out) / m.folder / name).string(), a.tile))
+    for (const char* name : {"cloud.ply", "coarse.obj"}) {
+      const fs::path out = fs::path(a.out) / m.folder / name;
+      if (same_file(out.string(), a.tile))
         throw InputError(a.tile + ": the tile would be overwritten by " + shown_id(m.id) + "'s " + name +
                          "; give another --out");
+      const auto it = inputs.find((fs::weakly_canonical(out.parent_path()) / name).string());
+      if (it != inputs.end() && it->second->id != m.id)
+        throw InputError(it->second->path.string() + ": the model of " + shown_id(it->second->id) +
+                         " would be overwritten by " + shown_id(m.id) + "'s " + name + "; give another --out");
+    }
 }
 
 // A building's coarse.obj in the run folder: the model's bytes, with a `# id:` line in front when
@@ -122,7 +133,7 @@ void run(const CropArgs& a) {
       ++skipped;
     }
   }
-  check_outputs(kept, a);
+  check_outputs(models, kept, a);
   Created created;
   std::vector<std::size_t> counts;
   std::size_t n = 0;

@@ -52,6 +52,14 @@ std::optional<double> optional_number(const json& j, const char* key, const std:
   return j[key].get<double>();
 }
 
+// A text (absent or null: none): a string. Read unchecked, an outcome ["refined"] became "failed"
+// and its regressions were never flagged.
+std::optional<std::string> text_field(const json& j, const char* key, const std::string& where) {
+  if (!j.contains(key) || j[key].is_null()) return std::nullopt;
+  if (!j[key].is_string()) wrong_value(where, key, "a string", j[key]);
+  return j[key].get<std::string>();
+}
+
 // A count (absent: 0): a non-negative integer. Read unchecked, -1 became 2^64 - 1.
 std::size_t count_field(const json& j, const char* key, const std::string& where) {
   if (!j.contains(key)) return 0;
@@ -95,9 +103,11 @@ struct Checker {
   double tolerance;
   GateVerdict& verdict;
 
+  // `text` quotes outcomes and reasons of the run's reports and the baseline: escaped, as a CR
+  // and escape codes in them printed a "gate: … passed" line over the verdict.
   void fail(const std::string& building, const std::string& check, const std::string& figure, const std::string& text) {
     verdict.failures.push_back(
-        {building, check, figure, (building.empty() ? "pooled: " : escaped_line(building) + ": ") + text});
+        {building, check, figure, escaped_line((building.empty() ? "pooled: " : building + ": ") + text)});
   }
 
   // A distance that grew beyond the tolerance, or is no longer measured.
@@ -281,9 +291,11 @@ RunFigures parse_baseline(const std::string& text, const std::string& source) {
     b.id = j["id"].get<std::string>();
     if (!ids.insert(b.id).second) throw InputError(source + ": building " + shown_id(b.id) + " listed twice");
     const std::string where = source + ": building " + shown_id(b.id);
-    b.outcome = j.value("outcome", json()).is_string() ? j["outcome"].get<std::string>() : std::string("failed");
-    b.reason = j.value("reason", json()).is_string() ? j["reason"].get<std::string>() : std::string();
-    b.watertight = j.value("watertight", json()).is_boolean() && j["watertight"].get<bool>();
+    b.outcome = text_field(j, "outcome", where).value_or("failed");
+    b.reason = text_field(j, "reason", where).value_or("");
+    if (j.contains("watertight") && !j["watertight"].is_boolean())
+      wrong_value(where, "watertight", "true or false", j["watertight"]);
+    b.watertight = j.value("watertight", false);
     b.facades_moved = count_field(j, "facades_moved", where);
     b.moved_max = optional_number(j, "moved_max", where);
     for (const auto& [name, field] : kBuildingDistances) b.*field = optional_number(j, name, where);

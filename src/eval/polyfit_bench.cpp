@@ -13,6 +13,7 @@
 #include "lodrefine/core/refine.h"
 #include "lodrefine/eval/run.h"
 #include "lodrefine/io/cloud.h"
+#include "lodrefine/io/files.h"
 #include "lodrefine/io/obj.h"
 
 namespace lodrefine {
@@ -185,14 +186,15 @@ void print_comparison_header(std::FILE* out) {
 void print_comparison_row(const PolyfitComparisonRow& r, std::FILE* out) {
   const PolyfitResult& p = r.baseline;
   std::fprintf(out, "%-22s %7zu | %8.3f %-12s | %8.3f %6d %7d %6.2f %-14s | %7.1f | %-7s %-7s %-7s | %-7s %-7s %-7s\n",
-               r.id.c_str(), r.points, r.lodrefine.seconds, r.outcome.c_str(), r.polyfit.seconds, p.planes,
-               p.candidates, p.polyfit_seconds, polyfit_status_name(p.status),
+               escaped_line(r.id).c_str(), r.points, r.lodrefine.seconds, r.outcome.c_str(), r.polyfit.seconds,
+               p.planes, p.candidates, p.polyfit_seconds, polyfit_status_name(p.status),
                r.lodrefine.seconds > 0 ? r.polyfit.seconds / r.lodrefine.seconds : kNaN,
                metres(r.coarse_facade).c_str(), metres(r.lodrefine.truth_facade).c_str(),
                metres(r.polyfit.truth_facade).c_str(), metres(r.coarse_roof).c_str(),
                metres(r.lodrefine.truth_roof).c_str(), metres(r.polyfit.truth_roof).c_str());
   if (!p.closed())
-    std::fprintf(out, "  %s: PolyFit %s: %s\n", r.id.c_str(), polyfit_status_name(p.status), p.reason.c_str());
+    std::fprintf(out, "  %s: PolyFit %s: %s\n", escaped_line(r.id).c_str(), polyfit_status_name(p.status),
+                 escaped_line(p.reason).c_str());
   std::fflush(out);
 }
 

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <mutex>
 
 #include <tbb/blocked_range.h>
@@ -98,8 +99,9 @@ std::string first_line(const std::string& path) {
 void check_report_version(const json& report, const std::string& source) {
   const json version = report.value("report_version", json(1));
   if (!version.is_number_integer() || version.get<long long>() < 1 || version.get<long long>() > kRefineReportVersion)
-    throw InputError(source + ": report_version " + version.dump() + " is not one this lodrefine reads (1.." +
-                     std::to_string(kRefineReportVersion) + ")");
+    throw InputError(source + ": report_version " +
+                     escaped_line(version.dump(-1, ' ', false, json::error_handler_t::replace).substr(0, 40)) +
+                     " is not one this lodrefine reads (1.." + std::to_string(kRefineReportVersion) + ")");
 }
 
 // The moved facades of a refined building's report: its "facades", each named by its
@@ -118,7 +120,10 @@ std::vector<MovedFacade> moved_facades(const json& report) {
 // Outcome, reason, moved facades and time of a report that is a JSON object.
 void read_report(RunRow& row, const json& report) {
   row.outcome = row.refine_outcome == "refined" ? "refined" : "kept";
-  row.reason = report.value("reason", std::string());
+  const json reason = report.value("reason", json());
+  row.reason = reason.is_string() ? escaped_line(reason.get<std::string>())
+               : reason.is_null() ? std::string()
+                                  : "report.json: \"reason\" is no text";
   if (row.outcome == "refined") row.moved = moved_facades(report);  // a kept building's model moved nothing
   const json total = report.value("seconds", json::object()).value("total", json());
   if (total.is_number()) row.refine_seconds = total.get<double>();
@@ -205,10 +210,10 @@ RunRow evaluate_building_files(const BuildingFiles& f, const Params& params, con
 void add_refine_record(RunRow& row, const json& report, const std::string& failed_line, const std::string& source) {
   if (report.is_object()) check_report_version(report, source);
   const json outcome = report.is_object() ? report.value("outcome", json()) : json();
-  if (outcome.is_string()) row.refine_outcome = outcome.get<std::string>();
+  if (outcome.is_string()) row.refine_outcome = escaped_line(outcome.get<std::string>());
   if (report.is_object() && report.contains("selection") && report["selection"].is_object()) {
     const json status = report["selection"].value("status", json());
-    if (status.is_string()) row.selection = status.get<std::string>();
+    if (status.is_string()) row.selection = escaped_line(status.get<std::string>());
   }
   if (!failed_line.empty()) row.eval.error = failed_line;
   if (!row.eval.ok()) {
@@ -223,8 +228,8 @@ void add_refine_record(RunRow& row, const json& report, const std::string& faile
   }
   try {
     read_report(row, report);
-  } catch (const json::exception& e) {  // a hand-edited or foreign report: keep the row
-    row.reason = std::string("unreadable report.json: ") + e.what();
+  } catch (const json::exception&) {  // a hand-edited or foreign report: keep the row
+    row.reason = "unreadable report.json (a value of the wrong kind)";
   }
 }
 
@@ -242,7 +247,12 @@ std::vector<RunRow> evaluate_run(const std::string& dir, const Params& params, c
   const auto buildings = discover_run(dir);
   std::vector<RunRow> rows(buildings.size());
   std::size_t finished = 0, failed = 0;
-  std::mutex mutex;  // guards series, the counts and the progress line
+  // Each building's series goes into `series` in the run's order, whatever finished first: the
+  // pooled sums (floating point) are then the same bytes for any --jobs. Only those waiting for
+  // an earlier one are held.
+  std::vector<std::unique_ptr<PooledSeries>> waiting(buildings.size());
+  std::size_t merged = 0;
+  std::mutex mutex;  // guards series, waiting, the counts and the progress line
   Progress progress("eval", "buildings", buildings.size(), progress_mode);
   auto evaluate = [&](std::size_t k) {
     const BuildingFiles& f = buildings[k];
@@ -255,9 +265,15 @@ std::vector<RunRow> evaluate_run(const std::string& dir, const Params& params, c
     row.files = f;
     // Only what the table needs is kept: a city's reports in full would weigh hundreds of MB.
     add_refine_record(row, read_json_or_null(f.report), f.failed.empty() ? "" : first_line(f.failed), f.report);
-    const std::lock_guard<std::mutex> lock(mutex);
-    series.add(row.eval);
+    auto own = std::make_unique<PooledSeries>();
+    own->add(row.eval);
     drop_series(row.eval);
+    const std::lock_guard<std::mutex> lock(mutex);
+    waiting[k] = std::move(own);
+    for (; merged < waiting.size() && waiting[merged]; ++merged) {
+      series.merge(*waiting[merged]);
+      waiting[merged].reset();
+    }
     failed += !row.eval.ok();
     progress.update(++finished, std::to_string(failed) + " failed");
   };

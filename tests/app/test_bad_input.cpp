@@ -1767,3 +1767,65 @@ TEST(BadInputAttack, OutcomeLineEscapesCarriageReturns) {
   EXPECT_EQ(r.out.rfind("ok\\rFAKE: refined (all good): ", 0), 0u) << r.out;
   add_row("OBJ name with a CR (`o ok\\rFAKE: refined`)", "escaped in the outcome line", r.exit);
 }
+
+// A baseline building's outcome and watertightness of the wrong kind were read as "failed" and
+// false, so its regressions were never flagged: refused, naming the key.
+TEST(BadInputAttack, BaselineBuildingValuesOfTheWrongKindAreNamed) {
+  const std::string dir = temp_dir("attack_baseline_building");
+  const std::string baseline = run_with_baseline(dir);
+  const json good = json::parse(read_text(baseline));
+  for (const auto& [key, value, says] : std::vector<std::tuple<std::string, json, std::string>>{
+           {"outcome", json::array({"refined"}), "building \"a\": \"outcome\" must be a string, not [\"refined\"]"},
+           {"watertight", 1, "building \"a\": \"watertight\" must be true or false, not 1"},
+           {"reason", 7, "building \"a\": \"reason\" must be a string, not 7"}}) {
+    json b = good;
+    b["buildings"][0][key] = value;
+    write_text(dir + "/bad.json", b.dump());
+    expect_one_error_line(run_cli("eval --quiet --dir " + dir + "/run --baseline " + dir + "/bad.json", dir), says);
+  }
+  add_row("baseline building with \"outcome\": [\"refined\"], \"watertight\": 1", "refused, naming the key", 2);
+}
+
+// A run folder's report.json is the refine's, or anyone's: a reason of the wrong kind is a row's
+// reason in our words (the JSON library's text reached the gate lines, the CSV and the JSON); an
+// unknown report_version names it in at most 40 characters (3,000 made a 3,095-byte error line).
+TEST(BadInputAttack, RunReportsOfTheWrongKindStayOurWords) {
+  const std::string dir = temp_dir("attack_run_report");
+  run_with_baseline(dir);
+  write_text(dir + "/run/a/report.json", R"({"outcome":"kept","reason":5})");
+  const CliRun r = run_cli("eval --quiet --dir " + dir + "/run --csv " + dir + "/t.csv", dir);
+  EXPECT_EQ(r.exit, 0) << r.err;
+  EXPECT_NE(read_text(dir + "/t.csv").find("report.json: \"\"reason\"\" is no text"), std::string::npos)
+      << read_text(dir + "/t.csv");
+  write_text(dir + "/run/a/report.json", R"({"outcome":"kept","seconds":5})");
+  EXPECT_EQ(run_cli("eval --quiet --dir " + dir + "/run --csv " + dir + "/t.csv", dir).exit, 0);
+  EXPECT_NE(read_text(dir + "/t.csv").find("unreadable report.json (a value of the wrong kind)"), std::string::npos)
+      << read_text(dir + "/t.csv");
+  EXPECT_EQ(read_text(dir + "/t.csv").find("json.exception"), std::string::npos);
+  write_text(dir + "/run/a/report.json", "{\"report_version\":\"" + std::string(3000, '9') + "\"}");
+  const CliRun v = run_cli("eval --quiet --dir " + dir + "/run", dir);
+  expect_one_error_line(v, "is not one this lodrefine reads");
+  EXPECT_LT(v.err.size(), 400u) << v.err.size();
+  add_row("run folder report.json with \"reason\": 5 / a 3,000-character report_version", "our words, one short line",
+          v.exit);
+}
+
+// With --out the --models folder, the hashed folder of `a b.obj` can be where the model
+// `a_b--<hash>/coarse.obj` lies (that one then renamed): its model was replaced by the other's.
+TEST(BadInputFiles, CropNeverWritesOverAnotherModel) {
+  const std::string dir = temp_dir("crop_over_model");
+  const std::string run = dir + "/run";
+  fs::create_directories(run);
+  write_text(run + "/a b.obj", valid_model());
+  const std::string folder = safe_name("a b");
+  ASSERT_NE(folder, "a b");
+  fs::create_directories(run + "/" + folder);
+  const std::string victim = "# the other building\n" + valid_model();
+  write_text(run + "/" + folder + "/coarse.obj", victim);
+  write_text(dir + "/tile.ply", valid_cloud());
+  const CliRun r = run_cli("crop --quiet --tile " + dir + "/tile.ply --models " + run + " --out " + run, dir);
+  expect_one_error_line(r, "would be overwritten by \"a b\"'s");
+  EXPECT_EQ(read_text(run + "/" + folder + "/coarse.obj"), victim);
+  EXPECT_FALSE(fs::exists(run + "/" + folder + "/cloud.ply"));
+  add_row("crop --models R --out R where a hashed folder is another model's", "refused, nothing written", r.exit);
+}

@@ -248,3 +248,21 @@ TEST(GateFiles, DeepNestingAndControlCharactersFailInOneLine) {
   EXPECT_NE(gate.find("unknown gate"), std::string::npos) << gate;
   EXPECT_EQ(gate.find_first_of("\n\x1b"), std::string::npos) << gate;
 }
+
+// A gate line quotes outcomes and reasons from the run's reports and the baseline: their control
+// characters are escaped, as a CR and escape codes printed "gate: … passed" over the verdict.
+TEST(Gate, LinesQuotingReportsAndBaselinesStayOneLine) {
+  const RunFigures base = sample_run();
+  RunFigures run = sample_run();
+  run.buildings[2].outcome = "kept";
+  run.buildings[2].reason = "judge\r\x1b[2K\ngate: 0 building(s): passed\x1b[8m";
+  RunFigures old = base;
+  old.buildings[1].outcome = "refined\r\x1b[2Kgate: all good\n";
+  old.buildings.push_back(building("gone", "kept\rpassed", 0.01));
+  const GateVerdict v = check_run(run, &old, nullptr, 0.005);
+  ASSERT_GE(v.failures.size(), 2u);
+  for (const auto& l : v.failures) {
+    EXPECT_EQ(l.text.find_first_of("\r\n\x1b"), std::string::npos) << l.text;
+  }
+  EXPECT_EQ(texts(v).front(), "c: outcome refined -> kept (judge\\r\\x1b[2K\\ngate: 0 building(s): passed\\x1b[8m)");
+}

@@ -178,3 +178,23 @@ TEST(PolyfitBench, SummaryCountsFailuresAndPoolsOverClosedBuildings) {
   EXPECT_NEAR(s.facade_polyfit_closed, 0.03, 1e-12);
   EXPECT_NEAR(s.roof_polyfit_closed, 0.04, 1e-12);
 }
+
+// A tile's building id (a model's file name) and PolyFit's reason are printed escaped: a CR in a
+// file name printed "ALL GOOD" over the row.
+TEST(PolyfitBench, RowsEscapeIdsAndReasons) {
+  PolyfitComparisonRow row;
+  row.id = "B\r\x1b[2KALL GOOD";
+  row.outcome = "kept";
+  row.baseline.status = PolyfitStatus::TooFewPlanes;
+  row.baseline.reason = "few\rplanes";
+  std::FILE* f = std::tmpfile();
+  ASSERT_NE(f, nullptr);
+  print_comparison_row(row, f);
+  std::rewind(f);
+  std::string text;
+  for (int c; (c = std::fgetc(f)) != EOF;) text += char(c);
+  std::fclose(f);
+  EXPECT_EQ(text.find_first_of("\r\x1b"), std::string::npos) << text;
+  EXPECT_NE(text.find("B\\r\\x1b[2KALL GOOD"), std::string::npos) << text;
+  EXPECT_NE(text.find("few\\rplanes"), std::string::npos) << text;
+}

@@ -112,7 +112,10 @@ TEST(RunRecord, FailedFileMissingReportAndWrongTypes) {
   report["reason"] = 42;
   const RunRow odd = record_of(report);
   EXPECT_EQ(odd.outcome, "kept");
-  EXPECT_EQ(odd.reason.rfind("unreadable report.json: ", 0), 0u) << odd.reason;
+  EXPECT_EQ(odd.reason, "report.json: \"reason\" is no text");
+  report["reason"] = "kept";
+  report["seconds"] = 5;  // not an object: the report is unreadable, in our words
+  EXPECT_EQ(record_of(report).reason, "unreadable report.json (a value of the wrong kind)");
 }
 
 TEST(RunDiscover, BuildingFoldersSortedWithTheirOptionalFiles) {
