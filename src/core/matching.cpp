@@ -63,10 +63,13 @@ bool adjacent(const Mesh& mesh, const ModelSurface& a, const ModelSurface& b) {
   return !common.empty();
 }
 
-// How far the corner where `plane` meets the adjacent facade's scan plane lies beyond the end
-// of that facade's points (0 when the points reach it). A wall moved onto a neighbour's wall
-// across a gap leaves the adjacent facade's scan ending well short of the new corner.
-double corner_gap(const Plane& plane, const ScanPlane& adjacent_scan, const PointCloud& cloud) {
+// How far the corner where `plane` meets the adjacent facade's scan plane lies beyond both the
+// end of that facade's points and the end of its wall in the model (`adjacent_wall`: 0 when
+// either reaches it). A wall moved onto a neighbour's wall across a gap puts the new corner past
+// where the adjacent facade ends, in the scan and in the model; a scan that stops short of the
+// corner (a tree, a parked van, the range) leaves the model's corner where it was.
+double corner_gap(const Plane& plane, const ScanPlane& adjacent_scan, const PointCloud& cloud,
+                  const std::vector<Vec3>& adjacent_wall) {
   const auto [u, v] = adjacent_scan.plane.basis();
   const Vec3 dir = plane.n.cross(adjacent_scan.plane.n);
   if (dir.norm() < kMinCornerSin) return 0.0;  // not a corner (near-parallel walls)
@@ -75,11 +78,14 @@ double corner_gap(const Plane& plane, const ScanPlane& adjacent_scan, const Poin
   if (!corner) return 0.0;
   const double uc = (*corner - adjacent_scan.centroid).dot(u);
   double lo = 1e300, hi = -1e300;
-  for (int i : adjacent_scan.inliers) {
-    const double q = (cloud.points[i] - adjacent_scan.centroid).dot(u);
+  const Vec3 along = u;  // a lambda may not capture a structured binding (C++17)
+  auto extend = [&](const Vec3& p) {
+    const double q = (p - adjacent_scan.centroid).dot(along);
     lo = std::min(lo, q);
     hi = std::max(hi, q);
-  }
+  };
+  for (int i : adjacent_scan.inliers) extend(cloud.points[i]);
+  for (const Vec3& p : adjacent_wall) extend(p);
   return std::max({0.0, uc - hi, lo - uc});
 }
 
@@ -319,7 +325,10 @@ std::vector<std::vector<char>> corner_conflicts(const std::vector<Match>& matche
       if (i == j || a.scan_plane == m.scan_plane) continue;
       if (unoriented_angle_deg(surfaces[a.surface].plane.n, surfaces[m.surface].plane.n) < kMinCornerAngleDeg) continue;
       if (!adjacent(mesh, surfaces[a.surface], surfaces[m.surface])) continue;
-      if (corner_gap(planes[m.scan_plane].plane, planes[a.scan_plane], cloud) > max_gap)
+      std::vector<Vec3> wall;
+      for (int f : surfaces[a.surface].faces)
+        for (int v : mesh.faces[f].v) wall.push_back(mesh.vertices[v]);
+      if (corner_gap(planes[m.scan_plane].plane, planes[a.scan_plane], cloud, wall) > max_gap)
         conflict[i][j] = conflict[j][i] = 1;
     }
   return conflict;

@@ -458,6 +458,38 @@ std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_sta
   return {};
 }
 
+// A real building's program (thousands of columns) spends its work budget at the root: GLPK ends
+// with its warm start though a selection far better exists (found with 300 times the budget). So
+// the warm start is first improved where the scan asks for a change: each scanned plane's
+// neighbourhood (the free candidates with a corner within kEvidenceReach of its points, in plan)
+// is solved alone, every other candidate fixed at the incumbent, in turn; each such program is
+// small, and its answer is at least as good as the incumbent it started from (which GLPK holds).
+// Returns the improved incumbent and counts the neighbourhoods that changed it.
+std::vector<char> improved_by_neighbourhoods(CandidateSet& cs, const SelectionProgram& pg, const Supports& s,
+                                             const Params& prm, int& improved) {
+  std::vector<char> current = pg.warm;
+  for (const auto& pts : s.points) {
+    if (pts.empty()) continue;
+    const EvidenceReach near(pts);
+    SelectionProgram local = pg;
+    local.warm = current;
+    int free = 0;
+    for (int f = 0; f < cs.size(); ++f) {
+      if (local.fixed[f] >= 0) continue;
+      bool reached = false;
+      for (int v : cs.corners(f)) reached = reached || near.reaches(cs.vertices[v]);
+      if (!reached) local.fixed[f] = int(current[f]);
+      free += reached;
+    }
+    if (free == 0) continue;
+    if (!select_faces(cs, local, prm).ok) continue;
+    const std::vector<char> selected = selected_faces(cs);
+    if (selected != current) ++improved;
+    current = selected;
+  }
+  return current;
+}
+
 // Buildings with fewer supporting planes are cut over the whole region (every dev tile building:
 // at most 31); local sections, which bound the large ones, changed a small real building's
 // program enough to lose its refinement (RealData.ThreeDBagSeqMovedWall).
@@ -562,8 +594,10 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
   const std::vector<Vec3> swept = detail::swept_evidence(start, s, prm, kEvidenceReach);
   reach_of.insert(reach_of.end(), swept.begin(), swept.end());
   const EvidenceReach evidence(reach_of);
-  if (!warm.empty())
+  if (!warm.empty()) {
     for (int f : beyond_evidence(cs, evidence)) pg.fixed[f] = int(base[f]);
+    pg.warm = improved_by_neighbourhoods(cs, pg, s, prm, st.neighbourhoods_improved);
+  }
   std::string problem;
   for (int attempt = 0;; ++attempt) {
     st.selection = select_faces(cs, pg, prm);
@@ -594,6 +628,7 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
       for (int f = 0; f < cs.size(); ++f)
         if (selected[f] != base[f]) refused.push_back(f);
     for (int f : refused) pg.fixed[f] = int(base[f]);
+    pg.warm = base;  // agrees with what is fixed back
   }
   if (st.candidates_changed == 0) {
     // The program chose its starting shell: it is written with the start's own faces, whose

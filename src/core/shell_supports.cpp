@@ -79,6 +79,22 @@ bool steps_from_any(const Mesh& start, const Supports& s, const std::vector<Vec3
   return false;
 }
 
+// Where a scanned facade's points are the building's own along its horizontal direction: within
+// the start's span, and past one of its ends only up to where a run crossing that end stops
+// within `reach` (the facade's own corner, a wall the model has short). A run going on past the
+// reach is the facade line running into a neighbour's: the party wall between them is not in the
+// scan, so the model's end stands. A run from the end (within kRunGap of it: a bay's return
+// starts at the model's front) counts as crossing it; runs that begin farther past an end (across
+// a gap) are another building's.
+Run own_extent(const std::vector<Run>& runs, const Run& span, double reach) {
+  Run own = span;
+  for (const Run& r : runs) {
+    if (r.a <= span.b + kRunGap && r.b > span.b && r.b <= span.b + reach) own.b = std::max(own.b, r.b);
+    if (r.b >= span.a - kRunGap && r.a < span.a && r.a >= span.a - reach) own.a = std::min(own.a, r.a);
+  }
+  return own;
+}
+
 }  // namespace
 
 void add_start_planes(const Mesh& start, double planarity_tolerance, Supports& s) {
@@ -116,8 +132,9 @@ void add_start_planes(const Mesh& start, double planarity_tolerance, Supports& s
 }
 
 // The scan's facade planes near the footprint: each one's points within match_distance +
-// bbox_margin of the start's box (in the plane's own horizontal frame), when at least
-// ransac_min_points, go to the supporting plane of the start that they lie on, else to a new one.
+// bbox_margin of the start's box (in the plane's own horizontal frame) and along it within the
+// building's own extent (own_extent), when at least ransac_min_points, go to the supporting plane
+// of the start that they lie on, else to a new one.
 // A facade farther before or behind the box (up to the building's depth) counts too where it
 // continues a scanned facade of the building across a step (steps_from): a facade line stepping
 // back or forward farther than the reach.
@@ -157,12 +174,14 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
     const Vec3 u(-n.y(), n.x(), 0.0);
     Eigen::AlignedBox3d box;  // the start in (u, n, z)
     for (const auto& p : start.vertices) box.extend(Vec3(u.dot(p), n.dot(p), p.z()));
+    std::vector<Vec3> inliers;
+    for (int idx : sp.inliers) inliers.push_back(cloud.points[idx]);
+    const Run own = own_extent(runs_along(inliers, u), {box.min().x(), box.max().x()}, reach);
     std::vector<Vec3> near, beyond;
-    for (int idx : sp.inliers) {
-      const Vec3& p = cloud.points[idx];
+    for (const Vec3& p : inliers) {
       const Vec3 q(u.dot(p), n.dot(p), p.z());
       const Vec3 below = box.min() - q, above = q - box.max();
-      if (std::max({below.x(), below.z(), above.x(), above.z()}) > reach) continue;
+      if (q.x() < own.a || q.x() > own.b || std::max(below.z(), above.z()) > reach) continue;
       const double out = std::max(below.y(), above.y());  // before or behind the box
       if (out <= reach) near.push_back(p);
       else if (out <= box.sizes().y()) beyond.push_back(p);

@@ -34,8 +34,10 @@ inline bool near_vertical(const Plane& pl) { return std::abs(pl.n.z()) < std::si
 // (matching.h), largest first; a surface on none of them goes to the one nearest in angle of
 // those its vertices all lie within `planarity_tolerance` (m) of (a sliver: counted in slivers).
 void add_start_planes(const Mesh& start, double planarity_tolerance, Supports& s);
-// The scan's facade planes near the footprint (within match_distance + bbox_margin), each on the
-// supporting plane it lies on, else a new one; ransac_min_points such points at least.
+// The scan's facade planes near the footprint (within match_distance + bbox_margin, and along the
+// facade no farther past the start's ends than the facade's own corner: a facade line running on
+// into a neighbour's is the neighbour's there), each on the supporting plane it lies on, else a
+// new one; ransac_min_points such points at least.
 void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& scan, const Params& prm,
                      Supports& s);
 // Hypothesised walls across where a scanned facade's points end inside the footprint.

@@ -34,6 +34,7 @@ json selection_json(const ShellSelectionStats& st, const std::string& reason) {
             {"supporting_planes", st.supporting_planes},
             {"scan_planes_added", st.scan_planes_added},
             {"step_walls", st.step_walls},
+            {"neighbourhoods_improved", st.neighbourhoods_improved},
             {"variables", m.variables},
             {"constraints", m.constraints},
             {"fixed_candidates", m.fixed},

@@ -200,3 +200,60 @@ TEST(ShellSelection, KeepsAnUnscannedEndWallBeforeANeighboursWall) {
   EXPECT_EQ(r.stats.candidates_changed, 0);
   EXPECT_NEAR(validate_mesh(r.mesh, prm.planarity_tolerance).volume, 480.0, 1e-6);
 }
+
+// A correct building whose facade line runs on, 0.3 m forward, into its neighbour's: the party
+// wall between them is not in the scan, so the neighbour's facade past the building's end is no
+// evidence for this building. It grew a 2-3 m box along the street onto it (the points within
+// match_distance + bbox_margin past the end counted as its own).
+TEST(ShellSelection, KeepsTheModelWhereTheFacadeLineRunsOnIntoANeighbour) {
+  for (const double offset : {-0.3, 0.3}) {
+    SCOPED_TRACE("neighbour's facade " + std::to_string(offset) + " m off the line");
+    Scan s;
+    s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 10.0, 0.0, 6.0), kStep));
+    s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({10, offset, 0}, Vec3::UnitX(), 10.0, 0.0, 6.0), kStep));
+    Params prm;
+    const ShellSelection r = select_shell(box({0, 0, 0}, {10, 8, 6}), s.cloud, s.planes, prm);
+    ASSERT_TRUE(r.ok) << r.reason;
+    EXPECT_EQ(r.stats.candidates_changed, 0);
+    EXPECT_NEAR(validate_mesh(r.mesh, prm.planarity_tolerance).volume, 480.0, 1e-6);
+  }
+}
+
+// The same facade where the building itself is longer than its model (its own corner 1 m past the
+// model's end, where the scan turns): the points up to that corner are its own, and the wall is
+// extended to them.
+TEST(ShellSelection, ExtendsAFacadeToItsOwnCornerPastTheModelsEnd) {
+  Scan s;
+  s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, -0.4, 0}, Vec3::UnitX(), 11.0, 0.0, 6.0), kStep));
+  s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({11, -0.4, 0}, Vec3::UnitY(), 6.0, 0.0, 6.0), kStep));
+  Params prm;
+  const ShellSelection r = select_shell(box({0, 0, 0}, {10, 8, 6}), s.cloud, s.planes, prm);
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_GT(validate_mesh(r.mesh, prm.planarity_tolerance).volume, 480.0 + 1.0);
+}
+
+// A program its budget stops at the root keeps its warm start, though moving the walls onto
+// their scans is far better (a real building's 3,000-column program at the default budget): each
+// scanned plane's neighbourhood is solved first, alone, and the whole program starts from that.
+// Here a box whose four walls are 0.8 m out, each scanned, under a budget a quarter of the whole
+// program's root needs (one wall's neighbourhood fits it).
+TEST(ShellSelection, MovesWallsWhenTheBudgetEndsTheSearchAtTheRoot) {
+  const Mesh start = box({-0.8, -0.8, 0}, {10.8, 8.8, 6});
+  Scan s;
+  const Vec3 x = Vec3::UnitX(), y = Vec3::UnitY();
+  s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 0, 0}, x, 10.0, 0.0, 6.0), kStep));
+  s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({10, 0, 0}, y, 8.0, 0.0, 6.0), kStep));
+  s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({10, 8, 0}, -x, 10.0, 0.0, 6.0), kStep));
+  s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 8, 0}, -y, 8.0, 0.0, 6.0), kStep));
+  for (const double budget : {0.02, 0.04}) {  // the whole program's root needs 0.08
+    Params prm;
+    prm.mip_work_limit = budget;
+    const ShellSelection r = select_shell(start, s.cloud, s.planes, prm);
+    ASSERT_TRUE(r.ok) << r.reason;
+    EXPECT_EQ(r.stats.selection.status, SolveStatus::FeasibleBudget);
+    EXPECT_EQ(r.stats.neighbourhoods_improved, 4);
+    const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
+    EXPECT_TRUE(v.valid()) << v.problem;
+    EXPECT_NEAR(v.volume, 480.0, 1e-6) << "budget " << budget;  // the start: 11.6 x 9.6 x 6 = 668.16
+  }
+}

@@ -57,8 +57,9 @@ struct MatchResult {
 // front of), and those points cover match_min_overlap of the wall (the largest of the in-plane
 // boxes' IoU and the share of either box inside the other). Of the matches, each wall keeps the
 // plane with most points, walls facing away from the one the plane fits best are dropped, and
-// so are matches whose corner with an adjacent matched facade lies over corner_gap beyond that
-// facade's points. S_match = w_normal |S_normal| + w_coverage IoU.
+// so are matches whose corner with an adjacent matched facade lies over corner_gap beyond both
+// that facade's points and its wall's end in the model (a scan that stops short of the corner is
+// no conflict). S_match = w_normal |S_normal| + w_coverage IoU.
 MatchResult match_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& surfaces, const PointCloud& cloud,
                            const std::vector<ScanPlane>& planes, const MatchConfig& config);
 

@@ -49,7 +49,7 @@ namespace lodrefine {
     "matching: scan points up to this far beyond a wall's outline (in its plane) still belong to it (m)")              \
   X(double, corner_gap, 0.6, 0.0, 100.0,                                                                               \
     "a wall match is rejected if the new corner lies farther than this beyond the adjacent scanned facade's points "   \
-    "(m)")                                                                                                             \
+    "and its wall's end in the model (m)")                                                                             \
   X(double, w_normal, 0.5, 0.0, 1.0, "matching score weight of |S_normal|")                                            \
   X(double, w_coverage, 0.5, 0.0, 1.0, "matching score weight of the OBB IoU C_bbox")
 

@@ -29,15 +29,16 @@
 namespace lodrefine {
 
 struct ShellSelectionStats {
-  int supporting_planes = 0;      // of the starting shell plus the scan's
-  int scan_planes_added = 0;      // facade planes on which no wall of the starting shell lies
-  int step_walls = 0;             // hypothesised walls across where a facade's points end (no points)
-  int candidates = 0, edges = 0;  // after pruning
-  int candidates_pruned = 0;      // fixed out by the starting shell and no evidence: not in the program
-  SelectionResult selection;      // status, variables, constraints, gap, seconds, warm start
-  int faces_from_selection = 0;   // output faces (each assembled from selected candidates)
-  int candidates_changed = 0;     // selected differently from the starting shell
-  std::vector<Vec3> evidence;     // the scan points the selection used (its planes', near the footprint)
+  int supporting_planes = 0;        // of the starting shell plus the scan's
+  int scan_planes_added = 0;        // facade planes on which no wall of the starting shell lies
+  int step_walls = 0;               // hypothesised walls across where a facade's points end (no points)
+  int candidates = 0, edges = 0;    // after pruning
+  int candidates_pruned = 0;        // fixed out by the starting shell and no evidence: not in the program
+  SelectionResult selection;        // status, variables, constraints, gap, seconds, warm start
+  int faces_from_selection = 0;     // output faces (each assembled from selected candidates)
+  int candidates_changed = 0;       // selected differently from the starting shell
+  int neighbourhoods_improved = 0;  // scanned planes' neighbourhoods that improved the warm start
+  std::vector<Vec3> evidence;       // the scan points the selection used (its planes', near the footprint)
   double seconds = 0.0;
 };
 
