@@ -464,10 +464,14 @@ std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_sta
 // neighbourhood (the free candidates with a corner within kEvidenceReach of its points, in plan)
 // is solved alone, every other candidate fixed at the incumbent, in turn; each such program is
 // small, and its answer is at least as good as the incumbent it started from (which GLPK holds).
+// Together they spend one work budget, shared evenly: the selection then costs at most twice it.
 // Returns the improved incumbent and counts the neighbourhoods that changed it.
 std::vector<char> improved_by_neighbourhoods(CandidateSet& cs, const SelectionProgram& pg, const Supports& s,
                                              const Params& prm, int& improved) {
   std::vector<char> current = pg.warm;
+  const auto scanned = std::count_if(s.points.begin(), s.points.end(), [](const auto& p) { return !p.empty(); });
+  SelectionConfig share = prm;
+  share.mip_work_limit = prm.mip_work_limit / double(std::max<std::ptrdiff_t>(1, scanned));
   for (const auto& pts : s.points) {
     if (pts.empty()) continue;
     const EvidenceReach near(pts);
@@ -482,7 +486,7 @@ std::vector<char> improved_by_neighbourhoods(CandidateSet& cs, const SelectionPr
       free += reached;
     }
     if (free == 0) continue;
-    if (!select_faces(cs, local, prm).ok) continue;
+    if (!select_faces(cs, local, share).ok) continue;
     const std::vector<char> selected = selected_faces(cs);
     if (selected != current) ++improved;
     current = selected;

@@ -235,8 +235,8 @@ TEST(ShellSelection, ExtendsAFacadeToItsOwnCornerPastTheModelsEnd) {
 // A program its budget stops at the root keeps its warm start, though moving the walls onto
 // their scans is far better (a real building's 3,000-column program at the default budget): each
 // scanned plane's neighbourhood is solved first, alone, and the whole program starts from that.
-// Here a box whose four walls are 0.8 m out, each scanned, under a budget a quarter of the whole
-// program's root needs (one wall's neighbourhood fits it).
+// Here a box whose four walls are 0.8 m out, each scanned, under a budget just short of what the
+// whole program's root needs: the neighbourhoods, sharing the same budget, each solve theirs.
 TEST(ShellSelection, MovesWallsWhenTheBudgetEndsTheSearchAtTheRoot) {
   const Mesh start = box({-0.8, -0.8, 0}, {10.8, 8.8, 6});
   Scan s;
@@ -245,7 +245,7 @@ TEST(ShellSelection, MovesWallsWhenTheBudgetEndsTheSearchAtTheRoot) {
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({10, 0, 0}, y, 8.0, 0.0, 6.0), kStep));
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({10, 8, 0}, -x, 10.0, 0.0, 6.0), kStep));
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 8, 0}, -y, 8.0, 0.0, 6.0), kStep));
-  for (const double budget : {0.02, 0.04}) {  // the whole program's root needs 0.08
+  for (const double budget : {0.07, 0.075}) {  // the whole program's root needs 0.08
     Params prm;
     prm.mip_work_limit = budget;
     const ShellSelection r = select_shell(start, s.cloud, s.planes, prm);
