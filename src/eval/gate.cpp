@@ -42,8 +42,7 @@ json optional_json(const std::optional<double>& v) { return v && std::isfinite(*
 
 // A value of the wrong kind refuses the file, naming the key and what it holds.
 [[noreturn]] void wrong_value(const std::string& where, const char* key, const char* expected, const json& v) {
-  throw InputError(where + ": \"" + key + "\" must be " + expected + ", not " +
-                   escaped_line(v.dump(-1, ' ', false, json::error_handler_t::replace).substr(0, 40)));
+  throw InputError(where + ": \"" + key + "\" must be " + expected + ", not " + shown_json(v));
 }
 
 std::optional<double> optional_number(const json& j, const char* key, const std::string& where) {
@@ -268,10 +267,8 @@ RunFigures parse_baseline(const std::string& text, const std::string& source) {
   if (!doc.is_object() || doc.value("format", json()) != "lodrefine-baseline")
     throw InputError(source + ": not a lodrefine baseline (write one with eval --dir RUN --write-baseline FILE)");
   if (doc.value("version", json()) != kBaselineVersion)
-    throw InputError(
-        source + ": baseline version " +
-        escaped_line(doc.value("version", json()).dump(-1, ' ', false, json::error_handler_t::replace).substr(0, 40)) +
-        ", this lodrefine reads " + std::to_string(kBaselineVersion) + "; write it again");
+    throw InputError(source + ": baseline version " + shown_json(doc.value("version", json())) +
+                     ", this lodrefine reads " + std::to_string(kBaselineVersion) + "; write it again");
   RunFigures run;
   const json pooled = doc.value("pooled", json::object());
   if (!pooled.is_object()) throw InputError(source + ": \"pooled\" is not an object");

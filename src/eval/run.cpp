@@ -99,9 +99,8 @@ std::string first_line(const std::string& path) {
 void check_report_version(const json& report, const std::string& source) {
   const json version = report.value("report_version", json(1));
   if (!version.is_number_integer() || version.get<long long>() < 1 || version.get<long long>() > kRefineReportVersion)
-    throw InputError(source + ": report_version " +
-                     escaped_line(version.dump(-1, ' ', false, json::error_handler_t::replace).substr(0, 40)) +
-                     " is not one this lodrefine reads (1.." + std::to_string(kRefineReportVersion) + ")");
+    throw InputError(source + ": report_version " + shown_json(version) + " is not one this lodrefine reads (1.." +
+                     std::to_string(kRefineReportVersion) + ")");
 }
 
 // The moved facades of a refined building's report: its "facades", each named by its

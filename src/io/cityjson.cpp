@@ -28,6 +28,10 @@ std::optional<double> lod_number(const std::string& s) {
   return std::strtod(s.c_str(), nullptr);
 }
 
+std::string shown_json(const nlohmann::json& value) {
+  return escaped_line(value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).substr(0, 40));
+}
+
 void add_feature_ids(const nlohmann::ordered_json& feature, std::unordered_set<std::string>& seen,
                      const std::string& where) {
   const auto objects = feature.find("CityObjects");

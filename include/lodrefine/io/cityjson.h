@@ -79,6 +79,10 @@ nlohmann::ordered_json parse_city_json(std::string_view text, const std::string&
 // InputError with one line "<name>: <fault>".
 nlohmann::json parse_json(std::string_view text, const std::string& name);
 
+// A value of such a file quoted in an error line: its JSON text (bytes that are no UTF-8 as
+// U+FFFD), cut to 40 characters, control characters escaped (escaped_line).
+std::string shown_json(const nlohmann::json& value);
+
 // True when `text` is a CityJSONSeq: a first line holding a complete "CityJSON" object, then
 // more lines (the CityJSONFeatures).
 bool is_cityjson_sequence(const std::string& text);
