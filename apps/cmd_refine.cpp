@@ -29,6 +29,7 @@ struct RefineArgs {
   std::string html;           // city files only: the review page
   int jobs = default_jobs();  // city files only
   bool quiet = false;
+  bool repair_all = false;                                // city files only
   std::uint64_t max_crop_points = kDefaultMaxCropPoints;  // city files only
 };
 
@@ -93,9 +94,9 @@ void write_review(const RefineArgs& a, const CityRefineSummary& s, ReviewCollect
   // No times: the same input gives the same page (stdout and --report have them).
   char line[512];
   std::snprintf(line, sizeof line,
-                "%s: %d building(s): %d refined, %d kept, %d kept-invalid, %d untouched (no cloud "
+                "%s: %d building(s): %d refined, %d repaired, %d kept, %d kept-invalid, %d untouched (no cloud "
                 "points)\ncloud: %llu points, %llu in building crops\n",
-                s.input_format.c_str(), s.buildings, s.refined, s.kept, s.kept_invalid, s.untouched,
+                s.input_format.c_str(), s.buildings, s.refined, s.repaired, s.kept, s.kept_invalid, s.untouched,
                 (unsigned long long)s.cloud_points, (unsigned long long)s.cropped_points);
   review.summary = line;
   write_file_atomic(a.html, city_review_html(review));
@@ -124,10 +125,10 @@ void check_outputs_are_new(const RefineArgs& a) {
                     {{"--out", a.out}, {"--report", a.report}, {"--html", a.html}});
 }
 
-// "12 refined, 3 kept, 1 kept-invalid": the progress line's tally.
+// "12 refined, 2 repaired, 3 kept, 1 kept-invalid": the progress line's tally.
 std::string tally_text(const CityRefineSummary& s) {
-  return std::to_string(s.refined) + " refined, " + std::to_string(s.kept) + " kept, " +
-         std::to_string(s.kept_invalid) + " kept-invalid";
+  return std::to_string(s.refined) + " refined, " + std::to_string(s.repaired) + " repaired, " +
+         std::to_string(s.kept) + " kept, " + std::to_string(s.kept_invalid) + " kept-invalid";
 }
 
 // A city file (CityJSON, CityJSONSeq, CityGML) in: every building the cloud covers, one
@@ -139,6 +140,7 @@ void run_city(const RefineArgs& a) {
   o.cloud = a.cloud_options;
   o.max_crop_points = a.max_crop_points;
   o.jobs = a.jobs;
+  o.repair_all = a.repair_all;
   ReviewCollector review;
   if (!a.html.empty()) o.on_building = std::ref(review);
   const Progress::Mode mode = Progress::mode_for_stderr(a.quiet);
@@ -150,7 +152,7 @@ void run_city(const RefineArgs& a) {
   o.progress = [&](const CityRefineSummary& s) {
     if (crop) crop->finish();
     if (!refine) refine = std::make_unique<Progress>("refine", "buildings", std::uint64_t(s.buildings), mode);
-    refine->update(std::uint64_t(s.refined + s.kept + s.kept_invalid + s.untouched), tally_text(s));
+    refine->update(std::uint64_t(s.refined + s.repaired + s.kept + s.kept_invalid + s.untouched), tally_text(s));
   };
   const CityRefineSummary s = refine_city(a.model, a.cloud, a.out, a.params, o);
   if (crop) crop->finish();
@@ -163,6 +165,7 @@ void run_city(const RefineArgs& a) {
                         {"input", s.input_format},
                         {"buildings", s.buildings},
                         {"refined", s.refined},
+                        {"repaired", s.repaired},
                         {"kept", s.kept},
                         {"kept_invalid", s.kept_invalid},
                         {"untouched", s.untouched},
@@ -194,11 +197,11 @@ void run_city(const RefineArgs& a) {
     n_refused += n;
   }
   std::printf(
-      "%s: %d building(s), %llu cloud points (%llu in building crops): %d refined, %d kept (never worse "
-      "refused %d%s), %d kept-invalid, %d untouched (no cloud points) -> %s (read %.1f s, crop %.1f s, "
+      "%s: %d building(s), %llu cloud points (%llu in building crops): %d refined, %d repaired, %d kept (never "
+      "worse refused %d%s), %d kept-invalid, %d untouched (no cloud points) -> %s (read %.1f s, crop %.1f s, "
       "refine %.1f s, write %.1f s)\n",
       escaped_line(s.input_format).c_str(), s.buildings, (unsigned long long)s.cloud_points,
-      (unsigned long long)s.cropped_points, s.refined, s.kept, n_refused,
+      (unsigned long long)s.cropped_points, s.refined, s.repaired, s.kept, n_refused,
       refused.empty() ? "" : (": " + refused).c_str(), s.kept_invalid, s.untouched, escaped_line(a.out).c_str(),
       s.seconds_read, s.seconds_crop, s.seconds_refine, s.seconds_write);
 }
@@ -278,6 +281,10 @@ void add_refine_command(CLI::App& app) {
                     "all cores; the output is the same whatever the number)",
                     1, 1024);
   cmd->add_flag("--quiet", args.quiet, "City file: no progress line on stderr");
+  cmd->add_flag("--repair-all", args.repair_all,
+                "City file: also the buildings the cloud does not reach go through repair: each one that is no "
+                "valid solid is rebuilt on its own planes (outcome repaired) or says why not (kept-invalid); the "
+                "valid ones are kept as read. Every building then gets lodrefine_outcome");
   cmd->add_option("--report", args.report, "JSON report: matches, planes, candidates, MIP, timings, validation");
   cmd->add_option("--max-crop-points", args.max_crop_points,
                   "City file: refuse the run when the buildings' crop boxes hold more points together (each "

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 #include <set>
 
@@ -114,6 +115,16 @@ std::optional<Mesh> one_wall_at_a_time(const Mesh& start, const PointCloud& loca
   return step_mesh;
 }
 
+// What a rebuild mended, for the reason of a repaired building.
+std::string rebuild_summary(const ShellRebuild& rb) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf,
+                "shell rebuilt on its planes (%.1f m² added, %.1f m² of partitions dropped, %d "
+                "piece(s) changed)",
+                rb.area_added, rb.area_dropped, rb.candidates_changed);
+  return buf;
+}
+
 // One building's run: the result being filled, its local frame and the stage timer.
 class Run {
  public:
@@ -132,8 +143,9 @@ class Run {
   }
   // The result: `local_mesh` validated and written back in the input frame.
   RefineResult finish(Outcome outcome, const std::string& reason, const Mesh& local_mesh, bool single_shell = true) {
-    out_.outcome = outcome;
-    out_.reason = reason;
+    const bool repaired = outcome == Outcome::Kept && out_.trace.rebuild && out_.trace.rebuild->ok;
+    out_.outcome = repaired ? Outcome::Repaired : outcome;
+    out_.reason = repaired ? rebuild_summary(*out_.trace.rebuild) + "; " + reason : reason;
     RefineTrace& trace = out_.trace;
     trace.output_validation = validate_mesh(local_mesh, planarity_tolerance_, true, single_shell);
     out_.valid = trace.output_validation.valid();
@@ -154,25 +166,63 @@ class Run {
 };
 
 // Repairs the exported soup into a closed shell (`kept`). Returns the building's result when
-// it ends here: a model that cannot be made one solid is written as read (kept-invalid) with
-// the reason; several closed shells (a multi-part export) are each valid and kept whole.
-std::optional<RefineResult> repair_or_stop(const Mesh& local_model, const RepairConfig& cfg, Run& run, Mesh& kept) {
-  RepairReport rr;
-  try {
-    kept = repair_input(local_model, cfg, rr);
-  } catch (const InputError& e) {
+// it ends here: several closed shells (a multi-part export) are each valid and kept whole; a
+// soup that welding and orientation cannot make one valid solid is rebuilt on its planes
+// (rebuild_shell), and written as read (kept-invalid) with the reason when that fails too or
+// the rebuilt shell leaves the input's surfaces by more than weld_tolerance.
+std::optional<RefineResult> repair_or_stop(const Mesh& local_model, const RefineConfig& cfg, Run& run, Mesh& kept) {
+  RefineTrace& trace = run.trace();
+  if (const std::string too_large = size_problem(local_model); !too_large.empty()) {
     run.lap(RefineStage::Repair);
-    return run.finish(Outcome::KeptInvalid, e.what(), local_model);
+    return run.finish(Outcome::KeptInvalid, too_large, local_model);
   }
-  kept.id = local_model.id;
-  run.trace().repair = rr;
-  const Validation v0 = validate_mesh(kept, cfg.planarity_tolerance);
-  run.trace().input_validation = v0;
+  std::string invalid;
+  try {
+    RepairReport rr;
+    kept = repair_input(local_model, cfg, rr);
+    kept.id = local_model.id;
+    trace.repair = rr;
+    const Validation v0 = validate_mesh(kept, cfg.planarity_tolerance);
+    trace.input_validation = v0;
+    if (v0.valid()) {
+      run.lap(RefineStage::Repair);
+      return std::nullopt;
+    }
+    if (v0.components > 1 && validate_mesh(kept, cfg.planarity_tolerance, true, false).valid()) {
+      run.lap(RefineStage::Repair);
+      return run.finish(Outcome::Kept, std::to_string(v0.components) + " separate closed shells: kept whole", kept,
+                        false);
+    }
+    invalid = "the input is no valid solid: " + v0.problem;
+  } catch (const InputError& e) {
+    invalid = e.what();
+  }
+  trace.invalid_input = invalid;
+  ShellRebuild rb;
+  try {
+    rb = rebuild_shell(welded_soup(local_model, cfg.weld_tolerance), cfg);
+  } catch (const InputError& e) {
+    rb.reason = e.what();
+  }
   run.lap(RefineStage::Repair);
-  if (!v0.valid() && v0.components > 1 && validate_mesh(kept, cfg.planarity_tolerance, true, false).valid())
-    return run.finish(Outcome::Kept, std::to_string(v0.components) + " separate closed shells: kept whole", kept,
-                      false);
-  if (!v0.valid()) return run.finish(Outcome::KeptInvalid, "the input is no valid solid: " + v0.problem, local_model);
+  if (rb.ok && rb.input_to_output > cfg.weld_tolerance) {
+    rb.ok = false;
+    char buf[160];
+    if (rb.area_fins > 0.0)
+      std::snprintf(buf, sizeof buf,
+                    "%.1f m² of it is a fin (outside on both sides: no solid holds it); its shell on its planes "
+                    "leaves its faces uncovered by up to %.3f m",
+                    rb.area_fins, rb.input_to_output);
+    else
+      std::snprintf(buf, sizeof buf, "its shell on its planes leaves %.1f m² of its faces uncovered, by up to %.3f m",
+                    rb.area_uncovered, rb.input_to_output);
+    rb.reason = buf;
+  }
+  kept = std::move(rb.mesh);
+  rb.mesh = Mesh();
+  trace.rebuild = rb;
+  if (!rb.ok) return run.finish(Outcome::KeptInvalid, invalid + "; not rebuilt: " + rb.reason, local_model);
+  kept.id = local_model.id;
   return std::nullopt;
 }
 
@@ -278,6 +328,7 @@ const char* outcome_name(Outcome outcome) {
   switch (outcome) {
     case Outcome::Refined: return "refined";
     case Outcome::Kept: return "kept";
+    case Outcome::Repaired: return "repaired";
     case Outcome::KeptInvalid: return "kept-invalid";
   }
   return "?";

@@ -439,6 +439,21 @@ void drop_straight_vertices(const std::vector<Vec3>& V, std::vector<Face>& faces
   }
 }
 
+// Welds the soup, drops its degenerate and duplicate faces and splits its T-junctions: the
+// faces on shared vertices, as read otherwise.
+std::vector<Face> welded_faces(const Mesh& soup, double weld_tolerance, double gap_tolerance, std::vector<Vec3>& V,
+                               RepairReport& r) {
+  r.input_vertices = int(soup.vertices.size());
+  r.input_faces = int(soup.faces.size());
+  check_input(soup);
+  const double tol = std::max(weld_tolerance, kMinWeldTolerance);
+  const std::vector<int> cluster = weld(soup, tol, gap_tolerance, V);
+  r.welded_vertices = int(soup.vertices.size() - V.size());
+  std::vector<Face> faces = clean_faces(soup, cluster, V, tol, r);
+  r.split_t_junctions = split_t_junctions(V, faces, tol);
+  return faces;
+}
+
 }  // namespace
 
 int orient_outward(Mesh& mesh) {
@@ -447,18 +462,18 @@ int orient_outward(Mesh& mesh) {
   return int(std::count(flipped.begin(), flipped.end(), 1));
 }
 
+Mesh welded_soup(const Mesh& soup, double weld_tolerance, RepairReport* report) {
+  RepairReport r;
+  std::vector<Vec3> V;
+  std::vector<Face> faces = welded_faces(soup, weld_tolerance, weld_tolerance, V, r);
+  if (report) *report = r;
+  return compact(V, std::move(faces), soup.id);
+}
+
 Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report, double gap_tolerance) {
   RepairReport r;
-  r.input_vertices = int(soup.vertices.size());
-  r.input_faces = int(soup.faces.size());
-  check_input(soup);
-  const double tol = std::max(weld_tolerance, kMinWeldTolerance);
-
   std::vector<Vec3> V;
-  const std::vector<int> cluster = weld(soup, tol, gap_tolerance, V);
-  r.welded_vertices = int(soup.vertices.size() - V.size());
-  std::vector<Face> faces = clean_faces(soup, cluster, V, tol, r);
-  r.split_t_junctions = split_t_junctions(V, faces, tol);
+  std::vector<Face> faces = welded_faces(soup, weld_tolerance, gap_tolerance, V, r);
 
   std::vector<char> flipped(faces.size(), 0);
   orient_consistently(faces, flipped);

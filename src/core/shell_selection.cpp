@@ -420,10 +420,16 @@ std::vector<int> enclosing_changes(const CandidateSet& cs, const std::vector<cha
 // merged within kSurfaceDistance), which leaves some edges used once or thrice. Those are
 // mended by the nearest selection that closes: a small program over the candidates around each
 // such edge (kMendRings edge-rings, more while it has no solution), the others fixed, each
-// change costing its area. Empty when it cannot be mended.
+// change costing its area; with `whole_last`, at last every candidate free. Empty when it cannot
+// be mended.
 constexpr int kMendRings = 2, kMendTries = 3;
 constexpr int kRetries = 2;
-std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_start, const Params& prm) {
+struct MendScope {
+  bool whole_last = false;   // at last, every candidate free
+  double keep_weight = 1.0;  // a start candidate dropped costs this times its area, one added its area
+};
+std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_start, const Params& prm,
+                               const MendScope& scope = {}) {
   if (every_edge_used_0_or_2(cs, in_start)) return in_start;
   std::vector<char> near(cs.size(), 0);
   for (const auto& e : cs.edges) {
@@ -432,7 +438,8 @@ std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_sta
     if (n != 0 && n != 2)
       for (auto h : e) near[cs.face(h)] = 1;
   }
-  for (int attempt = 0; attempt < kMendTries; ++attempt) {
+  for (int attempt = 0; attempt < kMendTries + int(scope.whole_last); ++attempt) {
+    if (attempt == kMendTries) near.assign(near.size(), 1);
     for (int ring = 0; ring < kMendRings; ++ring) {
       std::vector<char> grown = near;
       for (const auto& e : cs.edges) {
@@ -446,7 +453,7 @@ std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_sta
     SelectionProgram pg;
     const auto area = cs.areas();
     for (int f = 0; f < cs.size(); ++f) {
-      pg.cost.push_back(in_start[f] ? -area[FaceIndex(f)] : area[FaceIndex(f)]);
+      pg.cost.push_back(in_start[f] ? -scope.keep_weight * area[FaceIndex(f)] : area[FaceIndex(f)]);
       pg.fixed.push_back(near[f] ? -1 : int(in_start[f]));
     }
     pg.sharp_cost.assign(cs.edges.size(), 0.0);
@@ -648,7 +655,135 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
   return finish("");
 }
 
+// A soup's planes are cut over the whole region up to this many candidates (a local section
+// can end a plane short of where a part closes); beyond, within kRebuildReach (m) of their own
+// faces and open or overused edges.
+constexpr int kRebuildWholeRegion = 10000;
+constexpr double kRebuildReach = 1.0;
+// A covered candidate dropped costs this times what an uncovered one added costs (per m²): a
+// missing wall is added whatever its size, and only what crosses another face is dropped.
+constexpr double kKeepCover = 10.0;
+// Spacing (m) of the samples the rebuild's distances are measured on, both ways.
+constexpr double kRebuildSampling = 0.25;
+
+void set_selected(CandidateSet& cs, const std::vector<char>& chosen) {
+  auto map = cs.mesh.add_property_map<FaceIndex, bool>("f:selected", false).first;
+  for (int f = 0; f < cs.size(); ++f) map[FaceIndex(f)] = chosen[f] != 0;
+}
+
+// The samples of a face: a grid every kRebuildSampling, and its vertices moved a hundredth of the
+// way to its centroid (inside the face, off its neighbours).
+std::vector<Vec3> face_samples(const Mesh& m, int f) {
+  std::vector<Vec3> pts = sample_faces(m, {f}, kRebuildSampling);
+  const std::vector<Vec3> corners = face_points(m, m.faces[std::size_t(f)]);
+  const Vec3 c = polygon_centroid(corners);
+  for (const Vec3& p : corners) pts.push_back(p + 0.01 * (c - p));
+  return pts;
+}
+
+// The shell's area on the soup (samples within `tolerance` of it) and beside it (added), and the
+// farthest a sample lies from it.
+void added_area(const Mesh& shell, const Mesh& soup, double tolerance, ShellRebuild& out) {
+  const MeshDistance dist(soup);
+  for (int f = 0; f < int(shell.faces.size()); ++f)
+    for (const Vec3& p : sample_faces(shell, {f}, kRebuildSampling)) {
+      const double d = dist.distance(p, false);
+      out.output_to_input = std::max(out.output_to_input, d);
+      (d <= tolerance ? out.area_kept : out.area_added) += kRebuildSampling * kRebuildSampling;
+    }
+}
+
+// The generalized winding number (Jacobson, Kavan and Sorkine-Hornung 2013) of a soup's faces
+// other than `skip` at `p`, as read (outward): about 1 inside what they enclose, 0 outside,
+// fractional near a hole.
+double winding_without(const Mesh& soup, int skip, const Vec3& p) {
+  double sum = 0.0;
+  for_each_triangle(soup, [&](const Vec3& a0, const Vec3& b0, const Vec3& c0, int f) {
+    if (f == skip) return;
+    const Vec3 a = a0 - p, b = b0 - p, c = c0 - p;
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    sum += 2.0 * std::atan2(a.dot(b.cross(c)), la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb);
+  });
+  return sum / (4.0 * kPi);
+}
+
+// A soup face's point where the rest of the soup winds more than this has the soup's volume on
+// both sides: a partition between two parts. An outer wall has it on one side only (about 1/2),
+// a fin on neither (less than kFinWinding).
+constexpr double kPartitionWinding = 0.75;
+constexpr double kFinWinding = 0.25;
+
+// The farthest a soup sample lies from the rebuilt `shell` (m), over the samples the shell must
+// cover: all but a partition between parts it joins (inside the shell, the soup's volume on both
+// sides). A fin (a face with outside on both sides: a neighbour's wall standing above the roof)
+// is no part of any solid, and an outer wall the shell swallows is no partition: either leaves
+// the soup uncovered. `skipped` gets the area (m²) of the partitions' samples farther than
+// `tolerance`; `out` the area of those it leaves uncovered, and of those a fin's.
+double uncovered(const Mesh& soup, const Mesh& shell, double tolerance, ShellRebuild& out) {
+  const MeshDistance dist(shell);
+  constexpr double kSampleArea = kRebuildSampling * kRebuildSampling;
+  double worst = 0.0;
+  for (int f = 0; f < int(soup.faces.size()); ++f)
+    for (const Vec3& p : face_samples(soup, f)) {
+      const double d = dist.distance(p, true);
+      if (std::abs(d) <= tolerance) {
+        worst = std::max(worst, std::abs(d));
+        continue;
+      }
+      const double w = winding_without(soup, f, p);
+      if (d < 0.0 && w > kPartitionWinding) {
+        out.area_dropped += kSampleArea;
+        continue;
+      }
+      worst = std::max(worst, std::abs(d));
+      out.area_uncovered += kSampleArea;
+      if (std::abs(w) < kFinWinding) out.area_fins += kSampleArea;
+    }
+  return worst;
+}
+
 }  // namespace
+
+ShellRebuild rebuild_shell(const Mesh& soup, const Params& prm) {
+  ShellRebuild out;
+  Supports s;
+  detail::add_start_planes(soup, prm.planarity_tolerance, s);
+  detail::add_hole_planes(soup, s);
+  out.planes_added = s.hole_planes;
+  const Region region = detail::building_region(soup, s);
+  std::vector<Vec3> open_ends;
+  for (const auto& [key, uses] : edge_uses(soup.faces))
+    if (uses.size() != 2) open_ends.insert(open_ends.end(), {soup.vertices[key.first], soup.vertices[key.second]});
+  CandidateSet cs = build_candidates(s.planes, region, {}, kRebuildWholeRegion);
+  if (cs.capped)
+    cs = build_candidates(s.planes, region, detail::plane_reach(soup, s, region, kRebuildReach, open_ends));
+  if (cs.capped) {
+    out.reason = "too many candidate faces (over " + std::to_string(kMaxCandidates) + " from " +
+                 std::to_string(s.planes.size()) + " planes)";
+    return out;
+  }
+  describe_candidates(cs, soup, s, prm);
+  const std::vector<char> cover = face_flags(cs, "f:in_start");
+  const std::vector<char> chosen = mended_start(cs, cover, prm, {true, kKeepCover});
+  if (chosen.empty()) {
+    out.reason = "its planes bound no closed shell";
+    return out;
+  }
+  for (int f = 0; f < cs.size(); ++f) out.candidates_changed += chosen[f] != cover[f];
+  set_selected(cs, chosen);
+  out.mesh = traced_shell(cs);
+  out.mesh.id = soup.id;
+  if (const std::string problem = shell_problem(out.mesh, prm); !problem.empty()) {
+    out.reason = "the shell on its planes is invalid: " + problem;
+    return out;
+  }
+  Mesh snapped = snapped_to_start(out.mesh, soup);
+  if (shell_problem(snapped, prm).empty()) out.mesh = std::move(snapped);
+  out.input_to_output = uncovered(soup, out.mesh, prm.weld_tolerance, out);
+  added_area(out.mesh, soup, prm.weld_tolerance, out);
+  out.ok = true;
+  return out;
+}
 
 ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
                             const Params& prm) {

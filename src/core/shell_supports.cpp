@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "lodrefine/core/matching.h"
+#include "lodrefine/core/topology.h"
 
 namespace lodrefine::detail {
 namespace {
@@ -286,6 +287,47 @@ std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const Par
 }
 
 // The region: the start and the scan evidence, in the axes of the start's largest wall.
+// A boundary edge shorter than this in plan (m) is vertical: the edges beside it give the wall.
+constexpr double kPlanEdge = 0.05;
+
+namespace {
+// Whether a supporting plane already carries the plane `pl` through `a` and `b`.
+bool carried(const Supports& s, const Plane& pl, const Vec3& a, const Vec3& b) {
+  return std::any_of(s.planes.begin(), s.planes.end(), [&](const SupportPlane& sp) {
+    return unoriented_angle_deg(sp.plane.n, pl.n) <= kSurfaceAngleDeg &&
+           std::abs(sp.plane.distance(a)) <= kSurfaceDistance && std::abs(sp.plane.distance(b)) <= kSurfaceDistance;
+  });
+}
+
+void add_plane(Supports& s, const Plane& pl, Semantic sem) {
+  s.planes.push_back({pl, sem, false, -1});
+  s.points.emplace_back();
+  ++s.hole_planes;
+}
+}  // namespace
+
+void add_hole_planes(const Mesh& soup, Supports& s) {
+  for (const auto& [key, uses] : edge_uses(soup.faces)) {
+    if (uses.size() != 1) continue;
+    const Vec3 &a = soup.vertices[key.first], &b = soup.vertices[key.second];
+    const Vec3 d(b.x() - a.x(), b.y() - a.y(), 0.0);
+    Vec3 n(-d.y(), d.x(), 0.0);  // the wall under a roof's or beside a wall's horizontal edge
+    if (d.norm() < kPlanEdge) {  // a wall's vertical edge: the wall across its end
+      const std::vector<Vec3> pts = face_points(soup, soup.faces[std::size_t(uses.front().face)]);
+      n = (b - a).cross(polygon_plane(pts).n);
+      n.z() = 0.0;
+      if (n.norm() < 1e-6) continue;
+    }
+    const Plane wall = Plane::through(a, n.normalized());
+    if (!carried(s, wall, a, b)) add_plane(s, wall, Semantic::Wall);
+  }
+  if (soup.vertices.empty()) return;
+  const Eigen::AlignedBox3d box = bounding_box(soup.vertices);
+  const Plane ground = Plane::through(box.min(), -Vec3::UnitZ());
+  if (!carried(s, ground, box.min(), Vec3(box.max().x(), box.max().y(), box.min().z())))
+    add_plane(s, ground, Semantic::Ground);
+}
+
 Region building_region(const Mesh& start, const Supports& s) {
   Vec3 n = Vec3::UnitY();
   for (const auto& sp : s.planes)  // the start's planes come in decreasing area: the first wall
@@ -306,11 +348,15 @@ Region building_region(const Mesh& start, const Supports& s) {
   return r;
 }
 
-std::vector<Region> plane_reach(const Mesh& start, const Supports& s, const Region& region, double margin) {
+std::vector<Region> plane_reach(const Mesh& start, const Supports& s, const Region& region, double margin,
+                                const std::vector<Vec3>& also) {
   std::vector<Eigen::AlignedBox3d> box(s.planes.size());  // in the region's axes
   for (std::size_t f = 0; f < start.faces.size(); ++f)
     if (s.face_plane[f] >= 0)
       for (int v : start.faces[f].v) box[s.face_plane[f]].extend(region.axes.transpose() * start.vertices[v]);
+  for (std::size_t k = 0; k < box.size(); ++k)
+    for (const auto& p : also)
+      if (std::abs(s.planes[k].plane.distance(p)) <= kSurfaceDistance) box[k].extend(region.axes.transpose() * p);
   for (std::size_t k = 0; k < s.points.size(); ++k)
     for (const auto& p : s.points[k]) box[k].extend(region.axes.transpose() * p);
   for (std::size_t k = 0; k < box.size(); ++k) {

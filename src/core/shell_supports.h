@@ -22,7 +22,8 @@ struct Supports {
   std::vector<int> face_plane;            // start face -> supporting plane
   std::vector<std::vector<Vec3>> points;  // per supporting plane: its scan points
   int added = 0;
-  int slivers = 0;  // start surfaces on a plane by the planarity tolerance alone (add_start_planes)
+  int slivers = 0;      // start surfaces on a plane by the planarity tolerance alone (add_start_planes)
+  int hole_planes = 0;  // planes no face of the start lies on (add_hole_planes)
 };
 
 // A plane whose normal is within this of horizontal is a wall's (deg): the contradiction and the
@@ -40,6 +41,10 @@ void add_start_planes(const Mesh& start, double planarity_tolerance, Supports& s
 // new one; ransac_min_points such points at least.
 void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& scan, const Params& prm,
                      Supports& s);
+// The planes a soup's holes need to close (after add_start_planes): the vertical plane through each
+// boundary edge (an edge of one face, not vertical) and the ground at the lowest vertex, each
+// unless a supporting plane carries it already. No scan points.
+void add_hole_planes(const Mesh& soup, Supports& s);
 // Hypothesised walls across where a scanned facade's points end inside the footprint.
 void add_step_walls(const Mesh& start, const Params& prm, Supports& s);
 // Where the scan-only facades that step from another scanned facade ask for a change: each point
@@ -53,6 +58,9 @@ Region building_region(const Mesh& start, const Supports& s);
 // scan points, grown by `margin` (the farthest a wall may move); a plane with neither (a
 // hypothesised wall) those of the start and the evidence within `margin` of it. A scanned wall
 // spans the region's height (a street scan sees its lower storeys only).
-std::vector<Region> plane_reach(const Mesh& start, const Supports& s, const Region& region, double margin);
+// Points of `also` reach every plane they lie on (within kSurfaceDistance): a hole's edges, the
+// plane that closes it.
+std::vector<Region> plane_reach(const Mesh& start, const Supports& s, const Region& region, double margin,
+                                const std::vector<Vec3>& also = {});
 
 }  // namespace lodrefine::detail

@@ -225,7 +225,7 @@ RunFigures parse_baseline(const std::string& text, const std::string& source);
 
 int outcome_rank(const std::string& outcome) {
   if (outcome == "refined") return 3;
-  if (outcome == "kept") return 2;
+  if (outcome == "kept" || outcome == "repaired") return 2;
   if (outcome == "kept-invalid") return 1;
   return 0;
 }

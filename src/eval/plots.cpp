@@ -408,8 +408,11 @@ std::string svg_district_map(const std::vector<MapOutline>& buildings, const std
   const double plot_h = (maxy - miny) * v.scale;
   Svg svg(width, header + plot_h + footer);
   svg.title(title);
-  const std::pair<const char*, const char*> styles[] = {
-      {"refined", kOrange}, {"kept", "#e6c229"}, {"kept-invalid", "#d62728"}, {"untouched", "#bbbbbb"}};
+  const std::pair<const char*, const char*> styles[] = {{"refined", kOrange},
+                                                        {"repaired", "#1f77b4"},
+                                                        {"kept", "#e6c229"},
+                                                        {"kept-invalid", "#d62728"},
+                                                        {"untouched", "#bbbbbb"}};
   auto colour_of = [&](const std::string& outcome) {
     for (const auto& [name, colour] : styles)
       if (outcome == name) return colour;

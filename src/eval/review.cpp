@@ -42,13 +42,13 @@ std::vector<T> thinned(const std::vector<T>& v, std::size_t cap) {
   return out;
 }
 
-// kept-invalid, kept, refined; then the worst fit after refinement first, unmeasured last.
+// kept-invalid, kept, repaired, refined; then the worst fit after refinement first, unmeasured last.
 std::vector<const CityReviewBuilding*> reached_worst_first(const CityReview& r) {
   std::vector<const CityReviewBuilding*> order;
   for (const auto& b : r.buildings)
     if (b.outcome != "untouched") order.push_back(&b);
   auto key = [](const CityReviewBuilding* b) {
-    const int rank = b->outcome == "kept-invalid" ? 0 : b->outcome == "kept" ? 1 : 2;
+    const int rank = b->outcome == "kept-invalid" ? 0 : b->outcome == "kept" ? 1 : b->outcome == "repaired" ? 2 : 3;
     return std::make_tuple(rank, -b->fit_after.value_or(-1.0), b->id);
   };
   std::stable_sort(order.begin(), order.end(), [&](auto* a, auto* b) { return key(a) < key(b); });

@@ -40,14 +40,19 @@ std::string text_member(const json& j, const char* key, const std::string& other
   return it != j.end() && it->is_string() ? it->get<std::string>() : otherwise;
 }
 
-// The outcome of one building in the three words of the report, with its reason: anything
-// refine_building does not call "refined" is kept (its original geometry stays), and a kept
+// The outcome of one building in the words of the report, with its reason: a valid refined or
+// repaired building is written; anything else is kept (its original geometry stays), and a kept
 // building whose repaired original is not valid either is kept-invalid.
 CityBuildingOutcome classify(const RefineResult& r) {
   CityBuildingOutcome o;
   if (r.refined() && r.valid) {
     o.outcome = "refined";
     o.facades_moved = int(r.trace.facades.size());
+    return o;
+  }
+  if (r.outcome == Outcome::Repaired && r.valid) {
+    o.outcome = "repaired";
+    o.reason = r.reason;
     return o;
   }
   o.outcome = (!r.valid || r.outcome == Outcome::KeptInvalid) ? "kept-invalid" : "kept";
@@ -84,7 +89,7 @@ CityJsonTransform transform_of(const json& header) {
 // and GLPK's environment are thread-local, see ARCHITECTURE.md).
 struct BuildingJob {
   std::size_t index = 0;    // in the document's buildings
-  bool has_points = false;  // or refused: either way the building gets an outcome
+  bool has_points = false;  // or refused, or every building is to be repaired: it gets an outcome
   std::string refused;      // why its crop target was refused (e.g. an absurd extent)
   PointCloud cloud;
   RefineResult result;
@@ -109,13 +114,15 @@ void run_job(BuildingJob& job, const CityJsonBuilding& b, const Params& params) 
   job.outcome.seconds = seconds_since(t0);
 }
 
-// Takes building i's crop out of the targets (npos target or no points: nothing to refine).
+// Takes building i's crop out of the targets (npos target: not asked for; no points: nothing to
+// refine, unless `repair_all`).
 BuildingJob take_job(std::size_t i, std::vector<CropTarget>& targets, const std::vector<std::size_t>& target_of,
-                     std::size_t first) {
+                     std::size_t first, bool repair_all) {
   BuildingJob job;
   job.index = i;
   const std::size_t ti = target_of[first + i];
-  if (ti == std::string::npos || (targets[ti].cloud.points.empty() && targets[ti].refused.empty())) return job;
+  if (ti == std::string::npos || (targets[ti].cloud.points.empty() && targets[ti].refused.empty() && !repair_all))
+    return job;
   job.has_points = true;
   job.refused = targets[ti].refused;
   job.cloud = std::move(targets[ti].cloud);
@@ -135,13 +142,13 @@ void apply_job(json& doc, const CityJsonTransform& tf, const CityJsonBuilding& b
   }
   CityBuildingOutcome& o = job.outcome;
   json& obj = doc["CityObjects"][b.mesh.id];
-  if (o.outcome == "refined") {
+  if (o.outcome == "refined" || o.outcome == "repaired") {
     const std::string lod = obj["geometry"][std::size_t(b.geometry_index)]["lod"].is_string()
                                 ? obj["geometry"][std::size_t(b.geometry_index)]["lod"].get<std::string>()
                                 : b.lod;
     obj["geometry"][std::size_t(b.geometry_index)] =
         cityjson_solid(job.result.mesh, lod, tf.scale, tf.translate, doc["vertices"]);
-    ++sum.refined;
+    ++(o.outcome == "refined" ? sum.refined : sum.repaired);
   } else {
     ++(o.outcome == "kept" ? sum.kept : sum.kept_invalid);
   }
@@ -193,6 +200,7 @@ void merge_into(CityRefineSummary& sum, CityRefineSummary&& part) {
   sum.refined += part.refined;
   sum.kept += part.kept;
   sum.kept_invalid += part.kept_invalid;
+  sum.repaired += part.repaired;
   sum.untouched += part.untouched;
   for (const auto& [check, n] : part.refused) sum.refused[check] += n;
   for (auto& o : part.outcomes) sum.outcomes.push_back(std::move(o));
@@ -205,15 +213,15 @@ void merge_into(CityRefineSummary& sum, CityRefineSummary&& part) {
 // empty) is called after each building with the summary so far.
 void refine_document(json& doc, const CityJsonTransform& tf, const std::vector<CityJsonBuilding>& buildings,
                      std::vector<CropTarget>& targets, const std::vector<std::size_t>& target_of, std::size_t first,
-                     const Params& params, int jobs, const CityBuildingHook& hook, CityRefineSummary& sum,
-                     const std::function<void(const CityRefineSummary&)>& progress) {
+                     bool repair_all, const Params& params, int jobs, const CityBuildingHook& hook,
+                     CityRefineSummary& sum, const std::function<void(const CityRefineSummary&)>& progress) {
   std::size_t next = 0;
   in_order_pool<BuildingJob>(
       jobs,
       [&]() -> std::shared_ptr<BuildingJob> {
         if (next == buildings.size()) return nullptr;
         const std::size_t i = next++;
-        return std::make_shared<BuildingJob>(take_job(i, targets, target_of, first));
+        return std::make_shared<BuildingJob>(take_job(i, targets, target_of, first, repair_all));
       },
       [&](BuildingJob& job) { run_job(job, buildings[job.index], params); },
       [&](BuildingJob& job) {
@@ -444,8 +452,8 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
         json feature = parse_feature(job.text, where);
         const CityJsonFile f = read_cityjson_document(feature_document(header, feature), where, options.lod);
         if (upgrade) upgrade_objects(feature["CityObjects"]);
-        refine_document(feature, tf, f.buildings, targets, target_of, job.first, params, 1, options.on_building,
-                        job.part, {});
+        refine_document(feature, tf, f.buildings, targets, target_of, job.first, options.repair_all, params, 1,
+                        options.on_building, job.part, {});
         job.text = feature.dump(-1, ' ', false, json::error_handler_t::replace) + "\n";
       },
       [&](FeatureJob& job) {
@@ -534,8 +542,8 @@ CityRefineSummary refine_city(const std::string& model_path, const std::string& 
     upgrade_objects(doc["CityObjects"]);
   }
   ensure_transform(doc);
-  refine_document(doc, transform_of(doc), file.buildings, targets, target_of, 0, params, options.jobs,
-                  options.on_building, sum, options.progress);
+  refine_document(doc, transform_of(doc), file.buildings, targets, target_of, 0, options.repair_all, params,
+                  options.jobs, options.on_building, sum, options.progress);
   sum.seconds_refine = seconds_since(t);
 
   t = Clock::now();

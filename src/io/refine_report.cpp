@@ -91,6 +91,21 @@ json refine_report(const RefineResult& r) {
                      {"notes", rr.notes}};
   }
   if (t.input_validation) rep["input_validation"] = validation_json(*t.input_validation);
+  if (t.rebuild) {
+    const ShellRebuild& rb = *t.rebuild;
+    rep["rebuild"] = {{"why", t.invalid_input},
+                      {"ok", rb.ok},
+                      {"reason", rb.reason},
+                      {"planes_added", rb.planes_added},
+                      {"area_added", rb.area_added},
+                      {"area_kept", rb.area_kept},
+                      {"area_dropped", rb.area_dropped},
+                      {"area_uncovered", rb.area_uncovered},
+                      {"area_fins", rb.area_fins},
+                      {"candidates_changed", rb.candidates_changed},
+                      {"hausdorff_input_to_output", rb.input_to_output},
+                      {"hausdorff_output_to_input", rb.output_to_input}};
+  }
   if (t.cloud) rep["cloud"] = {{"points", t.cloud->first}, {"points_near_model", t.cloud->second}};
   if (t.planes) {
     json planes = json::array();

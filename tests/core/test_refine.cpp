@@ -204,3 +204,67 @@ TEST(Refine, ABuildingBeyondTheCandidateCapIsKeptQuickly) {
   EXPECT_EQ(r.mesh.faces.size(), coarse.faces.size());
   EXPECT_LT(seconds, 20.0) << "the cap did not bound the time";
 }
+
+namespace {
+
+// The box [0,12]x[y0,8]x[0,7] as an exported soup without its faces listed (box(): 0 ground,
+// 1 roof, walls 2 y = y0, 3 x = 12, 4 y = 8, 5 x = 0).
+Mesh box_soup_without(double y0, std::initializer_list<int> drop) {
+  const Mesh whole = box_soup(0, 12, y0, 8, 7);
+  Mesh m = whole;
+  m.faces.clear();
+  for (int f = 0; f < int(whole.faces.size()); ++f)
+    if (std::find(drop.begin(), drop.end(), f) == drop.end()) m.faces.push_back(whole.faces[std::size_t(f)]);
+  return m;
+}
+
+PointCloud far_cloud() {
+  PointCloud far;
+  for (int i = 0; i < 200; ++i) far.points.push_back(kOrigin + Vec3(500.0 + 0.1 * i, 0.0, 0.0));
+  return far;
+}
+
+}  // namespace
+
+// A house exported as roof, ground and one end wall (no single face fills the hole the others
+// leave) is no valid solid; its shell is rebuilt on its own planes and written as `repaired`,
+// every vertex one of the input's.
+TEST(Refine, AHouseMissingThreeWallsIsRepairedOnItsPlanes) {
+  const Mesh coarse = box_soup_without(0.0, {2, 4, 5});
+  const RefineResult r = refine_building(coarse, far_cloud(), Params{});
+  ASSERT_EQ(r.outcome, Outcome::Repaired) << r.reason;
+  EXPECT_TRUE(r.valid) << r.trace.output_validation.problem;
+  EXPECT_EQ(r.reason.rfind("shell rebuilt on its planes", 0), 0u) << r.reason;
+  ASSERT_TRUE(r.trace.rebuild.has_value());
+  EXPECT_FALSE(r.trace.invalid_input.empty());
+  EXPECT_NEAR(validate_mesh(r.mesh, kPlanarity).volume, 12 * 8 * 7, 1e-6);
+  EXPECT_LE(largest_vertex_move(r.mesh, coarse), 1e-6);
+}
+
+// The same house with its street facade scanned 0.5 m inside the model: the rebuilt shell is the
+// start of the refinement, which moves the facade.
+TEST(Refine, ARepairedHouseIsRefinedOnItsScan) {
+  const Mesh coarse = box_soup_without(-0.5, {3, 4, 5});  // the front wall kept, 0.5 m too far out
+  const RefineResult r = refine_building(coarse, scan_front(0.0, 0.5, 11.5, 5.0, 7), Params{});
+  ASSERT_EQ(r.outcome, Outcome::Refined) << r.reason;
+  EXPECT_TRUE(r.valid) << r.trace.output_validation.problem;
+  ASSERT_TRUE(r.trace.rebuild.has_value());
+  EXPECT_TRUE(r.trace.rebuild->ok);
+  EXPECT_LT(max_abs_y_of_front(r.mesh, 0.0), 0.02);
+}
+
+// A neighbour's wall standing 3 m above the roof (a fin) is part of no solid: the building is
+// kept as read, and the reason says how much of it no shell on its planes covers.
+TEST(Refine, AHouseWithAFinIsKeptInvalidAsRead) {
+  Mesh coarse = box_soup_without(0.0, {});
+  const int n = int(coarse.vertices.size());
+  for (const Vec3& p : {Vec3(0, 0, 7), Vec3(0, 8, 7), Vec3(0, 8, 10), Vec3(0, 0, 10)})
+    coarse.vertices.push_back(p + kOrigin);
+  coarse.faces.push_back({{n, n + 1, n + 2, n + 3}, Semantic::Wall, 6});
+  const RefineResult r = refine_building(coarse, far_cloud(), Params{});
+  ASSERT_EQ(r.outcome, Outcome::KeptInvalid) << r.reason;
+  const std::size_t at = r.reason.find("uncovered by up to ");
+  ASSERT_NE(at, std::string::npos) << r.reason;
+  EXPECT_NEAR(std::stod(r.reason.substr(at + 19)), 3.0, 0.05) << r.reason;
+  EXPECT_EQ(r.mesh.faces.size(), coarse.faces.size());
+}

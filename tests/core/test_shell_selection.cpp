@@ -1,6 +1,9 @@
 // Stages 3-4 for the whole building: the selection adds the faces the model lacks.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
+#include "lodrefine/core/repair.h"
 #include "lodrefine/core/shell_selection.h"
 #include "lodrefine/core/validate.h"
 #include "support/mesh_fixtures.h"
@@ -256,4 +259,97 @@ TEST(ShellSelection, MovesWallsWhenTheBudgetEndsTheSearchAtTheRoot) {
     EXPECT_TRUE(v.valid()) << v.problem;
     EXPECT_NEAR(v.volume, 480.0, 1e-6) << "budget " << budget;  // the start: 11.6 x 9.6 x 6 = 668.16
   }
+}
+
+// Repair by reconstruction (rebuild_shell): the defect classes of municipal LoD2 exports.
+namespace {
+
+// A 10 x 8 x 6 m box as an exported soup with only the faces listed (box(): 0 ground, 1 roof,
+// walls 2 y = 0, 3 x = 10, 4 y = 8, 5 x = 0).
+Mesh box_faces(std::initializer_list<int> keep) {
+  const Mesh whole = as_soup(box(Vec3(0, 0, 0), Vec3(10, 8, 6)));
+  Mesh m;
+  for (int f : keep) {
+    Face face = whole.faces[std::size_t(f)];
+    face.source = f;
+    for (int& v : face.v) {
+      m.vertices.push_back(whole.vertices[std::size_t(v)]);
+      v = int(m.vertices.size()) - 1;
+    }
+    m.faces.push_back(face);
+  }
+  return m;
+}
+
+// `soup` with the faces of the box [lo, hi] added, as a part exported with it.
+Mesh with_box(Mesh soup, const Vec3& lo, const Vec3& hi) {
+  const Mesh b = as_soup(box(lo, hi));
+  const int n = int(soup.vertices.size());
+  soup.vertices.insert(soup.vertices.end(), b.vertices.begin(), b.vertices.end());
+  for (Face f : b.faces) {
+    for (int& v : f.v) v += n;
+    soup.faces.push_back(f);
+  }
+  return soup;
+}
+
+}  // namespace
+
+// A terraced house exported as roof, ground and one end wall (its facades and party wall
+// missing, a hole no single face fills): closed along the footprint on the vertical planes
+// through the hole's edges, the input's faces kept where they were.
+TEST(RebuildShell, WallsMissingAlongTheFootprintAreAdded) {
+  const Mesh soup = box_faces({0, 1, 3});
+  const Params prm;
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
+  ASSERT_TRUE(rb.ok) << rb.reason;
+  const Validation v = validate_mesh(rb.mesh, prm.planarity_tolerance);
+  EXPECT_TRUE(v.valid()) << v.problem;
+  EXPECT_NEAR(v.volume, 480.0, 1e-6);
+  EXPECT_EQ(rb.planes_added, 3);  // walls y = 0, y = 8, x = 0
+  EXPECT_LE(rb.input_to_output, 1e-9);
+  EXPECT_NEAR(rb.area_added, 2 * 60.0 + 48.0, 10.0);  // sampled every 0.25 m
+  EXPECT_NEAR(rb.area_kept, 2 * 80.0 + 48.0, 10.0);
+  EXPECT_LE(largest_vertex_move(rb.mesh, soup), 1e-9);
+  int walls = 0;
+  for (const Face& f : rb.mesh.faces) walls += f.sem == Semantic::Wall;
+  EXPECT_EQ(walls, 4);
+}
+
+// A neighbour's wall standing 3 m above the roof (a fin: outside on both sides) is part of no
+// solid: the rebuilt box leaves it uncovered, and says by how much.
+TEST(RebuildShell, AFinLeavesTheInputUncovered) {
+  Mesh soup = box_faces({0, 1, 2, 3, 4, 5});
+  const int n = int(soup.vertices.size());
+  for (const Vec3& p : {Vec3(0, 0, 6), Vec3(0, 8, 6), Vec3(0, 8, 9), Vec3(0, 0, 9)}) soup.vertices.push_back(p);
+  soup.faces.push_back({{n, n + 1, n + 2, n + 3}, Semantic::Wall, 6});
+  const Params prm;
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
+  ASSERT_TRUE(rb.ok) << rb.reason;
+  EXPECT_NEAR(rb.input_to_output, 3.0, 0.05);
+  EXPECT_EQ(rb.area_dropped, 0.0);
+}
+
+// Two overlapping boxes exported as one soup with their own walls inside each other: the walls
+// inside the union (the other box's volume on both sides) are partitions, dropped; the union
+// covers everything else.
+TEST(RebuildShell, PartitionsBetweenOverlappingPartsAreJoined) {
+  const Mesh soup = with_box(box_faces({0, 1, 2, 3, 4, 5}), Vec3(6, 4, 0), Vec3(14, 12, 6));
+  const Params prm;
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
+  ASSERT_TRUE(rb.ok) << rb.reason;
+  const Validation v = validate_mesh(rb.mesh, prm.planarity_tolerance);
+  EXPECT_TRUE(v.valid()) << v.problem;
+  EXPECT_NEAR(v.volume, 6.0 * (80.0 + 64.0 - 16.0), 1e-6);
+  EXPECT_LE(rb.input_to_output, prm.weld_tolerance);
+  EXPECT_NEAR(rb.area_dropped, 2 * (4.0 + 4.0) * 6.0, 6.0);  // each box's two walls inside the other
+}
+
+// Two boxes that touch along one edge only: closing them as one shell would swallow their walls
+// at the corner (no partition: outside on one side). Not rebuilt; the walls stay uncovered.
+TEST(RebuildShell, PartsTouchingAlongAnEdgeAreNotSwallowed) {
+  const Mesh soup = with_box(box_faces({0, 1, 2, 3, 4, 5}), Vec3(10, 8, 0), Vec3(16, 14, 5));
+  const Params prm;
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
+  EXPECT_TRUE(!rb.ok || rb.input_to_output > prm.weld_tolerance) << rb.input_to_output;
 }

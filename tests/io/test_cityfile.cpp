@@ -129,14 +129,15 @@ json synth_city(const std::vector<SynthBuilding>& bs, const Vec3& translate) {
 }
 
 // Checks the contract on an output: counts add up, untouched and kept buildings identical to
-// the input (objects and their vertices), refined ones a valid Solid with semantics, schema.
+// the input (objects and their vertices), refined and repaired ones a valid Solid with semantics,
+// schema.
 void check_city_output(const json& in, const std::string& out_path, const CityRefineSummary& s) {
   const json out = load(out_path);
   EXPECT_EQ(out["version"], "2.0");
   EXPECT_EQ(out["metadata"], in["metadata"]);
   EXPECT_EQ(out["transform"], in["transform"]);
   ASSERT_EQ(out["CityObjects"].size(), in["CityObjects"].size());
-  EXPECT_EQ(s.refined + s.kept + s.kept_invalid + s.untouched, s.buildings);
+  EXPECT_EQ(s.refined + s.repaired + s.kept + s.kept_invalid + s.untouched, s.buildings);
   std::map<std::string, std::string> outcome;
   for (const auto& o : s.outcomes) outcome[o.id] = o.outcome;
   int identical = 0;
@@ -151,7 +152,7 @@ void check_city_output(const json& in, const std::string& out_path, const CityRe
         o["attributes"].erase(k);
       if (o["attributes"].empty() && !obj.contains("attributes")) o.erase("attributes");
     }
-    if (it != outcome.end() && it->second == "refined") {
+    if (it != outcome.end() && (it->second == "refined" || it->second == "repaired")) {
       EXPECT_EQ(o.value("attributes", json()), obj.value("attributes", json())) << id;
       EXPECT_EQ(o.value("geometry", json()).size(), obj.value("geometry", json()).size()) << id;
       continue;
@@ -170,12 +171,12 @@ void check_city_output(const json& in, const std::string& out_path, const CityRe
     ++identical;
   }
   EXPECT_EQ(vertex_mismatches, 0u);
-  EXPECT_EQ(identical, s.buildings - s.refined + int(in["CityObjects"].size()) - s.buildings);
+  EXPECT_EQ(identical, s.buildings - s.refined - s.repaired + int(in["CityObjects"].size()) - s.buildings);
   // Refined geometry passes the project's validity check.
   const CityJsonFile back = read_cityjson(out_path);
   for (const auto& b : back.buildings) {
     const auto it = outcome.find(b.mesh.id);
-    if (it == outcome.end() || it->second != "refined") continue;
+    if (it == outcome.end() || (it->second != "refined" && it->second != "repaired")) continue;
     EXPECT_EQ(b.geometry_type, "Solid") << b.mesh.id;
     EXPECT_EQ(geometry_problem(b.mesh), "") << b.mesh.id;
     int walls = 0, roofs = 0, grounds = 0;
@@ -189,8 +190,8 @@ void check_city_output(const json& in, const std::string& out_path, const CityRe
   if (!verdict.empty()) {
     EXPECT_EQ(verdict, "valid");
   }
-  std::printf("  %s: %d building(s): %d refined, %d kept, %d kept-invalid, %d untouched; schema: %s\n",
-              out_path.c_str(), s.buildings, s.refined, s.kept, s.kept_invalid, s.untouched,
+  std::printf("  %s: %d building(s): %d refined, %d repaired, %d kept, %d kept-invalid, %d untouched; schema: %s\n",
+              out_path.c_str(), s.buildings, s.refined, s.repaired, s.kept, s.kept_invalid, s.untouched,
               verdict.empty() ? "not checked (validator or schemas absent)" : verdict.c_str());
 }
 
@@ -387,6 +388,54 @@ TEST(CityFile, RotterdamDelfshaven) {
   EXPECT_EQ(s.buildings, 853);
   EXPECT_GE(s.refined, 1);
   check_city_output(load(path.string()), dir + "/rotterdam.city.json", s);
+}
+
+// A building the cloud does not reach stays as read though it is no valid solid (a house exported
+// as roof, ground and one end wall); with repair_all it is rebuilt on its planes, written as a
+// Solid and says so, and a valid building the cloud does not reach is kept as read.
+TEST(CityFile, RepairAllMendsTheBuildingsTheCloudDoesNotReach) {
+  const std::string dir = test_dir();
+  SynthOptions so;
+  so.target_points = 4000;
+  so.origin = Vec3(93000.0, 436000.0, 0.0);
+  std::vector<SynthBuilding> bs = {make_building(BuildingType::Gable, 5, so)};
+  SynthBuilding open = bs[0], whole = bs[0];
+  open.id = "open";
+  whole.id = "whole";
+  const Mesh box = fixtures::as_soup(translated(fixtures::box(Vec3(0, 0, 0), Vec3(10, 8, 6)), Vec3(93200, 436000, 0)));
+  whole.coarse = box;
+  open.coarse = box;
+  open.coarse.faces = {box.faces[0], box.faces[1], box.faces[3]};  // ground, roof, one end wall
+  whole.coarse.vertices = box.vertices;
+  for (auto& v : whole.coarse.vertices) v += Vec3(100, 0, 0);
+  bs.push_back(open);
+  bs.push_back(whole);
+  const json in = synth_city(bs, Vec3(93000, 436000, 0));
+  write_file_atomic(dir + "/city.json", in.dump());
+  write_ply(dir + "/cloud.ply", bs[0].cloud);
+
+  const CityRefineSummary plain =
+      refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/plain.city.json", Params{}, {});
+  EXPECT_EQ(plain.untouched, 2);
+  EXPECT_EQ(plain.repaired, 0);
+  check_city_output(in, dir + "/plain.city.json", plain);
+
+  CityRefineOptions all;
+  all.repair_all = true;
+  const CityRefineSummary s =
+      refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/all.city.json", Params{}, all);
+  ASSERT_EQ(s.outcomes.size(), 3u);
+  EXPECT_EQ(s.untouched, 0);
+  EXPECT_EQ(s.outcomes[1].id, "open");
+  EXPECT_EQ(s.outcomes[1].outcome, "repaired") << s.outcomes[1].reason;
+  EXPECT_EQ(s.outcomes[1].reason.rfind("shell rebuilt on its planes", 0), 0u) << s.outcomes[1].reason;
+  EXPECT_EQ(s.outcomes[2].outcome, "kept") << s.outcomes[2].reason;
+  check_city_output(in, dir + "/all.city.json", s);
+  const CityJsonFile back = read_cityjson(dir + "/all.city.json");
+  for (const auto& b : back.buildings)
+    if (b.mesh.id == "open") {
+      EXPECT_NEAR(validate_mesh(b.mesh, 0.01).volume, 480.0, 0.5);
+    }
 }
 
 TEST(CityFile, DenHaagCityGml) {

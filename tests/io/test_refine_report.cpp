@@ -86,7 +86,8 @@ TEST(RefineReport, RefinedBuildingHasEveryStage) {
 
 TEST(RefineReport, ABuildingStoppedAtRepairHasOnlyWhatItReached) {
   Scene s;
-  s.model.faces.resize(2);  // two faces: no weld closes a shell
+  // Two opposite walls: no weld closes a shell, nor do their planes (nothing across their ends).
+  s.model.faces = {s.model.faces[2], s.model.faces[4]};
   const RefineResult r = refine_building(s.model, s.scan, Params{});
   ASSERT_EQ(r.outcome, Outcome::KeptInvalid);
   const nlohmann::json j = refine_report(r);
@@ -96,6 +97,9 @@ TEST(RefineReport, ABuildingStoppedAtRepairHasOnlyWhatItReached) {
   for (const char* key :
        {"repair", "cloud", "planes", "matches", "substitution", "replacements", "judgement", "selection"})
     EXPECT_FALSE(j.contains(key)) << key;
+  ASSERT_TRUE(j.contains("rebuild"));
+  EXPECT_EQ(j["rebuild"]["ok"], false);
+  EXPECT_EQ(j["rebuild"]["why"], r.trace.invalid_input);
   EXPECT_EQ(j["seconds"].size(), 3u);  // repair, validation, total
   EXPECT_EQ(j["faces"], 2u);
 }

@@ -23,8 +23,10 @@ namespace lodrefine {
 // "refined": walls moved, validated, and never worse: the scan points near the building and
 // each moved wall's own points fit better than before (judge.h);
 // "kept": the repaired input (nothing to change, or the judge refused the refinement);
+// "repaired": as kept, but the input was no valid solid and its shell was rebuilt on its own
+// planes (rebuild_shell, shell_selection.h): faces added, split or dropped, nothing moved;
 // "kept-invalid": the input cannot be made a valid solid and the output is it as read.
-enum class Outcome { Refined, Kept, KeptInvalid };
+enum class Outcome { Refined, Kept, Repaired, KeptInvalid };
 const char* outcome_name(Outcome outcome);
 
 // The stages a refinement times (RefineTrace::seconds), in pipeline order; "total" follows
@@ -75,6 +77,9 @@ struct RefineTrace {
   std::vector<std::pair<std::string, double>> seconds;  // per stage, then "total"
   std::optional<RepairReport> repair;
   std::optional<Validation> input_validation;
+  // When the repaired input was no valid solid: why, and its rebuild on its planes (no mesh).
+  std::string invalid_input;
+  std::optional<ShellRebuild> rebuild;
   Validation output_validation;
   std::size_t faces = 0;                                     // of the output
   std::optional<std::pair<std::size_t, std::size_t>> cloud;  // points, points near the model

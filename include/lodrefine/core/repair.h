@@ -32,6 +32,12 @@ struct RepairReport {
 // only within weld_tolerance, so a face's own short edges never collapse.
 Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report = nullptr, double gap_tolerance = 0.0);
 
+// The soup welded as repair_model welds it at `weld_tolerance`, its degenerate and duplicate faces
+// dropped and its T-junctions split; nothing closed, filled or oriented. What a rebuild
+// (shell_selection.h) reads when the soup cannot be made a valid solid. Throws InputError for a
+// vertex that is not finite or a face with a missing vertex.
+Mesh welded_soup(const Mesh& soup, double weld_tolerance, RepairReport* report = nullptr);
+
 // Orients the faces of a closed mesh with shared vertices consistently (across manifold edges)
 // and outward (each edge-connected component encloses a positive volume); no vertex moves.
 // Returns how many faces were reversed.

@@ -33,7 +33,7 @@ struct RunFigures {
   std::optional<double> c2m_rmse_original, c2m_rmse, c2m_mae, truth_facade_rmse, truth_roof_rmse;
 };
 
-// Rank of an outcome, higher is better: refined 3, kept 2, kept-invalid 1, failed (or anything
+// Rank of an outcome, higher is better: refined 3, kept or repaired 2, kept-invalid 1, failed (or anything
 // else) 0.
 int outcome_rank(const std::string& outcome);
 

@@ -34,13 +34,13 @@ std::string svg_footprint(const Mesh& original, const Mesh& refined, const std::
 // One building of a district map: its XY outline rings (any common frame, metres) and outcome.
 struct MapOutline {
   std::string id;
-  std::string outcome;  // "refined", "kept", "kept-invalid", anything else drawn as untouched
+  std::string outcome;  // "refined", "repaired", "kept", "kept-invalid", anything else drawn as untouched
   std::vector<std::vector<Vec2>> rings;
   bool linked = false;  // a link to "#view-<id>" (its view on the same page)
 };
 
 // Top view of a district, north up, about `width` pixels wide: each outline filled by its
-// outcome (refined orange, kept yellow, kept-invalid red, untouched grey) with its id as tooltip,
+// outcome (refined orange, repaired blue, kept yellow, kept-invalid red, untouched grey) with its id as tooltip,
 // a legend with the counts and a scale bar. Ids are escaped.
 std::string svg_district_map(const std::vector<MapOutline>& buildings, const std::string& title, double width = 1100);
 

@@ -16,7 +16,7 @@ namespace lodrefine {
 
 struct CityReviewBuilding {
   std::string id;
-  std::string outcome;     // "refined", "kept", "kept-invalid" or "untouched" (no cloud points)
+  std::string outcome;     // "refined", "repaired", "kept", "kept-invalid" or "untouched" (no cloud points)
   std::string reason;      // why kept
   std::size_t points = 0;  // cloud points in its crop
   std::size_t facades_moved = 0;
@@ -46,7 +46,7 @@ BuildingView review_view(const std::string& id, const Mesh& coarse, const Mesh& 
                          const std::vector<Vec3>& points, std::size_t max_points);
 
 // The page. Ids, reasons and captions are escaped (ids may be hostile); the table lists the
-// buildings the cloud reached (not the untouched ones): kept-invalid, kept, then refined, each
+// buildings the cloud reached (not the untouched ones): kept-invalid, kept, repaired, then refined, each
 // by fit after refinement, worst first.
 std::string city_review_html(const CityReview& review);
 

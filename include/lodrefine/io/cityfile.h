@@ -8,8 +8,10 @@
 // semantics (WallSurface / RoofSurface / GroundSurface from the refined mesh's faces); its other LoDs, attributes and
 // id stay. Every other building, attribute, LoD, the metadata and the transform are kept as read (new vertices are
 // appended, so existing indices hold). Each building the cloud reaches gets the attributes lodrefine_outcome ("refined"
-// / "kept" / "kept-invalid"), lodrefine_reason and lodrefine_facades_moved; buildings without cloud points are
-// untouched. CityGML input is converted first (citygml_to_cityjson) and written as CityJSON 2.0.
+// / "repaired" / "kept" / "kept-invalid"), lodrefine_reason and lodrefine_facades_moved; buildings without cloud points
+// are untouched (with repair_all, those too are repaired when they are no valid solid, and get the attributes). A
+// repaired building (no valid solid as read, its shell rebuilt on its own planes: refine.h) is written as a Solid, as a
+// refined one is. CityGML input is converted first (citygml_to_cityjson) and written as CityJSON 2.0.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -54,6 +56,9 @@ struct CityRefineOptions {
   // Buildings refined at once, each on its own thread (1: one after another on the caller's).
   // The output is the same bytes whatever the number.
   int jobs = 1;
+  // Every building goes through refinement, with or without cloud points: each one that is no
+  // valid solid is repaired (or kept-invalid) and says so; the others are kept as read.
+  bool repair_all = false;
   // Called after each building (CityJSONSeq: each feature) is written into the output, in
   // file order on the caller's thread, with the counts so far (may be empty).
   std::function<void(const CityRefineSummary&)> progress;
@@ -62,8 +67,8 @@ struct CityRefineOptions {
 
 struct CityBuildingOutcome {
   std::string id;
-  std::string outcome;  // "refined", "kept", "kept-invalid"
-  std::string reason;   // why kept / kept-invalid (empty when refined)
+  std::string outcome;  // "refined", "repaired", "kept", "kept-invalid"
+  std::string reason;   // why repaired / kept / kept-invalid (empty when refined)
   int facades_moved = 0;
   std::string refused_by;  // the never-worse check that refused its refinement (judge.h), or empty
   std::size_t points = 0;  // cloud points in the building's crop box
@@ -73,7 +78,7 @@ struct CityBuildingOutcome {
 struct CityRefineSummary {
   std::string input_format;  // "CityJSON 2.0", "CityJSONSeq 2.0", "CityGML 2.0"
   int buildings = 0;         // LoD 2 buildings / building parts in the file
-  int refined = 0, kept = 0, kept_invalid = 0;
+  int refined = 0, repaired = 0, kept = 0, kept_invalid = 0;
   int untouched = 0;                          // no cloud point in their box: written exactly as read
   std::map<std::string, int> refused;         // kept because this never-worse check refused the refinement
   int objects_without_lod = 0;                // Building/BuildingPart objects without the LoD asked for
