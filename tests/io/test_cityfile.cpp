@@ -463,6 +463,17 @@ TEST(CityFile, DenHaagCityGml) {
   const json out = load(dir + "/denhaag.city.json");
   EXPECT_EQ(out["metadata"]["referenceSystem"], "https://www.opengis.net/def/crs/EPSG/0/28992");
   for (const auto& [id, obj] : out["CityObjects"].items()) EXPECT_EQ(id.find("genID"), std::string::npos) << id;
+  // Every building of this export is a valid solid: with --repair-all each gets an outcome and
+  // none but the scanned one changes (check_city_output: kept ones object by object, vertex by vertex).
+  CityRefineOptions all;
+  all.repair_all = true;
+  const CityRefineSummary r =
+      refine_city(path.string(), dir + "/scan.ply", dir + "/denhaag_all.city.json", Params{}, all);
+  EXPECT_EQ(int(r.outcomes.size()), r.buildings);
+  EXPECT_EQ(r.repaired, 0);
+  EXPECT_EQ(r.kept_invalid, 0);
+  EXPECT_EQ(r.refined, s.refined);
+  check_city_output(citygml_to_cityjson(path.string()), dir + "/denhaag_all.city.json", r);
 }
 
 TEST(CityFile, CityJsonSeqStreamedThrough) {
