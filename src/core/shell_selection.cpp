@@ -663,18 +663,32 @@ constexpr double kRebuildReach = 1.0;
 // A covered candidate dropped costs this times what an uncovered one added costs (per m²): a
 // missing wall is added whatever its size, and only what crosses another face is dropped.
 constexpr double kKeepCover = 10.0;
-// Spacing (m) of the samples the rebuild's distances are measured on, both ways.
+// Spacing (m) of the samples the rebuild's distances are measured on, both ways; wider for a
+// soup so large that it would take more than kMaxRebuildSamples (each face's grid spans its box).
 constexpr double kRebuildSampling = 0.25;
+constexpr double kMaxRebuildSamples = 250000;
+// The most triangle-sample terms the winding numbers may take per building (each sample farther
+// than the tolerance from the shell costs the soup's triangles); past it, a sample counts as
+// uncovered: the rebuild is refused rather than slow (untrusted input).
+constexpr double kMaxWindingTerms = 2e8;
 
 void set_selected(CandidateSet& cs, const std::vector<char>& chosen) {
   auto map = cs.mesh.add_property_map<FaceIndex, bool>("f:selected", false).first;
   for (int f = 0; f < cs.size(); ++f) map[FaceIndex(f)] = chosen[f] != 0;
 }
 
-// The samples of a face: a grid every kRebuildSampling, and its vertices moved a hundredth of the
-// way to its centroid (inside the face, off its neighbours).
-std::vector<Vec3> face_samples(const Mesh& m, int f) {
-  std::vector<Vec3> pts = sample_faces(m, {f}, kRebuildSampling);
+// The spacing of `m`'s samples: kRebuildSampling, or wider where its faces' boxes (bounded by
+// their diagonals) would hold more than kMaxRebuildSamples.
+double sample_spacing(const Mesh& m) {
+  double box_area = 0.0;
+  for (const Face& f : m.faces) box_area += bounding_box(face_points(m, f)).sizes().squaredNorm();
+  return std::max(kRebuildSampling, std::sqrt(box_area / kMaxRebuildSamples));
+}
+
+// The samples of a face: a grid every `spacing`, and its vertices moved a hundredth of the way to
+// its centroid (inside the face, off its neighbours).
+std::vector<Vec3> face_samples(const Mesh& m, int f, double spacing) {
+  std::vector<Vec3> pts = sample_faces(m, {f}, spacing);
   const std::vector<Vec3> corners = face_points(m, m.faces[std::size_t(f)]);
   const Vec3 c = polygon_centroid(corners);
   for (const Vec3& p : corners) pts.push_back(p + 0.01 * (c - p));
@@ -685,27 +699,42 @@ std::vector<Vec3> face_samples(const Mesh& m, int f) {
 // farthest a sample lies from it.
 void added_area(const Mesh& shell, const Mesh& soup, double tolerance, ShellRebuild& out) {
   const MeshDistance dist(soup);
+  const double spacing = sample_spacing(shell);
   for (int f = 0; f < int(shell.faces.size()); ++f)
-    for (const Vec3& p : sample_faces(shell, {f}, kRebuildSampling)) {
+    for (const Vec3& p : sample_faces(shell, {f}, spacing)) {
       const double d = dist.distance(p, false);
       out.output_to_input = std::max(out.output_to_input, d);
-      (d <= tolerance ? out.area_kept : out.area_added) += kRebuildSampling * kRebuildSampling;
+      (d <= tolerance ? out.area_kept : out.area_added) += spacing * spacing;
     }
 }
 
-// The generalized winding number (Jacobson, Kavan and Sorkine-Hornung 2013) of a soup's faces
-// other than `skip` at `p`, as read (outward): about 1 inside what they enclose, 0 outside,
-// fractional near a hole.
-double winding_without(const Mesh& soup, int skip, const Vec3& p) {
-  double sum = 0.0;
-  for_each_triangle(soup, [&](const Vec3& a0, const Vec3& b0, const Vec3& c0, int f) {
-    if (f == skip) return;
-    const Vec3 a = a0 - p, b = b0 - p, c = c0 - p;
-    const double la = a.norm(), lb = b.norm(), lc = c.norm();
-    sum += 2.0 * std::atan2(a.dot(b.cross(c)), la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb);
-  });
-  return sum / (4.0 * kPi);
-}
+// The generalized winding number (Jacobson, Kavan and Sorkine-Hornung 2013) of a soup's faces, as
+// read (outward): about 1 inside what they enclose, 0 outside, fractional near a hole.
+class Winding {
+ public:
+  explicit Winding(const Mesh& soup) {
+    for_each_triangle(soup, [&](const Vec3& a, const Vec3& b, const Vec3& c, int f) { tris_.push_back({a, b, c, f}); });
+  }
+  std::size_t triangles() const { return tris_.size(); }
+  // At `p`, of the faces other than `skip`.
+  double without(int skip, const Vec3& p) const {
+    double sum = 0.0;
+    for (const Tri& t : tris_) {
+      if (t.face == skip) continue;
+      const Vec3 a = t.a - p, b = t.b - p, c = t.c - p;
+      const double la = a.norm(), lb = b.norm(), lc = c.norm();
+      sum += 2.0 * std::atan2(a.dot(b.cross(c)), la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb);
+    }
+    return sum / (4.0 * kPi);
+  }
+
+ private:
+  struct Tri {
+    Vec3 a, b, c;
+    int face;
+  };
+  std::vector<Tri> tris_;
+};
 
 // A soup face's point where the rest of the soup winds more than this has the soup's volume on
 // both sides: a partition between two parts. An outer wall has it on one side only (about 1/2),
@@ -717,27 +746,30 @@ constexpr double kFinWinding = 0.25;
 // cover: all but a partition between parts it joins (inside the shell, the soup's volume on both
 // sides). A fin (a face with outside on both sides: a neighbour's wall standing above the roof)
 // is no part of any solid, and an outer wall the shell swallows is no partition: either leaves
-// the soup uncovered. `skipped` gets the area (m²) of the partitions' samples farther than
-// `tolerance`; `out` the area of those it leaves uncovered, and of those a fin's.
+// the soup uncovered. `out` gets the areas (m²) of the samples farther than `tolerance`: the
+// partitions' (dropped), the others (uncovered) and of those a fin's.
 double uncovered(const Mesh& soup, const Mesh& shell, double tolerance, ShellRebuild& out) {
   const MeshDistance dist(shell);
-  constexpr double kSampleArea = kRebuildSampling * kRebuildSampling;
-  double worst = 0.0;
+  const Winding winding(soup);
+  const double spacing = sample_spacing(soup), sample_area = spacing * spacing;
+  out.sampling = spacing;
+  double terms = 0.0, worst = 0.0;
   for (int f = 0; f < int(soup.faces.size()); ++f)
-    for (const Vec3& p : face_samples(soup, f)) {
+    for (const Vec3& p : face_samples(soup, f, spacing)) {
       const double d = dist.distance(p, true);
       if (std::abs(d) <= tolerance) {
         worst = std::max(worst, std::abs(d));
         continue;
       }
-      const double w = winding_without(soup, f, p);
+      terms += double(winding.triangles());
+      const double w = terms <= kMaxWindingTerms ? winding.without(f, p) : 0.5;  // past the budget: a wall
       if (d < 0.0 && w > kPartitionWinding) {
-        out.area_dropped += kSampleArea;
+        out.area_dropped += sample_area;
         continue;
       }
       worst = std::max(worst, std::abs(d));
-      out.area_uncovered += kSampleArea;
-      if (std::abs(w) < kFinWinding) out.area_fins += kSampleArea;
+      out.area_uncovered += sample_area;
+      if (std::abs(w) < kFinWinding) out.area_fins += sample_area;
     }
   return worst;
 }

@@ -102,6 +102,7 @@ json refine_report(const RefineResult& r) {
                       {"area_dropped", rb.area_dropped},
                       {"area_uncovered", rb.area_uncovered},
                       {"area_fins", rb.area_fins},
+                      {"sampling", rb.sampling},
                       {"candidates_changed", rb.candidates_changed},
                       {"hausdorff_input_to_output", rb.input_to_output},
                       {"hausdorff_output_to_input", rb.output_to_input}};

@@ -316,6 +316,19 @@ TEST(RebuildShell, WallsMissingAlongTheFootprintAreAdded) {
   EXPECT_EQ(walls, 4);
 }
 
+// A soup far larger than a building (2 km square, within size_problem's bounds: untrusted input)
+// is measured on a sparser grid, so its rebuild's samples stay bounded.
+TEST(RebuildShell, AHugeSoupIsSampledWithinBounds) {
+  Mesh soup = box_faces({0, 1, 3});
+  for (Vec3& p : soup.vertices) p = p.cwiseProduct(Vec3(200.0, 250.0, 1.0));
+  const Params prm;
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
+  ASSERT_TRUE(rb.ok) << rb.reason;
+  EXPECT_GT(rb.sampling, 5.0);
+  const double kept = 2 * 2000.0 * 2000.0 + 2000.0 * 6.0;
+  EXPECT_NEAR(rb.area_kept, kept, 0.02 * kept);
+}
+
 // A neighbour's wall standing 3 m above the roof (a fin: outside on both sides) is part of no
 // solid: the rebuilt box leaves it uncovered, and says by how much.
 TEST(RebuildShell, AFinLeavesTheInputUncovered) {

@@ -70,7 +70,9 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
 // soup face on its plane holds its centroid; the selection is the closed one nearest the cover
 // (each change costing its area), searched around the edges the cover leaves open or overused,
 // then over every candidate. Output vertices within 3 cm of a soup vertex are put on it. The
-// distances both ways are measured on samples every 0.25 m (and near each vertex).
+// distances both ways are measured on samples every 0.25 m (and near each vertex), wider for a
+// soup that would take more than 250,000; time and memory are bounded for any soup within
+// size_problem's bounds (validate.h).
 struct ShellRebuild {
   bool ok = false;
   std::string reason;    // why not, when !ok
@@ -86,6 +88,7 @@ struct ShellRebuild {
   double input_to_output = 0.0;
   double area_dropped = 0.0;     // m²
   double area_uncovered = 0.0;   // m²: of the soup farther than weld_tolerance from the output (not dropped)
+  double sampling = 0.0;         // m: the spacing of the samples these areas and distances come from
   double area_fins = 0.0;        // m²: of that, with outside on both sides (winding below 1/4): a fin
   double output_to_input = 0.0;  // m: the farthest the output lies from the soup (an added wall's middle)
 };
