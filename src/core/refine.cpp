@@ -208,7 +208,7 @@ std::optional<RefineResult> repair_or_stop(const Mesh& local_model, const Refine
   if (rb.ok && rb.input_to_output > cfg.weld_tolerance) {
     rb.ok = false;
     char buf[160];
-    if (rb.area_fins > 0.0)
+    if (rb.area_fins >= 0.5 * rb.area_uncovered)  // mostly a fin
       std::snprintf(buf, sizeof buf,
                     "%.1f m² of it is a fin (outside on both sides: no solid holds it); its shell on its planes "
                     "leaves its faces uncovered by up to %.3f m",
