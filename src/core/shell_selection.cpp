@@ -657,7 +657,9 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
 
 // A soup's planes are cut over the whole region up to this many candidates (a local section
 // can end a plane short of where a part closes); beyond, within kRebuildReach (m) of their own
-// faces and open or overused edges.
+// faces and open or overused edges, up to as many again: a larger program is refused (GLPK's
+// root LP of 60,000 columns took seconds its work budget does not count: time, not work, ended
+// it).
 constexpr int kRebuildWholeRegion = 10000;
 constexpr double kRebuildReach = 1.0;
 // A covered candidate dropped costs this times what an uncovered one added costs (per m²): a
@@ -782,15 +784,20 @@ ShellRebuild rebuild_shell(const Mesh& soup, const Params& prm) {
   detail::add_start_planes(soup, prm.planarity_tolerance, s);
   detail::add_hole_planes(soup, s);
   out.planes_added = s.hole_planes;
+  if (s.ground_added) {
+    out.reason = "it has no ground face: the foot of its walls would be invented";
+    return out;
+  }
   const Region region = detail::building_region(soup, s);
   std::vector<Vec3> open_ends;
   for (const auto& [key, uses] : edge_uses(soup.faces))
     if (uses.size() != 2) open_ends.insert(open_ends.end(), {soup.vertices[key.first], soup.vertices[key.second]});
   CandidateSet cs = build_candidates(s.planes, region, {}, kRebuildWholeRegion);
   if (cs.capped)
-    cs = build_candidates(s.planes, region, detail::plane_reach(soup, s, region, kRebuildReach, open_ends));
+    cs = build_candidates(s.planes, region, detail::plane_reach(soup, s, region, kRebuildReach, open_ends),
+                          kRebuildWholeRegion);
   if (cs.capped) {
-    out.reason = "too many candidate faces (over " + std::to_string(kMaxCandidates) + " from " +
+    out.reason = "too many candidate faces (over " + std::to_string(kRebuildWholeRegion) + " from " +
                  std::to_string(s.planes.size()) + " planes)";
     return out;
   }

@@ -324,8 +324,10 @@ void add_hole_planes(const Mesh& soup, Supports& s) {
   if (soup.vertices.empty()) return;
   const Eigen::AlignedBox3d box = bounding_box(soup.vertices);
   const Plane ground = Plane::through(box.min(), -Vec3::UnitZ());
-  if (!carried(s, ground, box.min(), Vec3(box.max().x(), box.max().y(), box.min().z())))
+  if (!carried(s, ground, box.min(), Vec3(box.max().x(), box.max().y(), box.min().z()))) {
     add_plane(s, ground, Semantic::Ground);
+    s.ground_added = true;
+  }
 }
 
 Region building_region(const Mesh& start, const Supports& s) {

@@ -22,8 +22,9 @@ struct Supports {
   std::vector<int> face_plane;            // start face -> supporting plane
   std::vector<std::vector<Vec3>> points;  // per supporting plane: its scan points
   int added = 0;
-  int slivers = 0;      // start surfaces on a plane by the planarity tolerance alone (add_start_planes)
-  int hole_planes = 0;  // planes no face of the start lies on (add_hole_planes)
+  int slivers = 0;            // start surfaces on a plane by the planarity tolerance alone (add_start_planes)
+  int hole_planes = 0;        // planes no face of the start lies on (add_hole_planes)
+  bool ground_added = false;  // of those, the ground
 };
 
 // A plane whose normal is within this of horizontal is a wall's (deg): the contradiction and the
@@ -43,7 +44,8 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
                      Supports& s);
 // The planes a soup's holes need to close (after add_start_planes): the vertical plane through each
 // boundary edge (an edge of one face, not vertical) and the ground at the lowest vertex, each
-// unless a supporting plane carries it already. No scan points.
+// unless a supporting plane carries it already (ground_added says whether the ground was). No
+// scan points.
 void add_hole_planes(const Mesh& soup, Supports& s);
 // Hypothesised walls across where a scanned facade's points end inside the footprint.
 void add_step_walls(const Mesh& start, const Params& prm, Supports& s);

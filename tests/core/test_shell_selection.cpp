@@ -366,3 +366,34 @@ TEST(RebuildShell, PartsTouchingAlongAnEdgeAreNotSwallowed) {
   const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
   EXPECT_TRUE(!rb.ok || rb.input_to_output > prm.weld_tolerance) << rb.input_to_output;
 }
+
+// A roof alone (or with one wall) has no ground: closing it would invent the foot of every wall.
+TEST(RebuildShell, ARoofWithoutAGroundIsNotClosed) {
+  const Params prm;
+  const ShellRebuild with_wall = rebuild_shell(welded_soup(box_faces({1, 3}), prm.weld_tolerance), prm);
+  EXPECT_FALSE(with_wall.ok);
+  EXPECT_EQ(with_wall.reason, "it has no ground face: the foot of its walls would be invented");
+  // A flat roof alone is its own lowest plane: nothing closes it.
+  EXPECT_FALSE(rebuild_shell(welded_soup(box_faces({1}), prm.weld_tolerance), prm).ok);
+}
+
+// Thirty rotated boxes overlapping one another (180 planes, an attacker's soup well within
+// size_problem's bounds): the arrangement would pass 10,000 candidates, and GLPK's root LP on it
+// took seconds its work budget does not count. Refused before any program is built.
+TEST(RebuildShell, AnArrangementTooLargeForABuildingIsRefused) {
+  Mesh soup;
+  for (int k = 0; k < 30; ++k) {
+    Mesh b = as_soup(box(Vec3(-4, -3, 0), Vec3(4, 3, 5 + 0.3 * k)));
+    const Eigen::Matrix3d r = Eigen::AngleAxisd(radians(7.0 * k), Vec3::UnitZ()).toRotationMatrix();
+    const int n = int(soup.vertices.size());
+    for (const Vec3& p : b.vertices) soup.vertices.push_back(r * p + Vec3(0.5 * k, 0.3 * k, 0));
+    for (Face f : b.faces) {
+      for (int& v : f.v) v += n;
+      soup.faces.push_back(f);
+    }
+  }
+  const Params prm;
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
+  EXPECT_FALSE(rb.ok);
+  EXPECT_EQ(rb.reason.rfind("too many candidate faces (over 10000", 0), 0u) << rb.reason;
+}

@@ -66,7 +66,7 @@ ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const st
 // Repair by reconstruction: the closed shell a polygon soup that is no valid solid (faces crossing,
 // missing or doubled, parts touching along an edge) stands for, from the same arrangement and
 // selection on the soup's own planes plus those its holes need (a missing party wall: the
-// vertical plane through the hole's edge; a missing ground). A candidate is covered when a
+// vertical plane through the hole's edge). A candidate is covered when a
 // soup face on its plane holds its centroid; the selection is the closed one nearest the cover
 // (each change costing its area), searched around the edges the cover leaves open or overused,
 // then over every candidate. Output vertices within 3 cm of a soup vertex are put on it. The
@@ -94,7 +94,9 @@ struct ShellRebuild {
 };
 
 // `soup`: the welded faces (welded_soup, repair.h), local frame; Face::source says which input
-// face each is. Not ok when its planes bound no valid shell. Never throws for geometry.
+// face each is. Not ok when its planes bound no valid shell, when it has no ground face (the
+// walls' foot would be invented: a roof alone is no building), or when its arrangement would
+// exceed 10,000 candidates. Never throws for geometry.
 ShellRebuild rebuild_shell(const Mesh& soup, const Params& params);
 
 }  // namespace lodrefine
