@@ -218,10 +218,11 @@ std::optional<RefineResult> repair_or_stop(const Mesh& local_model, const Refine
                     rb.area_uncovered, rb.input_to_output);
     rb.reason = buf;
   }
-  kept = std::move(rb.mesh);
-  rb.mesh = Mesh();
+  Mesh rebuilt = std::move(rb.mesh);
+  rb.mesh = Mesh();  // the trace keeps the figures; the shell goes on as `kept`
   trace.rebuild = rb;
   if (!rb.ok) return run.finish(Outcome::KeptInvalid, invalid + "; not rebuilt: " + rb.reason, local_model);
+  kept = std::move(rebuilt);
   kept.id = local_model.id;
   return std::nullopt;
 }

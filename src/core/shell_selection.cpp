@@ -782,20 +782,21 @@ ShellRebuild rebuild_shell(const Mesh& soup, const Params& prm) {
   ShellRebuild out;
   Supports s;
   detail::add_start_planes(soup, prm.planarity_tolerance, s);
-  detail::add_hole_planes(soup, s);
-  out.planes_added = s.hole_planes;
-  if (s.ground_added) {
+  if (!detail::carries_ground(soup, s)) {
     out.reason = "it has no ground face: the foot of its walls would be invented";
     return out;
   }
+  detail::add_hole_planes(soup, s);
+  out.planes_added = s.hole_planes;
   const Region region = detail::building_region(soup, s);
-  std::vector<Vec3> open_ends;
-  for (const auto& [key, uses] : edge_uses(soup.faces))
-    if (uses.size() != 2) open_ends.insert(open_ends.end(), {soup.vertices[key.first], soup.vertices[key.second]});
   CandidateSet cs = build_candidates(s.planes, region, {}, kRebuildWholeRegion);
-  if (cs.capped)
+  if (cs.capped) {
+    std::vector<Vec3> open_ends;
+    for (const auto& [key, uses] : edge_uses(soup.faces))
+      if (uses.size() != 2) open_ends.insert(open_ends.end(), {soup.vertices[key.first], soup.vertices[key.second]});
     cs = build_candidates(s.planes, region, detail::plane_reach(soup, s, region, kRebuildReach, open_ends),
                           kRebuildWholeRegion);
+  }
   if (cs.capped) {
     out.reason = "too many candidate faces (over " + std::to_string(kRebuildWholeRegion) + " from " +
                  std::to_string(s.planes.size()) + " planes)";

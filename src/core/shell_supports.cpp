@@ -286,7 +286,6 @@ std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const Par
   return out;
 }
 
-// The region: the start and the scan evidence, in the axes of the start's largest wall.
 // A boundary edge shorter than this in plan (m) is vertical: the edges beside it give the wall.
 constexpr double kPlanEdge = 0.05;
 
@@ -299,11 +298,6 @@ bool carried(const Supports& s, const Plane& pl, const Vec3& a, const Vec3& b) {
   });
 }
 
-void add_plane(Supports& s, const Plane& pl, Semantic sem) {
-  s.planes.push_back({pl, sem, false, -1});
-  s.points.emplace_back();
-  ++s.hole_planes;
-}
 }  // namespace
 
 void add_hole_planes(const Mesh& soup, Supports& s) {
@@ -319,17 +313,21 @@ void add_hole_planes(const Mesh& soup, Supports& s) {
       if (n.norm() < 1e-6) continue;
     }
     const Plane wall = Plane::through(a, n.normalized());
-    if (!carried(s, wall, a, b)) add_plane(s, wall, Semantic::Wall);
-  }
-  if (soup.vertices.empty()) return;
-  const Eigen::AlignedBox3d box = bounding_box(soup.vertices);
-  const Plane ground = Plane::through(box.min(), -Vec3::UnitZ());
-  if (!carried(s, ground, box.min(), Vec3(box.max().x(), box.max().y(), box.min().z()))) {
-    add_plane(s, ground, Semantic::Ground);
-    s.ground_added = true;
+    if (carried(s, wall, a, b)) continue;
+    s.planes.push_back({wall, Semantic::Wall, false, -1});
+    s.points.emplace_back();
+    ++s.hole_planes;
   }
 }
 
+bool carries_ground(const Mesh& soup, const Supports& s) {
+  if (soup.vertices.empty()) return false;
+  const Eigen::AlignedBox3d box = bounding_box(soup.vertices);
+  const Vec3 far_corner(box.max().x(), box.max().y(), box.min().z());
+  return carried(s, Plane::through(box.min(), -Vec3::UnitZ()), box.min(), far_corner);
+}
+
+// The region: the start and the scan evidence, in the axes of the start's largest wall.
 Region building_region(const Mesh& start, const Supports& s) {
   Vec3 n = Vec3::UnitY();
   for (const auto& sp : s.planes)  // the start's planes come in decreasing area: the first wall

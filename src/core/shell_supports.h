@@ -22,9 +22,8 @@ struct Supports {
   std::vector<int> face_plane;            // start face -> supporting plane
   std::vector<std::vector<Vec3>> points;  // per supporting plane: its scan points
   int added = 0;
-  int slivers = 0;            // start surfaces on a plane by the planarity tolerance alone (add_start_planes)
-  int hole_planes = 0;        // planes no face of the start lies on (add_hole_planes)
-  bool ground_added = false;  // of those, the ground
+  int slivers = 0;      // start surfaces on a plane by the planarity tolerance alone (add_start_planes)
+  int hole_planes = 0;  // planes no face of the start lies on (add_hole_planes)
 };
 
 // A plane whose normal is within this of horizontal is a wall's (deg): the contradiction and the
@@ -43,10 +42,12 @@ void add_start_planes(const Mesh& start, double planarity_tolerance, Supports& s
 void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& scan, const Params& prm,
                      Supports& s);
 // The planes a soup's holes need to close (after add_start_planes): the vertical plane through each
-// boundary edge (an edge of one face, not vertical) and the ground at the lowest vertex, each
-// unless a supporting plane carries it already (ground_added says whether the ground was). No
-// scan points.
+// boundary edge (an edge of one face; through a vertical one, across the wall's end) unless a
+// supporting plane carries it already. No scan points.
 void add_hole_planes(const Mesh& soup, Supports& s);
+// Whether a supporting plane lies on the soup's lowest level, horizontal, across its whole box:
+// the ground its walls stand on.
+bool carries_ground(const Mesh& soup, const Supports& s);
 // Hypothesised walls across where a scanned facade's points end inside the footprint.
 void add_step_walls(const Mesh& start, const Params& prm, Supports& s);
 // Where the scan-only facades that step from another scanned facade ask for a change: each point
