@@ -51,18 +51,6 @@ Scene front_scanned(double y, double x0, double x1) {
   return s;
 }
 
-// Both meshes in one (no vertex shared).
-Mesh merged(const Mesh& a, const Mesh& b) {
-  Mesh m = a;
-  const int offset = int(a.vertices.size());
-  m.vertices.insert(m.vertices.end(), b.vertices.begin(), b.vertices.end());
-  for (Face f : b.faces) {
-    for (int& v : f.v) v += offset;
-    m.faces.push_back(f);
-  }
-  return m;
-}
-
 const Match* match_of(const MatchResult& r, int surface) {
   for (const auto& m : r.matches)
     if (m.surface == surface) return &m;

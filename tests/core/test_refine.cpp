@@ -207,16 +207,9 @@ TEST(Refine, ABuildingBeyondTheCandidateCapIsKeptQuickly) {
 
 namespace {
 
-// The box [0,12]x[y0,8]x[0,7] as an exported soup without its faces listed (box(): 0 ground,
+// The box [0,12]x[y0,8]x[0,7] as an exported soup with only the faces listed (box(): 0 ground,
 // 1 roof, walls 2 y = y0, 3 x = 12, 4 y = 8, 5 x = 0).
-Mesh box_soup_without(double y0, std::initializer_list<int> drop) {
-  const Mesh whole = box_soup(0, 12, y0, 8, 7);
-  Mesh m = whole;
-  m.faces.clear();
-  for (int f = 0; f < int(whole.faces.size()); ++f)
-    if (std::find(drop.begin(), drop.end(), f) == drop.end()) m.faces.push_back(whole.faces[std::size_t(f)]);
-  return m;
-}
+Mesh box_soup_with(double y0, std::initializer_list<int> keep) { return only_faces(box_soup(0, 12, y0, 8, 7), keep); }
 
 PointCloud far_cloud() {
   PointCloud far;
@@ -230,7 +223,7 @@ PointCloud far_cloud() {
 // leave) is no valid solid; its shell is rebuilt on its own planes and written as `repaired`,
 // every vertex one of the input's.
 TEST(Refine, AHouseMissingThreeWallsIsRepairedOnItsPlanes) {
-  const Mesh coarse = box_soup_without(0.0, {2, 4, 5});
+  const Mesh coarse = box_soup_with(0.0, {0, 1, 3});
   const RefineResult r = refine_building(coarse, far_cloud(), Params{});
   ASSERT_EQ(r.outcome, Outcome::Repaired) << r.reason;
   EXPECT_TRUE(r.valid) << r.trace.output_validation.problem;
@@ -244,7 +237,7 @@ TEST(Refine, AHouseMissingThreeWallsIsRepairedOnItsPlanes) {
 // The same house with its street facade scanned 0.5 m inside the model: the rebuilt shell is the
 // start of the refinement, which moves the facade.
 TEST(Refine, ARepairedHouseIsRefinedOnItsScan) {
-  const Mesh coarse = box_soup_without(-0.5, {3, 4, 5});  // the front wall kept, 0.5 m too far out
+  const Mesh coarse = box_soup_with(-0.5, {0, 1, 2});  // the front wall kept, 0.5 m too far out
   const RefineResult r = refine_building(coarse, scan_front(0.0, 0.5, 11.5, 5.0, 7), Params{});
   ASSERT_EQ(r.outcome, Outcome::Refined) << r.reason;
   EXPECT_TRUE(r.valid) << r.trace.output_validation.problem;
@@ -256,7 +249,7 @@ TEST(Refine, ARepairedHouseIsRefinedOnItsScan) {
 // A neighbour's wall standing 3 m above the roof (a fin) is part of no solid: the building is
 // kept as read, and the reason says how much of it no shell on its planes covers.
 TEST(Refine, AHouseWithAFinIsKeptInvalidAsRead) {
-  Mesh coarse = box_soup_without(0.0, {});
+  Mesh coarse = box_soup(0, 12, 0, 8, 7);
   const int n = int(coarse.vertices.size());
   for (const Vec3& p : {Vec3(0, 0, 7), Vec3(0, 8, 7), Vec3(0, 8, 10), Vec3(0, 0, 10)})
     coarse.vertices.push_back(p + kOrigin);

@@ -266,32 +266,7 @@ namespace {
 
 // A 10 x 8 x 6 m box as an exported soup with only the faces listed (box(): 0 ground, 1 roof,
 // walls 2 y = 0, 3 x = 10, 4 y = 8, 5 x = 0).
-Mesh box_faces(std::initializer_list<int> keep) {
-  const Mesh whole = as_soup(box(Vec3(0, 0, 0), Vec3(10, 8, 6)));
-  Mesh m;
-  for (int f : keep) {
-    Face face = whole.faces[std::size_t(f)];
-    face.source = f;
-    for (int& v : face.v) {
-      m.vertices.push_back(whole.vertices[std::size_t(v)]);
-      v = int(m.vertices.size()) - 1;
-    }
-    m.faces.push_back(face);
-  }
-  return m;
-}
-
-// `soup` with the faces of the box [lo, hi] added, as a part exported with it.
-Mesh with_box(Mesh soup, const Vec3& lo, const Vec3& hi) {
-  const Mesh b = as_soup(box(lo, hi));
-  const int n = int(soup.vertices.size());
-  soup.vertices.insert(soup.vertices.end(), b.vertices.begin(), b.vertices.end());
-  for (Face f : b.faces) {
-    for (int& v : f.v) v += n;
-    soup.faces.push_back(f);
-  }
-  return soup;
-}
+Mesh box_faces(std::initializer_list<int> keep) { return only_faces(box(Vec3(0, 0, 0), Vec3(10, 8, 6)), keep); }
 
 }  // namespace
 
@@ -347,7 +322,7 @@ TEST(RebuildShell, AFinLeavesTheInputUncovered) {
 // inside the union (the other box's volume on both sides) are partitions, dropped; the union
 // covers everything else.
 TEST(RebuildShell, PartitionsBetweenOverlappingPartsAreJoined) {
-  const Mesh soup = with_box(box_faces({0, 1, 2, 3, 4, 5}), Vec3(6, 4, 0), Vec3(14, 12, 6));
+  const Mesh soup = merged(box_faces({0, 1, 2, 3, 4, 5}), as_soup(box(Vec3(6, 4, 0), Vec3(14, 12, 6))));
   const Params prm;
   const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
   ASSERT_TRUE(rb.ok) << rb.reason;
@@ -361,7 +336,7 @@ TEST(RebuildShell, PartitionsBetweenOverlappingPartsAreJoined) {
 // Two boxes that touch along one edge only: closing them as one shell would swallow their walls
 // at the corner (no partition: outside on one side). Not rebuilt; the walls stay uncovered.
 TEST(RebuildShell, PartsTouchingAlongAnEdgeAreNotSwallowed) {
-  const Mesh soup = with_box(box_faces({0, 1, 2, 3, 4, 5}), Vec3(10, 8, 0), Vec3(16, 14, 5));
+  const Mesh soup = merged(box_faces({0, 1, 2, 3, 4, 5}), as_soup(box(Vec3(10, 8, 0), Vec3(16, 14, 5))));
   const Params prm;
   const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
   EXPECT_TRUE(!rb.ok || rb.input_to_output > prm.weld_tolerance) << rb.input_to_output;
@@ -385,12 +360,8 @@ TEST(RebuildShell, AnArrangementTooLargeForABuildingIsRefused) {
   for (int k = 0; k < 30; ++k) {
     Mesh b = as_soup(box(Vec3(-4, -3, 0), Vec3(4, 3, 5 + 0.3 * k)));
     const Eigen::Matrix3d r = Eigen::AngleAxisd(radians(7.0 * k), Vec3::UnitZ()).toRotationMatrix();
-    const int n = int(soup.vertices.size());
-    for (const Vec3& p : b.vertices) soup.vertices.push_back(r * p + Vec3(0.5 * k, 0.3 * k, 0));
-    for (Face f : b.faces) {
-      for (int& v : f.v) v += n;
-      soup.faces.push_back(f);
-    }
+    for (Vec3& p : b.vertices) p = r * p + Vec3(0.5 * k, 0.3 * k, 0);
+    soup = merged(soup, b);
   }
   const Params prm;
   const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);

@@ -72,6 +72,34 @@ inline Mesh as_soup(const Mesh& m) {
   return s;
 }
 
+// Both meshes in one (no vertex shared): a part exported beside another.
+inline Mesh merged(const Mesh& a, const Mesh& b) {
+  Mesh m = a;
+  const int offset = int(a.vertices.size());
+  m.vertices.insert(m.vertices.end(), b.vertices.begin(), b.vertices.end());
+  for (Face f : b.faces) {
+    for (int& v : f.v) v += offset;
+    m.faces.push_back(f);
+  }
+  return m;
+}
+
+// The faces of `m` listed in `keep`, in that order, each with its own copies of its vertices (an
+// export that lost the others).
+inline Mesh only_faces(const Mesh& m, std::initializer_list<int> keep) {
+  Mesh out;
+  out.id = m.id;
+  for (int f : keep) {
+    Face face = m.faces[std::size_t(f)];
+    for (int& v : face.v) {
+      out.vertices.push_back(m.vertices[std::size_t(v)]);
+      v = int(out.vertices.size()) - 1;
+    }
+    out.faces.push_back(face);
+  }
+  return out;
+}
+
 // Largest distance of a vertex of `out` from the nearest vertex of `in` (a kept building is its
 // input when this is within the weld tolerance).
 inline double largest_vertex_move(const Mesh& out, const Mesh& in) {
