@@ -15,8 +15,9 @@ struct SynthArgs {
   std::string type = "all";
   std::uint64_t seed = 1;
   int count = 1;
-  std::string out, tile;
+  std::string out, tile, rescan, city;
   double grid = 80.0;
+  std::string scanner = "even";
   bool no_defects = false, no_nuisances = false, quiet = false;
   SynthOptions opt;
 };
@@ -41,6 +42,16 @@ std::string scanned_summary(const SynthBuilding& b) {
 void run(SynthArgs& a) {
   a.opt.defects = !a.no_defects;
   a.opt.nuisances = !a.no_nuisances;
+  a.opt.scanner = a.scanner == "van" ? Scanner::Van : Scanner::Even;
+  if (!a.rescan.empty()) {
+    if (a.opt.scanner != Scanner::Van) throw InputError("synth --rescan: give --scanner van");
+    rescan_tile(a.rescan, a.city, a.out, a.opt, a.seed, [&](const std::string& id, std::size_t points) {
+      if (!a.quiet) std::printf("%s  crop=%zu points\n", id.c_str(), points);
+    });
+    std::printf("%s rescanned by the van -> %s/{meta.json,tile.ply,clouds,models,truth}\n", a.rescan.c_str(),
+                a.out.c_str());
+    return;
+  }
   if (!a.tile.empty()) {
     std::uint64_t done = 0;
     Progress progress("synth", "buildings", std::uint64_t(a.count), Progress::mode_for_stderr(a.quiet));
@@ -78,6 +89,15 @@ void add_synth_command(CLI::App& app) {
   cmd->add_option("--tile", a.tile,
                   "city tile: --count buildings in all (types cycling) on a grid, their clouds "
                   "streamed into this one PLY instead of <id>/cloud.ply (cut with `lodrefine crop`)");
+  cmd->add_option("--rescan", a.rescan,
+                  "with --scanner van: a dev tile folder (meta.json, truth/, models/; ../shared/devtiles "
+                  "layout) whose buildings the van scans again: --out gets the same truths and models and "
+                  "the van's clouds (seed: --seed)")
+      ->check(CLI::ExistingDirectory);
+  cmd->add_option("--city", a.city,
+                  "with --rescan: the CityJSON file the tile's buildings come from; its buildings within 40 m "
+                  "stand in the street as neighbours (without it, boxes stand in for them)")
+      ->check(CLI::ExistingFile);
   add_ranged_option(cmd, "--grid", a.grid, "with --tile: grid spacing between buildings (m)", 10.0, 10000.0);
   auto& o = a.opt;
   add_ranged_option(cmd, "--shift-min", o.min_shift, "min facade offset (m)", 0.0, 3.0);
@@ -91,6 +111,26 @@ void add_synth_command(CLI::App& app) {
   add_ranged_option(cmd, "--points", o.target_points, "points on the scanned facades before nuisances", 100, 10000000);
   cmd->add_option("--origin-x", o.origin.x(), "georeferenced origin x")->capture_default_str();
   cmd->add_option("--origin-y", o.origin.y(), "georeferenced origin y")->capture_default_str();
+  cmd->add_option("--scanner", a.scanner,
+                  "even: the facades sampled evenly (--points); van: a mapping van's profile scanners, ray cast "
+                  "first hit from its drives past the street facades (--van-*), with facade relief (window "
+                  "reveals, glass with no return or the room behind it, doors, shop fronts, cornices, ledges, "
+                  "balconies) and street clutter (parked cars, people, lamp posts, trees with porous crowns)")
+      ->check(CLI::IsMember({"even", "van"}))
+      ->capture_default_str();
+  auto& v = o.van;
+  add_ranged_option(cmd, "--van-speed", v.speed, "van: speed (m/s)", 0.5, 40.0);
+  add_ranged_option(cmd, "--van-rate", v.profile_rate, "van: profiles per second, per profiler (Hz)", 1.0, 1000.0);
+  add_ranged_option(cmd, "--van-step", v.angle_step_deg, "van: angle between rays of a profile (deg)", 0.01, 10.0);
+  add_ranged_option(cmd, "--van-height", v.height, "van: scanner height above the road (m)", 0.5, 6.0);
+  add_ranged_option(cmd, "--van-yaw", v.yaw_deg, "van: the two profilers turned +- this from across the street (deg)",
+                    0.0, 80.0);
+  add_ranged_option(cmd, "--van-range", v.max_range, "van: maximum range (m)", 2.0, 1000.0);
+  add_ranged_option(cmd, "--van-drives", v.drives, "van: drives past each street (the second back in the far lane)", 1,
+                    8);
+  add_ranged_option(cmd, "--van-offset", v.offset,
+                    "van: misregistration of the later drives: horizontal offset up to this (m)", 0.0, 5.0);
+  add_ranged_option(cmd, "--van-heading", v.heading_deg, "van: and heading error up to this (deg)", 0.0, 5.0);
   cmd->add_flag("--no-defects", a.no_defects, "coarse model without export defects");
   cmd->add_flag("--no-nuisances", a.no_nuisances, "cloud without windows, clutter, ground and neighbours");
   cmd->add_flag("--quiet", a.quiet, "with --tile: no progress line on stderr");

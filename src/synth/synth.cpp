@@ -11,12 +11,16 @@
 #include "perturb.h"
 #include "scan.h"
 #include "shapes.h"
+#include "van.h"
 
 namespace lodrefine {
 
 using namespace synth;
 
 namespace {
+
+// m: a van scan is cropped to the building's box grown by this and 10 %.
+constexpr double kCropMargin = 3.0;
 
 // Georeferencing.
 struct Frame {
@@ -41,6 +45,15 @@ void check_options(const SynthOptions& o) {
   if (o.noise < 0 || o.global_shift < 0) throw InputError("synth: noise and global_shift must be >= 0");
   if (o.target_points < 100) throw InputError("synth: target_points must be >= 100");
   if (o.scanned_facades < 0) throw InputError("synth: scanned_facades must be >= 0");
+  const VanOptions& v = o.van;
+  if (!(v.speed > 0 && v.profile_rate > 0 && v.speed / v.profile_rate >= 0.005))
+    throw InputError("synth: the van needs speed / profile_rate >= 5 mm between profiles");
+  if (!(v.angle_step_deg >= 0.01 && v.angle_step_deg <= 10))
+    throw InputError("synth: angle_step_deg must be in 0.01..10");
+  if (!(v.max_range > 1 && v.max_range <= 1000) || !(v.height > 0 && v.height < 10))
+    throw InputError("synth: the van needs max_range in 1..1000 m and height in 0..10 m");
+  if (v.drives < 1 || v.drives > 8 || !(v.offset >= 0 && v.offset <= 5) || !(std::abs(v.heading_deg) <= 5))
+    throw InputError("synth: the van needs 1..8 drives, offset in 0..5 m and heading_deg in -5..5");
 }
 
 // Every building type with its name, in the order `--type all` generates them.
@@ -131,10 +144,23 @@ SynthBuilding make_building(BuildingType type, std::uint64_t seed, const SynthOp
   if (opt.defects) b.defects = add_defects(coarse, r_defects);
   for (int i = 0; i < int(coarse.faces.size()); ++i) coarse.faces[i].source = i;
 
-  ScanResult sc = simulate_scan(truth, b.scanned_truth_faces, z0, spec.street_normal, opt, r_scan);
-  b.point_spacing = sc.spacing;
-  for (const auto& p : sc.pts) b.cloud.points.push_back(frame.apply(p));
-  b.point_label = std::move(sc.labels);
+  if (opt.scanner == Scanner::Van) {
+    const VanScan sc = van_scan(truth, b.scanned_truth_faces, z0, {}, opt, r_scan);
+    b.point_spacing = sc.spacing;
+    Eigen::AlignedBox3d crop = bounding_box(truth.vertices);  // a crop: the building's box grown by 3 m and 10 %
+    const Vec3 grow = 0.1 * crop.sizes() + Vec3::Constant(kCropMargin);
+    crop = Eigen::AlignedBox3d(crop.min() - grow, crop.max() + grow);
+    for (std::size_t i = 0; i < sc.pts.size(); ++i)
+      if (crop.contains(sc.pts[i]))
+        b.cloud.points.push_back(frame.apply(sc.pts[i])), b.point_label.push_back(sc.labels[i]);
+    if (sc.misregistration.size() > 1)
+      b.misregistration = frame.apply(sc.misregistration[1].shift) - frame.apply(Vec3::Zero());
+  } else {
+    ScanResult sc = simulate_scan(truth, b.scanned_truth_faces, z0, spec.street_normal, opt, r_scan);
+    b.point_spacing = sc.spacing;
+    for (const auto& p : sc.pts) b.cloud.points.push_back(frame.apply(p));
+    b.point_label = std::move(sc.labels);
+  }
 
   b.truth = to_world(truth, frame, Vec3::Zero());
   b.truth.id = coarse.id = b.id;

@@ -36,7 +36,13 @@ Json meta_json(const SynthBuilding& b) {
                      {"scanned", m.scanned}});
   std::map<std::string, int> by_label;
   for (int l : b.point_label)
-    by_label[l >= 0 ? "facade" : l == -1 ? "window_recess" : l == -2 ? "clutter" : l == -3 ? "ground" : "neighbour"]++;
+    by_label[l >= 0    ? "facade"
+             : l == -1 ? "window_recess"
+             : l == -2 ? "clutter"
+             : l == -3 ? "ground"
+             : l == -4 ? "neighbour"
+             : l == -5 ? "relief"
+                       : "interior"]++;
   return {
       {"id", b.id},
       {"type", building_type_name(b.type)},
@@ -53,7 +59,19 @@ Json meta_json(const SynthBuilding& b) {
         {"noise", o.noise},
         {"target_points", o.target_points},
         {"defects", o.defects},
-        {"nuisances", o.nuisances}}},
+        {"nuisances", o.nuisances},
+        {"scanner", o.scanner == Scanner::Van ? "van" : "even"}}},
+      {"van", o.scanner != Scanner::Van ? Json(nullptr)
+                                        : Json{{"speed", o.van.speed},
+                                               {"profile_rate", o.van.profile_rate},
+                                               {"angle_step_deg", o.van.angle_step_deg},
+                                               {"height", o.van.height},
+                                               {"yaw_deg", o.van.yaw_deg},
+                                               {"max_range", o.van.max_range},
+                                               {"drives", o.van.drives},
+                                               {"offset", o.van.offset},
+                                               {"heading_deg", o.van.heading_deg},
+                                               {"misregistration", vec_json(b.misregistration)}}},
       {"moved_walls", moved},
       {"coarse_shift", vec_json(b.coarse_shift)},
       {"defects", b.defects},
@@ -61,7 +79,8 @@ Json meta_json(const SynthBuilding& b) {
       {"point_spacing", b.point_spacing},
       {"point_labels",
        "cloud.ply property 'label': truth face index for facade points, -1 window recess, "
-       "-2 clutter (trees, cars, people), -3 street ground, -4 neighbouring building"},
+       "-2 clutter (trees, cars, people), -3 street ground, -4 neighbouring building, -5 relief (balcony, "
+       "cornice, ledge), -6 room behind glass"},
       {"counts",
        {{"truth_faces", b.truth.faces.size()},
         {"truth_vertices", b.truth.vertices.size()},

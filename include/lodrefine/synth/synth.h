@@ -20,6 +20,28 @@ std::vector<BuildingType> all_building_types();
 // Recess, Bay, Setback: the coarse model lacks faces of the truth's street facade.
 bool street_facade_type(BuildingType t);
 
+// A mapping van's profile scanners (`--scanner van`): two profilers turned +-yaw_deg from across
+// the street, `height` above the road, the van at `speed`; each profiler records a profile every
+// 1 / profile_rate s with a ray every angle_step_deg, first hit within max_range. `drives` passes
+// (the second back the other way in the far lane), misregistered against the first by a
+// horizontal offset of up to `offset` m and a heading of up to heading_deg.
+struct VanOptions {
+  double speed = 10.0;          // m/s
+  double profile_rate = 50.0;   // Hz, per profiler
+  double angle_step_deg = 0.3;  // within a profile
+  double height = 2.3;          // m above the road
+  double yaw_deg = 45.0;        // profilers turned +- this from across the street
+  double max_range = 40.0;      // m
+  int drives = 2;
+  double offset = 0.08;       // m: the second drive's misregistration, drawn in [offset / 4, offset]
+  double heading_deg = 0.03;  // deg: and its heading error, drawn in [-heading_deg, heading_deg]
+};
+
+enum class Scanner {
+  Even,  // the facades sampled evenly (a jittered grid), nuisances cut from it
+  Van,   // ray cast from a van's trajectory (VanOptions), facade relief and street clutter
+};
+
 struct SynthOptions {
   double max_shift = 0.8;         // facade offset, uniform in [min_shift, max_shift] with random sign (m);
   double min_shift = 0.2;         // the street types' generalised front: [min_shift/2, 0.75 max_shift], no rotation
@@ -31,6 +53,8 @@ struct SynthOptions {
   bool defects = true;            // missing ground / mm gaps / flipped face / duplicate face
   bool nuisances = true;          // windows, recesses, occlusion holes, trees, cars, ground, neighbours
   Vec3 origin{85000.0, 447000.0, 0.0};  // georeferenced offset (RD New-like by default)
+  Scanner scanner = Scanner::Even;
+  VanOptions van;  // with Scanner::Van (target_points is then unused)
 };
 
 // A facade of the coarse model that differs from the truth.
@@ -57,8 +81,9 @@ struct SynthBuilding {
   PointCloud cloud;                      // georeferenced MLS crop
   std::vector<int> scanned_truth_faces;  // indices into truth.faces of the scanned walls (street types:
                                          // every street wall, returns and bay sides seen obliquely)
+  Vec3 misregistration = Vec3::Zero();   // Scanner::Van: the second drive's shift against the first (m)
   std::vector<int> point_label;  // per cloud point: truth face index for facade points, -1 window recess, -2 clutter,
-                                 // -3 ground, -4 neighbour
+                                 // -3 ground, -4 neighbour, -5 relief (balcony, cornice), -6 room behind glass
 };
 
 // Deterministic for (type, seed, options).
@@ -76,5 +101,17 @@ void write_synth_building(const std::string& dir, const SynthBuilding& b, bool w
 std::uint64_t write_synth_tile(const std::string& dir, const std::string& tile_ply, int count, std::uint64_t first_seed,
                                double spacing, const SynthOptions& opt,
                                const std::function<void(const SynthBuilding&)>& progress);
+
+// A dev tile (../shared/devtiles layout: meta.json, truth/, models/, clouds/; from this
+// project's tile generators) scanned again by the van: OUT gets the same truths, models and
+// meta.json (with a "scanner" object and, per building, its drives and misregistration), and
+// clouds/<id>.ply and tile.ply from the van (labels and building as the dev tiles'). Each
+// building's van drives past the walls meta.json's scanned_walls names; `city` (a CityJSON
+// file, may be empty) puts its buildings within 40 m in the street as neighbours (the one named
+// by cityjson_id excepted); without it, boxes stand in for them. Crops: the model's box grown
+// by 10 % and 3 m. Deterministic for (tile, city, opt, seed). `progress` (may be empty) gets each
+// building's id and crop size. Throws InputError when OUT already holds a meta.json.
+void rescan_tile(const std::string& tile, const std::string& city, const std::string& out, const SynthOptions& opt,
+                 std::uint64_t seed, const std::function<void(const std::string&, std::size_t)>& progress);
 
 }  // namespace lodrefine
