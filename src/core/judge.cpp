@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <set>
 
@@ -176,6 +177,52 @@ struct Side {
   }
 };
 
+// Returns from behind a scanned wall's openings (a room seen through glass, a pane in its
+// reveal): between kBehindWall and kRoomDepth behind a facade plane, in a column (kColumn wide)
+// where the wall's own points stand above and below them, and inside both models by kBehindWall
+// (not a wall of either: the building's own wall behind a neighbour's standing before it). They show what is behind the
+// facade, not where it is: the judge leaves them out, whichever way a wall moved.
+constexpr double kBehindWall = 0.1, kRoomDepth = 6.0;  // m
+class Openings {
+ public:
+  Openings(const std::vector<ScanPlane>& planes, const PointCloud& cloud, const Mesh& model, const Mesh& other)
+      : distance_(model), other_(other) {
+    const auto normals = face_planes(model);
+    for (const auto& sp : planes) {
+      if (!sp.facade || sp.inliers.empty() || normals.empty()) continue;
+      Wall w{sp.plane, horizontal_along(sp.plane), {}};
+      const int f = distance_.nearest(sp.centroid, false).face;
+      if (f >= 0 && w.plane.n.dot(normals[std::size_t(f)].n) < 0) w.plane = w.plane.flipped();
+      for (int i : sp.inliers) {
+        const Vec3& q = cloud.points[std::size_t(i)];
+        auto [it, fresh] = w.columns.try_emplace(column_of(q, w.plane), q.z(), q.z());
+        if (!fresh)
+          it->second.first = std::min(it->second.first, q.z()), it->second.second = std::max(it->second.second, q.z());
+      }
+      walls_.push_back(std::move(w));
+    }
+  }
+  bool behind(const Vec3& p) const {
+    for (const auto& w : walls_) {
+      const double d = w.plane.distance(p);
+      if (d > -kBehindWall || d < -kRoomDepth) continue;
+      const auto it = w.columns.find(column_of(p, w.plane));
+      if (it != w.columns.end() && it->second.first < p.z() && p.z() < it->second.second)
+        return distance_.distance(p, true) < -kBehindWall && other_.distance(p, true) < -kBehindWall;
+    }
+    return false;
+  }
+
+ private:
+  struct Wall {
+    Plane plane;  // outwards
+    Vec3 u;
+    std::map<long long, std::pair<double, double>> columns;  // the lowest and highest inlier per column
+  };
+  MeshDistance distance_, other_;
+  std::vector<Wall> walls_;
+};
+
 // The points near either model with their capped distances: within `cap` of one, or a facade
 // line's within `reach` where it stands before no points of the face it faces (judge.h).
 std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const std::vector<JudgedWall>& walls,
@@ -194,12 +241,13 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
   box.max() += Vec3::Constant(reach);
   Side s0(before, facade_lines), s1(after, facade_lines);
   const std::vector<int> facade = facade_plane_of(planes, cloud.points.size());
+  const Openings openings(planes, cloud, before, after);
   std::vector<std::size_t> judged;  // the cloud's points near enough to be judged
   std::vector<Vec3> at;
   for (std::size_t i = 0; i < cloud.points.size(); ++i) {
     const Vec3& p = cloud.points[i];
     if (!box.contains(p) || (facade[i] < 0 && !within_cap.contains(p)) || p.z() < ground ||
-        neighbours(p, walls, on_plane))
+        neighbours(p, walls, on_plane) || openings.behind(p))
       continue;
     judged.push_back(i);
     at.push_back(p);

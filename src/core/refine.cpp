@@ -342,6 +342,45 @@ Vec3 local_origin(const Mesh& model) {
   return (lo / kOriginGrid).array().floor().matrix() * kOriginGrid;
 }
 
+namespace {
+
+// The scan's planes near the model, its doubled walls laid onto one plane in `local`, and the
+// facade planes that are relief moved to `relief`.
+std::vector<ScanPlane> scan_walls(const Mesh& model, PointCloud& local, const RefineConfig& prm,
+                                  std::vector<ScanPlane>& relief) {
+  auto planes = detect_planes(local, prm);
+  collapse_doubled_walls(local, planes);
+  return without_relief(std::move(planes), model, local, prm, &relief);
+}
+
+RefineTrace::Scan scan_summary(const std::vector<ScanPlane>& walls, const std::vector<ScanPlane>& relief,
+                               std::size_t points) {
+  RefineTrace::Scan s;
+  std::vector<std::pair<double, std::size_t>> gaps;  // (distance, points), for the median
+  std::size_t doubled_points = 0;
+  for (const auto& p : walls) {
+    if (p.doubled > 0)
+      ++s.doubled_walls, gaps.emplace_back(p.doubled, p.inliers.size()), doubled_points += p.inliers.size();
+    if (!p.facade || p.hull_area <= 0) continue;
+    const double density = double(p.inliers.size()) / p.hull_area;
+    s.min_density = s.min_density == 0 ? density : std::min(s.min_density, density);
+    s.max_density = std::max(s.max_density, density);
+  }
+  std::sort(gaps.begin(), gaps.end());
+  std::size_t seen = 0;
+  for (const auto& [gap, n] : gaps)
+    if ((seen += n) * 2 >= doubled_points) {
+      s.misregistration = gap;
+      break;
+    }
+  s.relief = relief;
+  for (const auto& p : relief) s.relief_points += p.inliers.size();
+  s.relief_share = points ? double(s.relief_points) / double(points) : 0.0;
+  return s;
+}
+
+}  // namespace
+
 RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const RefineConfig& prm) {
   prm.validate();
   Run run(model, prm.planarity_tolerance);
@@ -352,10 +391,12 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const R
   Mesh current = merge_coplanar_faces(kept);
   current.id = model.id;
 
-  // Planes of the scan near the model.
-  const PointCloud local = cloud_near(current, cloud, run.origin(), prm);
+  // Planes of the scan near the model: a wall seen twice is one, relief is no wall.
+  PointCloud local = cloud_near(current, cloud, run.origin(), prm);
   trace.cloud = {cloud.points.size(), local.points.size()};
-  const auto planes = detect_planes(local, prm);
+  std::vector<ScanPlane> relief;
+  const auto planes = scan_walls(current, local, prm, relief);
+  trace.scan = scan_summary(planes, relief, local.points.size());
   run.lap(RefineStage::Planes);
   trace.planes = planes;
   if (planes.empty()) return run.finish(Outcome::Kept, "no planes found in the cloud near the model", kept);

@@ -108,17 +108,26 @@ json refine_report(const RefineResult& r) {
                       {"hausdorff_output_to_input", rb.output_to_input}};
   }
   if (t.cloud) rep["cloud"] = {{"points", t.cloud->first}, {"points_near_model", t.cloud->second}};
-  if (t.planes) {
-    json planes = json::array();
-    for (const auto& p : *t.planes)
-      planes.push_back({{"normal", {p.plane.n.x(), p.plane.n.y(), p.plane.n.z()}},
-                        {"d", p.plane.d},
-                        {"inliers", p.inliers.size()},
-                        {"rms", p.rms},
-                        {"area", p.hull_area},
-                        {"facade", p.facade}});
-    rep["planes"] = planes;
-  }
+  auto planes_json = [](const std::vector<ScanPlane>& planes) {
+    json out = json::array();
+    for (const auto& p : planes)
+      out.push_back({{"normal", {p.plane.n.x(), p.plane.n.y(), p.plane.n.z()}},
+                     {"d", p.plane.d},
+                     {"inliers", p.inliers.size()},
+                     {"rms", p.rms},
+                     {"area", p.hull_area},
+                     {"facade", p.facade},
+                     {"doubled", p.doubled}});
+    return out;
+  };
+  if (t.planes) rep["planes"] = planes_json(*t.planes);
+  if (t.scan)
+    rep["scan"] = {{"doubled_walls", t.scan->doubled_walls},
+                   {"misregistration", t.scan->misregistration},
+                   {"relief_planes", planes_json(t.scan->relief)},
+                   {"relief_points", t.scan->relief_points},
+                   {"relief_share", t.scan->relief_share},
+                   {"wall_density", {{"min", t.scan->min_density}, {"max", t.scan->max_density}}}};
   if (t.matching) {
     json matches = json::array();
     for (const auto& w : t.matching->walls) {

@@ -57,10 +57,13 @@ void StreetScene::add_mesh(const Mesh& m, int building, bool faces_labelled, con
 
 void StreetScene::add_box(const Vec3& c, const Vec3& u, const Vec3& n, const Vec3& half, int label, int building) {
   const Vec3 ax[3] = {u * half.x(), n * half.y(), Vec3::UnitZ() * half.z()};
-  auto corner = [&](int i, int j, int k) { return c + (i ? 1 : -1) * ax[0] + (j ? 1 : -1) * ax[1] + (k ? 1 : -1) * ax[2]; };
-  const int quads[6][4][3] = {{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, {{0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1}},
-                              {{0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}}, {{0, 1, 0}, {1, 1, 0}, {1, 1, 1}, {0, 1, 1}},
-                              {{0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1}}, {{1, 0, 0}, {1, 0, 1}, {1, 1, 1}, {1, 1, 0}}};
+  auto corner = [&](int i, int j, int k) {
+    return c + (i ? 1 : -1) * ax[0] + (j ? 1 : -1) * ax[1] + (k ? 1 : -1) * ax[2];
+  };
+  const int quads[6][4][3] = {
+      {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, {{0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1}},
+      {{0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}}, {{0, 1, 0}, {1, 1, 0}, {1, 1, 1}, {0, 1, 1}},
+      {{0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1}}, {{1, 0, 0}, {1, 0, 1}, {1, 1, 1}, {1, 1, 0}}};
   for (const auto& q : quads) {
     std::vector<Vec3> poly;
     for (const auto& v : q) poly.push_back(corner(v[0], v[1], v[2]));
@@ -96,10 +99,8 @@ std::optional<Shot> through_opening(const SceneWall& w, const Vec3& hit, const V
       return Shot{hit + d * (a * op.reveal / facing), kWindow};
     }
     switch (op.pane) {
-      case Opening::Pane::Opaque:
-        return Shot{pane, kWindow};
-      case Opening::Pane::Dark:
-        return std::nullopt;
+      case Opening::Pane::Opaque: return Shot{pane, kWindow};
+      case Opening::Pane::Dark: return std::nullopt;
       case Opening::Pane::Room:
         if (r.chance(0.3)) return std::nullopt;  // the glass reflects it away
         return Shot{pane + d * (op.room / facing), kInterior};
@@ -233,8 +234,8 @@ int add_relief(StreetScene& scene, const std::vector<Vec3>& poly, double z0, int
     for (double s = r.uniform(0.6, 1.2); s + ww < smax - 0.5; s += pitch)
       if (rect_inside(sz, s - 0.2, s + ww + 0.2, zb - 0.2, zt + 0.2)) {
         const double room = r.uniform(1.0, 4.0);
-        w.openings.push_back({s, s + ww, zb, zt, std::clamp(reveal + r.uniform(-0.03, 0.03), 0.1, 0.3), draw_pane(r),
-                              room});
+        w.openings.push_back(
+            {s, s + ww, zb, zt, std::clamp(reveal + r.uniform(-0.03, 0.03), 0.1, 0.3), draw_pane(r), room});
       }
   }
   // Proud of the wall: a cornice under the eave, ledges at storey lines, balconies.
@@ -337,7 +338,8 @@ std::vector<FacadeGroup> facade_groups(const Mesh& truth, const std::vector<int>
     const auto poly = face_points(truth, truth.faces[std::size_t(f)]);
     const Vec3 nn = newell_normal(poly);
     const Vec3 n = Vec3(nn.x(), nn.y(), 0).normalized();
-    auto g = std::find_if(groups.begin(), groups.end(), [&](const FacadeGroup& x) { return x.n.dot(n) > kNewStreetCos; });
+    auto g =
+        std::find_if(groups.begin(), groups.end(), [&](const FacadeGroup& x) { return x.n.dot(n) > kNewStreetCos; });
     if (g == groups.end()) g = groups.insert(groups.end(), {n, -1e300, 0.0});
     g->area += polygon_area(poly);
     for (const auto& p : poly) g->front = std::max(g->front, g->n.dot(p));
@@ -374,12 +376,13 @@ void add_neighbour_boxes(StreetScene& scene, const FacadeGroup& g, double s0, do
 
 }  // namespace
 
-VanScan van_scan(const Mesh& truth, const std::vector<int>& street_faces, double z0, const std::vector<Mesh>& neighbours,
-                 const SynthOptions& o, Rng& r) {
+VanScan van_scan(const Mesh& truth, const std::vector<int>& street_faces, double z0,
+                 const std::vector<Mesh>& neighbours, const SynthOptions& o, Rng& r) {
   StreetScene scene;
   std::vector<int> face_walls(truth.faces.size(), -1);
   for (int f : street_faces)
-    if (o.nuisances) face_walls[std::size_t(f)] = add_relief(scene, face_points(truth, truth.faces[std::size_t(f)]), z0, 0, r);
+    if (o.nuisances)
+      face_walls[std::size_t(f)] = add_relief(scene, face_points(truth, truth.faces[std::size_t(f)]), z0, 0, r);
   scene.add_mesh(truth, 0, true, face_walls);
   for (const Mesh& m : neighbours) scene.add_mesh(m, -1, false);
   std::vector<const Mesh*> solids{&truth};
@@ -415,9 +418,10 @@ VanScan van_scan(const Mesh& truth, const std::vector<int>& street_faces, double
   // The street itself, under every lane.
   const Eigen::AlignedBox3d box = bounding_box(truth.vertices);
   const double reach = kRunOn + kLaneMax + kFarLaneMax + 10;
-  scene.add_face({Vec3(box.min().x() - reach, box.min().y() - reach, z0), Vec3(box.max().x() + reach, box.min().y() - reach, z0),
-                  Vec3(box.max().x() + reach, box.max().y() + reach, z0), Vec3(box.min().x() - reach, box.max().y() + reach, z0)},
-                 kGround, -1);
+  scene.add_face(
+      {Vec3(box.min().x() - reach, box.min().y() - reach, z0), Vec3(box.max().x() + reach, box.min().y() - reach, z0),
+       Vec3(box.max().x() + reach, box.max().y() + reach, z0), Vec3(box.min().x() - reach, box.max().y() + reach, z0)},
+      kGround, -1);
 
   const Vec3 pivot = 0.5 * (box.min() + box.max());
   for (const auto& [first, far_offset] : lanes)
@@ -427,7 +431,8 @@ VanScan van_scan(const Mesh& truth, const std::vector<int>& street_faces, double
         std::swap(d.start, d.end);
         d.start -= far_offset * first.side, d.end -= far_offset * first.side;
       }
-      const Misregistration m = k == 0 ? Misregistration{Vec3::Zero(), 0.0, pivot} : draw_misregistration(o.van, pivot, r);
+      const Misregistration m =
+          k == 0 ? Misregistration{Vec3::Zero(), 0.0, pivot} : draw_misregistration(o.van, pivot, r);
       const int index = int(out.drives.size());
       for (const ScenePoint& sp : scene.scan(d, index, o.van, o.noise, r)) {
         out.pts.push_back(m.apply(sp.p));

@@ -131,7 +131,7 @@ struct VanScan {
 // whose street is clear (no building between the facade and the far lane), o.van.drives times
 // each. `neighbours` stand in the scene as kNeighbour; with none, boxes stand in for them past
 // the street's ends. Noise o.noise along each ray.
-VanScan van_scan(const Mesh& truth, const std::vector<int>& street_faces, double z0, const std::vector<Mesh>& neighbours,
-                 const SynthOptions& o, Rng& r);
+VanScan van_scan(const Mesh& truth, const std::vector<int>& street_faces, double z0,
+                 const std::vector<Mesh>& neighbours, const SynthOptions& o, Rng& r);
 
 }  // namespace lodrefine::synth

@@ -60,17 +60,12 @@ struct DevtileCloud {
 std::pair<int, int> devtile_label(int label, int b) {
   if (label >= 0) return {0, b};
   switch (label) {
-    case kWindow:
-      return {1, b};
+    case kWindow: return {1, b};
     case kRelief:
-    case kInterior:
-      return {2, b};
-    case kGround:
-      return {3, -1};
-    case kNeighbour:
-      return {0, -1};
-    default:
-      return {2, -1};
+    case kInterior: return {2, b};
+    case kGround: return {3, -1};
+    case kNeighbour: return {0, -1};
+    default: return {2, -1};
   }
 }
 
@@ -166,11 +161,21 @@ void rescan_tile(const std::string& tile, const std::string& city_path, const st
     ++index;
   }
   const VanOptions& v = opt.van;
-  meta["scanner"] = {{"kind", "van"},          {"source_tile", tile},           {"city", city_path},
-                     {"seed", seed},           {"speed", v.speed},              {"profile_rate", v.profile_rate},
-                     {"angle_step_deg", v.angle_step_deg}, {"height", v.height}, {"yaw_deg", v.yaw_deg},
-                     {"max_range", v.max_range}, {"drives", v.drives},          {"offset", v.offset},
-                     {"heading_deg", v.heading_deg}, {"noise", opt.noise},      {"relief", opt.nuisances}};
+  meta["scanner"] = {{"kind", "van"},
+                     {"source_tile", tile},
+                     {"city", city_path},
+                     {"seed", seed},
+                     {"speed", v.speed},
+                     {"profile_rate", v.profile_rate},
+                     {"angle_step_deg", v.angle_step_deg},
+                     {"height", v.height},
+                     {"yaw_deg", v.yaw_deg},
+                     {"max_range", v.max_range},
+                     {"drives", v.drives},
+                     {"offset", v.offset},
+                     {"heading_deg", v.heading_deg},
+                     {"noise", opt.noise},
+                     {"relief", opt.nuisances}};
   write_file_atomic((to / "tile.ply").string(), whole.ply());
   write_file_atomic((to / "meta.json").string(), meta.dump(1) + "\n");
 }

@@ -268,3 +268,26 @@ TEST(Judge, AFacadeLineBeforeTheWallsOwnPointsIsNotJudged) {
   EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
   EXPECT_EQ(j.building.points, facade);
 }
+
+// The model's front stands 0.5 m behind the scanned wall, which has a shop window 8 m wide: the
+// van sees the shop 1 m behind the glass. Those returns show what is behind the facade, not where
+// it is: moving the wall out onto its scan takes it away from them, and that does not count.
+TEST(Judge, ReturnsFromARoomSeenThroughGlassAreNotJudged) {
+  const Mesh coarse = box({0, 0.5, 0}, {12, 8, 6}), refined = box({0, 0, 0}, {12, 8, 6});
+  PointCloud cloud;
+  ScanPlane front;
+  front.plane = Plane(-kY, 0.0);
+  front.facade = true;
+  for (const auto& part : {wall_patch({0, 0, 0}, kX, 2.0, 0.3, 5.5), wall_patch({10, 0, 0}, kX, 2.0, 0.3, 5.5),
+                           wall_patch({2, 0, 0}, kX, 8.0, 3.1, 5.5), wall_patch({2, 0, 0}, kX, 8.0, 0.3, 0.6)})
+    for (int i : add_grid(cloud, part, 0.1, 0.005)) front.inliers.push_back(i);
+  for (int i : front.inliers) front.centroid += cloud.points[i];
+  front.centroid /= double(front.inliers.size());
+  const std::size_t wall = cloud.points.size();
+  add_grid(cloud, wall_patch({2.1, 1.0, 0}, kX, 7.8, 0.7, 3.0), 0.03, 0.005);  // the shop's back, through the glass
+  const Judgement j = judge_refinement(coarse, refined, {front_wall(0.5, 0.0)}, cloud, MatchConfig{}, PlaneConfig{},
+                                       {front}, MatchConfig{}.match_distance + 1.0);
+  EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
+  EXPECT_EQ(j.building.points, wall);
+  EXPECT_LT(j.building.rms_after, 0.02);
+}

@@ -12,6 +12,7 @@
 #include <set>
 
 #include "lodrefine/core/planes.h"
+#include "support/mesh_fixtures.h"
 #include "support/scan_fixtures.h"
 
 using namespace lodrefine;
@@ -369,4 +370,80 @@ TEST_P(Planes, RepeatedPointsBesideAFacadeLeaveItsPlane) {
   ASSERT_EQ(planes.size(), 1u);
   expect_same_plane(planes[0], wall.plane);
   EXPECT_EQ(count_of(planes[0].inliers, wall.points), planes[0].inliers.size());
+}
+
+// Two drives registered 7 cm apart see one wall twice: one plane midway, holding both copies,
+// with their distance; laid onto it, the copies are one layer of the scan's noise.
+TEST_P(Planes, AWallSeenTwiceByMisregisteredDrivesIsOnePlaneMidway) {
+  PointCloud cloud;
+  add_grid(cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 10.0, 0.0, 6.0), 0.05, 0.008, 1);
+  add_grid(cloud, wall_patch({0.02, -0.07, 0}, Vec3::UnitX(), 10.0, 0.0, 6.0), 0.07, 0.008, 2);
+  auto planes = detect_planes(cloud, params());
+  ASSERT_EQ(planes.size(), 1u);
+  EXPECT_NEAR(planes[0].doubled, 0.07, 0.01);
+  EXPECT_NEAR(std::abs(planes[0].plane.distance(Vec3(5, -0.035, 3))), 0.0, 0.005);  // midway, not at the denser copy
+  EXPECT_GE(planes[0].inliers.size(), std::size_t(0.97 * double(cloud.points.size())));
+  collapse_doubled_walls(cloud, planes);
+  double worst = 0.0;
+  for (int i : planes[0].inliers) worst = std::max(worst, std::abs(planes[0].plane.distance(cloud.points[i])));
+  EXPECT_LT(worst, 0.04);
+}
+
+// A wall and a plinth 7 cm proud along its foot: two surfaces, not one wall seen twice.
+TEST_P(Planes, AWallWithAPlinthIsNotAWallSeenTwice) {
+  PointCloud cloud;
+  add_grid(cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 10.0, 1.0, 6.0), 0.05, 0.005, 1);
+  add_grid(cloud, wall_patch({0, -0.07, 0}, Vec3::UnitX(), 10.0, 0.0, 1.0), 0.05, 0.005, 2);
+  for (const auto& p : detect_planes(cloud, params())) EXPECT_EQ(p.doubled, 0.0);
+}
+
+namespace {
+
+// The front wall (y = 0, 12 m long, 9 m high) of a box model, scanned, and a patch before it.
+struct FrontAndPatch {
+  PointCloud cloud;
+  std::vector<ScanPlane> planes;
+};
+FrontAndPatch front_and(const Patch& patch, double step) {
+  FrontAndPatch f;
+  f.planes.push_back(grid_scan_plane(f.cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 12.0, 0.0, 9.0), 0.1));
+  f.planes.push_back(grid_scan_plane(f.cloud, patch, step));
+  return f;
+}
+
+}  // namespace
+
+// A balcony's front 1.2 m before the wall, 1.1 m high, and a cornice: relief, not walls. A bay's
+// front standing the wall's height, however sparse, is a wall.
+TEST_P(Planes, BalconiesAndCornicesAreReliefABayIsAWall) {
+  const Mesh model = fixtures::box({0, 0, 0}, {12, 8, 9});
+  for (const auto& [patch, step, wall] :
+       {std::tuple{wall_patch({3, -1.2, 0}, Vec3::UnitX(), 3.0, 3.0, 4.1), 0.05, false},
+        std::tuple{wall_patch({0, -0.25, 0}, Vec3::UnitX(), 12.0, 8.4, 8.8), 0.05, false},
+        std::tuple{wall_patch({4, -1.0, 0}, Vec3::UnitX(), 3.0, 0.0, 9.0), 0.3, true}}) {
+    FrontAndPatch f = front_and(patch, step);
+    std::vector<ScanPlane> relief;
+    const auto walls = without_relief(f.planes, model, f.cloud, params(), &relief);
+    EXPECT_EQ(walls.size(), wall ? 2u : 1u) << patch.origin.transpose() << " z " << patch.t0 << "-" << patch.t1;
+    EXPECT_EQ(relief.size(), wall ? 0u : 1u);
+  }
+}
+
+// Rooms seen through the windows of three storeys, at one depth behind the wall: storey-high
+// gaps, relief.
+TEST_P(Planes, RoomsSeenThroughWindowsStoreyByStoreyAreRelief) {
+  const Mesh model = fixtures::box({0, 0, 0}, {12, 8, 9});
+  FrontAndPatch f;
+  f.planes.push_back(grid_scan_plane(f.cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 12.0, 0.0, 9.0), 0.1));
+  ScanPlane rooms;
+  for (double z : {1.0, 4.0, 7.0}) {
+    const ScanPlane storey = grid_scan_plane(f.cloud, wall_patch({2, 2.5, 0}, Vec3::UnitX(), 8.0, z, z + 1.4), 0.05);
+    rooms.inliers.insert(rooms.inliers.end(), storey.inliers.begin(), storey.inliers.end());
+    rooms.plane = storey.plane;
+    rooms.facade = true;
+  }
+  f.planes.push_back(rooms);
+  std::vector<ScanPlane> relief;
+  EXPECT_EQ(without_relief(f.planes, model, f.cloud, params(), &relief).size(), 1u);
+  EXPECT_EQ(relief.size(), 1u);
 }

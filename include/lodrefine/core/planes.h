@@ -16,6 +16,9 @@ struct ScanPlane {
   double rms = 0.0;        // inlier distance RMS (m)
   double hull_area = 0.0;  // area of the inliers' 2D convex hull in the plane (m^2)
   bool facade = false;     // near-vertical
+  // m: the distance between the two copies of a facade seen by two drives registered apart
+  // (0: one copy). The plane then lies midway between them and holds both copies' points.
+  double doubled = 0.0;
 };
 
 // Detects planes in `cloud` (local frame). Deterministic for a given PlaneConfig::seed. Reads its
@@ -30,7 +33,33 @@ struct ScanPlane {
 // point joining a region when within ransac_epsilon of its least-squares plane, its normal within
 // ransac_normal_deg, and within the detection's cluster epsilon of a member (a point of the voxels
 // around or of its normal's neighbourhood). Too few, repeated or nearly coincident points give no
-// plane.
+// plane. A facade seen twice (two drives registered a few centimetres apart: the points within
+// kMaxDoubledWall of its plane and inside its extent fall in two layers, each holding a fifth of
+// them or more, as wide and tall as each other) is one plane midway between the layers, with
+// `doubled` their distance; the pieces RANSAC cut from the second layer are gone.
 std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const PlaneConfig& config);
+
+// m: the farthest apart two copies of one facade are taken for a misregistration, not two walls.
+constexpr double kMaxDoubledWall = 0.12;
+
+// Lays the two copies of each doubled facade (ScanPlane::doubled) onto its plane: each inlier
+// moves by half their distance towards the plane, from the side it lies on. Later stages then see
+// one wall with one drive's noise. `planes` index into `cloud`.
+void collapse_doubled_walls(PointCloud& cloud, const std::vector<ScanPlane>& planes);
+
+// The scan's facade planes that are relief, not walls: balconies, cornices, ledges, shop fronts,
+// window panes and rooms seen through glass (storey by storey), cars. A wall stands from its
+// foot to its eave, however sparse its points (a return seen at a grazing angle); relief covers
+// a part of that, or leaves storey-high gaps. A facade plane is a wall when, beside some model
+// wall parallel to it (within facade_max_tilt_deg; its extent along the street), its inliers fill
+// height bins (kHeightBin, the wall's foot to its eave: its lowest vertex to the highest at either
+// end) over kMinWallSpan of the wall's height, no more than kMaxWallGap empty bins apart. Planes
+// beside no parallel model wall (a wall the model lacks) are walls. Returns the walls; `relief`
+// (optional) gets the others.
+constexpr double kHeightBin = 0.5;  // m
+constexpr double kMinWallSpan = 0.5;
+constexpr int kMaxWallGap = 2;  // bins: window rows leave none across a wall; storeys of rooms or balconies 3-4
+std::vector<ScanPlane> without_relief(std::vector<ScanPlane> planes, const Mesh& model, const PointCloud& cloud,
+                                      const PlaneConfig& config, std::vector<ScanPlane>* relief = nullptr);
 
 }  // namespace lodrefine

@@ -83,7 +83,17 @@ struct RefineTrace {
   Validation output_validation;
   std::size_t faces = 0;                                     // of the output
   std::optional<std::pair<std::size_t, std::size_t>> cloud;  // points, points near the model
-  std::optional<std::vector<ScanPlane>> planes;
+  std::optional<std::vector<ScanPlane>> planes;              // the walls, roofs and ground (relief left out)
+  // What the scan near the model is like: a survey's drives registered apart, relief, density.
+  struct Scan {
+    int doubled_walls = 0;                        // facades seen twice (ScanPlane::doubled)
+    double misregistration = 0.0;                 // m: their distance, median over their points (0: none)
+    std::vector<ScanPlane> relief;                // facade planes left out as relief (without_relief)
+    std::size_t relief_points = 0;                // their points
+    double relief_share = 0.0;                    // of the points near the model
+    double min_density = 0.0, max_density = 0.0;  // points per m² on the facade planes kept
+  };
+  std::optional<Scan> scan;
   std::optional<Matching> matching;
   std::optional<Substitution> substitution, substitution_without_corners;
   std::optional<std::vector<Step>> replacements;  // set together with `facades`
