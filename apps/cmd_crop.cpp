@@ -147,12 +147,13 @@ void run(const CropArgs& a) {
       created.file(fs::path(a.out) / m.folder / "coarse.obj");
     }
     std::unique_ptr<Progress> progress;  // made once the tile reads (its header count is the total)
-    n = crop_tile_to_files(a.tile, targets, clouds, a.buffer_points, counts, a.cloud_options, [&](std::uint64_t read) {
-      if (!progress)
-        progress =
-            std::make_unique<Progress>("crop", "points", cloud_point_count(a.tile), Progress::mode_for_stderr(a.quiet));
-      progress->update(read);
-    });
+    n = crop_tile_to_files({a.tile}, targets, clouds, a.buffer_points, counts, a.cloud_options,
+                           [&](std::uint64_t read) {
+                             if (!progress)
+                               progress = std::make_unique<Progress>("crop", "points", cloud_point_count(a.tile),
+                                                                     Progress::mode_for_stderr(a.quiet));
+                             progress->update(read);
+                           });
     if (progress) progress->update(n), progress->finish();
     for (const auto& m : kept) place_model(m, fs::path(a.out) / m.folder);
   } catch (...) {

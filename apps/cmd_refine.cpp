@@ -154,7 +154,7 @@ void run_city(const RefineArgs& a) {
     if (!refine) refine = std::make_unique<Progress>("refine", "buildings", std::uint64_t(s.buildings), mode);
     refine->update(std::uint64_t(s.refined + s.repaired + s.kept + s.kept_invalid + s.untouched), tally_text(s));
   };
-  const CityRefineSummary s = refine_city(a.model, a.cloud, a.out, a.params, o);
+  const CityRefineSummary s = refine_city(a.model, {a.cloud}, a.out, a.params, o);
   if (crop) crop->finish();
   if (refine) refine->finish();
   if (!a.html.empty()) write_review(a, s, review);
