@@ -991,3 +991,66 @@ TEST(CityFile, CloudInSeveralFilesRefinesAsTheMergedFile) {
     for (std::size_t k = 0; k < 4; ++k) EXPECT_EQ(s.clouds[k].points, parts[k].points.size()) << k;
   }
 }
+
+// A file of another area among the cloud files is named on its own line, in the summary, on
+// stdout and in the report, and the buildings get the other files' points; when no file reaches
+// the model the run is refused as with one file.
+TEST(CityFile, ACloudFileOfAnotherAreaIsNamed) {
+  const std::string dir = test_dir();
+  PointCloud cloud;
+  const std::vector<SynthBuilding> bs = synth_street({BuildingType::Gable}, 5, 4000, 1, cloud);
+  write_file_atomic(dir + "/city.json", synth_city(bs, Vec3(93000, 436000, 0)).dump());
+  PointCloud far = cloud;
+  for (auto& p : far.points) p += Vec3(-50000, 70000, 0);  // another tile, or another CRS
+  const std::string near_path = dir + "/near.ply", far_path = dir + "/far.ply", far2_path = dir + "/far2.ply";
+  write_ply(near_path, cloud);
+  write_ply(far_path, far);
+  write_ply(far2_path, far);
+  const CityRefineSummary alone = refine_city(dir + "/city.json", {near_path}, dir + "/alone.city.json", {}, {});
+  const CityRefineSummary s = refine_city(dir + "/city.json", {near_path, far_path}, dir + "/out.city.json", {}, {});
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_EQ(s.warnings[0].rfind(far_path + ": cloud x 4", 0), 0u) << s.warnings[0];
+  EXPECT_NE(s.warnings[0].find("does not overlap the city model x 92"), std::string::npos) << s.warnings[0];
+  EXPECT_TRUE(alone.warnings.empty());
+  EXPECT_EQ(s.cloud_points, 2 * cloud.points.size());
+  EXPECT_EQ(s.cropped_points, alone.cropped_points);
+  EXPECT_TRUE(cli_fixtures::slurp(dir + "/out.city.json") == cli_fixtures::slurp(dir + "/alone.city.json"));
+  try {
+    refine_city(dir + "/city.json", {far_path, far2_path}, dir + "/none.city.json", {}, {});
+    ADD_FAILURE() << "no file reaches the model";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(far_path + " and 1 other cloud file: cloud x 4", 0), 0u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("does not overlap the city model"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir + "/none.city.json"));
+
+  // The command line: a warning line per file on stdout, every file in the report.
+  const Cli r = run_cli("refine --quiet --model " + dir + "/city.json --cloud " + near_path + " --cloud " + far_path +
+                            " --out " + dir + "/cli.city.json --report " + dir + "/report.json",
+                        dir);
+  ASSERT_EQ(r.exit, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_EQ(r.out.rfind("warning: " + far_path + ": cloud x 4", 0), 0u) << r.out;
+  EXPECT_EQ(r.out.find("warning: " + near_path), std::string::npos) << r.out;
+  const json report = load(dir + "/report.json");
+  ASSERT_EQ(report["warnings"].size(), 1u);
+  EXPECT_EQ(report["warnings"][0], s.warnings[0]);
+  EXPECT_FALSE(report["cloud"].contains("path")) << "several files: each in files";
+  ASSERT_EQ(report["cloud"]["files"].size(), 2u);
+  EXPECT_EQ(report["cloud"]["files"][0]["path"], near_path);
+  EXPECT_EQ(report["cloud"]["files"][0]["points"], cloud.points.size());
+  EXPECT_EQ(report["cloud"]["files"][1]["path"], far_path);
+  const Eigen::AlignedBox3d far_box = bounding_box(far.points);
+  EXPECT_EQ(report["cloud"]["files"][1]["bounds"]["min"],
+            json({far_box.min().x(), far_box.min().y(), far_box.min().z()}));
+  EXPECT_EQ(report["cloud"]["files"][1]["bounds"]["max"],
+            json({far_box.max().x(), far_box.max().y(), far_box.max().z()}));
+  const Cli single = run_cli("refine --quiet --model " + dir + "/city.json --cloud " + near_path + " --out " + dir +
+                                 "/single.city.json --report " + dir + "/single.json",
+                             dir);
+  ASSERT_EQ(single.exit, 0) << single.err;
+  const json single_report = load(dir + "/single.json");
+  EXPECT_EQ(single_report["cloud"]["path"], near_path);
+  EXPECT_EQ(single_report["cloud"]["files"].size(), 1u);
+  EXPECT_FALSE(single_report.contains("warnings"));
+}
