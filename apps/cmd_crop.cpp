@@ -20,7 +20,8 @@ namespace {
 namespace fs = std::filesystem;
 
 struct CropArgs {
-  std::string tile, models, out;
+  std::vector<std::string> tiles;  // --tile values: files or folders (cloud_files)
+  std::string models, out;
   double expand = 0.1, margin = 3.0;
   // Points held in memory before spilling to per-building files: ~100 MB at 24 bytes a point,
   // whatever the tile's size.
@@ -62,15 +63,17 @@ std::vector<Model> find_models(const fs::path& dir) {
 // The outputs of the kept models, refused before anything is written when one is the tile or
 // another model (with --out the --models folder, `a b.obj`'s hashed folder can be where a model
 // `a_b--<hash>/coarse.obj` lies, renamed itself: its model was replaced without a word).
-void check_outputs(const std::vector<Model>& models, const std::vector<Model>& kept, const CropArgs& a) {
+void check_outputs(const std::vector<Model>& models, const std::vector<Model>& kept,
+                   const std::vector<std::string>& tiles, const CropArgs& a) {
   std::map<std::string, const Model*> inputs;  // by path with its folders' links resolved
   for (const auto& m : models) inputs[fs::weakly_canonical(m.path).string()] = &m;
   for (const auto& m : kept)
     for (const char* name : {"cloud.ply", "coarse.obj"}) {
       const fs::path out = fs::path(a.out) / m.folder / name;
-      if (same_file(out.string(), a.tile))
-        throw InputError(a.tile + ": the tile would be overwritten by " + shown_id(m.id) + "'s " + name +
-                         "; give another --out");
+      for (const std::string& tile : tiles)
+        if (same_file(out.string(), tile))
+          throw InputError(tile + ": the tile would be overwritten by " + shown_id(m.id) + "'s " + name +
+                           "; give another --out");
       const auto it = inputs.find((fs::weakly_canonical(out.parent_path()) / name).string());
       if (it != inputs.end() && it->second->id != m.id)
         throw InputError(it->second->path.string() + ": the model of " + shown_id(it->second->id) +
@@ -114,7 +117,16 @@ struct Created {
   }
 };
 
+// The box of every model kept (their crop boxes): a tile that misses it is of another area or CRS.
+Eigen::AlignedBox3d models_box(const std::vector<CropTarget>& targets) {
+  Eigen::AlignedBox3d box;
+  for (const CropTarget& t : targets)
+    if ((t.lo.array() <= t.hi.array()).all()) box.extend(t.lo), box.extend(t.hi);
+  return box;
+}
+
 void run(const CropArgs& a) {
+  const std::vector<std::string> tiles = cloud_files(a.tiles, "--tile");
   if (!fs::is_directory(a.models)) throw InputError(a.models + ": not a directory");
   const auto models = find_models(a.models);
   if (models.empty()) throw InputError(a.models + ": no *.obj or */coarse.obj models");
@@ -133,10 +145,11 @@ void run(const CropArgs& a) {
       ++skipped;
     }
   }
-  check_outputs(models, kept, a);
+  check_outputs(models, kept, tiles, a);
   Created created;
   std::vector<std::size_t> counts;
   std::size_t n = 0;
+  std::vector<CloudFileRead> read;
   try {
     created.dir(a.out);
     std::vector<std::string> clouds;
@@ -146,13 +159,16 @@ void run(const CropArgs& a) {
       created.file(clouds.back());
       created.file(fs::path(a.out) / m.folder / "coarse.obj");
     }
-    std::unique_ptr<Progress> progress;  // made once the tile reads (its header count is the total)
-    n = crop_tile_to_files(a.tile, targets, clouds, a.buffer_points, counts, a.cloud_options, [&](std::uint64_t read) {
-      if (!progress)
-        progress =
-            std::make_unique<Progress>("crop", "points", cloud_point_count(a.tile), Progress::mode_for_stderr(a.quiet));
-      progress->update(read);
-    });
+    std::unique_ptr<Progress> progress;  // made once the tiles read (their header counts are the total)
+    n = crop_tile_to_files(
+        tiles, targets, clouds, a.buffer_points, counts, a.cloud_options,
+        [&](std::uint64_t points) {
+          if (!progress)
+            progress = std::make_unique<Progress>("crop", "points", cloud_point_count(tiles),
+                                                  Progress::mode_for_stderr(a.quiet));
+          progress->update(points);
+        },
+        &read);
     if (progress) progress->update(n), progress->finish();
     for (const auto& m : kept) place_model(m, fs::path(a.out) / m.folder);
   } catch (...) {
@@ -164,6 +180,11 @@ void run(const CropArgs& a) {
     if (kept[i].folder == id) std::printf("%s: %zu points\n", kept[i].folder.c_str(), counts[i]);
     else std::printf("%s: %zu points (building %s)\n", kept[i].folder.c_str(), counts[i], shown_id(id).c_str());
   }
+  for (const std::string& w : overlap_problems(read, models_box(targets), "the models"))
+    std::fprintf(stderr, "lodrefine: warning: %s\n", escaped_line(w).c_str());
+  if (tiles.size() > 1)
+    for (const CloudFileRead& f : read)
+      std::printf("tile %s: %llu points\n", escaped_line(f.path).c_str(), (unsigned long long)f.points);
   std::printf("%zu tile points, %zu buildings cropped, %d skipped\n", n, targets.size(), skipped);
   if (skipped) exit_code() = 1;
 }
@@ -173,7 +194,11 @@ void run(const CropArgs& a) {
 void add_crop_command(CLI::App& app) {
   static CropArgs args;
   auto* cmd = app.add_subcommand("crop", "Cut one cloud per building from a large PLY or LAS tile (streaming)");
-  cmd->add_option("--tile", args.tile, "Large point cloud tile (PLY or LAS)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--tile", args.tiles,
+                  "Large point cloud tile (PLY, LAS or LAZ); a folder gives its cloud files by name; repeat for "
+                  "several (one per drive or tile): read one after another as one cloud")
+      ->required()
+      ->check(CLI::ExistingPath);
   cmd->add_option("--models", args.models, "Folder of models: *.obj or <id>/coarse.obj")->required();
   cmd->add_option("--out", args.out,
                   "Run folder: writes <name>/cloud.ply and <name>/coarse.obj (<name>: the id when it is a safe folder "

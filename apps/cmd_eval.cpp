@@ -53,7 +53,10 @@ void add_eval_command(CLI::App& app) {
                               "meta.json,report.json]}, pooled over all buildings");
   auto* orig = cmd->add_option("--original", a.original, "Coarse model (OBJ)")->check(CLI::ExistingFile);
   cmd->add_option("--refined", a.refined, "Refined model (OBJ); a missing file is reported as a failure");
-  cmd->add_option("--cloud", a.cloud, "MLS crop (PLY or LAS)")->check(CLI::ExistingFile);
+  cmd->add_option("--cloud", a.clouds,
+                  "MLS crop (PLY, LAS or LAZ); a folder gives its cloud files by name; repeat for several: read "
+                  "one after another as one cloud")
+      ->check(CLI::ExistingPath);
   cmd->add_option("--truth", a.truth, "Truth model (OBJ): adds truth_facade_* / truth_roof_* distances")
       ->check(CLI::ExistingFile);
   cmd->add_option("--meta", a.meta, "Generator meta.json listing the scanned truth faces (else detected)")

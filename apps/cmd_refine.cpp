@@ -22,7 +22,8 @@ namespace lodrefine::app {
 namespace {
 
 struct RefineArgs {
-  std::string model, cloud, out, report;
+  std::string model, out, report;
+  std::vector<std::string> clouds;  // --cloud values: files or folders (cloud_files)
   Params params;
   CloudOptions cloud_options;
   std::string building, lod;  // city files only
@@ -87,10 +88,13 @@ struct ReviewCollector {
   }
 };
 
-void write_review(const RefineArgs& a, const CityRefineSummary& s, ReviewCollector& c) {
+void write_review(const RefineArgs& a, const std::vector<std::string>& clouds, const CityRefineSummary& s,
+                  ReviewCollector& c) {
   CityReview review = c.page();
+  std::vector<std::string> names;
+  for (const std::string& path : clouds) names.push_back(std::filesystem::path(path).filename().string());
   review.title = "lodrefine city refine: " + std::filesystem::path(a.model).filename().string() + " with " +
-                 std::filesystem::path(a.cloud).filename().string();
+                 cloud_files_text(names);
   // No times: the same input gives the same page (stdout and --report have them).
   char line[512];
   std::snprintf(line, sizeof line,
@@ -119,10 +123,27 @@ void check_output_dir(const std::string& path) {
 
 // Refuses, before anything is read, an output that is an input or another output (compared
 // as files: links and other spellings of one path count). --html too: it replaced the model,
-// the cloud or the city file out without a word.
-void check_outputs_are_new(const RefineArgs& a) {
-  refuse_overwrites({{"--model", a.model}, {"--cloud", a.cloud}},
-                    {{"--out", a.out}, {"--report", a.report}, {"--html", a.html}});
+// a cloud file or the city file out without a word.
+void check_outputs_are_new(const RefineArgs& a, const std::vector<std::string>& clouds) {
+  std::vector<FileOption> inputs = {{"--model", a.model}};
+  for (const std::string& cloud : clouds) inputs.push_back({"--cloud", cloud});
+  refuse_overwrites(inputs, {{"--out", a.out}, {"--report", a.report}, {"--html", a.html}});
+}
+
+// The report's "cloud" files: each file's path, the points read from it and their bounds (null
+// when none), in reading order; "path" too when the cloud is one file, as before several were read.
+nlohmann::json cloud_json(const std::vector<CloudFileRead>& files) {
+  nlohmann::json cloud = nlohmann::json::object(), list = nlohmann::json::array();
+  if (files.size() == 1) cloud["path"] = files.front().path;
+  const auto xyz = [](const Vec3& p) { return nlohmann::json::array({p.x(), p.y(), p.z()}); };
+  for (const CloudFileRead& f : files)
+    list.push_back(
+        {{"path", f.path},
+         {"points", f.points},
+         {"bounds", f.bounds.isEmpty() ? nlohmann::json()
+                                       : nlohmann::json{{"min", xyz(f.bounds.min())}, {"max", xyz(f.bounds.max())}}}});
+  cloud["files"] = std::move(list);
+  return cloud;
 }
 
 // "12 refined, 2 repaired, 3 kept, 1 kept-invalid": the progress line's tally.
@@ -133,7 +154,7 @@ std::string tally_text(const CityRefineSummary& s) {
 
 // A city file (CityJSON, CityJSONSeq, CityGML) in: every building the cloud covers, one
 // CityJSON 2.0 file out.
-void run_city(const RefineArgs& a) {
+void run_city(const RefineArgs& a, const std::vector<std::string>& clouds) {
   CityRefineOptions o;
   o.building = a.building;
   o.lod = a.lod;
@@ -146,7 +167,7 @@ void run_city(const RefineArgs& a) {
   const Progress::Mode mode = Progress::mode_for_stderr(a.quiet);
   std::unique_ptr<Progress> crop, refine;
   o.crop_progress = [&](std::uint64_t read) {
-    if (!crop) crop = std::make_unique<Progress>("crop", "points", cloud_point_count(a.cloud), mode);
+    if (!crop) crop = std::make_unique<Progress>("crop", "points", cloud_point_count(clouds), mode);
     crop->update(read);
   };
   o.progress = [&](const CityRefineSummary& s) {
@@ -154,13 +175,13 @@ void run_city(const RefineArgs& a) {
     if (!refine) refine = std::make_unique<Progress>("refine", "buildings", std::uint64_t(s.buildings), mode);
     refine->update(std::uint64_t(s.refined + s.repaired + s.kept + s.kept_invalid + s.untouched), tally_text(s));
   };
-  const CityRefineSummary s = refine_city(a.model, a.cloud, a.out, a.params, o);
+  const CityRefineSummary s = refine_city(a.model, clouds, a.out, a.params, o);
   if (crop) crop->finish();
   if (refine) refine->finish();
-  if (!a.html.empty()) write_review(a, s, review);
+  if (!a.html.empty()) write_review(a, clouds, s, review);
   if (!a.report.empty()) {
     nlohmann::json j = {{"model", a.model},
-                        {"cloud", a.cloud},
+                        {"cloud", cloud_json(s.clouds)},
                         {"written", a.out},
                         {"input", s.input_format},
                         {"buildings", s.buildings},
@@ -180,6 +201,7 @@ void run_city(const RefineArgs& a) {
                           {"write", s.seconds_write}}},
                         {"params", params_json(a.params)},
                         {"outcomes", nlohmann::json::array()}};
+    if (!s.warnings.empty()) j["warnings"] = s.warnings;
     for (const auto& b : s.outcomes)
       j["outcomes"].push_back({{"id", b.id},
                                {"outcome", b.outcome},
@@ -196,6 +218,7 @@ void run_city(const RefineArgs& a) {
     refused += (refused.empty() ? "" : ", ") + check + " " + std::to_string(n);
     n_refused += n;
   }
+  for (const std::string& w : s.warnings) std::printf("warning: %s\n", escaped_line(w).c_str());
   std::printf(
       "%s: %d building(s), %llu cloud points (%llu in building crops): %d refined, %d repaired, %d kept (never "
       "worse refused %d%s), %d kept-invalid, %d untouched (no cloud points) -> %s (read %.1f s, crop %.1f s, "
@@ -213,7 +236,8 @@ bool is_city_file(const std::string& path) {
 
 void run(const RefineArgs& a) {
   a.params.validate();
-  check_outputs_are_new(a);
+  const std::vector<std::string> clouds = cloud_files(a.clouds);
+  check_outputs_are_new(a, clouds);
   check_output_dir(a.out);
   check_output_dir(a.report);
   check_output_dir(a.html);
@@ -221,7 +245,7 @@ void run(const RefineArgs& a) {
     const std::string ext = std::filesystem::path(a.out).extension().string();
     if (ext == ".obj" || ext == ".OBJ")
       throw InputError(a.out + ": a city file in gives a CityJSON city file out; name it e.g. refined.city.json");
-    return run_city(a);
+    return run_city(a, clouds);
   }
   if (!a.html.empty())
     throw InputError(a.html + ": --html is the review page of a city refine (a city file as --model)");
@@ -229,20 +253,20 @@ void run(const RefineArgs& a) {
     throw InputError(a.model +
                      ": --building and --lod pick buildings of a city file (CityJSON, CityGML), not of an OBJ");
   const Mesh model = read_obj(a.model);
-  const std::uint64_t declared = cloud_point_count(a.cloud);
-  const PointCloud cloud = read_cloud(a.cloud, a.cloud_options);
+  std::vector<CloudFileRead> read;
+  const PointCloud cloud = read_cloud(clouds, a.cloud_options, &read);
   if (cloud.points.empty())
-    throw InputError(a.cloud + ": the cloud has no points" +
+    throw InputError(cloud_files_text(clouds) + ": the cloud has no points" +
                      (a.cloud_options.classes.empty() ? std::string()
                                                       : " of classes " + classes_text(a.cloud_options.classes) +
-                                                            " (of " + std::to_string(declared) + ")"));
+                                                            " (of " + std::to_string(cloud_point_count(clouds)) + ")"));
   // Said on stdout and in the report (stderr is for the one error line of a failed run).
-  const std::string overlap = overlap_problem(bounding_box(cloud.points), bounding_box(model.vertices));
+  const std::vector<std::string> warnings = overlap_problems(read, bounding_box(model.vertices));
   const RefineResult r = refine_building(model, cloud, a.params);
   nlohmann::json report = refine_report(r);
-  if (!overlap.empty()) report["warnings"].push_back(overlap);
+  for (const std::string& w : warnings) report["warnings"].push_back(w);
   report["model"] = a.model;
-  report["cloud"]["path"] = a.cloud;
+  report["cloud"].update(cloud_json(read));
   report["params"] = params_json(a.params);
   report["written"] = a.out;
   write_obj(a.out, r.mesh);  // the model first: a report never names a model that is not there
@@ -250,9 +274,11 @@ void run(const RefineArgs& a) {
     write_file_atomic(a.report, report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   // One line whatever the model's name holds (batch logs keep it): a CR let `o ok\rFAKE: …` print
   // over the outcome.
+  std::string warned;
+  for (const std::string& w : warnings) warned += "; warning: " + escaped_line(w);
   std::printf("%s: %s (%s) -> %s (%.2f s)%s\n", escaped_line(model.id).c_str(), outcome_name(r.outcome),
               escaped_line(r.reason).c_str(), escaped_line(a.out).c_str(), r.trace.stage_seconds("total").value_or(0.0),
-              overlap.empty() ? "" : ("; warning: " + escaped_line(overlap)).c_str());
+              warned.c_str());
 }
 
 }  // namespace
@@ -265,9 +291,12 @@ void add_refine_command(CLI::App& app) {
                   "CityGML): then --out is a CityJSON 2.0 city file")
       ->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("--cloud", args.cloud, "MLS point cloud crop around the building (PLY or LAS)")
+  cmd->add_option("--cloud", args.clouds,
+                  "MLS point cloud (PLY, LAS or LAZ): the building's crop, or a city file's tile; a folder gives "
+                  "its cloud files by name; repeat for several (one per drive or tile): read one after another "
+                  "as one cloud")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(CLI::ExistingPath);
   cmd->add_option("--out", args.out, "Refined model (OBJ; CityJSON for a city file), written atomically")->required();
   cmd->add_option("--building", args.building, "City file: refine only this CityObject id");
   cmd->add_option("--lod", args.lod, "City file: the LoD geometry to refine, e.g. 2.2 (default: the highest 2.x)")

@@ -36,7 +36,7 @@ std::vector<BuildingFiles> discover_tile(const fs::path& dir) {
     const std::string id = e.path().stem().string();
     const fs::path truth = dir / "truth" / (id + ".obj");
     BuildingFiles f;
-    f.id = id, f.original = e.path().string(), f.cloud = (dir / "clouds" / (id + ".ply")).string();
+    f.id = id, f.original = e.path().string(), f.clouds = {(dir / "clouds" / (id + ".ply")).string()};
     if (fs::exists(truth)) f.truth = truth.string();
     out.push_back(std::move(f));
   }
@@ -97,7 +97,7 @@ BenchBuilding read_bench_building(const BuildingFiles& f) {
   BenchBuilding b;
   b.id = f.id;
   b.coarse = read_eval_model(f.original);
-  b.cloud = read_cloud(f.cloud);
+  b.cloud = read_cloud(f.clouds);
   if (!f.truth.empty()) b.truth = read_eval_model(f.truth);
   return b;
 }

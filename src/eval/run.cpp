@@ -137,9 +137,14 @@ std::vector<BuildingFiles> discover_run(const std::string& dir) {
     const fs::path d = entry.path();
     if (!entry.is_directory() || !fs::exists(d / "coarse.obj")) continue;
     auto optional_file = [&](const char* name) { return fs::exists(d / name) ? (d / name).string() : std::string(); };
-    out.push_back({d.filename().string(), (d / "coarse.obj").string(), (d / "refined.obj").string(),
-                   (d / "cloud.ply").string(), optional_file("truth.obj"), optional_file("meta.json"),
-                   optional_file("report.json"), optional_file("FAILED")});
+    out.push_back({d.filename().string(),
+                   (d / "coarse.obj").string(),
+                   (d / "refined.obj").string(),
+                   {(d / "cloud.ply").string()},
+                   optional_file("truth.obj"),
+                   optional_file("meta.json"),
+                   optional_file("report.json"),
+                   optional_file("FAILED")});
   }
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
   if (out.empty()) throw InputError(dir + ": no building directories (<id>/coarse.obj) found");
@@ -169,7 +174,7 @@ LocalBuilding read_local(const BuildingFiles& f, const std::optional<Vec3>& orig
   b.original = read_eval_model(f.original);
   b.origin = origin ? *origin : local_origin(b.original);
   b.original = translated(std::move(b.original), -b.origin);
-  b.cloud = read_cloud(f.cloud, cloud_options);
+  b.cloud = read_cloud(f.clouds, cloud_options);
   for (auto& p : b.cloud.points) p -= b.origin;
   b.refined = translated(read_refined(f.refined, refined_error), -b.origin);
   return b;
@@ -195,12 +200,10 @@ RunRow evaluate_building_files(const BuildingFiles& f, const Params& params, con
   if (!refined_error.empty()) row.eval.error = refined_error;
   if (!svg_dir.empty()) {
     const std::string svg = (fs::path(svg_dir) / ("footprint_" + safe_name(row.eval.id) + ".svg")).string();
-    refuse_overwrites({{"--original", f.original},
-                       {"--refined", f.refined},
-                       {"--cloud", f.cloud},
-                       {"--truth", f.truth},
-                       {"--meta", f.meta}},
-                      {{"--svg-dir", svg}});
+    std::vector<FileOption> inputs = {
+        {"--original", f.original}, {"--refined", f.refined}, {"--truth", f.truth}, {"--meta", f.meta}};
+    for (const std::string& cloud : f.clouds) inputs.push_back({"--cloud", cloud});
+    refuse_overwrites(inputs, {{"--svg-dir", svg}});
     write_file_atomic(svg, building_footprint_svg(row.eval, b, kFootprintFilePoints));
   }
   return row;

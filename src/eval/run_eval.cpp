@@ -99,19 +99,22 @@ bool apply_gate(const EvalOptions& a, const GateInputs& in, const RunFigures& ru
   return v.failed();
 }
 
-// Every file the evaluation reads: the options' and, with --dir, each building's of the run.
-std::vector<FileOption> eval_inputs(const EvalOptions& a) {
-  std::vector<FileOption> in = {{"--original", a.original}, {"--refined", a.refined}, {"--cloud", a.cloud},
-                                {"--truth", a.truth},       {"--meta", a.meta},       {"--baseline", a.baseline_in},
-                                {"--gates", a.gates}};
+// Every file the evaluation reads: the options' (`clouds`: --cloud's files) and, with --dir, each
+// building's of the run.
+std::vector<FileOption> eval_inputs(const EvalOptions& a, const std::vector<std::string>& clouds) {
+  std::vector<FileOption> in = {{"--original", a.original}, {"--refined", a.refined},      {"--truth", a.truth},
+                                {"--meta", a.meta},         {"--baseline", a.baseline_in}, {"--gates", a.gates}};
+  for (const std::string& cloud : clouds) in.push_back({"--cloud", cloud});
   if (a.dir.empty() || !fs::is_directory(a.dir)) return in;
-  for (const BuildingFiles& f : discover_run(a.dir))
-    for (const std::string* path : {&f.original, &f.refined, &f.cloud, &f.truth, &f.meta, &f.report, &f.failed})
+  for (const BuildingFiles& f : discover_run(a.dir)) {
+    for (const std::string* path : {&f.original, &f.refined, &f.truth, &f.meta, &f.report, &f.failed})
       in.push_back({"run's", *path});
+    for (const std::string& cloud : f.clouds) in.push_back({"run's", cloud});
+  }
   return in;
 }
 
-void check_options(const EvalOptions& a) {
+void check_options(const EvalOptions& a, const std::vector<std::string>& clouds) {
   a.params.validate();
   // An output given as an input (--json r.obj --refined r.obj, or --json RUN/<id>/coarse.obj)
   // replaced it without a word.
@@ -123,17 +126,17 @@ void check_options(const EvalOptions& a) {
   if (!a.svg_dir.empty())
     for (const char* name : {"c2m_histogram.svg", "c2m_boxplot.svg"})
       outputs.push_back({"--svg-dir", (fs::path(a.svg_dir) / name).string()});
-  refuse_overwrites(eval_inputs(a), outputs);
+  refuse_overwrites(eval_inputs(a, clouds), outputs);
   if (!a.dir.empty() && !a.cloud_options.classes.empty())
     throw InputError(a.dir + ": --classes applies to --cloud; a run folder holds cropped PLY clouds");
-  if (a.dir.empty() && (a.original.empty() || a.refined.empty() || a.cloud.empty()))
+  if (a.dir.empty() && (a.original.empty() || a.refined.empty() || clouds.empty()))
     throw InputError("eval: give --dir RUN_DIR, or --original, --refined and --cloud");
 }
 
 // The one building of --original/--refined/--cloud; a refined model that cannot be used is a
 // warning (the row says failed).
-RunRow evaluate_single(const EvalOptions& a, PooledSeries& series) {
-  RunRow row = evaluate_building_files({"", a.original, a.refined, a.cloud, a.truth, a.meta, "", ""}, a.params,
+RunRow evaluate_single(const EvalOptions& a, const std::vector<std::string>& clouds, PooledSeries& series) {
+  RunRow row = evaluate_building_files({"", a.original, a.refined, clouds, a.truth, a.meta, "", ""}, a.params,
                                        a.svg_dir, a.cloud_options);
   if (!row.eval.ok()) std::fprintf(stderr, "lodrefine: warning: %s\n", escaped_line(row.eval.error).c_str());
   series.add(row.eval);
@@ -143,7 +146,8 @@ RunRow evaluate_single(const EvalOptions& a, PooledSeries& series) {
 }  // namespace
 
 int run_eval(const EvalOptions& a, std::FILE* out) {
-  check_options(a);
+  const std::vector<std::string> clouds = a.clouds.empty() ? std::vector<std::string>() : cloud_files(a.clouds);
+  check_options(a, clouds);
   const GateInputs gate_inputs = read_gate_inputs(a);
   const bool batch = !a.dir.empty();
   if (!a.svg_dir.empty()) fs::create_directories(a.svg_dir);
@@ -152,7 +156,7 @@ int run_eval(const EvalOptions& a, std::FILE* out) {
   if (batch)
     rows =
         evaluate_run(a.dir, a.params, a.svg_dir, a.jobs, series, Progress::mode_for_stderr(a.quiet), a.cloud_options);
-  else rows.push_back(evaluate_single(a, series));
+  else rows.push_back(evaluate_single(a, clouds, series));
   std::vector<BuildingEval> evals;
   for (const RunRow& r : rows) evals.push_back(r.eval);
   const PooledEval pooled = pool_evaluations(evals, series);

@@ -312,15 +312,23 @@ void check_targets(const std::vector<CropTarget>& targets, const std::string& mo
                    std::to_string(without) + " building object(s) without one); nothing to refine");
 }
 
-// Returns the number of points the crops hold; throws when the cloud reaches no building.
-std::uint64_t check_cloud_reaches(const std::vector<CropTarget>& targets, const Eigen::AlignedBox3d& cloud_box,
-                                  const Eigen::AlignedBox3d& city_box, const std::string& cloud_path) {
+// The cloud pass: one stream over the cloud files fills the targets' crops and the summary's
+// cloud figures. Throws when no point reaches a building's box; a file whose bounds miss the city
+// model while others reach it gets a warning of its own.
+void crop_clouds(const std::vector<std::string>& cloud_paths, std::vector<CropTarget>& targets,
+                 const Eigen::AlignedBox3d& city_box, const CityRefineOptions& o, CityRefineSummary& sum) {
+  sum.cloud_points = crop_tile(cloud_paths, targets, o.cloud, &sum.clouds, o.crop_progress, o.max_crop_points);
   std::uint64_t held = 0;
   for (const auto& t : targets) held += t.cloud.points.size();
-  if (held > 0) return held;
-  std::string why = overlap_problem(cloud_box, city_box, "the city model");
-  if (why.empty()) why = "the cloud has no point within " + std::to_string(targets.size()) + " building box(es)";
-  throw InputError(cloud_path + ": " + why);
+  Eigen::AlignedBox3d cloud_box;
+  for (const auto& f : sum.clouds) cloud_box.extend(f.bounds);
+  if (held == 0) {
+    std::string why = overlap_problem(cloud_box, city_box, "the city model");
+    if (why.empty()) why = "the cloud has no point within " + std::to_string(targets.size()) + " building box(es)";
+    throw InputError(cloud_files_text(cloud_paths) + ": " + why);
+  }
+  sum.warnings = overlap_problems(sum.clouds, city_box, "the city model");
+  sum.cropped_points = held;
 }
 
 // A CityJSONSeq feature as a CityJSON document the reader takes: the header's transform
@@ -364,8 +372,9 @@ json parse_feature(const std::string& line, const std::string& where) {
 // CityJSONSeq in, CityJSONSeq out, streamed: pass 1 reads each feature's buildings for the
 // crop boxes (keeping only the boxes), the cloud pass fills them, pass 2 reads each feature
 // again, refines its buildings (features on the pool) and writes the lines out in order.
-CityRefineSummary refine_sequence(const json& header, const std::string& model_path, const std::string& cloud_path,
-                                  const std::string& out_path, const Params& params, const CityRefineOptions& options) {
+CityRefineSummary refine_sequence(const json& header, const std::string& model_path,
+                                  const std::vector<std::string>& cloud_paths, const std::string& out_path,
+                                  const Params& params, const CityRefineOptions& options) {
   CityRefineSummary sum;
   sum.input_format = "CityJSONSeq " + text_member(header, "version", "?");
   if (!header.contains("transform"))
@@ -405,10 +414,7 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
   sum.seconds_read = seconds_since(t);
 
   t = Clock::now();
-  Eigen::AlignedBox3d cloud_box;
-  sum.cloud_points =
-      crop_tile(cloud_path, targets, options.cloud, &cloud_box, options.crop_progress, options.max_crop_points);
-  sum.cropped_points = check_cloud_reaches(targets, cloud_box, city_box, cloud_path);
+  crop_clouds(cloud_paths, targets, city_box, options, sum);
   sum.seconds_crop = seconds_since(t);
 
   t = Clock::now();
@@ -499,15 +505,15 @@ json cityjson_solid(const Mesh& mesh, const std::string& lod, const Vec3& scale,
   return g;
 }
 
-CityRefineSummary refine_city(const std::string& model_path, const std::string& cloud_path, const std::string& out_path,
-                              const Params& params, const CityRefineOptions& options) {
+CityRefineSummary refine_city(const std::string& model_path, const std::vector<std::string>& cloud_paths,
+                              const std::string& out_path, const Params& params, const CityRefineOptions& options) {
   CityRefineSummary sum;
   auto t = Clock::now();
   json doc;
   std::string format;
   if (sniff_file(model_path) != FileKind::Xml) {
     const json header = sequence_header(model_path);
-    if (!header.is_null()) return refine_sequence(header, model_path, cloud_path, out_path, params, options);
+    if (!header.is_null()) return refine_sequence(header, model_path, cloud_paths, out_path, params, options);
   }
   if (sniff_file(model_path) == FileKind::Xml) {
     std::string version;
@@ -530,10 +536,7 @@ CityRefineSummary refine_city(const std::string& model_path, const std::string& 
   sum.seconds_read = seconds_since(t);
 
   t = Clock::now();
-  Eigen::AlignedBox3d cloud_box;
-  sum.cloud_points =
-      crop_tile(cloud_path, targets, options.cloud, &cloud_box, options.crop_progress, options.max_crop_points);
-  sum.cropped_points = check_cloud_reaches(targets, cloud_box, model_box(file.buildings), cloud_path);
+  crop_clouds(cloud_paths, targets, model_box(file.buildings), options, sum);
   sum.seconds_crop = seconds_since(t);
 
   t = Clock::now();

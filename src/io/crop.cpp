@@ -92,24 +92,34 @@ class TargetGrid {
   }
 };
 
-// Streams the tile (PLY or LAS, `options` filtering LAS classes) once and calls on_hit(i, p)
-// for every target i whose box holds p; the grid keeps this O(points).
-// Returns the number of points read; `bounds` (optional) gets their bounding box.
-std::size_t for_each_hit(const std::string& tile, const std::vector<CropTarget>& targets, const CloudOptions& options,
-                         Eigen::AlignedBox3d* bounds, const std::function<void(std::size_t, const Vec3&)>& on_hit,
+// Streams the tiles (PLY or LAS, `options` filtering LAS classes) once and calls on_hit(i, p, file)
+// for every target i whose box holds p, `file` the path of the tile being read; the grid keeps
+// this O(points). Returns the number of points read; `read` (optional) as for stream_cloud.
+std::size_t for_each_hit(const std::vector<std::string>& tiles, const std::vector<CropTarget>& targets,
+                         const CloudOptions& options, std::vector<CloudFileRead>* read,
+                         const std::function<void(std::size_t, const Vec3&, const std::string&)>& on_hit,
                          const std::function<void(std::uint64_t)>& on_read) {
   if (targets.empty()) return 0;
   const TargetGrid grid(targets);
+  std::vector<CloudFileRead> own;  // the files read, when the caller keeps none
+  std::vector<CloudFileRead>& files = read ? *read : own;
   std::size_t n = 0;
-  stream_cloud(tile, options, [&](const Vec3& p) {
-    if (++n % kProgressPoints == 0 && on_read) on_read(n);
-    if (bounds) bounds->extend(p);
-    grid.visit(p, [&](std::size_t i) {
-      const auto& t = targets[i];
-      if ((p.array() >= t.lo.array()).all() && (p.array() <= t.hi.array()).all()) on_hit(i, p);
-    });
-  });
+  stream_cloud(
+      tiles, options,
+      [&](const Vec3& p) {
+        if (++n % kProgressPoints == 0 && on_read) on_read(n);
+        grid.visit(p, [&](std::size_t i) {
+          const auto& t = targets[i];
+          if ((p.array() >= t.lo.array()).all() && (p.array() <= t.hi.array()).all()) on_hit(i, p, files.back().path);
+        });
+      },
+      &files);
   return n;
+}
+
+// A limit passed while reading several tiles counts the points of those read before.
+std::string before_it(const std::vector<std::string>& tiles) {
+  return tiles.size() > 1 ? ", counting the tiles read before it" : "";
 }
 
 // Appends points to a spill file (raw doubles), created exclusively beside `out_path` on the
@@ -135,25 +145,25 @@ std::vector<Vec3> unspill(const std::string& path) {
 
 }  // namespace
 
-std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets, const CloudOptions& options,
-                      Eigen::AlignedBox3d* bounds, const std::function<void(std::uint64_t)>& on_read,
-                      std::uint64_t max_held) {
+std::size_t crop_tile(const std::vector<std::string>& tiles, std::vector<CropTarget>& targets,
+                      const CloudOptions& options, std::vector<CloudFileRead>* read,
+                      const std::function<void(std::uint64_t)>& on_read, std::uint64_t max_held) {
   std::uint64_t held = 0;
   return for_each_hit(
-      tile, targets, options, bounds,
-      [&](std::size_t i, const Vec3& p) {
+      tiles, targets, options, read,
+      [&](std::size_t i, const Vec3& p, const std::string& tile) {
         if (++held > max_held)
           throw InputError(tile + ": the buildings' crop boxes hold more than " + std::to_string(max_held) +
-                           " points (--max-crop-points); refine the district in parts");
+                           " points (--max-crop-points)" + before_it(tiles) + "; refine the district in parts");
         targets[i].cloud.points.push_back(p);
       },
       on_read);
 }
 
-std::size_t crop_tile_to_files(const std::string& tile, const std::vector<CropTarget>& targets,
+std::size_t crop_tile_to_files(const std::vector<std::string>& tiles, const std::vector<CropTarget>& targets,
                                const std::vector<std::string>& out_paths, std::size_t buffer_points,
                                std::vector<std::size_t>& counts, const CloudOptions& options,
-                               const std::function<void(std::uint64_t)>& on_read) {
+                               const std::function<void(std::uint64_t)>& on_read, std::vector<CloudFileRead>* read) {
   static_assert(sizeof(Vec3) == 3 * sizeof(double), "spill files hold Vec3 as three doubles");
   std::vector<std::vector<Vec3>> held(targets.size());
   std::vector<std::string> spills(targets.size());  // created on a target's first spill
@@ -167,12 +177,12 @@ std::size_t crop_tile_to_files(const std::string& tile, const std::vector<CropTa
   std::size_t n = 0;
   try {
     n = for_each_hit(
-        tile, targets, options, nullptr,
-        [&](std::size_t i, const Vec3& p) {
+        tiles, targets, options, read,
+        [&](std::size_t i, const Vec3& p, const std::string& tile) {
           // Each crop is read back whole to be written: bounded as a cloud read whole is.
           if (++counts[i] > options.max_points)
             throw InputError(tile + ": the crop of " + shown_id(targets[i].id) + " holds more than " +
-                             std::to_string(options.max_points) + " points (--max-points)");
+                             std::to_string(options.max_points) + " points (--max-points)" + before_it(tiles));
           held[i].push_back(p);
           if (++in_memory > buffer_points) flush_all();
         },

@@ -114,7 +114,7 @@ TEST(RunEval, OneBuildingWithoutARefinedModelIsAFailedRow) {
   EvalOptions o;
   o.original = (dir / "run" / "b" / "coarse.obj").string();
   o.refined = (dir / "run" / "b" / "refined.obj").string();
-  o.cloud = (dir / "run" / "b" / "cloud.ply").string();
+  o.clouds = {(dir / "run" / "b" / "cloud.ply").string()};
   o.json_out = (dir / "one.json").string();
   const EvalRun r = run(o);
   EXPECT_EQ(r.exit, 0);

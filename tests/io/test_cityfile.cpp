@@ -6,6 +6,7 @@
 
 #include "support/cli_fixtures.h"
 #include "support/cpu_burners.h"
+#include "support/io_fixtures.h"
 #include "support/mesh_fixtures.h"
 #include "support/scan_fixtures.h"
 
@@ -222,7 +223,8 @@ TEST(CityFile, GeneratedCityRefinedIntoCityJson2) {
   write_file_atomic(dir + "/city.json", in.dump());
   write_ply(dir + "/cloud.ply", cloud);
 
-  const CityRefineSummary s = refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/out.city.json", Params{}, {});
+  const CityRefineSummary s =
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", Params{}, {});
   EXPECT_EQ(s.buildings, 4);
   EXPECT_EQ(s.untouched, 1);  // the Hip building has no points
   EXPECT_EQ(s.outcomes.size(), 3u);
@@ -246,7 +248,7 @@ TEST(CityFile, GeneratedCityRefinedIntoCityJson2) {
   CityRefineOptions one;
   one.building = bs[1].id;
   const CityRefineSummary s1 =
-      refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/one.city.json", Params{}, one);
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/one.city.json", Params{}, one);
   ASSERT_EQ(s1.outcomes.size(), 1u);
   EXPECT_EQ(s1.outcomes[0].id, bs[1].id);
   EXPECT_EQ(s1.untouched, 3);
@@ -272,7 +274,7 @@ TEST(CityFile, OnlyTheMisplacedTerracedHouseChanges) {
   for (auto& p : cloud.points) p += origin;
   write_ply(dir + "/terraced.ply", cloud);
   const CityRefineSummary s =
-      refine_city(dir + "/terraced.city.json", dir + "/terraced.ply", dir + "/terraced.out.city.json", Params{}, {});
+      refine_city(dir + "/terraced.city.json", {dir + "/terraced.ply"}, dir + "/terraced.out.city.json", Params{}, {});
   ASSERT_EQ(s.outcomes.size(), 3u);
   std::map<std::string, CityBuildingOutcome> by_id;
   for (const auto& o : s.outcomes) by_id[o.id] = o;
@@ -313,7 +315,8 @@ TEST(CityFile, ErrorsAndBuildingsThatCannotBeRefined) {
   PointCloud cloud = bs[0].cloud;
   for (int i = 0; i < 500; ++i) cloud.points.push_back(Vec3(93005.0 + 0.002 * i, 436005.5, 0.5));
   write_ply(dir + "/cloud.ply", cloud);
-  const CityRefineSummary s = refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/out.city.json", Params{}, {});
+  const CityRefineSummary s =
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", Params{}, {});
   ASSERT_EQ(s.outcomes.size(), 2u);
   EXPECT_EQ(s.outcomes[1].id, "broken");
   EXPECT_EQ(s.outcomes[1].outcome, "kept-invalid");
@@ -415,7 +418,7 @@ TEST(CityFile, RepairAllMendsTheBuildingsTheCloudDoesNotReach) {
   write_ply(dir + "/cloud.ply", bs[0].cloud);
 
   const CityRefineSummary plain =
-      refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/plain.city.json", Params{}, {});
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/plain.city.json", Params{}, {});
   EXPECT_EQ(plain.untouched, 2);
   EXPECT_EQ(plain.repaired, 0);
   check_city_output(in, dir + "/plain.city.json", plain);
@@ -423,7 +426,7 @@ TEST(CityFile, RepairAllMendsTheBuildingsTheCloudDoesNotReach) {
   CityRefineOptions all;
   all.repair_all = true;
   const CityRefineSummary s =
-      refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/all.city.json", Params{}, all);
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/all.city.json", Params{}, all);
   ASSERT_EQ(s.outcomes.size(), 3u);
   EXPECT_EQ(s.untouched, 0);
   EXPECT_EQ(s.outcomes[1].id, "open");
@@ -455,7 +458,7 @@ TEST(CityFile, DenHaagCityGml) {
       moved = moved || big;
     }
   write_ply(dir + "/scan.ply", cloud);
-  const CityRefineSummary s = refine_city(path.string(), dir + "/scan.ply", dir + "/denhaag.city.json", Params{}, {});
+  const CityRefineSummary s = refine_city(path.string(), {dir + "/scan.ply"}, dir + "/denhaag.city.json", Params{}, {});
   EXPECT_EQ(s.input_format, "CityGML 1.0");
   EXPECT_EQ(s.buildings, 6);
   EXPECT_GE(s.outcomes.size(), 1u);
@@ -468,7 +471,7 @@ TEST(CityFile, DenHaagCityGml) {
   CityRefineOptions all;
   all.repair_all = true;
   const CityRefineSummary r =
-      refine_city(path.string(), dir + "/scan.ply", dir + "/denhaag_all.city.json", Params{}, all);
+      refine_city(path.string(), {dir + "/scan.ply"}, dir + "/denhaag_all.city.json", Params{}, all);
   EXPECT_EQ(int(r.outcomes.size()), r.buildings);
   EXPECT_EQ(r.repaired, 0);
   EXPECT_EQ(r.kept_invalid, 0);
@@ -497,7 +500,7 @@ TEST(CityFile, CityJsonSeqStreamedThrough) {
   write_file_atomic(dir + "/city.city.jsonl", text);
   write_ply(dir + "/cloud.ply", cloud);
   const CityRefineSummary s =
-      refine_city(dir + "/city.city.jsonl", dir + "/cloud.ply", dir + "/out.city.jsonl", Params{}, {});
+      refine_city(dir + "/city.city.jsonl", {dir + "/cloud.ply"}, dir + "/out.city.jsonl", Params{}, {});
   EXPECT_EQ(s.input_format, "CityJSONSeq 2.0");
   EXPECT_EQ(s.buildings, 3);
   EXPECT_EQ(s.untouched, 1);
@@ -542,7 +545,8 @@ TEST(CityFile, CityJson1xUpgradedTo2) {
   for (auto& [id, obj] : in["CityObjects"].items()) obj["geometry"][1]["lod"] = 2.2;  // a number, as 1.0 wrote it
   write_file_atomic(dir + "/city.json", in.dump());
   write_ply(dir + "/cloud.ply", cloud);
-  const CityRefineSummary s = refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/out.city.json", Params{}, {});
+  const CityRefineSummary s =
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", Params{}, {});
   EXPECT_EQ(s.input_format, "CityJSON 1.1");
   EXPECT_EQ(s.untouched, 1);
   const json out = load(dir + "/out.city.json");
@@ -588,7 +592,7 @@ TEST(CityFile, LodPicksTheGeometryToRefine) {
     write_ply(dir + "/c.ply", cloud);
     CityRefineOptions o;
     o.lod = lod;
-    const CityRefineSummary s = refine_city(path.string(), dir + "/c.ply", dir + "/out.city.json", Params{}, o);
+    const CityRefineSummary s = refine_city(path.string(), {dir + "/c.ply"}, dir + "/out.city.json", Params{}, o);
     ASSERT_EQ(s.outcomes.size(), 1u);
     const json out = load(dir + "/out.city.json");
     for (std::size_t k = 0; k < in["CityObjects"][id]["geometry"].size(); ++k) {
@@ -679,7 +683,7 @@ TEST(CityFile, JobsWriteTheSameBytesAsOneAtATime) {
         EXPECT_EQ(s.buildings, int(bs.size()));
       };
       const std::string out = dir + "/out" + std::to_string(jobs) + "." + name;
-      const CityRefineSummary s = refine_city(dir + "/" + name, dir + "/cloud.ply", out, Params{}, o);
+      const CityRefineSummary s = refine_city(dir + "/" + name, {dir + "/cloud.ply"}, out, Params{}, o);
       EXPECT_EQ(s.refined + s.kept + s.kept_invalid, 6);
       EXPECT_GE(s.refined, 4) << name;
       ASSERT_EQ(done.size(), bs.size()) << name;
@@ -719,7 +723,7 @@ TEST(CityFile, JobsWriteTheSameBytesWhenSelectionsEndAtTheBudget) {
         ++at_budget;
     };
     const std::string out = dir + "/out" + std::to_string(jobs) + ".city.json";
-    const CityRefineSummary s = refine_city(dir + "/city.json", dir + "/cloud.ply", out, prm, o);
+    const CityRefineSummary s = refine_city(dir + "/city.json", {dir + "/cloud.ply"}, out, prm, o);
     EXPECT_GE(s.refined, 1);
     std::ifstream f(out, std::ios::binary);
     written[jobs].assign(std::istreambuf_iterator<char>(f), {});
@@ -779,7 +783,8 @@ TEST(CityFileSecurity, FlatAndStrayBuildingsAreKeptInvalidTheRunGoesOn) {
   const json in = synth_city(bs, Vec3(93000, 436000, 0));
   write_file_atomic(dir + "/city.json", in.dump());
   write_ply(dir + "/cloud.ply", cloud);
-  const CityRefineSummary s = refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/out.city.json", Params{}, {});
+  const CityRefineSummary s =
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", Params{}, {});
   ASSERT_EQ(s.outcomes.size(), 3u);
   EXPECT_NE(s.outcomes[0].outcome, "kept-invalid") << s.outcomes[0].reason;
   EXPECT_EQ(s.outcomes[1].outcome, "kept-invalid");
@@ -857,7 +862,7 @@ TEST(CityFile, HookSeesEveryBuildingOnceWithItsIndex) {
     const std::lock_guard<std::mutex> lock(m);
     EXPECT_TRUE(seen.emplace(index, model.id).second) << index;
   };
-  refine_city(dir + "/city.city.jsonl", dir + "/cloud.ply", dir + "/out.city.jsonl", Params{}, o);
+  refine_city(dir + "/city.city.jsonl", {dir + "/cloud.ply"}, dir + "/out.city.jsonl", Params{}, o);
   ASSERT_EQ(seen.size(), bs.size());
   for (std::size_t i = 0; i < bs.size(); ++i) EXPECT_EQ(seen[i], bs[i].id);
 }
@@ -880,7 +885,7 @@ TEST(CityFile, SequenceWithAnIdTwiceIsRefused) {
     EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
   }
   try {
-    refine_city(dir + "/city.city.jsonl", dir + "/cloud.ply", dir + "/out.city.jsonl", Params{}, {});
+    refine_city(dir + "/city.city.jsonl", {dir + "/cloud.ply"}, dir + "/out.city.jsonl", Params{}, {});
     ADD_FAILURE() << "refined";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
@@ -899,7 +904,7 @@ TEST(CityFile, AttributesThatAreNoObjectAreRefusedNotReplaced) {
   write_file_atomic(dir + "/city.json", doc.dump());
   write_ply(dir + "/cloud.ply", cloud);
   try {
-    refine_city(dir + "/city.json", dir + "/cloud.ply", dir + "/out.city.json", Params{}, {});
+    refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", Params{}, {});
     ADD_FAILURE() << "refined";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("object " + bs[0].id + ": \"attributes\" is not a JSON object"),
@@ -929,4 +934,123 @@ TEST(CityFile, LodIsAPlainDecimal) {
   EXPECT_EQ(lod_number("2.2"), 2.2);
   EXPECT_EQ(lod_number("2"), 2.0);
   EXPECT_EQ(lod_number("1.3"), 1.3);
+}
+
+// Issue 39: a survey delivered as several files (two parts of a drive; tiles cut along x through
+// the buildings, in a folder with a file that is no cloud) refines the city as the one file
+// holding their points in that order: the same bytes out, CityJSON and CityJSONSeq; every file
+// accounted for.
+TEST(CityFile, CloudInSeveralFilesRefinesAsTheMergedFile) {
+  const std::string dir = test_dir();
+  PointCloud cloud;
+  const std::vector<SynthBuilding> bs =
+      synth_street({BuildingType::Gable, BuildingType::LShape, BuildingType::Flat}, 11, 8000, 3, cloud);
+  write_file_atomic(dir + "/city.json", synth_city(bs, Vec3(93000, 436000, 0)).dump());
+  write_file_atomic(dir + "/city.city.jsonl", synth_sequence(bs, Vec3(93000, 436000, 0)));
+  PointCloud first, second;  // a drive in two parts
+  const std::size_t half = cloud.points.size() * 9 / 20;
+  first.points.assign(cloud.points.begin(), cloud.points.begin() + std::ptrdiff_t(half));
+  second.points.assign(cloud.points.begin() + std::ptrdiff_t(half), cloud.points.end());
+  write_ply(dir + "/merged.ply", cloud);
+  write_ply(dir + "/first.ply", first);
+  write_ply(dir + "/second.ply", second);
+  const CityRefineSummary one = refine_city(dir + "/city.json", {dir + "/merged.ply"}, dir + "/one.city.json", {}, {});
+  const CityRefineSummary two =
+      refine_city(dir + "/city.json", {dir + "/first.ply", dir + "/second.ply"}, dir + "/two.city.json", {}, {});
+  EXPECT_GE(one.refined, 2);
+  EXPECT_TRUE(cli_fixtures::slurp(dir + "/two.city.json") == cli_fixtures::slurp(dir + "/one.city.json"));
+  ASSERT_EQ(two.outcomes.size(), one.outcomes.size());
+  for (std::size_t i = 0; i < one.outcomes.size(); ++i) {
+    EXPECT_EQ(two.outcomes[i].outcome, one.outcomes[i].outcome) << one.outcomes[i].id;
+    EXPECT_EQ(two.outcomes[i].points, one.outcomes[i].points) << one.outcomes[i].id;
+  }
+  EXPECT_EQ(two.cloud_points, cloud.points.size());
+  EXPECT_EQ(two.cropped_points, one.cropped_points);
+  ASSERT_EQ(two.clouds.size(), 2u);
+  EXPECT_EQ(two.clouds[0].path, dir + "/first.ply");
+  EXPECT_EQ(two.clouds[0].points, first.points.size());
+  EXPECT_EQ(two.clouds[1].path, dir + "/second.ply");
+  EXPECT_EQ(two.clouds[1].points, second.points.size());
+  EXPECT_TRUE(two.warnings.empty());
+
+  // Tiles cut along x, each building's scan in two of them.
+  const std::vector<PointCloud> parts = fixtures::split_by_x(cloud, 4);
+  fixtures::write_tiles(dir + "/tiles", parts);
+  write_file_atomic(dir + "/tiles/index.txt", "tile_00 tile_01 tile_02 tile_03\n");
+  write_ply(dir + "/tiles.ply", fixtures::concatenated(parts));
+  const std::vector<std::string> tiles = cloud_files({dir + "/tiles"});
+  ASSERT_EQ(tiles.size(), 4u);
+  for (const std::string name : {"city.json", "city.city.jsonl"}) {
+    const std::string model = dir + "/" + name, merged = dir + "/tiles_" + name, split = dir + "/split_" + name;
+    const CityRefineSummary m = refine_city(model, {dir + "/tiles.ply"}, merged, {}, {});
+    const CityRefineSummary s = refine_city(model, tiles, split, {}, {});
+    EXPECT_GE(m.refined, 2) << name;
+    EXPECT_EQ(s.refined, m.refined) << name;
+    EXPECT_TRUE(cli_fixtures::slurp(split) == cli_fixtures::slurp(merged)) << name;
+    ASSERT_EQ(s.clouds.size(), 4u);
+    for (std::size_t k = 0; k < 4; ++k) EXPECT_EQ(s.clouds[k].points, parts[k].points.size()) << k;
+  }
+}
+
+// A file of another area among the cloud files is named on its own line, in the summary, on
+// stdout and in the report, and the buildings get the other files' points; when no file reaches
+// the model the run is refused as with one file.
+TEST(CityFile, ACloudFileOfAnotherAreaIsNamed) {
+  const std::string dir = test_dir();
+  PointCloud cloud;
+  const std::vector<SynthBuilding> bs = synth_street({BuildingType::Gable}, 5, 4000, 1, cloud);
+  write_file_atomic(dir + "/city.json", synth_city(bs, Vec3(93000, 436000, 0)).dump());
+  PointCloud far = cloud;
+  for (auto& p : far.points) p += Vec3(-50000, 70000, 0);  // another tile, or another CRS
+  const std::string near_path = dir + "/near.ply", far_path = dir + "/far.ply", far2_path = dir + "/far2.ply";
+  write_ply(near_path, cloud);
+  write_ply(far_path, far);
+  write_ply(far2_path, far);
+  const CityRefineSummary alone = refine_city(dir + "/city.json", {near_path}, dir + "/alone.city.json", {}, {});
+  const CityRefineSummary s = refine_city(dir + "/city.json", {near_path, far_path}, dir + "/out.city.json", {}, {});
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_EQ(s.warnings[0].rfind(far_path + ": cloud x 4", 0), 0u) << s.warnings[0];
+  EXPECT_NE(s.warnings[0].find("does not overlap the city model x 92"), std::string::npos) << s.warnings[0];
+  EXPECT_TRUE(alone.warnings.empty());
+  EXPECT_EQ(s.cloud_points, 2 * cloud.points.size());
+  EXPECT_EQ(s.cropped_points, alone.cropped_points);
+  EXPECT_TRUE(cli_fixtures::slurp(dir + "/out.city.json") == cli_fixtures::slurp(dir + "/alone.city.json"));
+  try {
+    refine_city(dir + "/city.json", {far_path, far2_path}, dir + "/none.city.json", {}, {});
+    ADD_FAILURE() << "no file reaches the model";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(far_path + " and 1 other cloud file: cloud x 4", 0), 0u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("does not overlap the city model"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir + "/none.city.json"));
+
+  // The command line: a warning line per file on stdout, every file in the report.
+  const Cli r = run_cli("refine --quiet --model " + dir + "/city.json --cloud " + near_path + " --cloud " + far_path +
+                            " --out " + dir + "/cli.city.json --report " + dir + "/report.json",
+                        dir);
+  ASSERT_EQ(r.exit, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_EQ(r.out.rfind("warning: " + far_path + ": cloud x 4", 0), 0u) << r.out;
+  EXPECT_EQ(r.out.find("warning: " + near_path), std::string::npos) << r.out;
+  const json report = load(dir + "/report.json");
+  ASSERT_EQ(report["warnings"].size(), 1u);
+  EXPECT_EQ(report["warnings"][0], s.warnings[0]);
+  EXPECT_FALSE(report["cloud"].contains("path")) << "several files: each in files";
+  ASSERT_EQ(report["cloud"]["files"].size(), 2u);
+  EXPECT_EQ(report["cloud"]["files"][0]["path"], near_path);
+  EXPECT_EQ(report["cloud"]["files"][0]["points"], cloud.points.size());
+  EXPECT_EQ(report["cloud"]["files"][1]["path"], far_path);
+  const Eigen::AlignedBox3d far_box = bounding_box(far.points);
+  EXPECT_EQ(report["cloud"]["files"][1]["bounds"]["min"],
+            json({far_box.min().x(), far_box.min().y(), far_box.min().z()}));
+  EXPECT_EQ(report["cloud"]["files"][1]["bounds"]["max"],
+            json({far_box.max().x(), far_box.max().y(), far_box.max().z()}));
+  const Cli single = run_cli("refine --quiet --model " + dir + "/city.json --cloud " + near_path + " --out " + dir +
+                                 "/single.city.json --report " + dir + "/single.json",
+                             dir);
+  ASSERT_EQ(single.exit, 0) << single.err;
+  const json single_report = load(dir + "/single.json");
+  EXPECT_EQ(single_report["cloud"]["path"], near_path);
+  EXPECT_EQ(single_report["cloud"]["files"].size(), 1u);
+  EXPECT_FALSE(single_report.contains("warnings"));
 }

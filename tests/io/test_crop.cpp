@@ -13,6 +13,7 @@
 #include "lodrefine/io/crop.h"
 #include "lodrefine/io/ply.h"
 #include "lodrefine/synth/synth.h"
+#include "support/io_fixtures.h"
 
 using namespace lodrefine;
 
@@ -33,7 +34,7 @@ TEST(Crop, OneStreamingPassCutsEachBuildingsCloud) {
 
   std::vector<CropTarget> targets;
   for (const auto& b : bs) targets.push_back(crop_target(b.coarse, 0.1, 3.0));
-  EXPECT_EQ(crop_tile(path.string(), targets), tile.points.size());
+  EXPECT_EQ(crop_tile({path.string()}, targets), tile.points.size());
   for (std::size_t i = 0; i < bs.size(); ++i) {
     // Every point of the building's own crop lies in its box; the crop has (nearly) all of it.
     const auto& t = targets[i];
@@ -46,26 +47,35 @@ TEST(Crop, OneStreamingPassCutsEachBuildingsCloud) {
   std::filesystem::remove(path);
 }
 
-// The city-scale path: a tiny memory bound (spilling to disk all the time) writes exactly the
-// in-memory crops, in the same order.
-TEST(Crop, BoundedMemoryCropWritesTheSameClouds) {
+namespace {
+
+// Three generated buildings 25 m apart (their boxes overlap) in one tile; their crop targets.
+PointCloud overlapping_row(std::vector<CropTarget>& targets) {
   PointCloud tile;
-  std::vector<CropTarget> targets;
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
     SynthOptions opt;
     opt.target_points = 2000;
     const auto b = make_building(BuildingType::Flat, seed, opt);
-    // 25 m apart: the boxes overlap.
     const Vec3 shift = Vec3(85000.0 + 25.0 * double(seed), 447000.0, 0.0) - b.frame_origin;
     for (const auto& p : b.cloud.points) tile.points.push_back(p + shift);
     targets.push_back(crop_target(translated(b.coarse, shift), 0.1, 3.0));
   }
+  return tile;
+}
+
+}  // namespace
+
+// The city-scale path: a tiny memory bound (spilling to disk all the time) writes exactly the
+// in-memory crops, in the same order.
+TEST(Crop, BoundedMemoryCropWritesTheSameClouds) {
+  std::vector<CropTarget> targets;
+  const PointCloud tile = overlapping_row(targets);
   const auto dir = std::filesystem::temp_directory_path() / ("lodrefine_crop_files_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const auto path = (dir / "tile.ply").string();
   write_ply(path, tile);
   std::vector<CropTarget> in_memory = targets;
-  crop_tile(path, in_memory);
+  crop_tile({path}, in_memory);
   std::vector<std::string> outs;
   for (std::size_t i = 0; i < targets.size(); ++i)
     outs.push_back((dir / ("crop" + std::to_string(i) + ".ply")).string());
@@ -75,7 +85,7 @@ TEST(Crop, BoundedMemoryCropWritesTheSameClouds) {
   for (const auto& out : outs)
     std::filesystem::create_symlink(victim, out + ".spill.tmp." + std::to_string(::getpid()));
   std::vector<std::size_t> counts;
-  EXPECT_EQ(crop_tile_to_files(path, targets, outs, 7, counts), tile.points.size());
+  EXPECT_EQ(crop_tile_to_files({path}, targets, outs, 7, counts), tile.points.size());
   EXPECT_EQ(std::filesystem::file_size(victim), 9u);
   for (const auto& out : outs) std::filesystem::remove(out + ".spill.tmp." + std::to_string(::getpid()));
   std::filesystem::remove(victim);
@@ -146,7 +156,7 @@ TEST(Crop, HugeBoxAmongSmallOnesKeepsTheGridSmall) {
   write_ply(path.string(), tile);
   EXPECT_TRUE(runs_within(std::size_t(200) << 20, [&] {
     std::vector<CropTarget> copy = targets;
-    crop_tile(path.string(), copy);
+    crop_tile({path.string()}, copy);
     bool ok = copy.back().cloud.points.size() == 501;  // every point but the far one
     for (std::size_t k = 0; k + 1 < copy.size(); ++k) ok = ok && copy[k].cloud.points.size() == 1;
     if (!ok) throw std::runtime_error("wrong crops");
@@ -162,5 +172,81 @@ TEST(Crop, HugeBoxAmongSmallOnesKeepsTheGridSmall) {
     ADD_FAILURE() << "accepted";
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()).rfind("stray: spans 1000 km, more than a building can (5 km)", 0), 0u) << e.what();
+  }
+}
+
+// A tile delivered as several (issue 39): the crops of the tiles read as one are those of the one
+// tile holding their points in that order, also through the bounded-memory path; the limits
+// count the points of every tile.
+TEST(Crop, TilesReadAsOneCropAsTheirMergedTile) {
+  std::vector<CropTarget> targets;
+  const PointCloud tile = overlapping_row(targets);
+  const std::vector<PointCloud> parts = fixtures::split_by_x(tile, 3);
+  const std::string dir = fixtures::temp_path("tiles");
+  const std::vector<std::string> tiles = fixtures::write_tiles(dir, parts);
+  const std::string merged = fixtures::temp_path("merged.ply");
+  write_ply(merged, fixtures::concatenated(parts));
+
+  std::vector<CropTarget> one = targets, several = targets;
+  EXPECT_EQ(crop_tile({merged}, one), tile.points.size());
+  std::vector<CloudFileRead> read;
+  EXPECT_EQ(crop_tile(tiles, several, {}, &read), tile.points.size());
+  std::size_t held = 0, straddling = 0;
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    EXPECT_EQ(several[i].cloud.points, one[i].cloud.points) << i;
+    held += one[i].cloud.points.size();
+    std::size_t tiles_reached = 0;  // the tiles holding some of this crop
+    for (const PointCloud& part : parts)
+      tiles_reached += std::any_of(part.points.begin(), part.points.end(), [&](const Vec3& p) {
+        return (p.array() >= targets[i].lo.array()).all() && (p.array() <= targets[i].hi.array()).all();
+      });
+    straddling += tiles_reached > 1;
+  }
+  EXPECT_GE(straddling, 2u) << "the cuts run through buildings";
+  ASSERT_EQ(read.size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(read[k].path, tiles[k]);
+    EXPECT_EQ(read[k].points, parts[k].points.size());
+    EXPECT_EQ(read[k].bounds.min(), bounding_box(parts[k].points).min());
+  }
+
+  // The bounded-memory path writes the same crops.
+  std::vector<std::string> outs;
+  for (std::size_t i = 0; i < targets.size(); ++i)
+    outs.push_back(fixtures::temp_path("crop" + std::to_string(i) + ".ply"));
+  std::vector<std::size_t> counts;
+  EXPECT_EQ(crop_tile_to_files(tiles, targets, outs, 7, counts), tile.points.size());
+  for (std::size_t i = 0; i < targets.size(); ++i) EXPECT_EQ(read_ply(outs[i]).points, one[i].cloud.points) << i;
+
+  // --max-crop-points counts the crops' points over every tile read.
+  std::vector<CropTarget> copy = targets;
+  EXPECT_EQ(crop_tile(tiles, copy, {}, nullptr, {}, held), tile.points.size());
+  copy = targets;
+  try {
+    crop_tile(tiles, copy, {}, nullptr, {}, held - 1);
+    ADD_FAILURE() << "the crops hold more than --max-crop-points";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              tiles.back() + ": the buildings' crop boxes hold more than " + std::to_string(held - 1) +
+                  " points (--max-crop-points), counting the tiles read before it; refine the district in parts");
+  }
+  // --max-points bounds each crop over every tile: a crop under it in each tile, over it in all.
+  std::size_t largest = 0, largest_in_one_tile = 0;
+  for (const auto& t : one) largest = std::max(largest, t.cloud.points.size());
+  for (const std::string& path : tiles) {
+    std::vector<CropTarget> alone = targets;
+    crop_tile({path}, alone);
+    for (const auto& t : alone) largest_in_one_tile = std::max(largest_in_one_tile, t.cloud.points.size());
+  }
+  ASSERT_LT(largest_in_one_tile, largest - 1);
+  CloudOptions bounded;
+  bounded.max_points = largest - 1;
+  try {
+    crop_tile_to_files(tiles, targets, outs, 7, counts, bounded);
+    ADD_FAILURE() << "a crop holds more than --max-points";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(" points (--max-points), counting the tiles read before it"),
+              std::string::npos)
+        << e.what();
   }
 }

@@ -4,13 +4,16 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "lodrefine/core/types.h"
+#include "lodrefine/io/ply.h"
 
 namespace lodrefine::fixtures {
 
@@ -54,6 +57,39 @@ void expect_bytes_refused(const std::string& name, const std::string& bytes, con
 template <class T>
 void poke(std::string& bytes, std::size_t at, T v) {
   std::memcpy(&bytes[at], &v, sizeof v);
+}
+
+// A survey delivered per tile: the cloud cut along x into `n` tiles of about equal counts (cut at
+// the x quantiles, so buildings straddle tiles), each keeping the cloud's order.
+inline std::vector<PointCloud> split_by_x(const PointCloud& cloud, std::size_t n) {
+  std::vector<double> xs;
+  for (const Vec3& p : cloud.points) xs.push_back(p.x());
+  std::sort(xs.begin(), xs.end());
+  std::vector<double> cuts;  // tile k: cuts[k-1] <= x < cuts[k]
+  for (std::size_t k = 1; k < n; ++k) cuts.push_back(xs[k * xs.size() / n]);
+  std::vector<PointCloud> tiles(n);
+  for (const Vec3& p : cloud.points)
+    tiles[std::size_t(std::upper_bound(cuts.begin(), cuts.end(), p.x()) - cuts.begin())].points.push_back(p);
+  return tiles;
+}
+
+// The tiles one after another: the one file that reading them in this order equals.
+inline PointCloud concatenated(const std::vector<PointCloud>& tiles) {
+  PointCloud all;
+  for (const PointCloud& t : tiles) all.points.insert(all.points.end(), t.points.begin(), t.points.end());
+  return all;
+}
+
+// Writes the tiles as DIR/tile_00.ply, tile_01.ply, ... (created last first: the folder's order
+// is not the names') and returns their paths in name order.
+inline std::vector<std::string> write_tiles(const std::string& dir, const std::vector<PointCloud>& tiles) {
+  std::filesystem::create_directories(dir);
+  std::vector<std::string> paths(tiles.size());
+  for (std::size_t k = tiles.size(); k-- > 0;) {
+    paths[k] = dir + "/tile_" + (k < 10 ? "0" : "") + std::to_string(k) + ".ply";
+    write_ply(paths[k], tiles[k]);
+  }
+  return paths;
 }
 
 }  // namespace lodrefine::fixtures

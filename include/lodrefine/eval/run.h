@@ -17,9 +17,12 @@
 
 namespace lodrefine {
 
-// The files of one building; empty strings for absent optional ones.
+// The files of one building; empty strings for absent optional ones. Its cloud may be several
+// files, read as one (io/cloud.h); a run folder's is its cloud.ply.
 struct BuildingFiles {
-  std::string id, original, refined, cloud, truth, meta, report, failed;
+  std::string id, original, refined;
+  std::vector<std::string> clouds;
+  std::string truth, meta, report, failed;
 };
 
 // The buildings of a run folder: every RUN_DIR/<id>/ holding a coarse.obj, sorted by id, with

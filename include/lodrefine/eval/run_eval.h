@@ -13,8 +13,11 @@ namespace lodrefine {
 
 struct EvalOptions {
   // One building (original, refined and cloud required; truth and meta optional) or, with `dir`,
-  // a run folder (run.h's discover_run).
-  std::string original, refined, cloud, truth, meta, dir;
+  // a run folder (run.h's discover_run). The cloud: --cloud's values, files or folders
+  // (io/cloud.h's cloud_files), read as one cloud.
+  std::string original, refined;
+  std::vector<std::string> clouds;
+  std::string truth, meta, dir;
   // Outputs, each skipped when empty: --json, --csv, --svg-dir (created), --html (run folder only).
   std::string json_out, csv_out, svg_dir, html_out;
   int html_views = 20;  // buildings shown in 3D on the HTML page, worst first

@@ -2,7 +2,8 @@
 // that the cloud covers is refined, and one CityJSON 2.0 file (or CityJSONSeq for a sequence)
 // is written with everything else kept exactly.
 //
-// The cloud is read once: one streaming pass cuts a crop per building (lodrefine crop's box),
+// The cloud (one file or several, read as one: cloud.h) is read once: one streaming pass cuts a
+// crop per building (lodrefine crop's box),
 // then each building is refined on its crop, `jobs` buildings at once (memory: the crops, not
 // the cloud); results are written in file order. A refined building's chosen LoD geometry is replaced by a Solid with
 // semantics (WallSurface / RoofSurface / GroundSurface from the refined mesh's faces); its other LoDs, attributes and
@@ -79,21 +80,27 @@ struct CityRefineSummary {
   std::string input_format;  // "CityJSON 2.0", "CityJSONSeq 2.0", "CityGML 2.0"
   int buildings = 0;         // LoD 2 buildings / building parts in the file
   int refined = 0, repaired = 0, kept = 0, kept_invalid = 0;
-  int untouched = 0;                          // no cloud point in their box: written exactly as read
-  std::map<std::string, int> refused;         // kept because this never-worse check refused the refinement
-  int objects_without_lod = 0;                // Building/BuildingPart objects without the LoD asked for
-  std::uint64_t cloud_points = 0;             // points read (after the class filter)
+  int untouched = 0;                   // no cloud point in their box: written exactly as read
+  std::map<std::string, int> refused;  // kept because this never-worse check refused the refinement
+  int objects_without_lod = 0;         // Building/BuildingPart objects without the LoD asked for
+  std::uint64_t cloud_points = 0;      // points read (after the class filter)
+  std::vector<CloudFileRead> clouds;   // each cloud file, in reading order: its points and bounds
+  // One line per cloud file whose bounds miss the city model ("<file>: cloud x .. does not overlap
+  // the city model ..: wrong CRS or tile?") when other files reach it (else the run is refused).
+  std::vector<std::string> warnings;
   std::uint64_t cropped_points = 0;           // points held in the crops after the cloud pass (the memory that grows)
   std::vector<CityBuildingOutcome> outcomes;  // the buildings the cloud reached, in file order
   double seconds_read = 0.0, seconds_crop = 0.0, seconds_refine = 0.0, seconds_write = 0.0;
 };
 
-// Throws InputError (one line, nothing written) when the model or cloud cannot be read, when
-// no building has the LoD asked for, when --building names no such building, or when the cloud
-// overlaps no building ("cloud x..y does not overlap the city model x..y: wrong CRS or tile?").
-// A building whose refinement throws is kept as read with outcome kept-invalid and the reason.
-CityRefineSummary refine_city(const std::string& model_path, const std::string& cloud_path, const std::string& out_path,
-                              const Params& params, const CityRefineOptions& options);
+// Throws InputError (one line, nothing written) when the model or a cloud file cannot be read,
+// when no building has the LoD asked for, when --building names no such building, or when no
+// cloud file reaches a building ("cloud x..y does not overlap the city model x..y: wrong CRS or
+// tile?"). A building whose refinement throws is kept as read with outcome kept-invalid and the
+// reason. `cloud_paths` are files (cloud_files expands folders), read in that order as one cloud:
+// the output is that of one file holding their points in that order.
+CityRefineSummary refine_city(const std::string& model_path, const std::vector<std::string>& cloud_paths,
+                              const std::string& out_path, const Params& params, const CityRefineOptions& options);
 
 // The refined mesh as a CityJSON Solid geometry of LoD `lod` with semantics, its vertices
 // appended to `vertices` quantised by the document's transform (`scale`, `translate`).

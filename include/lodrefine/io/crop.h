@@ -24,25 +24,27 @@ constexpr double kMaxBuildingExtent = 5000.0;
 // wider than kMaxBuildingExtent.
 CropTarget crop_target(const Mesh& model, double relative, double absolute);
 
-// Streams the tile (PLY or LAS, `options` filtering LAS classes) once and appends each point
-// to every target whose box holds it (2D grids over the targets keep this O(points), their memory O(targets)).
-// Returns the number of points read (after the class filter); `bounds` (optional) gets the
-// bounding box of every point read. `on_read` (optional) is called with the points read so far
-// every 65,536 points (for a progress line). Throws InputError when the targets would hold more
+// Streams the tiles (PLY or LAS/LAZ files, read as one cloud: stream_cloud; `options` filtering
+// LAS classes) once and appends each point to every target whose box holds it (2D grids over the
+// targets keep this O(points), their memory O(targets)). Returns the number of points read (after
+// the class filter); `read` (optional) gets each file's points and bounds (stream_cloud). `on_read`
+// (optional) is called with the points read so far, over all files, every 65,536 points (for a
+// progress line). Throws InputError naming the file being read when the targets would hold more
 // than `max_held` points together.
-std::size_t crop_tile(const std::string& tile, std::vector<CropTarget>& targets, const CloudOptions& options = {},
-                      Eigen::AlignedBox3d* bounds = nullptr, const std::function<void(std::uint64_t)>& on_read = {},
-                      std::uint64_t max_held = UINT64_MAX);
+std::size_t crop_tile(const std::vector<std::string>& tiles, std::vector<CropTarget>& targets,
+                      const CloudOptions& options = {}, std::vector<CloudFileRead>* read = nullptr,
+                      const std::function<void(std::uint64_t)>& on_read = {}, std::uint64_t max_held = UINT64_MAX);
 
-// The same pass for a whole city tile, with memory bounded by `buffer_points`, not by the tile:
-// each target's points go to `out_paths[i]` (a PLY, written atomically), and points held beyond
-// the bound are spilled to per-target temporary files beside them. Only one target's crop is
-// in memory at a time when the PLYs are written, so a crop of more than options.max_points points
-// is refused (InputError). Returns the number of points read and sets `counts[i]` to each crop's
-// size.
-std::size_t crop_tile_to_files(const std::string& tile, const std::vector<CropTarget>& targets,
+// The same pass for a whole city tile (or several), with memory bounded by `buffer_points`, not
+// by the tiles: each target's points go to `out_paths[i]` (a PLY, written atomically), and points
+// held beyond the bound are spilled to per-target temporary files beside them. Only one target's
+// crop is in memory at a time when the PLYs are written, so a crop of more than
+// options.max_points points (over all tiles) is refused (InputError). Returns the number of
+// points read and sets `counts[i]` to each crop's size; `read` as for crop_tile.
+std::size_t crop_tile_to_files(const std::vector<std::string>& tiles, const std::vector<CropTarget>& targets,
                                const std::vector<std::string>& out_paths, std::size_t buffer_points,
                                std::vector<std::size_t>& counts, const CloudOptions& options = {},
-                               const std::function<void(std::uint64_t)>& on_read = {});
+                               const std::function<void(std::uint64_t)>& on_read = {},
+                               std::vector<CloudFileRead>* read = nullptr);
 
 }  // namespace lodrefine
