@@ -20,6 +20,7 @@
 #include <limits>
 #include <numeric>
 #include <optional>
+#include <set>
 #include <tuple>
 #include <unordered_map>
 
@@ -562,9 +563,12 @@ std::vector<std::vector<int>> take_back(const PointCloud& cloud, const Thinning&
 // extent, split in two layers by their signed distance (two-means, from the quartiles). The
 // layers are two copies of one wall when each holds kMinLayerShare of the points or more, the
 // density midway is below kMaxValley of either layer's (two peaks, not a thick or rough wall),
-// and neither copy is narrower or shorter than kMinLayerSpan of the other (one footprint: not a
-// plinth or a balcony before the wall).
+// and the copies overlap over kMinLayerSpan of the longer, along the wall and up it (one
+// footprint: not a plinth, a balcony before the wall, or a facade stepping a few cm part-way),
+// cell by cell (shared_cells: not a wall and its windows' panes set back in their reveals).
 constexpr double kMinLayerShare = 0.2, kMaxValley = 0.4, kMinLayerSpan = 0.6;
+// m, and the share of the sparser layer's cells the other must share (one footprint everywhere).
+constexpr double kLayerCell = 0.5, kMinSharedCells = 0.7;
 // Layers nearer than this many RANSAC epsilons are one thick plane to the detection anyway.
 constexpr double kMinLayerGapEpsilons = 1.0;
 
@@ -573,13 +577,36 @@ struct Layers {
   bool doubled = false;
 };
 
-double span_of(std::vector<double> x) {
-  if (x.size() < 2) return 0.0;
+// The 5th to 95th percentile of x.
+std::pair<double, double> range_of(std::vector<double> x) {
+  if (x.size() < 2) return {0.0, 0.0};
   const std::size_t lo = x.size() / 20, hi = x.size() - 1 - x.size() / 20;
   std::nth_element(x.begin(), x.begin() + long(lo), x.end());
   const double a = x[lo];
   std::nth_element(x.begin(), x.begin() + long(hi), x.end());
-  return x[hi] - a;
+  return {a, x[hi]};
+}
+
+// Whether two ranges overlap over kMinLayerSpan of the longer: one footprint, not two halves.
+bool same_extent(const std::pair<double, double>& a, const std::pair<double, double>& b) {
+  const double overlap = std::min(a.second, b.second) - std::max(a.first, b.first);
+  return overlap >= kMinLayerSpan * std::max(a.second - a.first, b.second - b.first);
+}
+
+// The share of the cells (kLayerCell square, in the wall) holding points of the sparser layer
+// that hold points of the other too: a wall seen twice is two copies everywhere; a wall and its
+// windows' panes set back behind it take turns.
+double shared_cells(const std::vector<double>& d, const std::vector<Vec2>& uv, double mid) {
+  std::set<std::pair<long long, long long>> near, far;
+  for (std::size_t i = 0; i < d.size(); ++i)
+    (d[i] < mid ? near : far)
+        .emplace((long long)std::floor(uv[i].x() / kLayerCell), (long long)std::floor(uv[i].y() / kLayerCell));
+  const auto& fewer = near.size() < far.size() ? near : far;
+  const auto& more = near.size() < far.size() ? far : near;
+  if (fewer.empty()) return 0.0;
+  std::size_t both = 0;
+  for (const auto& c : fewer) both += more.count(c);
+  return double(both) / double(fewer.size());
 }
 
 Layers two_layers(const std::vector<double>& d, const std::vector<Vec2>& uv, double min_gap) {
@@ -607,10 +634,9 @@ Layers two_layers(const std::vector<double>& d, const std::vector<Vec2>& uv, dou
     else ub.push_back(uv[i].x()), zb.push_back(uv[i].y());
   }
   const double share = double(std::min(na, d.size() - na)) / double(d.size());
-  const double wa = span_of(ua), wb = span_of(ub), ha = span_of(za), hb = span_of(zb);
   out.doubled = share >= kMinLayerShare && double(valley) < kMaxValley * double(std::min(peak_a, peak_b)) &&
-                std::min(wa, wb) >= kMinLayerSpan * std::max(wa, wb) &&
-                std::min(ha, hb) >= kMinLayerSpan * std::max(ha, hb);
+                same_extent(range_of(ua), range_of(ub)) && same_extent(range_of(za), range_of(zb)) &&
+                shared_cells(d, uv, mid) >= kMinSharedCells;
   return out;
 }
 
@@ -759,11 +785,11 @@ std::vector<ModelWall> model_walls(const Mesh& model, double max_tilt_deg) {
 }  // namespace
 
 // Whether the plane's inliers beside the wall (within its extent along the street) stand as a
-// wall does, over kMinWallSpan of its height bins from the lowest they fill to the highest, with
-// no gap of more than kMaxWallGap empty bins between; nullopt when none stands beside it.
+// wall does: the height bins they fill span kMinWallSpan of the wall's, from the lowest to the
+// highest; nullopt when none stands beside it.
 std::optional<bool> stands_as_wall(const ModelWall& w, const ScanPlane& p, const PointCloud& cloud) {
   const int bins = std::max(1, int(std::ceil((w.eave - w.foot) / kHeightBin)));
-  std::vector<char> filled(std::size_t(bins), 0);
+  int first = bins, last = -1;
   bool beside = false;
   for (int i : p.inliers) {
     const Vec3& q = cloud.points[std::size_t(i)];
@@ -771,20 +797,10 @@ std::optional<bool> stands_as_wall(const ModelWall& w, const ScanPlane& p, const
     if (t < w.a || t > w.b) continue;
     beside = true;
     const int bin = int(std::floor((q.z() - w.foot) / kHeightBin));
-    if (bin >= 0 && bin < bins) filled[std::size_t(bin)] = 1;
+    if (bin >= 0 && bin < bins) first = std::min(first, bin), last = std::max(last, bin);
   }
   if (!beside) return std::nullopt;
-  int first = -1, last = -1, gap = 0, widest = 0;
-  for (int k = 0; k < bins; ++k) {
-    if (!filled[std::size_t(k)]) {
-      ++gap;
-      continue;
-    }
-    if (first < 0) first = k;
-    else widest = std::max(widest, gap);
-    last = k, gap = 0;
-  }
-  return first >= 0 && double(last - first + 1) >= kMinWallSpan * double(bins) && widest <= kMaxWallGap;
+  return last >= first && double(last - first + 1) >= kMinWallSpan * double(bins);
 }
 
 std::vector<ScanPlane> without_relief(std::vector<ScanPlane> planes, const Mesh& model, const PointCloud& cloud,
@@ -795,7 +811,8 @@ std::vector<ScanPlane> without_relief(std::vector<ScanPlane> planes, const Mesh&
     bool beside = false, wall = false;  // beside a parallel model wall, and standing as one there
     if (p.facade)
       for (const auto& w : walls)
-        if (unoriented_angle_deg(w.plane.n, p.plane.n) <= prm.facade_max_tilt_deg)
+        if (unoriented_angle_deg(w.plane.n, p.plane.n) <= prm.facade_max_tilt_deg &&
+            std::abs(w.plane.distance(p.centroid)) <= kReliefDepth)
           if (const auto stands = stands_as_wall(w, p, cloud)) beside = true, wall = wall || *stands;
     if (!beside || wall) out.push_back(std::move(p));
     else if (relief) relief->push_back(std::move(p));

@@ -48,17 +48,17 @@ constexpr double kMaxDoubledWall = 0.12;
 void collapse_doubled_walls(PointCloud& cloud, const std::vector<ScanPlane>& planes);
 
 // The scan's facade planes that are relief, not walls: balconies, cornices, ledges, shop fronts,
-// window panes and rooms seen through glass (storey by storey), cars. A wall stands from its
-// foot to its eave, however sparse its points (a return seen at a grazing angle); relief covers
-// a part of that, or leaves storey-high gaps. A facade plane is a wall when, beside some model
-// wall parallel to it (within facade_max_tilt_deg; its extent along the street), its inliers fill
-// height bins (kHeightBin, the wall's foot to its eave: its lowest vertex to the highest at either
-// end) over kMinWallSpan of the wall's height, no more than kMaxWallGap empty bins apart. Planes
-// beside no parallel model wall (a wall the model lacks) are walls. Returns the walls; `relief`
-// (optional) gets the others.
-constexpr double kHeightBin = 0.5;  // m
+// cars. A wall stands from its foot to its eave, however sparse its points (a return seen at a
+// grazing angle); relief stands over a part of that. A facade plane is a wall when, beside some
+// model wall parallel to it (within facade_max_tilt_deg and kReliefDepth of it: balconies stand
+// 1-1.5 m proud, a recess's return stands metres from the side walls it parallels; its extent
+// along the street), its inliers span kMinWallSpan of the wall's height bins (kHeightBin, the
+// wall's foot to its eave: its lowest vertex to the highest at either end). Planes beside no
+// such model wall (a wall the model lacks) are walls. Returns the walls; `relief` (optional)
+// gets the others.
+constexpr double kHeightBin = 0.5;    // m
+constexpr double kReliefDepth = 1.6;  // m
 constexpr double kMinWallSpan = 0.5;
-constexpr int kMaxWallGap = 2;  // bins: window rows leave none across a wall; storeys of rooms or balconies 3-4
 std::vector<ScanPlane> without_relief(std::vector<ScanPlane> planes, const Mesh& model, const PointCloud& cloud,
                                       const PlaneConfig& config, std::vector<ScanPlane>* relief = nullptr);
 
