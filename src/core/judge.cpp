@@ -185,12 +185,14 @@ struct Side {
 constexpr double kBehindWall = 0.1, kRoomDepth = 6.0;  // m
 class Openings {
  public:
-  Openings(const std::vector<ScanPlane>& planes, const PointCloud& cloud, const Mesh& model, const Mesh& other)
-      : distance_(model), other_(other) {
+  // `model` with its distances, and the other model's distances (the judge's own, not built again).
+  Openings(const std::vector<ScanPlane>& planes, const PointCloud& cloud, const Mesh& model,
+           const MeshDistance& distance, const MeshDistance& other)
+      : distance_(distance), other_(other) {
     const auto normals = face_planes(model);
     for (const auto& sp : planes) {
       if (!sp.facade || sp.inliers.empty() || normals.empty()) continue;
-      Wall w{sp.plane, horizontal_along(sp.plane), {}};
+      Wall w{sp.plane, {}};
       const int f = distance_.nearest(sp.centroid, false).face;
       if (f >= 0 && w.plane.n.dot(normals[std::size_t(f)].n) < 0) w.plane = w.plane.flipped();
       for (int i : sp.inliers) {
@@ -215,11 +217,10 @@ class Openings {
 
  private:
   struct Wall {
-    Plane plane;  // outwards
-    Vec3 u;
+    Plane plane;                                             // outwards
     std::map<long long, std::pair<double, double>> columns;  // the lowest and highest inlier per column
   };
-  MeshDistance distance_, other_;
+  const MeshDistance &distance_, &other_;
   std::vector<Wall> walls_;
 };
 
@@ -241,7 +242,7 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
   box.max() += Vec3::Constant(reach);
   Side s0(before, facade_lines), s1(after, facade_lines);
   const std::vector<int> facade = facade_plane_of(planes, cloud.points.size());
-  const Openings openings(planes, cloud, before, after);
+  const Openings openings(planes, cloud, before, s0.distance, s1.distance);
   std::vector<std::size_t> judged;  // the cloud's points near enough to be judged
   std::vector<Vec3> at;
   for (std::size_t i = 0; i < cloud.points.size(); ++i) {

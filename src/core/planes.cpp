@@ -782,8 +782,6 @@ std::vector<ModelWall> model_walls(const Mesh& model, double max_tilt_deg) {
   return out;
 }
 
-}  // namespace
-
 // Whether the plane's inliers beside the wall (within its extent along the street) stand as a
 // wall does: the height bins they fill span kMinWallSpan of the wall's, from the lowest to the
 // highest; nullopt when none stands beside it.
@@ -802,6 +800,8 @@ std::optional<bool> stands_as_wall(const ModelWall& w, const ScanPlane& p, const
   if (!beside) return std::nullopt;
   return last >= first && double(last - first + 1) >= kMinWallSpan * double(bins);
 }
+
+}  // namespace
 
 std::vector<ScanPlane> without_relief(std::vector<ScanPlane> planes, const Mesh& model, const PointCloud& cloud,
                                       const PlaneConfig& prm, std::vector<ScanPlane>* relief) {

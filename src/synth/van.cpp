@@ -95,8 +95,7 @@ std::optional<Shot> through_opening(const SceneWall& w, const Vec3& hit, const V
     const Vec3 pane = hit + d * (op.reveal / facing);
     const double sp = (pane - w.o).dot(w.u), zp = pane.z();
     if (sp < op.s0 || sp > op.s1 || zp < op.z0 || zp > op.z1) {  // the reveal's side takes it
-      const double a = std::clamp(r.uniform(), 0.0, 1.0);
-      return Shot{hit + d * (a * op.reveal / facing), kWindow};
+      return Shot{hit + d * (r.uniform() * op.reveal / facing), kWindow};
     }
     switch (op.pane) {
       case Opening::Pane::Opaque: return Shot{pane, kWindow};
