@@ -110,6 +110,24 @@ std::vector<Mesh> neighbours(const City& city, const Eigen::AlignedBox3d& box, c
   return out;
 }
 
+// The tile's origin, once meta.json is known to be a dev tile's: an origin of three numbers, and
+// buildings each with an id that names a file in the tile's folders (no path, nothing hidden).
+Vec3 tile_origin(const nlohmann::json& meta, const std::string& tile) {
+  const std::string where = tile + "/meta.json: ";
+  const auto& o = meta.contains("origin") ? meta["origin"] : nlohmann::json();
+  if (!o.is_array() || o.size() != 3 || !o[0].is_number() || !o[1].is_number() || !o[2].is_number())
+    throw InputError(where + "no origin of three numbers: not a dev tile");
+  if (!meta.contains("buildings") || !meta["buildings"].is_array())
+    throw InputError(where + "no buildings: not a dev tile");
+  for (const auto& b : meta["buildings"]) {
+    const bool named = b.is_object() && b.contains("id") && b["id"].is_string();
+    const std::string id = named ? b["id"].get<std::string>() : std::string();
+    if (id.empty() || id.find('/') != std::string::npos || id.find('\0') != std::string::npos || id[0] == '.')
+      throw InputError(where + "a building without a safe id (" + (named ? id : b.dump().substr(0, 60)) + ")");
+  }
+  return {o[0].get<double>(), o[1].get<double>(), o[2].get<double>()};
+}
+
 }  // namespace
 
 void rescan_tile(const std::string& tile, const std::string& city_path, const std::string& out, const SynthOptions& opt,
@@ -117,16 +135,13 @@ void rescan_tile(const std::string& tile, const std::string& city_path, const st
   const fs::path in(tile), to(out);
   if (fs::exists(to / "meta.json")) throw InputError(out + ": already holds a tile; give an empty folder");
   nlohmann::json meta = parse_json(read_file((in / "meta.json").string()), (in / "meta.json").string());
-  if (!meta.contains("buildings") || !meta["buildings"].is_array() || !meta.contains("origin"))
-    throw InputError(tile + "/meta.json: no buildings or origin: not a dev tile");
-  const Vec3 origin(meta["origin"][0].get<double>(), meta["origin"][1].get<double>(), meta["origin"][2].get<double>());
+  const Vec3 origin = tile_origin(meta, tile);  // meta.json checked whole before anything is written
   const City city = read_city(city_path);
   for (const char* sub : {"clouds", "models", "truth"}) fs::create_directories(to / sub);
   DevtileCloud whole;
   int index = 0;
   for (auto& b : meta["buildings"]) {
-    const std::string id = b.at("id").get<std::string>();
-    if (id.empty() || id.find('/') != std::string::npos || id[0] == '.') throw InputError(tile + ": unsafe id " + id);
+    const std::string id = b["id"].get<std::string>();
     const Mesh truth = read_obj((in / "truth" / (id + ".obj")).string());
     const Mesh model = read_obj((in / "models" / (id + ".obj")).string());
     const Mesh local = translated(truth, -origin);
