@@ -8,6 +8,8 @@
 #   scripts/city_bench.sh DIR [BUILDINGS=2000] [POINTS=100000000] [JOBS=nproc]   (env: LODREFINE)
 #
 # Needs about 25 bytes per point on disk for the tile plus as much again for the crops.
+# Besides the printed table, DIR keeps what scripts/benchmarks.py reads: bench.meta (date, commit,
+# binary, settings), time.<stage> (wall s, peak KB), refine_rss.log, crop.log, run/summary.json.
 set -euo pipefail
 if [[ $# -lt 1 ]]; then
   sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'
@@ -32,6 +34,15 @@ measure() {
 wall() { cut -d' ' -f1 "$dir/time.$1"; }
 peak_mb() { echo $(($(cut -d' ' -f2 "$dir/time.$1") / 1024)); }
 
+{
+  echo "date=$(date -u +%Y-%m-%dT%H:%M:%SZ)"
+  echo "head=$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)"
+  echo "dirty=$(git -C "$root" status --porcelain --untracked-files=no 2>/dev/null | wc -l)"
+  echo "version=$("$bin" --version 2>&1 | head -n 1)"
+  echo "buildings=$n"
+  echo "points=$points"
+  echo "jobs=$jobs"
+} > "$dir/bench.meta"
 echo "generating $n buildings, about $points points ..."
 measure synth "$bin" synth --tile "$dir/tile.ply" --count "$n" --points "$per" --out "$run" > "$dir/synth.log"
 echo "cropping ..."

@@ -12,7 +12,7 @@
 # CI (.ci/run) runs every label but the suites that drive the same refine through make, Slurm or
 # GNU Parallel and the sweeps over real data, seeds and types (.ci/run says which and why; they
 # run unsanitized in scripts/test.sh).
-# Optimisation: -O1 -g1 (LODREFINE_SANITIZE_OPT in CMakeLists.txt; README, Tests, has the figures).
+# Optimisation: -O1 -g1 (LODREFINE_SANITIZE_OPT in CMakeLists.txt, which has the figures).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 targets=()
