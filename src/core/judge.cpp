@@ -118,13 +118,12 @@ bool neighbours(const Vec3& p, const std::vector<JudgedWall>& walls, double on_p
   return false;
 }
 
-// The facade plane each point of the cloud is an inlier of (-1: none).
-std::vector<int> facade_plane_of(const std::vector<ScanPlane>& planes, std::size_t points) {
+// The scan plane each point of the cloud is an inlier of (-1: none).
+std::vector<int> plane_of(const std::vector<ScanPlane>& planes, std::size_t points) {
   std::vector<int> of(points, -1);
   for (std::size_t k = 0; k < planes.size(); ++k)
-    if (planes[k].facade)
-      for (int i : planes[k].inliers)
-        if (i >= 0 && std::size_t(i) < points) of[std::size_t(i)] = int(k);
+    for (int i : planes[k].inliers)
+      if (i >= 0 && std::size_t(i) < points) of[std::size_t(i)] = int(k);
   return of;
 }
 
@@ -149,28 +148,34 @@ long long column_of(const Vec3& p, const Plane& f) {
 // judged, its faces' planes and the columns of each face's own points.
 struct Side {
   MeshDistance distance;
-  std::vector<Plane> faces;              // empty: no facade line is judged beyond the cap
-  std::vector<std::set<long long>> own;  // per face, the columns holding its own points
+  std::vector<Plane> faces;              // per face, its plane
+  std::vector<std::set<long long>> own;  // per face, the columns holding its own points (facade lines only)
 
-  Side(const Mesh& m, bool facade_lines)
-      : distance(m), faces(facade_lines ? face_planes(m) : std::vector<Plane>{}), own(faces.size()) {}
+  bool facade_lines;
+
+  Side(const Mesh& m, bool lines) : distance(m), faces(face_planes(m)), own(faces.size()), facade_lines(lines) {}
 
   // Records `p` (nearest face `near`) as a point of that face's own when within `cap` of it.
   void note(const Vec3& p, const MeshDistance::Nearest& near, double cap) {
-    if (!faces.empty() && near.distance <= cap)
+    if (facade_lines && near.distance <= cap)
       own[std::size_t(near.face)].insert(column_of(p, faces[std::size_t(near.face)]));
   }
 
+  // Whether the scan plane `scan`'s inlier `p` faces its nearest face `near`: turned from it by at
+  // most `max_angle_deg`, its foot on the face's plane inside the face (its distance is the plane
+  // distance, not beside the model).
+  bool faces_face(const Vec3& p, const Plane& scan, const MeshDistance::Nearest& near, double max_angle_deg,
+                  double tolerance) const {
+    const Plane& f = faces[std::size_t(near.face)];
+    return unoriented_angle_deg(scan.n, f.n) <= max_angle_deg && std::abs(f.distance(p)) >= near.distance - tolerance;
+  }
+
   // Whether the facade plane `scan`'s inlier `p` (nearest face `near`) is judged up to `reach`
-  // here: within it, facing its face (turned from it by at most `max_angle_deg`, its foot on the
-  // face's plane inside the face: its distance is the plane distance, not beside the model), and
-  // standing before no column of that face's own points.
+  // here: within it, facing its face, and standing before no column of that face's own points.
   bool reaches(const Vec3& p, const Plane& scan, const MeshDistance::Nearest& near, double reach, double max_angle_deg,
                double tolerance) const {
-    if (near.distance > reach) return false;
+    if (near.distance > reach || !faces_face(p, scan, near, max_angle_deg, tolerance)) return false;
     const Plane& f = faces[std::size_t(near.face)];
-    if (unoriented_angle_deg(scan.n, f.n) > max_angle_deg || std::abs(f.distance(p)) < near.distance - tolerance)
-      return false;
     const long long c = column_of(p, f);
     const auto& columns = own[std::size_t(near.face)];
     return !(columns.count(c - 1) || columns.count(c) || columns.count(c + 1));
@@ -224,6 +229,22 @@ class Openings {
   std::vector<Wall> walls_;
 };
 
+// Whether `p` (off both models' surfaces, nearest faces `a` and `b`, inlier of scan plane `plane`
+// or -1) is consistent with both models: outside both, and on no scan plane that faces its
+// nearest face in either. Such a return (a car, a tree, a neighbour's wall past the corner) says
+// only that the space it stands in is empty, which both models agree on: it is no evidence of
+// where the building's surface lies, and would count against any wall that moves away from it.
+bool in_free_space(const Vec3& p, int plane, const std::vector<ScanPlane>& planes, const Side& s0, const Side& s1,
+                   const MeshDistance::Nearest& a, const MeshDistance::Nearest& b, double on_plane,
+                   double max_angle_deg, double tolerance) {
+  if (plane >= 0) {
+    const Plane& scan = planes[std::size_t(plane)].plane;
+    if (s0.faces_face(p, scan, a, max_angle_deg, tolerance) || s1.faces_face(p, scan, b, max_angle_deg, tolerance))
+      return false;
+  }
+  return s0.distance.distance(p, true) > on_plane && s1.distance.distance(p, true) > on_plane;
+}
+
 // The points near either model with their capped distances: within `cap` of one, or a facade
 // line's within `reach` where it stands before no points of the face it faces (judge.h).
 std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const std::vector<JudgedWall>& walls,
@@ -241,13 +262,14 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
   box.min() -= Vec3::Constant(reach);
   box.max() += Vec3::Constant(reach);
   Side s0(before, facade_lines), s1(after, facade_lines);
-  const std::vector<int> facade = facade_plane_of(planes, cloud.points.size());
+  const std::vector<int> on = plane_of(planes, cloud.points.size());
+  const auto facade_of = [&](std::size_t i) { return on[i] >= 0 && planes[std::size_t(on[i])].facade ? on[i] : -1; };
   const Openings openings(planes, cloud, before, s0.distance, s1.distance);
   std::vector<std::size_t> judged;  // the cloud's points near enough to be judged
   std::vector<Vec3> at;
   for (std::size_t i = 0; i < cloud.points.size(); ++i) {
     const Vec3& p = cloud.points[i];
-    if (!box.contains(p) || (facade[i] < 0 && !within_cap.contains(p)) || p.z() < ground ||
+    if (!box.contains(p) || (facade_of(i) < 0 && !within_cap.contains(p)) || p.z() < ground ||
         neighbours(p, walls, on_plane) || openings.behind(p))
       continue;
     judged.push_back(i);
@@ -263,14 +285,17 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
     const std::size_t i = judged[k];
     const Vec3& p = at[k];
     const MeshDistance::Nearest &a = near0[k], &b = near1[k];
+    const double tol = detection.ransac_epsilon;
     double c = cap;
-    if (facade_lines && facade[i] >= 0 && std::min(a.distance, b.distance) > cap) {
-      const Plane& scan = planes[std::size_t(facade[i])].plane;
-      const double tol = detection.ransac_epsilon;
+    if (facade_lines && facade_of(i) >= 0 && std::min(a.distance, b.distance) > cap) {
+      const Plane& scan = planes[std::size_t(on[i])].plane;
       if (s0.reaches(p, scan, a, reach, max_angle_deg, tol) || s1.reaches(p, scan, b, reach, max_angle_deg, tol))
         c = reach;
     }
     if (a.distance > c && b.distance > c) continue;
+    if (std::min(a.distance, b.distance) > on_plane &&
+        in_free_space(p, on[i], planes, s0, s1, a, b, on_plane, max_angle_deg, tol))
+      continue;
     out.push_back({std::min(a.distance, c), std::min(b.distance, c), a.face, b.face, p});
   }
   return out;

@@ -15,6 +15,11 @@
 // neighbours) holding no point within the cap whose nearest face it is, is judged up to
 // `facade_reach` and capped there. So a move away from a setback's front line 2 m out counts,
 // and a neighbour's side wall across an alley, standing before the wall's own points, does not.
+// A return in space both models leave empty is no evidence either: a point outside both models by
+// more than on_plane_band (corners.h) is judged only as an inlier of a scan plane that faces its
+// nearest face in one of them (as above). A parked car, a tree or the neighbour's facade running on
+// past the corner says only that its space is empty; it would count against every wall moved away
+// from it. Points inside either model (the scanner saw through it) or on either's surface count.
 #pragma once
 #include <cstddef>
 #include <optional>
