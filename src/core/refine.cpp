@@ -292,8 +292,11 @@ RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::
   trace.selection = chosen.stats;
   trace.selection_reason = chosen.reason;
   run.lap(RefineStage::Selection);
-  if (!chosen.ok) return run.finish(Outcome::Kept, "the selection found no valid shell: " + chosen.reason, kept);
-  if (!refined && chosen.stats.candidates_changed == 0) {
+  // A search that ends with no shell falls back to the best shell known: the substitution's.
+  if (!chosen.ok && !refined)
+    return run.finish(Outcome::Kept, "the selection found no valid shell: " + chosen.reason, kept);
+  const Mesh& shell = chosen.ok ? chosen.mesh : *refined;
+  if (chosen.ok && !refined && chosen.stats.candidates_changed == 0) {
     trace.facades.clear();
     return run.finish(Outcome::Kept,
                       !any_match ? "the selection kept the model (no wall matched a scan plane)"
@@ -303,14 +306,17 @@ RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::
   std::vector<JudgedWall> moved;
   for (const auto& f : trace.facades) moved.push_back(f.wall);
   const Judgement& verdict = trace.judgement.emplace(
-      judge_refinement(kept, chosen.mesh, moved, local, prm, prm, planes, prm.match_distance + prm.bbox_margin));
+      judge_refinement(kept, shell, moved, local, prm, prm, planes, prm.match_distance + prm.bbox_margin));
   run.lap(RefineStage::Judge);
   if (!verdict.ok)
     return run.finish(Outcome::Kept, "not written: never worse, " + verdict.check + " check: " + verdict.detail, kept);
+  const std::string moved_walls = std::to_string(trace.facades.size()) + " wall(s) moved";
+  if (!chosen.ok)
+    return run.finish(Outcome::Refined,
+                      moved_walls + " by substitution (the selection found no valid shell: " + chosen.reason + ")",
+                      shell);
   return run.finish(Outcome::Refined,
-                    std::to_string(chosen.stats.faces_from_selection) + " face(s) selected, " +
-                        std::to_string(trace.facades.size()) + " wall(s) moved",
-                    chosen.mesh);
+                    std::to_string(chosen.stats.faces_from_selection) + " face(s) selected, " + moved_walls, shell);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // The whole method for one building: repair the coarse model, detect scan planes, match them to
 // walls, move the outdated walls (substitution), let the candidate selection decide the faces
-// (shell_selection.h), validate, and keep the input unless the result fits the scan better.
+// (shell_selection.h; when it ends with no shell, the substitution's stands in), validate, and
+// keep the input unless the result fits the scan better.
 #pragma once
 #include <array>
 #include <optional>
