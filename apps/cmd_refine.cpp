@@ -255,13 +255,14 @@ void run(const RefineArgs& a) {
   const Mesh model = read_obj(a.model);
   std::vector<CloudFileRead> read;
   const PointCloud cloud = read_cloud(clouds, a.cloud_options, &read);
-  if (cloud.points.empty())
-    throw InputError(cloud_files_text(clouds) + ": the cloud has no points" +
-                     (a.cloud_options.classes.empty() ? std::string()
-                                                      : " of classes " + classes_text(a.cloud_options.classes) +
-                                                            " (of " + std::to_string(cloud_point_count(clouds)) + ")"));
+  // A crop the scan did not reach is empty: its building is kept as read, as in a city file. A
+  // class filter that leaves none of a cloud's points is a mistake in the command.
+  if (cloud.points.empty() && !a.cloud_options.classes.empty() && cloud_point_count(clouds) > 0)
+    throw InputError(cloud_files_text(clouds) + ": the cloud has no points of classes " +
+                     classes_text(a.cloud_options.classes) + " (of " + std::to_string(cloud_point_count(clouds)) + ")");
   // Said on stdout and in the report (stderr is for the one error line of a failed run).
-  const std::vector<std::string> warnings = overlap_problems(read, bounding_box(model.vertices));
+  std::vector<std::string> warnings = overlap_problems(read, bounding_box(model.vertices));
+  if (cloud.points.empty()) warnings.push_back(cloud_files_text(clouds) + ": the cloud has no points");
   const RefineResult r = refine_building(model, cloud, a.params);
   nlohmann::json report = refine_report(r);
   for (const std::string& w : warnings) report["warnings"].push_back(w);

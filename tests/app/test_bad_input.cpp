@@ -463,7 +463,8 @@ std::vector<Case> cases() {
   c.push_back({"cloud: 'nan' in an ASCII PLY",
                [](Paths& p) { cloud_is(p, ply_header("ascii", 2) + "85001 447000 1\nnan 447000 2\n"); },
                Expect::Error});
-  c.push_back({"cloud: 0 points", [](Paths& p) { cloud_is(p, ply_binary({})); }, Expect::Error, "no points"});
+  c.push_back({"cloud: 0 points (a crop the scan did not reach)", [](Paths& p) { cloud_is(p, ply_binary({})); },
+               Expect::Kept, "no planes found"});
   c.push_back({"cloud: 1 point", [](Paths& p) { cloud_is(p, ply_binary({kOrigin + Vec3(6, 0, 2)})); }, Expect::Kept});
   c.push_back({"cloud: 10 points on the wall",
                [](Paths& p) {
