@@ -24,7 +24,7 @@ namespace {
 struct RefineArgs {
   std::string model, out, report;
   std::vector<std::string> clouds;  // --cloud values: files or folders (cloud_files)
-  Params params;
+  RefineConfig params;
   CloudOptions cloud_options;
   std::string building, lod;  // city files only
   std::string html;           // city files only: the review page

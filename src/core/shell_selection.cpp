@@ -110,7 +110,7 @@ struct FitPoints {
   double area_per_point = 0.0;
 };
 
-FitPoints fit_points(const Supports& s, const std::vector<Frame2>& frames, const Params& prm) {
+FitPoints fit_points(const Supports& s, const std::vector<Frame2>& frames, const RefineConfig& prm) {
   FitPoints fp;
   const int np = int(s.planes.size());
   fp.at.resize(np), fp.weight.resize(np), fp.cells.resize(np);
@@ -152,7 +152,7 @@ double fitted_area(const FitPoints& fp, int k, const std::vector<Vec2>& poly) {
 // selection adds "f:variable" (GLPK column, 0: fixed) and "f:selected".
 using FaceIndex = CandidateMesh::Face_index;
 
-void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s, const Params& prm) {
+void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s, const RefineConfig& prm) {
   const int np = int(s.planes.size());
   std::vector<Frame2> frames;
   for (const auto& sp : s.planes) frames.push_back(frame_of(sp.plane, cs.region.center));
@@ -379,7 +379,7 @@ std::vector<std::vector<int>> changed_pieces(const CandidateSet& cs, const std::
 // The changed candidates of the pieces that enclose scan points (see kEnclosedDepth): each
 // newly enclosed point counts for the piece with the changed candidate nearest to it.
 std::vector<int> enclosing_changes(const CandidateSet& cs, const std::vector<char>& changed, const Mesh& start,
-                                   const Mesh& shell, const std::vector<Vec3>& evidence, const Params& prm) {
+                                   const Mesh& shell, const std::vector<Vec3>& evidence, const RefineConfig& prm) {
   const auto pieces = changed_pieces(cs, changed);
   if (pieces.empty()) return {};
   Mesh changes;  // the changed candidates as one polygon soup, face i of piece piece_of[i]
@@ -428,7 +428,7 @@ struct MendScope {
   bool whole_last = false;   // at last, every candidate free
   double keep_weight = 1.0;  // a start candidate dropped costs this times its area, one added its area
 };
-std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_start, const Params& prm,
+std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_start, const RefineConfig& prm,
                                const MendScope& scope = {}) {
   if (every_edge_used_0_or_2(cs, in_start)) return in_start;
   std::vector<char> near(cs.size(), 0);
@@ -474,7 +474,7 @@ std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_sta
 // Together they spend one work budget, shared evenly: the selection then costs at most twice it.
 // Returns the improved incumbent and counts the neighbourhoods that changed it.
 std::vector<char> improved_by_neighbourhoods(CandidateSet& cs, const SelectionProgram& pg, const Supports& s,
-                                             const Params& prm, int& improved) {
+                                             const RefineConfig& prm, int& improved) {
   std::vector<char> current = pg.warm;
   const auto scanned = std::count_if(s.points.begin(), s.points.end(), [](const auto& p) { return !p.empty(); });
   SelectionConfig share = prm;
@@ -508,7 +508,7 @@ constexpr int kLocalSectionsFrom = 32;
 
 // Why the assembled shell cannot be written, or empty: validate_mesh's problem, or a face that
 // passes through one vertex twice (two pieces pinched together by the output weld or merge).
-std::string shell_problem(const Mesh& m, const Params& prm) {
+std::string shell_problem(const Mesh& m, const RefineConfig& prm) {
   const Validation v = validate_mesh(m, prm.planarity_tolerance);
   if (!v.valid()) return v.problem.empty() ? "invalid" : v.problem;
   for (const auto& f : m.faces) {
@@ -524,7 +524,7 @@ std::string shell_problem(const Mesh& m, const Params& prm) {
 // candidates (its pieces cannot be mended to close): select_shell then gives each sliver a plane
 // of its own, as it is.
 std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointCloud& cloud,
-                                              const std::vector<ScanPlane>& planes, const Params& prm,
+                                              const std::vector<ScanPlane>& planes, const RefineConfig& prm,
                                               double sliver_tolerance) {
   const auto t0 = Clock::now();
   ShellSelection out;
@@ -778,7 +778,7 @@ double uncovered(const Mesh& soup, const Mesh& shell, double tolerance, ShellReb
 
 }  // namespace
 
-ShellRebuild rebuild_shell(const Mesh& soup, const Params& prm) {
+ShellRebuild rebuild_shell(const Mesh& soup, const RefineConfig& prm) {
   ShellRebuild out;
   Supports s;
   detail::add_start_planes(soup, prm.planarity_tolerance, s);
@@ -826,7 +826,7 @@ ShellRebuild rebuild_shell(const Mesh& soup, const Params& prm) {
 }
 
 ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
-                            const Params& prm) {
+                            const RefineConfig& prm) {
   if (auto joined = select_shell_on(start, cloud, planes, prm, prm.planarity_tolerance)) return *joined;
   return *select_shell_on(start, cloud, planes, prm, -1.0);  // no slivers: always a selection
 }

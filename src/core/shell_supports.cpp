@@ -139,8 +139,8 @@ void add_start_planes(const Mesh& start, double planarity_tolerance, Supports& s
 // A facade farther before or behind the box (up to the building's depth) counts too where it
 // continues a scanned facade of the building across a step (steps_from): a facade line stepping
 // back or forward farther than the reach.
-void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& scan, const Params& prm,
-                     Supports& s) {
+void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& scan,
+                     const RefineConfig& prm, Supports& s) {
   const double reach = prm.match_distance + prm.bbox_margin;  // a wall off by up to match_distance, plus a bay
   auto attach = [&](int i, const std::vector<Vec3>& pts) {
     auto mean_distance = [&](const Plane& pl) {
@@ -200,7 +200,7 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
 // a hypothesis, and one at each nearby end of a parallel scanned facade's points (the other side
 // of the step, where the points usually end more sharply). The selection takes such a wall only
 // where it closes what the scan shows.
-void add_step_walls(const Mesh& start, const Params& prm, Supports& s) {
+void add_step_walls(const Mesh& start, const RefineConfig& prm, Supports& s) {
   const int existing = int(s.planes.size());
   for (int j = s.start_planes; j < existing; ++j) {
     const Plane& pj = s.planes[j].plane;
@@ -244,7 +244,7 @@ void add_step_walls(const Mesh& start, const Params& prm, Supports& s) {
 // face it stands before, sampled every `step` m (its endpoint included). Only a facade that
 // continues another scanned facade across a step (steps_from): a lone parallel facade before a
 // wall may be a neighbour's across an alley.
-std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const Params& prm, double step) {
+std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const RefineConfig& prm, double step) {
   struct Wall {
     Plane plane;
     Vec3 u, v;

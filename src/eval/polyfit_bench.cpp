@@ -102,7 +102,7 @@ BenchBuilding read_bench_building(const BuildingFiles& f) {
   return b;
 }
 
-BuildingEval evaluate_against_truth(const BenchBuilding& b, const Mesh& output, const Params& params) {
+BuildingEval evaluate_against_truth(const BenchBuilding& b, const Mesh& output, const RefineConfig& params) {
   const Vec3 o = local_origin(b.coarse);
   PointCloud cloud = b.cloud;
   for (auto& p : cloud.points) p -= o;
@@ -112,7 +112,8 @@ BuildingEval evaluate_against_truth(const BenchBuilding& b, const Mesh& output, 
                            b.scanned_truth_faces ? &*b.scanned_truth_faces : nullptr);
 }
 
-PolyfitComparisonRow compare_with_polyfit(const BenchBuilding& b, const Params& params, const PolyfitOptions& options) {
+PolyfitComparisonRow compare_with_polyfit(const BenchBuilding& b, const RefineConfig& params,
+                                          const PolyfitOptions& options) {
   PolyfitComparisonRow row;
   row.id = b.id, row.points = b.cloud.points.size();
   const Clock::time_point t0 = Clock::now();

@@ -180,7 +180,7 @@ LocalBuilding read_local(const BuildingFiles& f, const std::optional<Vec3>& orig
   return b;
 }
 
-RunRow evaluate_building_files(const BuildingFiles& f, const Params& params, const std::string& svg_dir,
+RunRow evaluate_building_files(const BuildingFiles& f, const RefineConfig& params, const std::string& svg_dir,
                                const CloudOptions& cloud_options) {
   RunRow row;
   row.files = f;
@@ -243,8 +243,8 @@ RunRow failure_row(const std::string& id, const std::string& error) {
   return row;
 }
 
-std::vector<RunRow> evaluate_run(const std::string& dir, const Params& params, const std::string& svg_dir, int jobs,
-                                 PooledSeries& series, Progress::Mode progress_mode,
+std::vector<RunRow> evaluate_run(const std::string& dir, const RefineConfig& params, const std::string& svg_dir,
+                                 int jobs, PooledSeries& series, Progress::Mode progress_mode,
                                  const CloudOptions& cloud_options) {
   const auto buildings = discover_run(dir);
   std::vector<RunRow> rows(buildings.size());

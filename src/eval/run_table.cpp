@@ -268,7 +268,7 @@ json html_row(const RunRow& r) {
           {"seconds", number_or_null(r.refine_seconds)}};
 }
 
-BuildingView html_view(const RunRow& r, const Params& params) {
+BuildingView html_view(const RunRow& r, const RefineConfig& params) {
   std::string refined_error;
   const LocalBuilding b = read_local(r.files, r.origin, refined_error);
   // A run drops each building's per-point series once pooled: the few shown are measured again

@@ -97,7 +97,7 @@ struct BuildingJob {
   CityBuildingOutcome outcome;
 };
 
-void run_job(BuildingJob& job, const CityJsonBuilding& b, const Params& params) {
+void run_job(BuildingJob& job, const CityJsonBuilding& b, const RefineConfig& params) {
   if (!job.has_points) return;
   const auto t0 = Clock::now();
   try {
@@ -213,7 +213,7 @@ void merge_into(CityRefineSummary& sum, CityRefineSummary&& part) {
 // empty) is called after each building with the summary so far.
 void refine_document(json& doc, const CityJsonTransform& tf, const std::vector<CityJsonBuilding>& buildings,
                      std::vector<CropTarget>& targets, const std::vector<std::size_t>& target_of, std::size_t first,
-                     bool repair_all, const Params& params, int jobs, const CityBuildingHook& hook,
+                     bool repair_all, const RefineConfig& params, int jobs, const CityBuildingHook& hook,
                      CityRefineSummary& sum, const std::function<void(const CityRefineSummary&)>& progress) {
   std::size_t next = 0;
   in_order_pool<BuildingJob>(
@@ -374,7 +374,7 @@ json parse_feature(const std::string& line, const std::string& where) {
 // again, refines its buildings (features on the pool) and writes the lines out in order.
 CityRefineSummary refine_sequence(const json& header, const std::string& model_path,
                                   const std::vector<std::string>& cloud_paths, const std::string& out_path,
-                                  const Params& params, const CityRefineOptions& options) {
+                                  const RefineConfig& params, const CityRefineOptions& options) {
   CityRefineSummary sum;
   sum.input_format = "CityJSONSeq " + text_member(header, "version", "?");
   if (!header.contains("transform"))
@@ -506,7 +506,8 @@ json cityjson_solid(const Mesh& mesh, const std::string& lod, const Vec3& scale,
 }
 
 CityRefineSummary refine_city(const std::string& model_path, const std::vector<std::string>& cloud_paths,
-                              const std::string& out_path, const Params& params, const CityRefineOptions& options) {
+                              const std::string& out_path, const RefineConfig& params,
+                              const CityRefineOptions& options) {
   CityRefineSummary sum;
   auto t = Clock::now();
   json doc;

@@ -49,7 +49,7 @@
 using namespace lodrefine;
 
 // Validation at the parameter table's planarity tolerance.
-const double kPlanarity = Params{}.planarity_tolerance;
+const double kPlanarity = RefineConfig{}.planarity_tolerance;
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
@@ -797,7 +797,7 @@ TEST(BadInputRegression, FaceListedTwiceOnAnEdgeDoesNotAbortTheSolver) {
   if (pid == 0) {
     ::close(2);  // GLPK prints its error before aborting
     CandidateSet cs = fixtures::hand_built({0, 0}, {1.0, 1.0}, {{0, 0, 1}});
-    const SelectionResult r = select_faces(cs, {-1.0, -1.0}, {0}, Params{});
+    const SelectionResult r = select_faces(cs, {-1.0, -1.0}, {0}, RefineConfig{});
     ::_exit(r.status == SolveStatus::NotRun ? 1 : 0);
   }
   int st = 0;
@@ -838,7 +838,7 @@ TEST(BadInputSolver, InfeasibleProgramIsReportedNotSelected) {
   // Face 0 alone on two edges: once with the outside surface (x0 + 1 = 2 y0 -> x0 = 1), once
   // without (x0 = 2 y1 -> x0 = 0). No selection satisfies both.
   CandidateSet cs = fixtures::hand_built({0}, {1.0}, {{0}, {0}});
-  const SelectionResult r = select_faces(cs, {-1.0}, {1, 0}, Params{});
+  const SelectionResult r = select_faces(cs, {-1.0}, {1, 0}, RefineConfig{});
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.status_text(), "infeasible");
   EXPECT_EQ(selected_faces(cs), std::vector<char>(1, 0));
@@ -847,7 +847,7 @@ TEST(BadInputSolver, InfeasibleProgramIsReportedNotSelected) {
 
 TEST(BadInputSolver, NoCandidatesIsReported) {
   CandidateSet none;
-  const SelectionResult r = select_faces(none, {}, {}, Params{});
+  const SelectionResult r = select_faces(none, {}, {}, RefineConfig{});
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.status_text(), "no candidates");
 }
@@ -856,7 +856,7 @@ TEST(BadInputSolver, TimeLimitWithoutSolutionIsReported) {
   std::vector<double> cost;
   std::vector<int> outside;
   CandidateSet cs = hard_program(3000, 4000, 3, cost, outside);
-  Params prm;
+  RefineConfig prm;
   prm.mip_time_limit = 0.01;
   const SelectionResult r = select_faces(cs, cost, outside, prm);
   EXPECT_NE(r.status_text().find("time limit"), std::string::npos) << r.status_text();
@@ -908,13 +908,13 @@ TEST(BadInputSolver, OneMillisecondLimitFailsEvenAnEasyProgram) {
   std::vector<int> outside;
   CandidateSet cs = cube_program(cost, outside);
   ASSERT_GE(cs.size(), 6);
-  const SelectionResult easy = select_faces(cs, cost, outside, Params{});
+  const SelectionResult easy = select_faces(cs, cost, outside, RefineConfig{});
   ASSERT_TRUE(easy.ok) << easy.status_text();
   EXPECT_EQ(easy.status_text(), "optimal");
   const std::vector<char> chosen = selected_faces(cs);
   EXPECT_EQ(std::count(chosen.begin(), chosen.end(), 1), 6);
   // GLPK stops at its first time check when tm_lim <= 1 ms: a deterministic solver fault.
-  Params prm;
+  RefineConfig prm;
   prm.mip_time_limit = 0.001;
   const SelectionResult r = select_faces(cs, cost, outside, prm);
   EXPECT_FALSE(r.ok);
@@ -935,7 +935,7 @@ TEST(BadInputSolver, RefineUnderAStarvedSolverWritesAValidShell) {
   const Mesh model = read_obj(dir + "/m.obj");
   PointCloud cloud;
   cloud.points = wall_scan();
-  Params prm;
+  RefineConfig prm;
   prm.mip_time_limit = 0.001;
   const RefineResult r = refine_building(model, cloud, prm);
   const nlohmann::json report = refine_report(r);

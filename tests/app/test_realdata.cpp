@@ -202,7 +202,7 @@ Row run_building(const Mesh& soup) {
   Row row;
   row.id = soup.id;
   row.faces = int(soup.faces.size());
-  const Params prm;
+  const RefineConfig prm;
   const Vec3 origin = local_origin(soup);
   const Mesh local = translated(soup, -origin);
   try {
@@ -377,7 +377,7 @@ TEST(RealData, RotterdamEveryBuildingKeptRepairedOrKeptInvalid) {
   const CityJsonFile f = read_cityjson(data_path.string());
   PointCloud far;
   for (int i = 0; i < 200; ++i) far.points.emplace_back(0.1 * i, 0.0, 0.0);
-  const Params prm;
+  const RefineConfig prm;
   std::map<std::string, int> outcomes;
   double worst = 0.0, worst_repaired = 0.0;
   for (const auto& b : f.buildings) {
@@ -442,7 +442,7 @@ void scan_wall(const std::vector<Vec3>& poly, const Plane& pl, double offset, do
 TEST(RealData, RotterdamCorrectTerracedHouseBesideAMisplacedOne) {
   REQUIRE_REALDATA("val3dity/data/rotterdam/3-20-DELFSHAVEN.city.json");
   const CityJsonFile f = read_cityjson(data_path.string());
-  const Params prm;
+  const RefineConfig prm;
   std::vector<Merged> ms;
   for (const auto& b : f.buildings) {
     const RefineResult base = refine_building(b.mesh, PointCloud{}, prm);

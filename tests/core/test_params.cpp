@@ -9,7 +9,7 @@
 using namespace lodrefine;
 
 TEST(Params, DefaultsAreValidAndMatchThePaper) {
-  Params p;
+  RefineConfig p;
   EXPECT_NO_THROW(p.validate());
   EXPECT_DOUBLE_EQ(p.tau_cov, 0.3);
   EXPECT_DOUBLE_EQ(p.merge_angle_deg, 5.0);
@@ -20,7 +20,7 @@ TEST(Params, DefaultsAreValidAndMatchThePaper) {
 }
 
 TEST(Params, OutOfRangeIsRejectedWithTheName) {
-  Params p;
+  RefineConfig p;
   p.tau_cov = 1.5;
   try {
     p.validate();

@@ -51,7 +51,7 @@ bool every_edge_twice(const Mesh& m) {
 TEST(ShellSelection, AddsARecessTheModelLacks) {
   const Mesh start = box({0, 0, 0}, {10, 8, 6});
   const Scan scan = facade_with_feature(0.8);
-  Params prm;
+  RefineConfig prm;
   const ShellSelection r = select_shell(start, scan.cloud, scan.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
   EXPECT_EQ(r.stats.scan_planes_added, 3);
@@ -78,7 +78,7 @@ TEST(ShellSelection, AddsARecessTheModelLacks) {
 TEST(ShellSelection, AddsABayTheModelLacks) {
   const Mesh start = box({0, 0, 0}, {10, 8, 6});
   const Scan scan = facade_with_feature(-0.9);
-  Params prm;
+  RefineConfig prm;
   const ShellSelection r = select_shell(start, scan.cloud, scan.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
   const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
@@ -108,7 +108,7 @@ Scan sparsely_scanned_bay() {
 TEST(ShellSelection, AddsASparselyScannedBay) {
   const Mesh start = box({0, 0, 0}, {10, 8, 6});
   const Scan scan = sparsely_scanned_bay();
-  Params prm;
+  RefineConfig prm;
   const ShellSelection r = select_shell(start, scan.cloud, scan.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
   EXPECT_TRUE(every_edge_twice(r.mesh));
@@ -128,7 +128,7 @@ TEST(ShellSelection, KeepsTheModelWhereTheScanAgrees) {
   const Mesh start = box({0, 0, 0}, {10, 8, 6});
   Scan s;
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 10.0, 0.0, 6.0), kStep));
-  Params prm;
+  RefineConfig prm;
   const ShellSelection r = select_shell(start, s.cloud, s.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
   EXPECT_EQ(r.stats.scan_planes_added, 0);
@@ -142,7 +142,7 @@ TEST(ShellSelection, MovesAWallOntoItsScanWithoutAStartingMove) {
   const Mesh start = box({0, -0.5, 0}, {10, 8, 6});
   Scan s;
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 10.0, 0.0, 6.0), kStep));
-  Params prm;
+  RefineConfig prm;
   const ShellSelection r = select_shell(start, s.cloud, s.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
   EXPECT_EQ(r.stats.scan_planes_added, 1);
@@ -165,7 +165,7 @@ Scan stepped_facade(double left, double right) {
 
 // The volume of the selection's shell for `start` and the scan `s`, asserted valid and closed.
 double selected_volume(const Mesh& start, const Scan& s) {
-  Params prm;
+  RefineConfig prm;
   const ShellSelection r = select_shell(start, s.cloud, s.planes, prm);
   EXPECT_TRUE(r.ok) << r.reason;
   const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
@@ -197,7 +197,7 @@ TEST(ShellSelection, KeepsAnUnscannedEndWallBeforeANeighboursWall) {
   Scan s;
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 10.0, 0.0, 6.0), kStep));
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({12.2, 8, 0}, -Vec3::UnitY(), 8.0, 0.0, 6.0), kStep));
-  Params prm;
+  RefineConfig prm;
   const ShellSelection r = select_shell(box({0, 0, 0}, {10, 8, 6}), s.cloud, s.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
   EXPECT_EQ(r.stats.candidates_changed, 0);
@@ -214,7 +214,7 @@ TEST(ShellSelection, KeepsTheModelWhereTheFacadeLineRunsOnIntoANeighbour) {
     Scan s;
     s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 10.0, 0.0, 6.0), kStep));
     s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({10, offset, 0}, Vec3::UnitX(), 10.0, 0.0, 6.0), kStep));
-    Params prm;
+    RefineConfig prm;
     const ShellSelection r = select_shell(box({0, 0, 0}, {10, 8, 6}), s.cloud, s.planes, prm);
     ASSERT_TRUE(r.ok) << r.reason;
     EXPECT_EQ(r.stats.candidates_changed, 0);
@@ -229,7 +229,7 @@ TEST(ShellSelection, ExtendsAFacadeToItsOwnCornerPastTheModelsEnd) {
   Scan s;
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, -0.4, 0}, Vec3::UnitX(), 11.0, 0.0, 6.0), kStep));
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({11, -0.4, 0}, Vec3::UnitY(), 6.0, 0.0, 6.0), kStep));
-  Params prm;
+  RefineConfig prm;
   const ShellSelection r = select_shell(box({0, 0, 0}, {10, 8, 6}), s.cloud, s.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
   EXPECT_GT(validate_mesh(r.mesh, prm.planarity_tolerance).volume, 480.0 + 1.0);
@@ -249,7 +249,7 @@ TEST(ShellSelection, MovesWallsWhenTheBudgetEndsTheSearchAtTheRoot) {
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({10, 8, 0}, -x, 10.0, 0.0, 6.0), kStep));
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 8, 0}, -y, 8.0, 0.0, 6.0), kStep));
   for (const double budget : {0.07, 0.075}) {  // the whole program's root needs 0.08
-    Params prm;
+    RefineConfig prm;
     prm.mip_work_limit = budget;
     const ShellSelection r = select_shell(start, s.cloud, s.planes, prm);
     ASSERT_TRUE(r.ok) << r.reason;
@@ -275,7 +275,7 @@ Mesh box_faces(std::initializer_list<int> keep) { return only_faces(box(Vec3(0, 
 // through the hole's edges, the input's faces kept where they were.
 TEST(RebuildShell, WallsMissingAlongTheFootprintAreAdded) {
   const Mesh soup = box_faces({0, 1, 3});
-  const Params prm;
+  const RefineConfig prm;
   const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
   ASSERT_TRUE(rb.ok) << rb.reason;
   const Validation v = validate_mesh(rb.mesh, prm.planarity_tolerance);
@@ -296,7 +296,7 @@ TEST(RebuildShell, WallsMissingAlongTheFootprintAreAdded) {
 TEST(RebuildShell, AHugeSoupIsSampledWithinBounds) {
   Mesh soup = box_faces({0, 1, 3});
   for (Vec3& p : soup.vertices) p = p.cwiseProduct(Vec3(200.0, 250.0, 1.0));
-  const Params prm;
+  const RefineConfig prm;
   const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
   ASSERT_TRUE(rb.ok) << rb.reason;
   EXPECT_GT(rb.sampling, 5.0);
@@ -311,7 +311,7 @@ TEST(RebuildShell, AFinLeavesTheInputUncovered) {
   const int n = int(soup.vertices.size());
   for (const Vec3& p : {Vec3(0, 0, 6), Vec3(0, 8, 6), Vec3(0, 8, 9), Vec3(0, 0, 9)}) soup.vertices.push_back(p);
   soup.faces.push_back({{n, n + 1, n + 2, n + 3}, Semantic::Wall, 6});
-  const Params prm;
+  const RefineConfig prm;
   const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
   ASSERT_TRUE(rb.ok) << rb.reason;
   EXPECT_NEAR(rb.input_to_output, 3.0, 0.05);
@@ -323,7 +323,7 @@ TEST(RebuildShell, AFinLeavesTheInputUncovered) {
 // covers everything else.
 TEST(RebuildShell, PartitionsBetweenOverlappingPartsAreJoined) {
   const Mesh soup = merged(box_faces({0, 1, 2, 3, 4, 5}), as_soup(box(Vec3(6, 4, 0), Vec3(14, 12, 6))));
-  const Params prm;
+  const RefineConfig prm;
   const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
   ASSERT_TRUE(rb.ok) << rb.reason;
   const Validation v = validate_mesh(rb.mesh, prm.planarity_tolerance);
@@ -337,14 +337,14 @@ TEST(RebuildShell, PartitionsBetweenOverlappingPartsAreJoined) {
 // at the corner (no partition: outside on one side). Not rebuilt; the walls stay uncovered.
 TEST(RebuildShell, PartsTouchingAlongAnEdgeAreNotSwallowed) {
   const Mesh soup = merged(box_faces({0, 1, 2, 3, 4, 5}), as_soup(box(Vec3(10, 8, 0), Vec3(16, 14, 5))));
-  const Params prm;
+  const RefineConfig prm;
   const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
   EXPECT_TRUE(!rb.ok || rb.input_to_output > prm.weld_tolerance) << rb.input_to_output;
 }
 
 // A roof alone (or with one wall) has no ground: closing it would invent the foot of every wall.
 TEST(RebuildShell, ARoofWithoutAGroundIsNotClosed) {
-  const Params prm;
+  const RefineConfig prm;
   const ShellRebuild with_wall = rebuild_shell(welded_soup(box_faces({1, 3}), prm.weld_tolerance), prm);
   EXPECT_FALSE(with_wall.ok);
   EXPECT_EQ(with_wall.reason, "it has no ground face: the foot of its walls would be invented");
@@ -363,7 +363,7 @@ TEST(RebuildShell, AnArrangementTooLargeForABuildingIsRefused) {
     for (Vec3& p : b.vertices) p = r * p + Vec3(0.5 * k, 0.3 * k, 0);
     soup = merged(soup, b);
   }
-  const Params prm;
+  const RefineConfig prm;
   const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
   EXPECT_FALSE(rb.ok);
   EXPECT_EQ(rb.reason.rfind("too many candidate faces (over 10000", 0), 0u) << rb.reason;

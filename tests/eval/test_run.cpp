@@ -147,7 +147,7 @@ TEST(RunEvaluate, RowsInIdOrderWithFiguresAndFailures) {
   std::ofstream(run / "c" / "cloud.ply") << "ply\nformat nonsense\n";
   for (int jobs : {1, 3}) {
     PooledSeries series;
-    const auto rows = evaluate_run(run.string(), Params{}, "", jobs, series, Progress::Mode::Off);
+    const auto rows = evaluate_run(run.string(), RefineConfig{}, "", jobs, series, Progress::Mode::Off);
     ASSERT_EQ(rows.size(), 3u);
     EXPECT_EQ(rows[0].eval.id, "a");
     EXPECT_EQ(rows[1].eval.id, "b");
@@ -177,5 +177,5 @@ TEST(RunEvaluate, ANewerReportStopsTheRun) {
   newer["report_version"] = kRefineReportVersion + 1;
   write_run_building(run, "b", true, newer);
   PooledSeries series;
-  EXPECT_THROW(evaluate_run(run.string(), Params{}, "", 2, series, Progress::Mode::Off), InputError);
+  EXPECT_THROW(evaluate_run(run.string(), RefineConfig{}, "", 2, series, Progress::Mode::Off), InputError);
 }

@@ -38,7 +38,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return 0;
   }
 
-  Params prm;
+  RefineConfig prm;
   prm.mip_time_limit = 1.0;
   if (tiny) {
     prm.ransac_min_points = 20;

@@ -35,7 +35,7 @@
 using namespace lodrefine;
 
 // Validation at the parameter table's planarity tolerance.
-const double kPlanarity = Params{}.planarity_tolerance;
+const double kPlanarity = RefineConfig{}.planarity_tolerance;
 
 namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
@@ -224,7 +224,7 @@ TEST(CityFile, GeneratedCityRefinedIntoCityJson2) {
   write_ply(dir + "/cloud.ply", cloud);
 
   const CityRefineSummary s =
-      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", Params{}, {});
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", RefineConfig{}, {});
   EXPECT_EQ(s.buildings, 4);
   EXPECT_EQ(s.untouched, 1);  // the Hip building has no points
   EXPECT_EQ(s.outcomes.size(), 3u);
@@ -248,7 +248,7 @@ TEST(CityFile, GeneratedCityRefinedIntoCityJson2) {
   CityRefineOptions one;
   one.building = bs[1].id;
   const CityRefineSummary s1 =
-      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/one.city.json", Params{}, one);
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/one.city.json", RefineConfig{}, one);
   ASSERT_EQ(s1.outcomes.size(), 1u);
   EXPECT_EQ(s1.outcomes[0].id, bs[1].id);
   EXPECT_EQ(s1.untouched, 3);
@@ -273,8 +273,8 @@ TEST(CityFile, OnlyTheMisplacedTerracedHouseChanges) {
   PointCloud cloud = fixtures::terraced_street_scan(-0.6, 24.6, 5);
   for (auto& p : cloud.points) p += origin;
   write_ply(dir + "/terraced.ply", cloud);
-  const CityRefineSummary s =
-      refine_city(dir + "/terraced.city.json", {dir + "/terraced.ply"}, dir + "/terraced.out.city.json", Params{}, {});
+  const CityRefineSummary s = refine_city(dir + "/terraced.city.json", {dir + "/terraced.ply"},
+                                          dir + "/terraced.out.city.json", RefineConfig{}, {});
   ASSERT_EQ(s.outcomes.size(), 3u);
   std::map<std::string, CityBuildingOutcome> by_id;
   for (const auto& o : s.outcomes) by_id[o.id] = o;
@@ -316,7 +316,7 @@ TEST(CityFile, ErrorsAndBuildingsThatCannotBeRefined) {
   for (int i = 0; i < 500; ++i) cloud.points.push_back(Vec3(93005.0 + 0.002 * i, 436005.5, 0.5));
   write_ply(dir + "/cloud.ply", cloud);
   const CityRefineSummary s =
-      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", Params{}, {});
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", RefineConfig{}, {});
   ASSERT_EQ(s.outcomes.size(), 2u);
   EXPECT_EQ(s.outcomes[1].id, "broken");
   EXPECT_EQ(s.outcomes[1].outcome, "kept-invalid");
@@ -418,7 +418,7 @@ TEST(CityFile, RepairAllMendsTheBuildingsTheCloudDoesNotReach) {
   write_ply(dir + "/cloud.ply", bs[0].cloud);
 
   const CityRefineSummary plain =
-      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/plain.city.json", Params{}, {});
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/plain.city.json", RefineConfig{}, {});
   EXPECT_EQ(plain.untouched, 2);
   EXPECT_EQ(plain.repaired, 0);
   check_city_output(in, dir + "/plain.city.json", plain);
@@ -426,7 +426,7 @@ TEST(CityFile, RepairAllMendsTheBuildingsTheCloudDoesNotReach) {
   CityRefineOptions all;
   all.repair_all = true;
   const CityRefineSummary s =
-      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/all.city.json", Params{}, all);
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/all.city.json", RefineConfig{}, all);
   ASSERT_EQ(s.outcomes.size(), 3u);
   EXPECT_EQ(s.untouched, 0);
   EXPECT_EQ(s.outcomes[1].id, "open");
@@ -458,7 +458,8 @@ TEST(CityFile, DenHaagCityGml) {
       moved = moved || big;
     }
   write_ply(dir + "/scan.ply", cloud);
-  const CityRefineSummary s = refine_city(path.string(), {dir + "/scan.ply"}, dir + "/denhaag.city.json", Params{}, {});
+  const CityRefineSummary s =
+      refine_city(path.string(), {dir + "/scan.ply"}, dir + "/denhaag.city.json", RefineConfig{}, {});
   EXPECT_EQ(s.input_format, "CityGML 1.0");
   EXPECT_EQ(s.buildings, 6);
   EXPECT_GE(s.outcomes.size(), 1u);
@@ -471,7 +472,7 @@ TEST(CityFile, DenHaagCityGml) {
   CityRefineOptions all;
   all.repair_all = true;
   const CityRefineSummary r =
-      refine_city(path.string(), {dir + "/scan.ply"}, dir + "/denhaag_all.city.json", Params{}, all);
+      refine_city(path.string(), {dir + "/scan.ply"}, dir + "/denhaag_all.city.json", RefineConfig{}, all);
   EXPECT_EQ(int(r.outcomes.size()), r.buildings);
   EXPECT_EQ(r.repaired, 0);
   EXPECT_EQ(r.kept_invalid, 0);
@@ -500,7 +501,7 @@ TEST(CityFile, CityJsonSeqStreamedThrough) {
   write_file_atomic(dir + "/city.city.jsonl", text);
   write_ply(dir + "/cloud.ply", cloud);
   const CityRefineSummary s =
-      refine_city(dir + "/city.city.jsonl", {dir + "/cloud.ply"}, dir + "/out.city.jsonl", Params{}, {});
+      refine_city(dir + "/city.city.jsonl", {dir + "/cloud.ply"}, dir + "/out.city.jsonl", RefineConfig{}, {});
   EXPECT_EQ(s.input_format, "CityJSONSeq 2.0");
   EXPECT_EQ(s.buildings, 3);
   EXPECT_EQ(s.untouched, 1);
@@ -546,7 +547,7 @@ TEST(CityFile, CityJson1xUpgradedTo2) {
   write_file_atomic(dir + "/city.json", in.dump());
   write_ply(dir + "/cloud.ply", cloud);
   const CityRefineSummary s =
-      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", Params{}, {});
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", RefineConfig{}, {});
   EXPECT_EQ(s.input_format, "CityJSON 1.1");
   EXPECT_EQ(s.untouched, 1);
   const json out = load(dir + "/out.city.json");
@@ -592,7 +593,7 @@ TEST(CityFile, LodPicksTheGeometryToRefine) {
     write_ply(dir + "/c.ply", cloud);
     CityRefineOptions o;
     o.lod = lod;
-    const CityRefineSummary s = refine_city(path.string(), {dir + "/c.ply"}, dir + "/out.city.json", Params{}, o);
+    const CityRefineSummary s = refine_city(path.string(), {dir + "/c.ply"}, dir + "/out.city.json", RefineConfig{}, o);
     ASSERT_EQ(s.outcomes.size(), 1u);
     const json out = load(dir + "/out.city.json");
     for (std::size_t k = 0; k < in["CityObjects"][id]["geometry"].size(); ++k) {
@@ -683,7 +684,7 @@ TEST(CityFile, JobsWriteTheSameBytesAsOneAtATime) {
         EXPECT_EQ(s.buildings, int(bs.size()));
       };
       const std::string out = dir + "/out" + std::to_string(jobs) + "." + name;
-      const CityRefineSummary s = refine_city(dir + "/" + name, {dir + "/cloud.ply"}, out, Params{}, o);
+      const CityRefineSummary s = refine_city(dir + "/" + name, {dir + "/cloud.ply"}, out, RefineConfig{}, o);
       EXPECT_EQ(s.refined + s.kept + s.kept_invalid, 6);
       EXPECT_GE(s.refined, 4) << name;
       ASSERT_EQ(done.size(), bs.size()) << name;
@@ -708,7 +709,7 @@ TEST(CityFile, JobsWriteTheSameBytesWhenSelectionsEndAtTheBudget) {
       {BuildingType::LShape, BuildingType::TShape, BuildingType::Stepped, BuildingType::Hip}, 43, 5000, 4, cloud);
   write_file_atomic(dir + "/city.json", synth_city(bs, Vec3(93000, 436000, 0)).dump());
   write_ply(dir + "/cloud.ply", cloud);
-  Params prm;
+  RefineConfig prm;
   prm.mip_work_limit = 0.02;
   fixtures::CpuBurners burners(2);
   std::map<int, std::string> written;
@@ -784,7 +785,7 @@ TEST(CityFileSecurity, FlatAndStrayBuildingsAreKeptInvalidTheRunGoesOn) {
   write_file_atomic(dir + "/city.json", in.dump());
   write_ply(dir + "/cloud.ply", cloud);
   const CityRefineSummary s =
-      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", Params{}, {});
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", RefineConfig{}, {});
   ASSERT_EQ(s.outcomes.size(), 3u);
   EXPECT_NE(s.outcomes[0].outcome, "kept-invalid") << s.outcomes[0].reason;
   EXPECT_EQ(s.outcomes[1].outcome, "kept-invalid");
@@ -862,7 +863,7 @@ TEST(CityFile, HookSeesEveryBuildingOnceWithItsIndex) {
     const std::lock_guard<std::mutex> lock(m);
     EXPECT_TRUE(seen.emplace(index, model.id).second) << index;
   };
-  refine_city(dir + "/city.city.jsonl", {dir + "/cloud.ply"}, dir + "/out.city.jsonl", Params{}, o);
+  refine_city(dir + "/city.city.jsonl", {dir + "/cloud.ply"}, dir + "/out.city.jsonl", RefineConfig{}, o);
   ASSERT_EQ(seen.size(), bs.size());
   for (std::size_t i = 0; i < bs.size(); ++i) EXPECT_EQ(seen[i], bs[i].id);
 }
@@ -885,7 +886,7 @@ TEST(CityFile, SequenceWithAnIdTwiceIsRefused) {
     EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
   }
   try {
-    refine_city(dir + "/city.city.jsonl", {dir + "/cloud.ply"}, dir + "/out.city.jsonl", Params{}, {});
+    refine_city(dir + "/city.city.jsonl", {dir + "/cloud.ply"}, dir + "/out.city.jsonl", RefineConfig{}, {});
     ADD_FAILURE() << "refined";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
@@ -904,7 +905,7 @@ TEST(CityFile, AttributesThatAreNoObjectAreRefusedNotReplaced) {
   write_file_atomic(dir + "/city.json", doc.dump());
   write_ply(dir + "/cloud.ply", cloud);
   try {
-    refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", Params{}, {});
+    refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", RefineConfig{}, {});
     ADD_FAILURE() << "refined";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("object " + bs[0].id + ": \"attributes\" is not a JSON object"),

@@ -149,8 +149,6 @@ struct RefineConfig : RepairConfig, PlaneConfig, MatchConfig, SelectionConfig, C
   // Each stage's validate() (the error names the stage), then the rules across rows.
   void validate() const;
 };
-// The former name of the whole configuration.
-using Params = RefineConfig;
 
 // visitor(field, value) for each field of `config` (a stage config or the RefineConfig).
 template <class Config, class Visitor>

@@ -73,7 +73,7 @@ std::string building_footprint_svg(const BuildingEval& e, const LocalBuilding& b
 // faces meta.json lists when it lists walls of the truth). Writes its footprint SVG into
 // `svg_dir` unless that is empty. The row's refine record is left empty (add_refine_record).
 // Throws InputError when the original model or the cloud cannot be read.
-RunRow evaluate_building_files(const BuildingFiles& files, const Params& params, const std::string& svg_dir,
+RunRow evaluate_building_files(const BuildingFiles& files, const RefineConfig& params, const std::string& svg_dir,
                                const CloudOptions& cloud_options = {});
 
 // Fills the refine record of `row` (evaluated already) from what refine left: `failed_line`, the
@@ -100,8 +100,8 @@ Mesh read_eval_model(const std::string& path);
 // the run and is rethrown. Each building's per-point series go into `series` as it finishes and
 // are then dropped (memory: the bins, not the run's points); a progress line counts the
 // buildings (`progress_mode`). Each building's cloud is read with `cloud_options` (max_points).
-std::vector<RunRow> evaluate_run(const std::string& dir, const Params& params, const std::string& svg_dir, int jobs,
-                                 PooledSeries& series, Progress::Mode progress_mode,
+std::vector<RunRow> evaluate_run(const std::string& dir, const RefineConfig& params, const std::string& svg_dir,
+                                 int jobs, PooledSeries& series, Progress::Mode progress_mode,
                                  const CloudOptions& cloud_options = {});
 
 }  // namespace lodrefine

@@ -100,7 +100,8 @@ struct CityRefineSummary {
 // reason. `cloud_paths` are files (cloud_files expands folders), read in that order as one cloud:
 // the output is that of one file holding their points in that order.
 CityRefineSummary refine_city(const std::string& model_path, const std::vector<std::string>& cloud_paths,
-                              const std::string& out_path, const Params& params, const CityRefineOptions& options);
+                              const std::string& out_path, const RefineConfig& params,
+                              const CityRefineOptions& options);
 
 // The refined mesh as a CityJSON Solid geometry of LoD `lod` with semantics, its vertices
 // appended to `vertices` quantised by the document's transform (`scale`, `translate`).
