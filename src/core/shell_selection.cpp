@@ -114,7 +114,7 @@ FitPoints fit_points(const Supports& s, const std::vector<Frame2>& frames, const
   FitPoints fp;
   const int np = int(s.planes.size());
   fp.at.resize(np), fp.weight.resize(np), fp.cells.resize(np);
-  const double tol = prm.ransac_epsilon + prm.merge_distance;
+  const double tol = prm.plane.ransac_epsilon + prm.selection.merge_distance;
   long long points = 0, occupied = 0;
   for (int k = 0; k < np; ++k) {
     for (const auto& p : s.points[k]) {
@@ -163,12 +163,12 @@ void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s,
     if (!near_vertical(s.planes[k].plane)) continue;
     for (int j = 0; j < np; ++j) {
       if (j == k || s.points[j].empty() ||
-          unoriented_angle_deg(s.planes[k].plane.n, s.planes[j].plane.n) > prm.merge_angle_deg)
+          unoriented_angle_deg(s.planes[k].plane.n, s.planes[j].plane.n) > prm.selection.merge_angle_deg)
         continue;
       double sum = 0.0;
       for (const auto& p : s.points[j]) sum += std::abs(s.planes[k].plane.distance(p));
       const double d = sum / double(s.points[j].size());
-      if (d <= prm.merge_distance || d > kSeeThrough) continue;
+      if (d <= prm.selection.merge_distance || d > kSeeThrough) continue;
       mark(other[k], s.points[j], frames[k]);
     }
   }
@@ -185,7 +185,7 @@ void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s,
   // reach of the evidence (a wall the scan moves takes the roof edge above it along: the zone
   // spans the whole height). Candidates with a vertex in it are free; the others stay as the
   // starting shell has them (the program grows with the region: keep it to the evidence).
-  const double margin = prm.match_distance + prm.bbox_margin;
+  const double margin = prm.match.match_distance + prm.selection.bbox_margin;
   std::vector<Eigen::AlignedBox3d> zones;
   for (const auto& pts : s.points) {
     if (pts.empty()) continue;
@@ -379,7 +379,7 @@ std::vector<std::vector<int>> changed_pieces(const CandidateSet& cs, const std::
 // The changed candidates of the pieces that enclose scan points (see kEnclosedDepth): each
 // newly enclosed point counts for the piece with the changed candidate nearest to it.
 std::vector<int> enclosing_changes(const CandidateSet& cs, const std::vector<char>& changed, const Mesh& start,
-                                   const Mesh& shell, const std::vector<Vec3>& evidence, const RefineConfig& prm) {
+                                   const Mesh& shell, const std::vector<Vec3>& evidence, const PlaneEvidence& prm) {
   const auto pieces = changed_pieces(cs, changed);
   if (pieces.empty()) return {};
   Mesh changes;  // the changed candidates as one polygon soup, face i of piece piece_of[i]
@@ -428,7 +428,7 @@ struct MendScope {
   bool whole_last = false;   // at last, every candidate free
   double keep_weight = 1.0;  // a start candidate dropped costs this times its area, one added its area
 };
-std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_start, const RefineConfig& prm,
+std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_start, const SelectionConfig& prm,
                                const MendScope& scope = {}) {
   if (every_edge_used_0_or_2(cs, in_start)) return in_start;
   std::vector<char> near(cs.size(), 0);
@@ -474,7 +474,7 @@ std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_sta
 // Together they spend one work budget, shared evenly: the selection then costs at most twice it.
 // Returns the improved incumbent and counts the neighbourhoods that changed it.
 std::vector<char> improved_by_neighbourhoods(CandidateSet& cs, const SelectionProgram& pg, const Supports& s,
-                                             const RefineConfig& prm, int& improved) {
+                                             const SelectionConfig& prm, int& improved) {
   std::vector<char> current = pg.warm;
   const auto scanned = std::count_if(s.points.begin(), s.points.end(), [](const auto& p) { return !p.empty(); });
   SelectionConfig share = prm;
@@ -508,7 +508,7 @@ constexpr int kLocalSectionsFrom = 32;
 
 // Why the assembled shell cannot be written, or empty: validate_mesh's problem, or a face that
 // passes through one vertex twice (two pieces pinched together by the output weld or merge).
-std::string shell_problem(const Mesh& m, const RefineConfig& prm) {
+std::string shell_problem(const Mesh& m, const RepairConfig& prm) {
   const Validation v = validate_mesh(m, prm.planarity_tolerance);
   if (!v.valid()) return v.problem.empty() ? "invalid" : v.problem;
   for (const auto& f : m.faces) {
@@ -548,7 +548,7 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
   // moved wall lies that far again; once measured lost a real building's refinement), so a large
   // building's program does not grow with the cube of its planes.
   const Region region = detail::building_region(start, s);
-  const double reach = 2.0 * (prm.match_distance + prm.bbox_margin);
+  const double reach = 2.0 * (prm.match.match_distance + prm.selection.bbox_margin);
   CandidateSet all = build_candidates(
       s.planes, region,
       int(s.planes.size()) < kLocalSectionsFrom ? std::vector<Region>{} : detail::plane_reach(start, s, region, reach));
@@ -559,7 +559,7 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
     return out;
   }
   describe_candidates(all, start, s, prm);
-  const std::vector<char> all_warm = mended_start(all, face_flags(all, "f:in_start"), prm);
+  const std::vector<char> all_warm = mended_start(all, face_flags(all, "f:in_start"), prm.selection);
   if (all_warm.empty() && s.slivers > 0) return std::nullopt;
   const auto all_in_zone = all.mesh.property_map<FaceIndex, bool>("f:in_zone").first;
   std::vector<char> keep(all.size(), 1);
@@ -581,10 +581,11 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
   const auto fit = cs.mesh.property_map<FaceIndex, double>("f:fit").first;
   const auto area = cs.areas();
   for (int f = 0; f < cs.size(); ++f) {
-    pg.cost.push_back(coverage_cost(area[FaceIndex(f)], confidence[FaceIndex(f)], prm.tau_cov));
+    pg.cost.push_back(coverage_cost(area[FaceIndex(f)], confidence[FaceIndex(f)], prm.selection.tau_cov));
     pg.fit.push_back(fit[FaceIndex(f)]);
   }
-  for (const auto& e : cs.edges) pg.sharp_cost.push_back(prm.lambda_complexity * cs.length(e) * kSharpEdgeWidth);
+  for (const auto& e : cs.edges)
+    pg.sharp_cost.push_back(prm.selection.lambda_complexity * cs.length(e) * kSharpEdgeWidth);
   if (!warm.empty()) {
     pg.warm = warm;
     const auto in_zone = cs.mesh.property_map<FaceIndex, bool>("f:in_zone").first;
@@ -607,11 +608,11 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
   const EvidenceReach evidence(reach_of);
   if (!warm.empty()) {
     for (int f : beyond_evidence(cs, evidence)) pg.fixed[f] = int(base[f]);
-    pg.warm = improved_by_neighbourhoods(cs, pg, s, prm, st.neighbourhoods_improved);
+    pg.warm = improved_by_neighbourhoods(cs, pg, s, prm.selection, st.neighbourhoods_improved);
   }
   std::string problem;
   for (int attempt = 0;; ++attempt) {
-    st.selection = select_faces(cs, pg, prm);
+    st.selection = select_faces(cs, pg, prm.selection);
     const auto& sel = st.selection;
     if (!sel.ok) return finish("face selection " + sel.status_text());
     const std::vector<char> selected = selected_faces(cs);
@@ -620,18 +621,18 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
     out.mesh = traced_shell(cs);
     out.mesh.id = start.id;
     st.faces_from_selection = int(out.mesh.faces.size());
-    problem = shell_problem(out.mesh, prm);
+    problem = shell_problem(out.mesh, prm.repair);
     std::vector<int> refused;  // the changes to fix back (all of them, unless said)
     if (problem.empty()) {
       Mesh snapped = snapped_to_start(out.mesh, start);
-      if (shell_problem(snapped, prm).empty()) out.mesh = std::move(snapped);
+      if (shell_problem(snapped, prm.repair).empty()) out.mesh = std::move(snapped);
       if (st.candidates_changed > 0 && moves_beyond_evidence(out.mesh, start, evidence))
         problem = "it moves the model where the scan shows nothing";
     }
     if (problem.empty() && st.candidates_changed > 0 && !warm.empty()) {
       std::vector<char> changed(cs.size());
       for (int f = 0; f < cs.size(); ++f) changed[f] = selected[f] != base[f];
-      refused = enclosing_changes(cs, changed, start, out.mesh, st.evidence, prm);
+      refused = enclosing_changes(cs, changed, start, out.mesh, st.evidence, prm.plane);
       if (!refused.empty()) problem = "it encloses scan points (a surface seen through it)";
     }
     if (problem.empty() || st.candidates_changed == 0 || warm.empty() || attempt == kRetries) break;
@@ -781,7 +782,7 @@ double uncovered(const Mesh& soup, const Mesh& shell, double tolerance, ShellReb
 ShellRebuild rebuild_shell(const Mesh& soup, const RefineConfig& prm) {
   ShellRebuild out;
   Supports s;
-  detail::add_start_planes(soup, prm.planarity_tolerance, s);
+  detail::add_start_planes(soup, prm.repair.planarity_tolerance, s);
   if (!detail::carries_ground(soup, s)) {
     out.reason = "it has no ground face: the foot of its walls would be invented";
     return out;
@@ -804,7 +805,7 @@ ShellRebuild rebuild_shell(const Mesh& soup, const RefineConfig& prm) {
   }
   describe_candidates(cs, soup, s, prm);
   const std::vector<char> cover = face_flags(cs, "f:in_start");
-  const std::vector<char> chosen = mended_start(cs, cover, prm, {true, kKeepCover});
+  const std::vector<char> chosen = mended_start(cs, cover, prm.selection, {true, kKeepCover});
   if (chosen.empty()) {
     out.reason = "its planes bound no closed shell";
     return out;
@@ -813,21 +814,21 @@ ShellRebuild rebuild_shell(const Mesh& soup, const RefineConfig& prm) {
   set_selected(cs, chosen);
   out.mesh = traced_shell(cs);
   out.mesh.id = soup.id;
-  if (const std::string problem = shell_problem(out.mesh, prm); !problem.empty()) {
+  if (const std::string problem = shell_problem(out.mesh, prm.repair); !problem.empty()) {
     out.reason = "the shell on its planes is invalid: " + problem;
     return out;
   }
   Mesh snapped = snapped_to_start(out.mesh, soup);
-  if (shell_problem(snapped, prm).empty()) out.mesh = std::move(snapped);
-  out.input_to_output = uncovered(soup, out.mesh, prm.weld_tolerance, out);
-  added_area(out.mesh, soup, prm.weld_tolerance, out);
+  if (shell_problem(snapped, prm.repair).empty()) out.mesh = std::move(snapped);
+  out.input_to_output = uncovered(soup, out.mesh, prm.repair.weld_tolerance, out);
+  added_area(out.mesh, soup, prm.repair.weld_tolerance, out);
   out.ok = true;
   return out;
 }
 
 ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
                             const RefineConfig& prm) {
-  if (auto joined = select_shell_on(start, cloud, planes, prm, prm.planarity_tolerance)) return *joined;
+  if (auto joined = select_shell_on(start, cloud, planes, prm, prm.repair.planarity_tolerance)) return *joined;
   return *select_shell_on(start, cloud, planes, prm, -1.0);  // no slivers: always a selection
 }
 

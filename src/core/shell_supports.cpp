@@ -141,7 +141,8 @@ void add_start_planes(const Mesh& start, double planarity_tolerance, Supports& s
 // back or forward farther than the reach.
 void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& scan,
                      const RefineConfig& prm, Supports& s) {
-  const double reach = prm.match_distance + prm.bbox_margin;  // a wall off by up to match_distance, plus a bay
+  const double reach =
+      prm.match.match_distance + prm.selection.bbox_margin;  // a wall off by up to match_distance, plus a bay
   auto attach = [&](int i, const std::vector<Vec3>& pts) {
     auto mean_distance = [&](const Plane& pl) {
       double sum = 0.0;
@@ -149,10 +150,10 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
       return sum / double(pts.size());
     };
     int k = -1;
-    double best = prm.merge_distance;
+    double best = prm.selection.merge_distance;
     for (int j = 0; j < int(s.planes.size()); ++j) {
       if (!near_vertical(s.planes[j].plane) ||
-          unoriented_angle_deg(s.planes[j].plane.n, scan[i].plane.n) > prm.merge_angle_deg)
+          unoriented_angle_deg(s.planes[j].plane.n, scan[i].plane.n) > prm.selection.merge_angle_deg)
         continue;
       const double d = mean_distance(s.planes[j].plane);
       if (d <= best) best = d, k = j;
@@ -187,11 +188,11 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
       if (out <= reach) near.push_back(p);
       else if (out <= box.sizes().y()) beyond.push_back(p);
     }
-    if (int(near.size()) >= prm.ransac_min_points) attach(i, near);
-    else if (int(beyond.size()) >= prm.ransac_min_points) deep.emplace_back(i, std::move(beyond));
+    if (int(near.size()) >= prm.plane.ransac_min_points) attach(i, near);
+    else if (int(beyond.size()) >= prm.plane.ransac_min_points) deep.emplace_back(i, std::move(beyond));
   }
   for (const auto& [i, pts] : deep)
-    if (steps_from_any(start, s, pts, scan[i].plane.n, prm.merge_angle_deg)) attach(i, pts);
+    if (steps_from_any(start, s, pts, scan[i].plane.n, prm.selection.merge_angle_deg)) attach(i, pts);
 }
 
 // A facade line that steps, a recess or a bay needs the wall across the step, which the scan
@@ -214,7 +215,8 @@ void add_step_walls(const Mesh& start, const RefineConfig& prm, Supports& s) {
       if (e < lo + kSideClear || e > hi - kSideClear) continue;
       positions.push_back(e);
       for (int k = 0; k < existing; ++k) {
-        if (k == j || s.points[k].empty() || unoriented_angle_deg(s.planes[k].plane.n, pj.n) > prm.merge_angle_deg)
+        if (k == j || s.points[k].empty() ||
+            unoriented_angle_deg(s.planes[k].plane.n, pj.n) > prm.selection.merge_angle_deg)
           continue;
         for (const auto& r : runs_along(s.points[k], u))
           for (double f : {r.a, r.b})
@@ -228,8 +230,9 @@ void add_step_walls(const Mesh& start, const RefineConfig& prm, Supports& s) {
       const Vec3 x = c + (t - u.dot(c)) * u;
       bool there = false;
       for (const auto& sp : s.planes)
-        there = there || (near_vertical(sp.plane) && unoriented_angle_deg(sp.plane.n, u) <= prm.merge_angle_deg &&
-                          std::abs(sp.plane.distance(x)) <= kSameStep);
+        there =
+            there || (near_vertical(sp.plane) && unoriented_angle_deg(sp.plane.n, u) <= prm.selection.merge_angle_deg &&
+                      std::abs(sp.plane.distance(x)) <= kSameStep);
       if (there) continue;
       s.planes.push_back({Plane::through(x, u), Semantic::Wall, true, -1});
       s.points.emplace_back();
@@ -262,11 +265,11 @@ std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const Ref
   std::vector<Vec3> out;
   for (int k = s.start_planes; k < int(s.planes.size()); ++k) {
     if (s.points[k].empty() || !near_vertical(s.planes[k].plane) ||
-        !steps_from_any(start, s, s.points[k], s.planes[k].plane.n, prm.merge_angle_deg, k))
+        !steps_from_any(start, s, s.points[k], s.planes[k].plane.n, prm.selection.merge_angle_deg, k))
       continue;
     std::vector<const Wall*> parallel;
     for (const auto& w : walls)
-      if (unoriented_angle_deg(w.plane.n, s.planes[k].plane.n) <= prm.merge_angle_deg) parallel.push_back(&w);
+      if (unoriented_angle_deg(w.plane.n, s.planes[k].plane.n) <= prm.selection.merge_angle_deg) parallel.push_back(&w);
     for (const auto& p : s.points[k]) {
       const Wall* near = nullptr;
       double best = std::numeric_limits<double>::infinity();

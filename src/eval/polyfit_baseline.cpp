@@ -69,7 +69,7 @@ void add_scan(PolyfitInput& in, const PointCloud& scan, const std::vector<ScanPl
 
 // One plane per surface of the repaired model: samples every `spacing` m and the vertices of
 // its faces (at least three points off a line, so the smallest surface still fits a plane).
-void add_model(PolyfitInput& in, const Mesh& local_model, const RefineConfig& params, double spacing) {
+void add_model(PolyfitInput& in, const Mesh& local_model, const RepairConfig& params, double spacing) {
   RepairReport report;
   const Mesh mesh = merge_coplanar_faces(repair_input(local_model, params, report));
   for (const ModelSurface& s : model_surfaces(mesh)) {
@@ -159,11 +159,11 @@ void run(const Mesh& model, const PointCloud& cloud, const RefineConfig& params,
   if (local_model.vertices.empty()) throw InputError("the model has no vertices");
   const PointCloud scan = cloud_near(local_model, cloud, origin, params);
   const Clock::time_point t0 = Clock::now();
-  const std::vector<ScanPlane> planes = detect_planes(scan, params);
+  const std::vector<ScanPlane> planes = detect_planes(scan, params.plane);
   r.detection_seconds = seconds_since(t0);
   PolyfitInput in;
   add_scan(in, scan, planes);
-  if (options.planes == PolyfitPlanes::ModelAndScan) add_model(in, local_model, params, options.model_spacing);
+  if (options.planes == PolyfitPlanes::ModelAndScan) add_model(in, local_model, params.repair, options.model_spacing);
   r.planes = in.planes, r.model_planes = in.model_planes, r.points = in.points.size();
   reconstruct(in, options, origin, r);
 }

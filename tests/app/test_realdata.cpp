@@ -207,7 +207,7 @@ Row run_building(const Mesh& soup) {
   const Mesh local = translated(soup, -origin);
   try {
     RepairReport rr;
-    repair_model(local, prm.weld_tolerance, &rr);
+    repair_model(local, prm.repair.weld_tolerance, &rr);
     row.closed = rr.closed;
   } catch (const InputError& e) {
     row.outcome = std::string("repair failed: ") + e.what();
@@ -403,8 +403,8 @@ TEST(RealData, RotterdamEveryBuildingKeptRepairedOrKeptInvalid) {
   EXPECT_EQ(outcomes["kept"] + outcomes["repaired"] + outcomes["kept-invalid"], int(f.buildings.size()));
   EXPECT_GT(outcomes["kept"], int(0.8 * f.buildings.size()));
   EXPECT_GE(outcomes["repaired"], 31);
-  EXPECT_LE(worst, prm.weld_tolerance);
-  EXPECT_LE(worst_repaired, prm.weld_tolerance);
+  EXPECT_LE(worst, prm.repair.weld_tolerance);
+  EXPECT_LE(worst_repaired, prm.repair.weld_tolerance);
 }
 
 // Real terraced houses: two Delfshaven buildings whose longest walls are flush and meet. The
@@ -501,7 +501,7 @@ TEST(RealData, RotterdamCorrectTerracedHouseBesideAMisplacedOne) {
   EXPECT_NE(ra.outcome, Outcome::Refined) << ra.reason;
   double worst = 0.0;
   for (const auto& v : ra.mesh.vertices) worst = std::max(worst, nearest_vertex_distance(v, a.soup));
-  EXPECT_LE(worst, prm.weld_tolerance) << ra.reason;
+  EXPECT_LE(worst, prm.repair.weld_tolerance) << ra.reason;
 
   const RefineResult rb = refine_building(b.soup, scan, prm);
   EXPECT_TRUE(rb.refined()) << rb.reason;

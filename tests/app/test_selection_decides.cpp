@@ -62,7 +62,7 @@ Figures expect_selection_decided(const Mesh& coarse, const Mesh& truth, const Po
   const Vec3 o = local_origin(truth);
   const Mesh refined = translated(r.mesh, -o), local_truth = translated(truth, -o),
              local_coarse = translated(coarse, -o);
-  const Validation v = validate_mesh(refined, RefineConfig{}.planarity_tolerance);
+  const Validation v = validate_mesh(refined, RefineConfig{}.repair.planarity_tolerance);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_EQ(v.boundary_edges, 0);
   EXPECT_EQ(v.nonmanifold_edges, 0);

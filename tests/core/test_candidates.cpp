@@ -108,7 +108,7 @@ TEST(Candidates, KeptCandidatesAreTheSameProgram) {
   EXPECT_EQ(box_edges, 12);
   std::vector<double> cost;
   for (int f = 0; f < k.size(); ++f) cost.push_back(-area_of(k, f));
-  const SelectionResult r = select_faces(k, cost, std::vector<int>(k.edges.size(), 0), RefineConfig{});
+  const SelectionResult r = select_faces(k, cost, std::vector<int>(k.edges.size(), 0), SelectionConfig{});
   ASSERT_TRUE(r.ok) << r.status_text();
   const std::vector<char> selected = selected_faces(k);
   EXPECT_EQ(std::count(selected.begin(), selected.end(), 1), 6);

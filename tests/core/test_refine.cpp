@@ -18,7 +18,7 @@ using namespace lodrefine;
 using namespace lodrefine::fixtures;
 
 // Validation at the parameter table's planarity tolerance.
-const double kPlanarity = RefineConfig{}.planarity_tolerance;
+const double kPlanarity = RefineConfig{}.repair.planarity_tolerance;
 
 namespace {
 
@@ -134,7 +134,7 @@ TEST(Refine, ACorrectTerracedHouseBesideAMisplacedOneIsLeftAsItIs) {
   const RefineResult ra = refine_building(a, cloud, prm);
   ASSERT_TRUE(ra.valid) << ra.reason;
   EXPECT_FALSE(ra.refined()) << ra.reason;
-  EXPECT_LE(fixtures::largest_vertex_move(ra.mesh, a), prm.weld_tolerance) << ra.reason;
+  EXPECT_LE(fixtures::largest_vertex_move(ra.mesh, a), prm.repair.weld_tolerance) << ra.reason;
 
   const RefineResult rb = refine_building(b, cloud, prm);
   ASSERT_TRUE(rb.valid) << rb.reason;
@@ -142,7 +142,7 @@ TEST(Refine, ACorrectTerracedHouseBesideAMisplacedOneIsLeftAsItIs) {
   EXPECT_LT(max_abs_y_of_front(rb.mesh, 0.0), 0.02);
   for (const auto& p : rb.mesh.vertices) {  // the side walls stay at x = 12 and x = 24
     const double x = p.x() - kOrigin.x();
-    EXPECT_TRUE(std::abs(x - 12) <= prm.weld_tolerance || std::abs(x - 24) <= prm.weld_tolerance) << x;
+    EXPECT_TRUE(std::abs(x - 12) <= prm.repair.weld_tolerance || std::abs(x - 24) <= prm.repair.weld_tolerance) << x;
   }
 }
 

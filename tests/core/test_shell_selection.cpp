@@ -60,7 +60,7 @@ TEST(ShellSelection, AddsARecessTheModelLacks) {
   EXPECT_EQ(r.stats.selection.warm_given, true);
   EXPECT_EQ(r.stats.selection.warm_feasible, true);
   EXPECT_TRUE(every_edge_twice(r.mesh));
-  const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
+  const Validation v = validate_mesh(r.mesh, prm.repair.planarity_tolerance);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_NEAR(v.volume, 10 * 8 * 6 - 2 * 0.8 * 6, 1e-6);
   // Box 6 faces + back wall and two returns; the street facade split in two.
@@ -81,7 +81,7 @@ TEST(ShellSelection, AddsABayTheModelLacks) {
   RefineConfig prm;
   const ShellSelection r = select_shell(start, scan.cloud, scan.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
-  const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
+  const Validation v = validate_mesh(r.mesh, prm.repair.planarity_tolerance);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_NEAR(v.volume, 10 * 8 * 6 + 2 * 0.9 * 6, 1e-6);
   EXPECT_EQ(r.mesh.faces.size(), 10u);
@@ -112,16 +112,16 @@ TEST(ShellSelection, AddsASparselyScannedBay) {
   const ShellSelection r = select_shell(start, scan.cloud, scan.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
   EXPECT_TRUE(every_edge_twice(r.mesh));
-  const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
+  const Validation v = validate_mesh(r.mesh, prm.repair.planarity_tolerance);
   EXPECT_NEAR(v.volume, 10 * 8 * 6 + 2.5 * 0.9 * 6, 1e-6);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_EQ(r.mesh.faces.size(), 10u);
   EXPECT_GT(r.stats.step_walls, 0);  // the unscanned side
   // Without the data-fitting term the program keeps the box: the term is what takes the bay.
-  prm.lambda_data = 0.0;
+  prm.selection.lambda_data = 0.0;
   const ShellSelection coverage_only = select_shell(start, scan.cloud, scan.planes, prm);
   ASSERT_TRUE(coverage_only.ok) << coverage_only.reason;
-  EXPECT_NEAR(validate_mesh(coverage_only.mesh, prm.planarity_tolerance).volume, 480.0, 1e-6);
+  EXPECT_NEAR(validate_mesh(coverage_only.mesh, prm.repair.planarity_tolerance).volume, 480.0, 1e-6);
 }
 
 TEST(ShellSelection, KeepsTheModelWhereTheScanAgrees) {
@@ -134,7 +134,7 @@ TEST(ShellSelection, KeepsTheModelWhereTheScanAgrees) {
   EXPECT_EQ(r.stats.scan_planes_added, 0);
   EXPECT_EQ(r.stats.candidates_changed, 0);
   EXPECT_EQ(r.mesh.faces.size(), 6u);
-  EXPECT_NEAR(validate_mesh(r.mesh, prm.planarity_tolerance).volume, 480.0, 1e-6);
+  EXPECT_NEAR(validate_mesh(r.mesh, prm.repair.planarity_tolerance).volume, 480.0, 1e-6);
 }
 
 TEST(ShellSelection, MovesAWallOntoItsScanWithoutAStartingMove) {
@@ -146,7 +146,7 @@ TEST(ShellSelection, MovesAWallOntoItsScanWithoutAStartingMove) {
   const ShellSelection r = select_shell(start, s.cloud, s.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
   EXPECT_EQ(r.stats.scan_planes_added, 1);
-  const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
+  const Validation v = validate_mesh(r.mesh, prm.repair.planarity_tolerance);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_NEAR(v.volume, 480.0, 1e-6);
 }
@@ -168,7 +168,7 @@ double selected_volume(const Mesh& start, const Scan& s) {
   RefineConfig prm;
   const ShellSelection r = select_shell(start, s.cloud, s.planes, prm);
   EXPECT_TRUE(r.ok) << r.reason;
-  const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
+  const Validation v = validate_mesh(r.mesh, prm.repair.planarity_tolerance);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_TRUE(every_edge_twice(r.mesh));
   return v.volume;
@@ -201,7 +201,7 @@ TEST(ShellSelection, KeepsAnUnscannedEndWallBeforeANeighboursWall) {
   const ShellSelection r = select_shell(box({0, 0, 0}, {10, 8, 6}), s.cloud, s.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
   EXPECT_EQ(r.stats.candidates_changed, 0);
-  EXPECT_NEAR(validate_mesh(r.mesh, prm.planarity_tolerance).volume, 480.0, 1e-6);
+  EXPECT_NEAR(validate_mesh(r.mesh, prm.repair.planarity_tolerance).volume, 480.0, 1e-6);
 }
 
 // A correct building whose facade line runs on, 0.3 m forward, into its neighbour's: the party
@@ -218,7 +218,7 @@ TEST(ShellSelection, KeepsTheModelWhereTheFacadeLineRunsOnIntoANeighbour) {
     const ShellSelection r = select_shell(box({0, 0, 0}, {10, 8, 6}), s.cloud, s.planes, prm);
     ASSERT_TRUE(r.ok) << r.reason;
     EXPECT_EQ(r.stats.candidates_changed, 0);
-    EXPECT_NEAR(validate_mesh(r.mesh, prm.planarity_tolerance).volume, 480.0, 1e-6);
+    EXPECT_NEAR(validate_mesh(r.mesh, prm.repair.planarity_tolerance).volume, 480.0, 1e-6);
   }
 }
 
@@ -232,7 +232,7 @@ TEST(ShellSelection, ExtendsAFacadeToItsOwnCornerPastTheModelsEnd) {
   RefineConfig prm;
   const ShellSelection r = select_shell(box({0, 0, 0}, {10, 8, 6}), s.cloud, s.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
-  EXPECT_GT(validate_mesh(r.mesh, prm.planarity_tolerance).volume, 480.0 + 1.0);
+  EXPECT_GT(validate_mesh(r.mesh, prm.repair.planarity_tolerance).volume, 480.0 + 1.0);
 }
 
 // A program its budget stops at the root keeps its warm start, though moving the walls onto
@@ -250,12 +250,12 @@ TEST(ShellSelection, MovesWallsWhenTheBudgetEndsTheSearchAtTheRoot) {
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 8, 0}, -y, 8.0, 0.0, 6.0), kStep));
   for (const double budget : {0.07, 0.075}) {  // the whole program's root needs 0.08
     RefineConfig prm;
-    prm.mip_work_limit = budget;
+    prm.selection.mip_work_limit = budget;
     const ShellSelection r = select_shell(start, s.cloud, s.planes, prm);
     ASSERT_TRUE(r.ok) << r.reason;
     EXPECT_EQ(r.stats.selection.status, SolveStatus::FeasibleBudget);
     EXPECT_EQ(r.stats.neighbourhoods_improved, 4);
-    const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
+    const Validation v = validate_mesh(r.mesh, prm.repair.planarity_tolerance);
     EXPECT_TRUE(v.valid()) << v.problem;
     EXPECT_NEAR(v.volume, 480.0, 1e-6) << "budget " << budget;  // the start: 11.6 x 9.6 x 6 = 668.16
   }
@@ -276,9 +276,9 @@ Mesh box_faces(std::initializer_list<int> keep) { return only_faces(box(Vec3(0, 
 TEST(RebuildShell, WallsMissingAlongTheFootprintAreAdded) {
   const Mesh soup = box_faces({0, 1, 3});
   const RefineConfig prm;
-  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
   ASSERT_TRUE(rb.ok) << rb.reason;
-  const Validation v = validate_mesh(rb.mesh, prm.planarity_tolerance);
+  const Validation v = validate_mesh(rb.mesh, prm.repair.planarity_tolerance);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_NEAR(v.volume, 480.0, 1e-6);
   EXPECT_EQ(rb.planes_added, 3);  // walls y = 0, y = 8, x = 0
@@ -297,7 +297,7 @@ TEST(RebuildShell, AHugeSoupIsSampledWithinBounds) {
   Mesh soup = box_faces({0, 1, 3});
   for (Vec3& p : soup.vertices) p = p.cwiseProduct(Vec3(200.0, 250.0, 1.0));
   const RefineConfig prm;
-  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
   ASSERT_TRUE(rb.ok) << rb.reason;
   EXPECT_GT(rb.sampling, 5.0);
   const double kept = 2 * 2000.0 * 2000.0 + 2000.0 * 6.0;
@@ -312,7 +312,7 @@ TEST(RebuildShell, AFinLeavesTheInputUncovered) {
   for (const Vec3& p : {Vec3(0, 0, 6), Vec3(0, 8, 6), Vec3(0, 8, 9), Vec3(0, 0, 9)}) soup.vertices.push_back(p);
   soup.faces.push_back({{n, n + 1, n + 2, n + 3}, Semantic::Wall, 6});
   const RefineConfig prm;
-  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
   ASSERT_TRUE(rb.ok) << rb.reason;
   EXPECT_NEAR(rb.input_to_output, 3.0, 0.05);
   EXPECT_EQ(rb.area_dropped, 0.0);
@@ -324,12 +324,12 @@ TEST(RebuildShell, AFinLeavesTheInputUncovered) {
 TEST(RebuildShell, PartitionsBetweenOverlappingPartsAreJoined) {
   const Mesh soup = merged(box_faces({0, 1, 2, 3, 4, 5}), as_soup(box(Vec3(6, 4, 0), Vec3(14, 12, 6))));
   const RefineConfig prm;
-  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
   ASSERT_TRUE(rb.ok) << rb.reason;
-  const Validation v = validate_mesh(rb.mesh, prm.planarity_tolerance);
+  const Validation v = validate_mesh(rb.mesh, prm.repair.planarity_tolerance);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_NEAR(v.volume, 6.0 * (80.0 + 64.0 - 16.0), 1e-6);
-  EXPECT_LE(rb.input_to_output, prm.weld_tolerance);
+  EXPECT_LE(rb.input_to_output, prm.repair.weld_tolerance);
   EXPECT_NEAR(rb.area_dropped, 2 * (4.0 + 4.0) * 6.0, 6.0);  // each box's two walls inside the other
 }
 
@@ -338,18 +338,18 @@ TEST(RebuildShell, PartitionsBetweenOverlappingPartsAreJoined) {
 TEST(RebuildShell, PartsTouchingAlongAnEdgeAreNotSwallowed) {
   const Mesh soup = merged(box_faces({0, 1, 2, 3, 4, 5}), as_soup(box(Vec3(10, 8, 0), Vec3(16, 14, 5))));
   const RefineConfig prm;
-  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
-  EXPECT_TRUE(!rb.ok || rb.input_to_output > prm.weld_tolerance) << rb.input_to_output;
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
+  EXPECT_TRUE(!rb.ok || rb.input_to_output > prm.repair.weld_tolerance) << rb.input_to_output;
 }
 
 // A roof alone (or with one wall) has no ground: closing it would invent the foot of every wall.
 TEST(RebuildShell, ARoofWithoutAGroundIsNotClosed) {
   const RefineConfig prm;
-  const ShellRebuild with_wall = rebuild_shell(welded_soup(box_faces({1, 3}), prm.weld_tolerance), prm);
+  const ShellRebuild with_wall = rebuild_shell(welded_soup(box_faces({1, 3}), prm.repair.weld_tolerance), prm);
   EXPECT_FALSE(with_wall.ok);
   EXPECT_EQ(with_wall.reason, "it has no ground face: the foot of its walls would be invented");
   // A flat roof alone is its own lowest plane: nothing closes it.
-  EXPECT_FALSE(rebuild_shell(welded_soup(box_faces({1}), prm.weld_tolerance), prm).ok);
+  EXPECT_FALSE(rebuild_shell(welded_soup(box_faces({1}), prm.repair.weld_tolerance), prm).ok);
 }
 
 // Thirty rotated boxes overlapping one another (180 planes, an attacker's soup well within
@@ -364,7 +364,7 @@ TEST(RebuildShell, AnArrangementTooLargeForABuildingIsRefused) {
     soup = merged(soup, b);
   }
   const RefineConfig prm;
-  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
   EXPECT_FALSE(rb.ok);
   EXPECT_EQ(rb.reason.rfind("too many candidate faces (over 10000", 0), 0u) << rb.reason;
 }

@@ -103,7 +103,7 @@ TEST(PolyfitBaseline, UnusableModelIsAnError) {
   EXPECT_EQ(r.status, PolyfitStatus::Error);
   EXPECT_FALSE(r.reason.empty());
   RefineConfig bad;
-  bad.ransac_epsilon = -1;  // out of the parameter table's range
+  bad.plane.ransac_epsilon = -1;  // out of the parameter table's range
   EXPECT_EQ(polyfit_baseline(truth_box(), PointCloud{}, bad, {}).status, PolyfitStatus::Error);
 }
 

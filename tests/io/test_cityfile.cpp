@@ -35,7 +35,7 @@
 using namespace lodrefine;
 
 // Validation at the parameter table's planarity tolerance.
-const double kPlanarity = RefineConfig{}.planarity_tolerance;
+const double kPlanarity = RefineConfig{}.repair.planarity_tolerance;
 
 namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
@@ -710,7 +710,7 @@ TEST(CityFile, JobsWriteTheSameBytesWhenSelectionsEndAtTheBudget) {
   write_file_atomic(dir + "/city.json", synth_city(bs, Vec3(93000, 436000, 0)).dump());
   write_ply(dir + "/cloud.ply", cloud);
   RefineConfig prm;
-  prm.mip_work_limit = 0.02;
+  prm.selection.mip_work_limit = 0.02;
   fixtures::CpuBurners burners(2);
   std::map<int, std::string> written;
   int at_budget = 0;

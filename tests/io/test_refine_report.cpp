@@ -117,8 +117,8 @@ TEST(RefineReport, ValidationJsonNamesTheProblem) {
 
 TEST(RefineReport, ParamsJsonHasEveryRowByNameWithItsValue) {
   RefineConfig c;
-  c.corner_gap = 0.75;
-  c.seed = 3;
+  c.match.corner_gap = 0.75;
+  c.plane.seed = 3;
   const nlohmann::json j = params_json(c);
   EXPECT_EQ(j.size(), param_table().size());
   for (const auto& p : param_table()) EXPECT_TRUE(j.contains(p.name)) << p.name;
