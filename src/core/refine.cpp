@@ -303,9 +303,8 @@ RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::
   }
   std::vector<JudgedWall> moved;
   for (const auto& f : trace.facades) moved.push_back(f.wall);
-  const Judgement& verdict =
-      trace.judgement.emplace(judge_refinement(kept, chosen.mesh, moved, local, prm.match, prm.plane, planes,
-                                               prm.match.match_distance + prm.selection.bbox_margin));
+  const Judgement& verdict = trace.judgement.emplace(
+      judge_refinement(kept, chosen.mesh, moved, local, prm.match, prm.plane, planes, prm.scan_reach()));
   run.lap(RefineStage::Judge);
   if (!verdict.ok)
     return run.finish(Outcome::Kept, "not written: never worse, " + verdict.check + " check: " + verdict.detail, kept);
@@ -319,8 +318,7 @@ RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::
 
 PointCloud cloud_near(const Mesh& local_model, const PointCloud& cloud, const Vec3& origin, const RefineConfig& prm) {
   const Eigen::AlignedBox3d box = bounding_box(local_model.vertices);
-  const Vec3 pad =
-      Vec3::Constant(prm.match.match_distance + prm.selection.bbox_margin) + prm.selection.bbox_expand * box.sizes();
+  const Vec3 pad = Vec3::Constant(prm.scan_reach()) + prm.selection.bbox_expand * box.sizes();
   const Eigen::AlignedBox3d near(box.min() - pad, box.max() + pad);
   PointCloud local;
   for (const auto& p : cloud.points)

@@ -185,7 +185,7 @@ void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s,
   // reach of the evidence (a wall the scan moves takes the roof edge above it along: the zone
   // spans the whole height). Candidates with a vertex in it are free; the others stay as the
   // starting shell has them (the program grows with the region: keep it to the evidence).
-  const double margin = prm.match.match_distance + prm.selection.bbox_margin;
+  const double margin = prm.scan_reach();
   std::vector<Eigen::AlignedBox3d> zones;
   for (const auto& pts : s.points) {
     if (pts.empty()) continue;
@@ -548,7 +548,7 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
   // moved wall lies that far again; once measured lost a real building's refinement), so a large
   // building's program does not grow with the cube of its planes.
   const Region region = detail::building_region(start, s);
-  const double reach = 2.0 * (prm.match.match_distance + prm.selection.bbox_margin);
+  const double reach = 2.0 * prm.scan_reach();
   CandidateSet all = build_candidates(
       s.planes, region,
       int(s.planes.size()) < kLocalSectionsFrom ? std::vector<Region>{} : detail::plane_reach(start, s, region, reach));

@@ -141,8 +141,7 @@ void add_start_planes(const Mesh& start, double planarity_tolerance, Supports& s
 // back or forward farther than the reach.
 void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& scan,
                      const RefineConfig& prm, Supports& s) {
-  const double reach =
-      prm.match.match_distance + prm.selection.bbox_margin;  // a wall off by up to match_distance, plus a bay
+  const double reach = prm.scan_reach();  // a wall off by up to match_distance, plus a bay
   auto attach = [&](int i, const std::vector<Vec3>& pts) {
     auto mean_distance = [&](const Plane& pl) {
       double sum = 0.0;

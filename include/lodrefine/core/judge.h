@@ -56,7 +56,7 @@ struct Judgement {
 
 // Whether `after` may replace `before` (both closed meshes, same frame as `cloud`). `planes`:
 // the scan planes detected in `cloud` (indices into it), for the facade lines beyond
-// match_distance, judged up to `facade_reach` (m; refine: match_distance + bbox_margin, the
+// match_distance, judged up to `facade_reach` (m; refine: RefineConfig::scan_reach, the
 // reach of the selection's scan supports); without them every point is capped at match_distance.
 // - building: refused when the capped RMS of every judged point grows by more than kRmsSlack,
 //   or when more than kWorseShare of the points that changed (by more than

@@ -136,7 +136,7 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const R
 
 // The scan points refine_building works on, in the model's local frame (`origin` subtracted;
 // crops may carry whole streets): those inside the model's bounding box grown by
-// match_distance + bbox_margin (m) and bbox_expand of its size on each side. `local_model` is in
+// RefineConfig::scan_reach (m) and bbox_expand of its size on each side. `local_model` is in
 // the local frame already.
 PointCloud cloud_near(const Mesh& local_model, const PointCloud& cloud, const Vec3& origin, const RefineConfig& prm);
 
