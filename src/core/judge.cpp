@@ -228,7 +228,7 @@ class Openings {
 // line's within `reach` where it stands before no points of the face it faces (judge.h).
 std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const std::vector<JudgedWall>& walls,
                                     const PointCloud& cloud, const std::vector<ScanPlane>& planes, double cap,
-                                    double reach, double max_angle_deg, const PlaneConfig& detection) {
+                                    double reach, double max_angle_deg, const PlaneEvidence& detection) {
   const double on_plane = on_plane_band(detection);
   reach = std::max(reach, cap);
   const bool facade_lines = reach > cap;
@@ -279,7 +279,7 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
 }  // namespace
 
 Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vector<JudgedWall>& walls,
-                           const PointCloud& cloud, const MatchConfig& prm, const PlaneConfig& detection,
+                           const PointCloud& cloud, const MatchConfig& prm, const PlaneEvidence& detection,
                            const std::vector<ScanPlane>& planes, double facade_reach) {
   Judgement j;
   const double cap = prm.match_distance, changed = detection.ransac_epsilon;

@@ -79,7 +79,7 @@ constexpr double kWorseShare = 0.25;
 constexpr int kMinGain = 50;
 constexpr double kMinRmsGain = 0.001;  // m
 Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vector<JudgedWall>& walls,
-                           const PointCloud& cloud, const MatchConfig& match, const PlaneConfig& detection,
+                           const PointCloud& cloud, const MatchConfig& match, const PlaneEvidence& detection,
                            const std::vector<ScanPlane>& planes = {}, double facade_reach = 0.0);
 
 }  // namespace lodrefine

@@ -129,11 +129,12 @@ LODREFINE_STAGES(LODREFINE_CONFIG_STRUCT)
 #undef LODREFINE_CONFIG_VISIT
 #undef LODREFINE_CONFIG_MEMBER
 
-// What a stage reads of another stage's rows, named here once (each row keeps its meaning):
-// the plane stage's sense of a scan plane, read by the match stage's corner_moves and
-// judge_refinement: a point within ransac_epsilon of a plane lies on it (a RANSAC inlier's
-// farthest), and ransac_min_points such points are a scanned surface (a plane's fewest). A
-// PlaneConfig converts to it.
+// What other stages read of the plane stage's rows, named here once (each row keeps its
+// meaning): a point within ransac_epsilon of a scan plane lies on it (a RANSAC inlier's
+// farthest), and ransac_min_points such points are a scanned surface (a plane's fewest). The
+// match stage's corner_moves and judge_refinement take it beside their MatchConfig, the
+// selection's test for enclosed scan points alone; a PlaneConfig converts to it. (The other
+// borrowed value is RefineConfig::scan_reach.)
 struct PlaneEvidence {
   double ransac_epsilon;
   int ransac_min_points;
