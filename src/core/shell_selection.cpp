@@ -160,7 +160,7 @@ void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s,
   std::vector<CellSet> own(np), other(np);
   for (int k = 0; k < np; ++k) mark(own[k], s.points[k], frames[k]);
   for (int k = 0; k < np; ++k) {
-    if (!near_vertical(s.planes[k].plane)) continue;
+    if (!near_vertical(s.planes[k].plane, prm.plane.facade_max_tilt_deg)) continue;
     for (int j = 0; j < np; ++j) {
       if (j == k || s.points[j].empty() ||
           unoriented_angle_deg(s.planes[k].plane.n, s.planes[j].plane.n) > prm.selection.merge_angle_deg)
@@ -547,7 +547,7 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
   // the farthest a wall may move: a face reaches a moved neighbour, whose corner with the next
   // moved wall lies that far again; once measured lost a real building's refinement), so a large
   // building's program does not grow with the cube of its planes.
-  const Region region = detail::building_region(start, s);
+  const Region region = detail::building_region(start, s, prm.plane.facade_max_tilt_deg);
   const double reach = 2.0 * prm.scan_reach();
   CandidateSet all = build_candidates(
       s.planes, region,
@@ -789,7 +789,7 @@ ShellRebuild rebuild_shell(const Mesh& soup, const RefineConfig& prm) {
   }
   detail::add_hole_planes(soup, s);
   out.planes_added = s.hole_planes;
-  const Region region = detail::building_region(soup, s);
+  const Region region = detail::building_region(soup, s, prm.plane.facade_max_tilt_deg);
   CandidateSet cs = build_candidates(s.planes, region, {}, kRebuildWholeRegion);
   if (cs.capped) {
     std::vector<Vec3> open_ends;

@@ -142,6 +142,7 @@ void add_start_planes(const Mesh& start, double planarity_tolerance, Supports& s
 void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& scan,
                      const RefineConfig& prm, Supports& s) {
   const double reach = prm.scan_reach();  // a wall off by up to match_distance, plus a bay
+  const double tilt = prm.plane.facade_max_tilt_deg;
   auto attach = [&](int i, const std::vector<Vec3>& pts) {
     auto mean_distance = [&](const Plane& pl) {
       double sum = 0.0;
@@ -151,7 +152,7 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
     int k = -1;
     double best = prm.selection.merge_distance;
     for (int j = 0; j < int(s.planes.size()); ++j) {
-      if (!near_vertical(s.planes[j].plane) ||
+      if (!near_vertical(s.planes[j].plane, tilt) ||
           unoriented_angle_deg(s.planes[j].plane.n, scan[i].plane.n) > prm.selection.merge_angle_deg)
         continue;
       const double d = mean_distance(s.planes[j].plane);
@@ -201,10 +202,11 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
 // of the step, where the points usually end more sharply). The selection takes such a wall only
 // where it closes what the scan shows.
 void add_step_walls(const Mesh& start, const RefineConfig& prm, Supports& s) {
+  const double tilt = prm.plane.facade_max_tilt_deg;
   const int existing = int(s.planes.size());
   for (int j = s.start_planes; j < existing; ++j) {
     const Plane& pj = s.planes[j].plane;
-    if (!s.planes[j].from_scan || s.points[j].empty() || !near_vertical(pj)) continue;
+    if (!s.planes[j].from_scan || s.points[j].empty() || !near_vertical(pj, tilt)) continue;
     const Vec3 u = Vec3(-pj.n.y(), pj.n.x(), 0.0).normalized();
     const auto [lo, hi] = span_along(start, u);
     std::vector<double> ends;
@@ -229,9 +231,9 @@ void add_step_walls(const Mesh& start, const RefineConfig& prm, Supports& s) {
       const Vec3 x = c + (t - u.dot(c)) * u;
       bool there = false;
       for (const auto& sp : s.planes)
-        there =
-            there || (near_vertical(sp.plane) && unoriented_angle_deg(sp.plane.n, u) <= prm.selection.merge_angle_deg &&
-                      std::abs(sp.plane.distance(x)) <= kSameStep);
+        there = there || (near_vertical(sp.plane, tilt) &&
+                          unoriented_angle_deg(sp.plane.n, u) <= prm.selection.merge_angle_deg &&
+                          std::abs(sp.plane.distance(x)) <= kSameStep);
       if (there) continue;
       s.planes.push_back({Plane::through(x, u), Semantic::Wall, true, -1});
       s.points.emplace_back();
@@ -247,6 +249,7 @@ void add_step_walls(const Mesh& start, const RefineConfig& prm, Supports& s) {
 // continues another scanned facade across a step (steps_from): a lone parallel facade before a
 // wall may be a neighbour's across an alley.
 std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const RefineConfig& prm, double step) {
+  const double tilt = prm.plane.facade_max_tilt_deg;
   struct Wall {
     Plane plane;
     Vec3 u, v;
@@ -255,7 +258,7 @@ std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const Ref
   std::vector<Wall> walls;
   for (std::size_t f = 0; f < start.faces.size(); ++f) {
     const int k = s.face_plane[f];
-    if (k < 0 || !near_vertical(s.planes[k].plane)) continue;
+    if (k < 0 || !near_vertical(s.planes[k].plane, tilt)) continue;
     Wall w{s.planes[k].plane, {}, {}, {}};
     std::tie(w.u, w.v) = w.plane.basis();
     for (int i : start.faces[f].v) w.poly.emplace_back(w.u.dot(start.vertices[i]), w.v.dot(start.vertices[i]));
@@ -263,7 +266,7 @@ std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const Ref
   }
   std::vector<Vec3> out;
   for (int k = s.start_planes; k < int(s.planes.size()); ++k) {
-    if (s.points[k].empty() || !near_vertical(s.planes[k].plane) ||
+    if (s.points[k].empty() || !near_vertical(s.planes[k].plane, tilt) ||
         !steps_from_any(start, s, s.points[k], s.planes[k].plane.n, prm.selection.merge_angle_deg, k))
       continue;
     std::vector<const Wall*> parallel;
@@ -330,10 +333,10 @@ bool carries_ground(const Mesh& soup, const Supports& s) {
 }
 
 // The region: the start and the scan evidence, in the axes of the start's largest wall.
-Region building_region(const Mesh& start, const Supports& s) {
+Region building_region(const Mesh& start, const Supports& s, double max_tilt_deg) {
   Vec3 n = Vec3::UnitY();
   for (const auto& sp : s.planes)  // the start's planes come in decreasing area: the first wall
-    if (!sp.from_scan && near_vertical(sp.plane)) {
+    if (!sp.from_scan && near_vertical(sp.plane, max_tilt_deg)) {
       n = Vec3(sp.plane.n.x(), sp.plane.n.y(), 0.0).normalized();
       break;
     }

@@ -26,10 +26,11 @@ struct Supports {
   int hole_planes = 0;  // planes no face of the start lies on (add_hole_planes)
 };
 
-// A plane whose normal is within this of horizontal is a wall's (deg): the contradiction and the
-// represented-facade tests apply to walls only.
-constexpr double kVerticalTiltDeg = 10.0;
-inline bool near_vertical(const Plane& pl) { return std::abs(pl.n.z()) < std::sin(radians(kVerticalTiltDeg)); }
+// A plane whose normal is within `max_tilt_deg` of horizontal (PlaneConfig::facade_max_tilt_deg)
+// is a wall's: the contradiction and the represented-facade tests apply to walls only.
+inline bool near_vertical(const Plane& pl, double max_tilt_deg) {
+  return std::abs(pl.n.z()) < std::sin(radians(max_tilt_deg));
+}
 
 // The start's planes, one per set of its surfaces within kSurfaceAngleDeg / kSurfaceDistance
 // (matching.h), largest first; a surface on none of them goes to the one nearest in angle of
@@ -54,9 +55,9 @@ void add_step_walls(const Mesh& start, const RefineConfig& prm, Supports& s);
 // swept along the normal of the nearest parallel start wall it stands before onto that wall (the
 // step, bay or recess between them), sampled every `step` m.
 std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const RefineConfig& prm, double step);
-// The region: the start and the scan evidence, in the axes of the start's largest wall, grown by
-// a margin.
-Region building_region(const Mesh& start, const Supports& s);
+// The region: the start and the scan evidence, in the axes of the start's largest wall (near_vertical
+// within `max_tilt_deg`), grown by a margin.
+Region building_region(const Mesh& start, const Supports& s, double max_tilt_deg);
 // Per supporting plane, the box (region's axes) its candidates need: its start faces and its
 // scan points, grown by `margin` (the farthest a wall may move); a plane with neither (a
 // hypothesised wall) those of the start and the evidence within `margin` of it. A scanned wall
