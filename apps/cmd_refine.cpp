@@ -207,7 +207,7 @@ void run_city(const RefineArgs& a, const std::vector<std::string>& clouds) {
                                {"outcome", b.outcome},
                                {"reason", b.reason},
                                {"facades_moved", b.facades_moved},
-                               {"refused_by", b.refused_by},
+                               {"refused_by", check_name(b.refused_by)},
                                {"points", b.points},
                                {"seconds", b.seconds}});
     write_file_atomic(a.report, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");

@@ -288,7 +288,7 @@ Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vec
     points = judged_points(before, after, walls, cloud, planes, cap, facade_reach, prm.match_angle_deg, detection);
   } catch (const InputError& e) {
     j.ok = false;
-    j.check = "building";
+    j.check = JudgeCheck::Building;
     j.detail = e.what();
     return j;
   }
@@ -299,7 +299,7 @@ Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vec
   }
   if (const std::string why = worse_reason(j.building, kRmsSlack, true); !why.empty()) {
     j.ok = false;
-    j.check = "building";
+    j.check = JudgeCheck::Building;
     j.detail = why;
     return j;
   }
@@ -314,7 +314,7 @@ Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vec
     }
     if (!why.empty()) {
       j.ok = false;
-      j.check = "wall";
+      j.check = JudgeCheck::Wall;
       j.wall = int(k);
       j.detail = "moved wall " + std::to_string(k) + ": " + why;
       return j;
@@ -323,7 +323,7 @@ Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vec
   const auto wall_gained = [](const Judgement::Fit& f) { return f.rms_before - f.rms_after >= kMinRmsGain; };
   if (j.building.better < std::size_t(kMinGain) && std::none_of(j.walls.begin(), j.walls.end(), wall_gained)) {
     j.ok = false;
-    j.check = "gain";
+    j.check = JudgeCheck::Gain;
     j.detail = std::to_string(j.building.better) + " scan points closer than before (" + std::to_string(kMinGain) +
                " needed) and no moved wall's RMS down by 1 mm: the scan shows no change";
   }

@@ -306,8 +306,7 @@ RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::
   const Judgement& verdict = trace.judgement.emplace(
       judge_refinement(kept, chosen.mesh, moved, local, prm.match, prm.plane, planes, prm.scan_reach()));
   run.lap(RefineStage::Judge);
-  if (!verdict.ok)
-    return run.finish(Outcome::Kept, "not written: never worse, " + verdict.check + " check: " + verdict.detail, kept);
+  if (!verdict.ok) return run.finish(Outcome::Kept, "not written: never worse, " + verdict.refusal(), kept);
   return run.finish(Outcome::Refined,
                     std::to_string(chosen.stats.faces_from_selection) + " face(s) selected, " +
                         std::to_string(trace.facades.size()) + " wall(s) moved",
@@ -433,20 +432,20 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const R
   };
   std::vector<CornerMove> kept_corners = corners;
   if (!corners.empty() && refused()) {
-    trace.corners_refused = trace.judgement->check + " check: " + trace.judgement->detail;
+    trace.corners_refused = trace.judgement->refusal();
     kept_corners.clear();
     result = again(kept_corners);
   }
   // A scan move whose own wall the judge refuses (its points got farther, or it has none: a
   // plane matched that is not the wall's) says nothing of the other walls: it is dropped and the
   // building refined again on theirs.
-  while (refused() && trace.judgement->check == "wall") {
+  while (refused() && trace.judgement->check == JudgeCheck::Wall) {
     const RefineTrace::FacadeMove& wall = trace.facades[std::size_t(trace.judgement->wall)];
     const auto dropped =
         std::remove_if(moves.begin(), moves.end(), [&](const WallMove& m) { return m.surface == wall.surface; });
     if (wall.surface < 0 || dropped == moves.end()) break;
     moves.erase(dropped, moves.end());
-    trace.walls_refused.push_back(trace.judgement->check + " check: " + trace.judgement->detail);
+    trace.walls_refused.push_back(trace.judgement->refusal());
     result = again(kept_corners);
   }
   return result;

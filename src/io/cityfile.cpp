@@ -152,7 +152,7 @@ void apply_job(json& doc, const CityJsonTransform& tf, const CityJsonBuilding& b
   } else {
     ++(o.outcome == "kept" ? sum.kept : sum.kept_invalid);
   }
-  if (!o.refused_by.empty()) ++sum.refused[o.refused_by];
+  if (o.refused_by != JudgeCheck::None) ++sum.refused[check_name(o.refused_by)];
   if (!obj.contains("attributes") || !obj["attributes"].is_object()) obj["attributes"] = json::object();
   obj["attributes"]["lodrefine_outcome"] = o.outcome;
   obj["attributes"]["lodrefine_reason"] = o.reason;

@@ -22,6 +22,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lodrefine/core/judge.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/io/cloud.h"
 
@@ -71,8 +72,8 @@ struct CityBuildingOutcome {
   std::string outcome;  // "refined", "repaired", "kept", "kept-invalid"
   std::string reason;   // why repaired / kept / kept-invalid (empty when refined)
   int facades_moved = 0;
-  std::string refused_by;  // the never-worse check that refused its refinement (judge.h), or empty
-  std::size_t points = 0;  // cloud points in the building's crop box
+  JudgeCheck refused_by = JudgeCheck::None;  // the never-worse check that refused its refinement (judge.h)
+  std::size_t points = 0;                    // cloud points in the building's crop box
   double seconds = 0.0;
 };
 
