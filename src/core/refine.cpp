@@ -331,8 +331,15 @@ const char* outcome_name(Outcome outcome) {
     case Outcome::Kept: return "kept";
     case Outcome::Repaired: return "repaired";
     case Outcome::KeptInvalid: return "kept-invalid";
+    case Outcome::Untouched: return "untouched";
   }
   return "?";
+}
+
+std::optional<Outcome> parse_outcome(const std::string& name) {
+  for (Outcome o : {Outcome::Refined, Outcome::Kept, Outcome::Repaired, Outcome::KeptInvalid, Outcome::Untouched})
+    if (name == outcome_name(o)) return o;
+  return std::nullopt;
 }
 
 Vec3 local_origin(const Mesh& model) {

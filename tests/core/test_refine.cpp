@@ -261,3 +261,11 @@ TEST(Refine, AHouseWithAFinIsKeptInvalidAsRead) {
   EXPECT_NEAR(std::stod(r.reason.substr(at + 19)), 3.0, 0.05) << r.reason;
   EXPECT_EQ(r.mesh.faces.size(), coarse.faces.size());
 }
+
+TEST(Refine, OutcomeNamesReadBack) {
+  for (Outcome o : {Outcome::Refined, Outcome::Kept, Outcome::Repaired, Outcome::KeptInvalid, Outcome::Untouched})
+    EXPECT_EQ(parse_outcome(outcome_name(o)), o) << outcome_name(o);
+  EXPECT_EQ(std::string(outcome_name(Outcome::KeptInvalid)), "kept-invalid");
+  EXPECT_FALSE(parse_outcome("Refined").has_value());
+  EXPECT_FALSE(parse_outcome("").has_value());
+}

@@ -140,7 +140,7 @@ void check_city_output(const json& in, const std::string& out_path, const CityRe
   ASSERT_EQ(out["CityObjects"].size(), in["CityObjects"].size());
   EXPECT_EQ(s.refined + s.repaired + s.kept + s.kept_invalid + s.untouched, s.buildings);
   std::map<std::string, std::string> outcome;
-  for (const auto& o : s.outcomes) outcome[o.id] = o.outcome;
+  for (const auto& o : s.outcomes) outcome[o.id] = outcome_name(o.outcome);
   int identical = 0;
   std::size_t vertex_mismatches = 0;
   for (const auto& [id, obj] : in["CityObjects"].items()) {
@@ -231,14 +231,14 @@ TEST(CityFile, GeneratedCityRefinedIntoCityJson2) {
   EXPECT_GE(s.refined, 2);
   EXPECT_EQ(s.cloud_points, cloud.points.size());
   for (const auto& o : s.outcomes)
-    if (o.outcome == "refined") {
+    if (o.outcome == Outcome::Refined) {
       EXPECT_GE(o.facades_moved, 1) << o.id;
     }
   check_city_output(in, dir + "/out.city.json", s);
   // The refined LoD 2.2 geometry replaced in place; the LoD 1 geometry before it kept.
   const json out = load(dir + "/out.city.json");
   for (const auto& o : s.outcomes) {
-    if (o.outcome != "refined") continue;
+    if (o.outcome != Outcome::Refined) continue;
     EXPECT_EQ(out["CityObjects"][o.id]["geometry"][0], in["CityObjects"][o.id]["geometry"][0]);
     EXPECT_EQ(out["CityObjects"][o.id]["geometry"][1]["lod"], "2.2");
     EXPECT_EQ(out["CityObjects"][o.id]["geometry"][1]["type"], "Solid");
@@ -278,9 +278,9 @@ TEST(CityFile, OnlyTheMisplacedTerracedHouseChanges) {
   ASSERT_EQ(s.outcomes.size(), 3u);
   std::map<std::string, CityBuildingOutcome> by_id;
   for (const auto& o : s.outcomes) by_id[o.id] = o;
-  EXPECT_EQ(by_id["A"].outcome, "kept") << by_id["A"].reason;
-  EXPECT_EQ(by_id["B"].outcome, "refined") << by_id["B"].reason;
-  EXPECT_EQ(by_id["G"].outcome, "kept");
+  EXPECT_EQ(by_id["A"].outcome, Outcome::Kept) << by_id["A"].reason;
+  EXPECT_EQ(by_id["B"].outcome, Outcome::Refined) << by_id["B"].reason;
+  EXPECT_EQ(by_id["G"].outcome, Outcome::Kept);
   EXPECT_EQ(by_id["G"].reason, "scan covers no facade of this building");
   EXPECT_EQ(s.refused.size(), 0u);
   check_city_output(in, dir + "/terraced.out.city.json", s);  // A and G exactly as read
@@ -319,7 +319,7 @@ TEST(CityFile, ErrorsAndBuildingsThatCannotBeRefined) {
       refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", RefineConfig{}, {});
   ASSERT_EQ(s.outcomes.size(), 2u);
   EXPECT_EQ(s.outcomes[1].id, "broken");
-  EXPECT_EQ(s.outcomes[1].outcome, "kept-invalid");
+  EXPECT_EQ(s.outcomes[1].outcome, Outcome::KeptInvalid);
   EXPECT_FALSE(s.outcomes[1].reason.empty());
   check_city_output(in, dir + "/out.city.json", s);
 
@@ -387,7 +387,7 @@ TEST(CityFile, RotterdamDelfshaven) {
   s.buildings = rep["buildings"], s.refined = rep["refined"], s.kept = rep["kept"];
   s.kept_invalid = rep["kept_invalid"], s.untouched = rep["untouched"];
   for (const auto& o : rep["outcomes"])
-    s.outcomes.push_back({o["id"], o["outcome"], o["reason"], o["facades_moved"], {}});
+    s.outcomes.push_back({o["id"], parse_outcome(o["outcome"]).value(), o["reason"], o["facades_moved"], {}});
   EXPECT_EQ(s.buildings, 853);
   EXPECT_GE(s.refined, 1);
   check_city_output(load(path.string()), dir + "/rotterdam.city.json", s);
@@ -430,9 +430,9 @@ TEST(CityFile, RepairAllMendsTheBuildingsTheCloudDoesNotReach) {
   ASSERT_EQ(s.outcomes.size(), 3u);
   EXPECT_EQ(s.untouched, 0);
   EXPECT_EQ(s.outcomes[1].id, "open");
-  EXPECT_EQ(s.outcomes[1].outcome, "repaired") << s.outcomes[1].reason;
+  EXPECT_EQ(s.outcomes[1].outcome, Outcome::Repaired) << s.outcomes[1].reason;
   EXPECT_EQ(s.outcomes[1].reason.rfind("shell rebuilt on its planes", 0), 0u) << s.outcomes[1].reason;
-  EXPECT_EQ(s.outcomes[2].outcome, "kept") << s.outcomes[2].reason;
+  EXPECT_EQ(s.outcomes[2].outcome, Outcome::Kept) << s.outcomes[2].reason;
   check_city_output(in, dir + "/all.city.json", s);
   const CityJsonFile back = read_cityjson(dir + "/all.city.json");
   for (const auto& b : back.buildings)
@@ -517,7 +517,7 @@ TEST(CityFile, CityJsonSeqStreamedThrough) {
   ASSERT_EQ(back.buildings.size(), 3u);
   for (const auto& o : s.outcomes)
     for (const auto& b : back.buildings)
-      if (b.mesh.id == o.id && o.outcome == "refined") {
+      if (b.mesh.id == o.id && o.outcome == Outcome::Refined) {
         EXPECT_EQ(geometry_problem(b.mesh), "") << b.mesh.id;
       }
   const fs::path schemas = shared_dir() / "schemas" / "cityjson-2.0.2";
@@ -600,10 +600,12 @@ TEST(CityFile, LodPicksTheGeometryToRefine) {
       const json& before = in["CityObjects"][id]["geometry"][k];
       const json& after = out["CityObjects"][id]["geometry"][k];
       EXPECT_EQ(after["lod"], before["lod"]);
-      if (int(k) != index || s.outcomes[0].outcome != "refined") EXPECT_EQ(after, before) << "LoD " << before["lod"];
+      if (int(k) != index || s.outcomes[0].outcome != Outcome::Refined)
+        EXPECT_EQ(after, before) << "LoD " << before["lod"];
       else EXPECT_EQ(after["type"], "Solid");
     }
-    std::printf("  --lod %s: %s (%s)\n", lod.c_str(), s.outcomes[0].outcome.c_str(), s.outcomes[0].reason.c_str());
+    std::printf("  --lod %s: %s (%s)\n", lod.c_str(), outcome_name(s.outcomes[0].outcome),
+                s.outcomes[0].reason.c_str());
     // convert --lod writes that LoD's faces.
     const Cli c =
         run_cli("convert --cityjson " + path.string() + " --lod " + lod + " --out-dir " + dir + "/obj_" + lod, dir);
@@ -787,9 +789,9 @@ TEST(CityFileSecurity, FlatAndStrayBuildingsAreKeptInvalidTheRunGoesOn) {
   const CityRefineSummary s =
       refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", RefineConfig{}, {});
   ASSERT_EQ(s.outcomes.size(), 3u);
-  EXPECT_NE(s.outcomes[0].outcome, "kept-invalid") << s.outcomes[0].reason;
-  EXPECT_EQ(s.outcomes[1].outcome, "kept-invalid");
-  EXPECT_EQ(s.outcomes[2].outcome, "kept-invalid");
+  EXPECT_NE(s.outcomes[0].outcome, Outcome::KeptInvalid) << s.outcomes[0].reason;
+  EXPECT_EQ(s.outcomes[1].outcome, Outcome::KeptInvalid);
+  EXPECT_EQ(s.outcomes[2].outcome, Outcome::KeptInvalid);
   EXPECT_NE(s.outcomes[2].reason.find("spans 1000 km, more than a building can"), std::string::npos)
       << s.outcomes[2].reason;
   EXPECT_EQ(s.outcomes[2].points, 0u);

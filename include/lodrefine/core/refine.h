@@ -26,8 +26,13 @@ namespace lodrefine {
 // "repaired": as kept, but the input was no valid solid and its shell was rebuilt on its own
 // planes (rebuild_shell, shell_selection.h): faces added, split or dropped, nothing moved;
 // "kept-invalid": the input cannot be made a valid solid and the output is it as read.
-enum class Outcome { Refined, Kept, Repaired, KeptInvalid };
+// Never from refine_building: "untouched", a building of a city file that the cloud does not
+// reach, written exactly as read (cityfile.h).
+enum class Outcome { Refined, Kept, Repaired, KeptInvalid, Untouched };
 const char* outcome_name(Outcome outcome);
+// The outcome outcome_name() calls `name`; none for any other text (what outcomes read back
+// from reports and city files are checked with).
+std::optional<Outcome> parse_outcome(const std::string& name);
 
 // The stages a refinement times (RefineTrace::seconds), in pipeline order; "total" follows
 // them. A building's run stops after any of them (a refusal, nothing to change).

@@ -24,6 +24,7 @@
 
 #include "lodrefine/core/judge.h"
 #include "lodrefine/core/params.h"
+#include "lodrefine/core/refine.h"
 #include "lodrefine/io/cloud.h"
 
 namespace lodrefine {
@@ -69,8 +70,8 @@ struct CityRefineOptions {
 
 struct CityBuildingOutcome {
   std::string id;
-  std::string outcome;  // "refined", "repaired", "kept", "kept-invalid"
-  std::string reason;   // why repaired / kept / kept-invalid (empty when refined)
+  Outcome outcome = Outcome::KeptInvalid;  // refined, repaired, kept or kept-invalid (outcome_name: the text)
+  std::string reason;                      // why repaired / kept / kept-invalid (empty when refined)
   int facades_moved = 0;
   JudgeCheck refused_by = JudgeCheck::None;  // the never-worse check that refused its refinement (judge.h)
   std::size_t points = 0;                    // cloud points in the building's crop box
