@@ -325,23 +325,6 @@ PointCloud cloud_near(const Mesh& local_model, const PointCloud& cloud, const Ve
   return local;
 }
 
-const char* outcome_name(Outcome outcome) {
-  switch (outcome) {
-    case Outcome::Refined: return "refined";
-    case Outcome::Kept: return "kept";
-    case Outcome::Repaired: return "repaired";
-    case Outcome::KeptInvalid: return "kept-invalid";
-    case Outcome::Untouched: return "untouched";
-  }
-  return "?";
-}
-
-std::optional<Outcome> parse_outcome(const std::string& name) {
-  for (Outcome o : {Outcome::Refined, Outcome::Kept, Outcome::Repaired, Outcome::KeptInvalid, Outcome::Untouched})
-    if (name == outcome_name(o)) return o;
-  return std::nullopt;
-}
-
 Vec3 local_origin(const Mesh& model) {
   if (model.vertices.empty()) return Vec3::Zero();
   const Vec3 lo = bounding_box(model.vertices).min();

@@ -118,12 +118,12 @@ std::vector<MovedFacade> moved_facades(const json& report) {
 
 // Outcome, reason, moved facades and time of a report that is a JSON object.
 void read_report(RunRow& row, const json& report) {
-  row.outcome = row.refine_outcome == "refined" ? "refined" : "kept";
+  row.outcome = parse_outcome(row.refine_outcome) == Outcome::Refined ? Outcome::Refined : Outcome::Kept;
   const json reason = report.value("reason", json());
   row.reason = reason.is_string() ? escaped_line(reason.get<std::string>())
                : reason.is_null() ? std::string()
                                   : "report.json: \"reason\" is no text";
-  if (row.outcome == "refined") row.moved = moved_facades(report);  // a kept building's model moved nothing
+  if (row.outcome == Outcome::Refined) row.moved = moved_facades(report);  // a kept building's model moved nothing
   const json total = report.value("seconds", json::object()).value("total", json());
   if (total.is_number()) row.refine_seconds = total.get<double>();
 }
@@ -219,11 +219,11 @@ void add_refine_record(RunRow& row, const json& report, const std::string& faile
   }
   if (!failed_line.empty()) row.eval.error = failed_line;
   if (!row.eval.ok()) {
-    row.outcome = "failed";
+    row.outcome = Outcome::Failed;
     row.reason = row.eval.error;
     return;
   }
-  row.outcome = "kept";
+  row.outcome = Outcome::Kept;
   if (!report.is_object()) {
     row.reason = "no report.json";
     return;

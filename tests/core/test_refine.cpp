@@ -263,7 +263,8 @@ TEST(Refine, AHouseWithAFinIsKeptInvalidAsRead) {
 }
 
 TEST(Refine, OutcomeNamesReadBack) {
-  for (Outcome o : {Outcome::Refined, Outcome::Kept, Outcome::Repaired, Outcome::KeptInvalid, Outcome::Untouched})
+  for (Outcome o :
+       {Outcome::Refined, Outcome::Kept, Outcome::Repaired, Outcome::KeptInvalid, Outcome::Untouched, Outcome::Failed})
     EXPECT_EQ(parse_outcome(outcome_name(o)), o) << outcome_name(o);
   EXPECT_EQ(std::string(outcome_name(Outcome::KeptInvalid)), "kept-invalid");
   EXPECT_FALSE(parse_outcome("Refined").has_value());

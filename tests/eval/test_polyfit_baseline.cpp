@@ -184,7 +184,7 @@ TEST(PolyfitBench, SummaryCountsFailuresAndPoolsOverClosedBuildings) {
 TEST(PolyfitBench, RowsEscapeIdsAndReasons) {
   PolyfitComparisonRow row;
   row.id = "B\r\x1b[2KALL GOOD";
-  row.outcome = "kept";
+  row.outcome = Outcome::Kept;
   row.baseline.status = PolyfitStatus::TooFewPlanes;
   row.baseline.reason = "few\rplanes";
   std::FILE* f = std::tmpfile();

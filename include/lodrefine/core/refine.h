@@ -11,6 +11,7 @@
 
 #include "lodrefine/core/judge.h"
 #include "lodrefine/core/matching.h"
+#include "lodrefine/core/outcome.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/planes.h"
 #include "lodrefine/core/repair.h"
@@ -19,20 +20,6 @@
 #include "lodrefine/core/validate.h"
 
 namespace lodrefine {
-
-// "refined": walls moved, validated, and never worse: the scan points near the building and
-// each moved wall's own points fit better than before (judge.h);
-// "kept": the repaired input (nothing to change, or the judge refused the refinement);
-// "repaired": as kept, but the input was no valid solid and its shell was rebuilt on its own
-// planes (rebuild_shell, shell_selection.h): faces added, split or dropped, nothing moved;
-// "kept-invalid": the input cannot be made a valid solid and the output is it as read.
-// Never from refine_building: "untouched", a building of a city file that the cloud does not
-// reach, written exactly as read (cityfile.h).
-enum class Outcome { Refined, Kept, Repaired, KeptInvalid, Untouched };
-const char* outcome_name(Outcome outcome);
-// The outcome outcome_name() calls `name`; none for any other text (what outcomes read back
-// from reports and city files are checked with).
-std::optional<Outcome> parse_outcome(const std::string& name);
 
 // The stages a refinement times (RefineTrace::seconds), in pipeline order; "total" follows
 // them. A building's run stops after any of them (a refusal, nothing to change).

@@ -47,8 +47,8 @@ struct MethodRun {
 
 struct PolyfitComparisonRow {
   std::string id;
-  std::size_t points = 0;  // of the cloud
-  std::string outcome;     // lodrefine's (refine.h's outcome_name)
+  std::size_t points = 0;             // of the cloud
+  Outcome outcome = Outcome::Failed;  // lodrefine's
   std::optional<DistanceStats> coarse_facade, coarse_roof;
   MethodRun lodrefine, polyfit;
   PolyfitResult baseline;  // the mesh dropped; status, reason, planes, candidates, times

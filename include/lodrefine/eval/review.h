@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/core/refine.h"
+#include "lodrefine/core/outcome.h"
 #include "lodrefine/core/types.h"
 #include "lodrefine/eval/report.h"
 

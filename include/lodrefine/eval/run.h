@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lodrefine/core/outcome.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/types.h"
 #include "lodrefine/eval/eval.h"
@@ -43,10 +44,12 @@ struct RunRow {
   BuildingEval eval;
   Vec3 origin = Vec3::Zero();      // local frame origin (added back to centroids in the JSON)
   std::string truth_faces_source;  // "meta.json", "detected" or empty (no truth)
-  std::string refine_outcome;      // the refine report's "outcome" as written, if any
+  std::string refine_outcome;      // the refine report's "outcome" as written, if any (echoed; parse_outcome reads it)
   std::string selection;           // the report's selection.status (empty when none ran)
   // What the refine step recorded (report.json or FAILED).
-  std::string outcome;             // "refined", "kept" (anything else written) or "failed"
+  // Refined, kept (anything else written) or failed; none without a refine record (one building's
+  // eval: written as "").
+  std::optional<Outcome> outcome;
   std::string reason;              // why kept / why failed
   std::vector<MovedFacade> moved;  // facades replaced in the written model
   double refine_seconds = std::numeric_limits<double>::quiet_NaN();

@@ -23,8 +23,8 @@
 #include <nlohmann/json.hpp>
 
 #include "lodrefine/core/judge.h"
+#include "lodrefine/core/outcome.h"
 #include "lodrefine/core/params.h"
-#include "lodrefine/core/refine.h"
 #include "lodrefine/io/cloud.h"
 
 namespace lodrefine {
