@@ -145,14 +145,48 @@ double fitted_area(const FitPoints& fp, int k, const std::vector<Vec2>& poly) {
   return sum * fp.area_per_point;
 }
 
-// What the program knows of each candidate, as face property maps of the candidate mesh:
-// "f:in_start" (bool: the starting shell has a face there), "f:source" (int: that face's source,
-// -1 without one), "f:confidence" (double: the data term's c), "f:in_zone" (bool: scan evidence
-// reaches it), "f:fit" (double: the data-fitting term's scanned area it explains, m²). The
-// selection adds "f:variable" (GLPK column, 0: fixed) and "f:selected".
 using FaceIndex = CandidateMesh::Face_index;
 
-void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s, const RefineConfig& prm) {
+// The face map `in` of a candidate set on the candidates kept_candidates(that set, keep): the
+// map `property` added to their mesh `to`, each kept face's value carried.
+template <class T>
+CandidateMap<T> carried(const CandidateMap<T>& in, const CandidateFaceProperty<T>& property, CandidateMesh& to,
+                        const std::vector<char>& keep) {
+  auto out = property.add(to);
+  int g = 0;
+  for (std::size_t f = 0; f < keep.size(); ++f)
+    if (keep[f]) out[FaceIndex(g++)] = in[FaceIndex(f)];
+  return out;
+}
+
+// What the program knows of each candidate, as face property maps of the candidate mesh (their
+// names: candidate_props): in_start (the starting shell has a face there), source (that face's
+// source, -1 without one; traced_shell gives it to the output's faces), confidence (the data
+// term's c), in_zone (scan evidence reaches it), fit (the data-fitting term's scanned area it
+// explains, m²). Added once (describe_candidates) and carried whole to the kept candidates. The
+// selection adds its own maps (variable, selected).
+struct FaceProps {
+  CandidateMap<bool> in_start;
+  CandidateMap<int> source;
+  CandidateMap<double> confidence;
+  CandidateMap<bool> in_zone;
+  CandidateMap<double> fit;
+
+  // The maps added to `mesh`, every face at each map's unset value.
+  static FaceProps add(CandidateMesh& mesh) {
+    return {candidate_props::in_start.add(mesh), candidate_props::source.add(mesh),
+            candidate_props::confidence.add(mesh), candidate_props::in_zone.add(mesh), candidate_props::fit.add(mesh)};
+  }
+  // The same maps on `to`, the mesh of kept_candidates(this mesh's set, keep), with the kept
+  // faces' values.
+  FaceProps carried_to(CandidateMesh& to, const std::vector<char>& keep) const {
+    return {carried(in_start, candidate_props::in_start, to, keep), carried(source, candidate_props::source, to, keep),
+            carried(confidence, candidate_props::confidence, to, keep),
+            carried(in_zone, candidate_props::in_zone, to, keep), carried(fit, candidate_props::fit, to, keep)};
+  }
+};
+
+FaceProps describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s, const RefineConfig& prm) {
   const int np = int(s.planes.size());
   std::vector<Frame2> frames;
   for (const auto& sp : s.planes) frames.push_back(frame_of(sp.plane, cs.region.center));
@@ -195,11 +229,12 @@ void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s,
     zones.emplace_back(b.min() - grow, b.max() + grow);
   }
 
-  auto in_start = cs.mesh.add_property_map<FaceIndex, bool>("f:in_start", false).first;
-  auto source = cs.mesh.add_property_map<FaceIndex, int>("f:source", -1).first;
-  auto confidence = cs.mesh.add_property_map<FaceIndex, double>("f:confidence", 0.0).first;
-  auto in_zone = cs.mesh.add_property_map<FaceIndex, bool>("f:in_zone", false).first;
-  auto fit = cs.mesh.add_property_map<FaceIndex, double>("f:fit", 0.0).first;
+  FaceProps props = FaceProps::add(cs.mesh);
+  auto& in_start = props.in_start;
+  auto& source = props.source;
+  auto& confidence = props.confidence;
+  auto& in_zone = props.in_zone;
+  auto& fit = props.fit;
   const FitPoints fp = fit_points(s, frames, prm);
   const auto support = cs.supports();
   const auto centroid = cs.centroids();
@@ -229,21 +264,11 @@ void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s,
       for (const auto& p : pts) reached = reached || z.contains(cs.region.axes.transpose() * p);
     in_zone[fi] = reached;
   }
+  return props;
 }
 
-// A face map of `from` on the candidates `to` = kept_candidates(from, keep).
-template <class T>
-void carry(const CandidateSet& from, CandidateSet& to, const std::vector<char>& keep, const std::string& name) {
-  const auto in = from.mesh.property_map<FaceIndex, T>(name).first;
-  auto out = to.mesh.add_property_map<FaceIndex, T>(name, T()).first;
-  int g = 0;
-  for (std::size_t f = 0; f < keep.size(); ++f)
-    if (keep[f]) out[FaceIndex(g++)] = in[FaceIndex(f)];
-}
-
-// A boolean face map as 0/1 per candidate (a selection).
-std::vector<char> face_flags(const CandidateSet& cs, const std::string& name) {
-  const auto map = cs.mesh.property_map<FaceIndex, bool>(name).first;
+// A boolean face map of `cs` as 0/1 per candidate (a selection).
+std::vector<char> face_flags(const CandidateSet& cs, const CandidateMap<bool>& map) {
   std::vector<char> out;
   for (auto f : cs.mesh.faces()) out.push_back(char(map[f]));
   return out;
@@ -558,38 +583,30 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
     st.seconds = seconds_since(t0);
     return out;
   }
-  describe_candidates(all, start, s, prm);
-  const std::vector<char> all_warm = mended_start(all, face_flags(all, "f:in_start"), prm.selection);
+  const FaceProps all_props = describe_candidates(all, start, s, prm);
+  const std::vector<char> all_warm = mended_start(all, face_flags(all, all_props.in_start), prm.selection);
   if (all_warm.empty() && s.slivers > 0) return std::nullopt;
-  const auto all_in_zone = all.mesh.property_map<FaceIndex, bool>("f:in_zone").first;
   std::vector<char> keep(all.size(), 1);
   if (!all_warm.empty())
-    for (std::size_t f = 0; f < keep.size(); ++f) keep[f] = all_in_zone[FaceIndex(f)] || all_warm[f];
+    for (std::size_t f = 0; f < keep.size(); ++f) keep[f] = all_props.in_zone[FaceIndex(f)] || all_warm[f];
   CandidateSet cs = kept_candidates(all, keep);
-  carry<bool>(all, cs, keep, "f:in_start");
-  carry<int>(all, cs, keep, "f:source");
-  carry<double>(all, cs, keep, "f:confidence");
-  carry<bool>(all, cs, keep, "f:in_zone");
-  carry<double>(all, cs, keep, "f:fit");
+  const FaceProps props = all_props.carried_to(cs.mesh, keep);
   const std::vector<char> warm = all_warm.empty() ? all_warm : kept(all_warm, keep);
   st.candidates = cs.size();
   st.candidates_pruned = all.size() - st.candidates;
   st.edges = int(cs.edges.size());
 
   SelectionProgram pg;
-  const auto confidence = cs.mesh.property_map<FaceIndex, double>("f:confidence").first;
-  const auto fit = cs.mesh.property_map<FaceIndex, double>("f:fit").first;
   const auto area = cs.areas();
   for (int f = 0; f < cs.size(); ++f) {
-    pg.cost.push_back(coverage_cost(area[FaceIndex(f)], confidence[FaceIndex(f)], prm.selection.tau_cov));
-    pg.fit.push_back(fit[FaceIndex(f)]);
+    pg.cost.push_back(coverage_cost(area[FaceIndex(f)], props.confidence[FaceIndex(f)], prm.selection.tau_cov));
+    pg.fit.push_back(props.fit[FaceIndex(f)]);
   }
   for (const auto& e : cs.edges)
     pg.sharp_cost.push_back(prm.selection.lambda_complexity * cs.length(e) * kSharpEdgeWidth);
   if (!warm.empty()) {
     pg.warm = warm;
-    const auto in_zone = cs.mesh.property_map<FaceIndex, bool>("f:in_zone").first;
-    for (int f = 0; f < cs.size(); ++f) pg.fixed.push_back(in_zone[FaceIndex(f)] ? -1 : int(warm[f]));
+    for (int f = 0; f < cs.size(); ++f) pg.fixed.push_back(props.in_zone[FaceIndex(f)] ? -1 : int(warm[f]));
   }
   auto finish = [&](const std::string& reason) {
     out.reason = reason;
@@ -601,7 +618,7 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
   // A selection whose shell does not validate (two shells touching, faces meeting at a point)
   // is excluded: its changes from the starting shell are fixed back, and the program solved
   // again (at most kRetries times).
-  const std::vector<char> base = warm.empty() ? face_flags(cs, "f:in_start") : warm;
+  const std::vector<char> base = warm.empty() ? face_flags(cs, props.in_start) : warm;
   std::vector<Vec3> reach_of = st.evidence;
   const std::vector<Vec3> swept = detail::swept_evidence(start, s, prm, kEvidenceReach);
   reach_of.insert(reach_of.end(), swept.begin(), swept.end());
@@ -676,7 +693,7 @@ constexpr double kMaxRebuildSamples = 250000;
 constexpr double kMaxWindingTerms = 2e8;
 
 void set_selected(CandidateSet& cs, const std::vector<char>& chosen) {
-  auto map = cs.mesh.add_property_map<FaceIndex, bool>("f:selected", false).first;
+  auto map = candidate_props::selected.add(cs.mesh);
   for (int f = 0; f < cs.size(); ++f) map[FaceIndex(f)] = chosen[f] != 0;
 }
 
@@ -803,8 +820,8 @@ ShellRebuild rebuild_shell(const Mesh& soup, const RefineConfig& prm) {
                  std::to_string(s.planes.size()) + " planes)";
     return out;
   }
-  describe_candidates(cs, soup, s, prm);
-  const std::vector<char> cover = face_flags(cs, "f:in_start");
+  const FaceProps props = describe_candidates(cs, soup, s, prm);
+  const std::vector<char> cover = face_flags(cs, props.in_start);
   const std::vector<char> chosen = mended_start(cs, cover, prm.selection, {true, kKeepCover});
   if (chosen.empty()) {
     out.reason = "its planes bound no closed shell";
