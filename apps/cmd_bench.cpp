@@ -37,7 +37,7 @@ struct BenchArgs {
   std::string tile;  // a dev tile or run folder instead of generated buildings
   std::string polyfit_planes = "model+scan";
   PolyfitOptions polyfit_options;
-  Params params;
+  RefineConfig params;
 };
 
 std::vector<BuildingType> bench_types(const BenchArgs& a) {
@@ -124,7 +124,8 @@ std::vector<double> stage_times(const RefineTrace& t) {
 
 // The building refined `repeat` times: the result (the same each time) and each stage's least
 // seconds, since a loaded machine only ever adds time.
-std::pair<RefineResult, std::vector<double>> refine_best_of(const BenchBuilding& b, const Params& params, int repeat) {
+std::pair<RefineResult, std::vector<double>> refine_best_of(const BenchBuilding& b, const RefineConfig& params,
+                                                            int repeat) {
   RefineResult r = refine_building(b.coarse, b.cloud, params);
   std::vector<double> best = stage_times(r.trace);
   for (int k = 1; k < repeat; ++k) {

@@ -24,7 +24,7 @@ namespace {
 struct RefineArgs {
   std::string model, out, report;
   std::vector<std::string> clouds;  // --cloud values: files or folders (cloud_files)
-  Params params;
+  RefineConfig params;
   CloudOptions cloud_options;
   std::string building, lod;  // city files only
   std::string html;           // city files only: the review page
@@ -55,11 +55,11 @@ struct ReviewCollector {
                   const PointCloud* crop) {
     CityReviewBuilding b;
     b.id = model.id;
-    b.outcome = o ? o->outcome : "untouched";
+    b.outcome = o ? o->outcome : Outcome::Untouched;
     if (o) b.reason = o->reason, b.points = o->points, b.facades_moved = std::size_t(o->facades_moved);
     if (r && r->trace.judgement && r->trace.judgement->building.points > 0)  // the judge's fit on the scan near it
       b.fit_before = r->trace.judgement->building.rms_before, b.fit_after = r->trace.judgement->building.rms_after;
-    if (r && b.outcome == "refined") {
+    if (r && b.outcome == Outcome::Refined) {
       add_moves(b, r->trace.facades);
       if (crop) b.view = review_view(b.id, model, r->mesh, crop->points, kReviewPoints);
     }
@@ -204,10 +204,10 @@ void run_city(const RefineArgs& a, const std::vector<std::string>& clouds) {
     if (!s.warnings.empty()) j["warnings"] = s.warnings;
     for (const auto& b : s.outcomes)
       j["outcomes"].push_back({{"id", b.id},
-                               {"outcome", b.outcome},
+                               {"outcome", outcome_name(b.outcome)},
                                {"reason", b.reason},
                                {"facades_moved", b.facades_moved},
-                               {"refused_by", b.refused_by},
+                               {"refused_by", check_name(b.refused_by)},
                                {"points", b.points},
                                {"seconds", b.seconds}});
     write_file_atomic(a.report, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");

@@ -51,16 +51,14 @@ Region Region::around(const std::vector<Vec3>& pts, double relative, double abso
   return r;
 }
 
-CandidateMap<int> CandidateSet::supports() const { return mesh.property_map<CandidateFace, int>("f:support").first; }
-CandidateMap<double> CandidateSet::areas() const { return mesh.property_map<CandidateFace, double>("f:area").first; }
-CandidateMap<Vec3> CandidateSet::centroids() const {
-  return mesh.property_map<CandidateFace, Vec3>("f:centroid").first;
-}
+CandidateMap<int> CandidateSet::supports() const { return candidate_props::support.get(mesh); }
+CandidateMap<double> CandidateSet::areas() const { return candidate_props::area.get(mesh); }
+CandidateMap<Vec3> CandidateSet::centroids() const { return candidate_props::centroid.get(mesh); }
 
 std::vector<int> CandidateSet::corners(int f) const {
   std::vector<int> out;
   if (f >= size()) return out;
-  const auto point = mesh.property_map<CandidateMesh::Vertex_index, int>("v:point").first;
+  const auto point = candidate_props::point.get(mesh);
   for (auto h : CGAL::halfedges_around_face(mesh.halfedge(CandidateMesh::Face_index(f)), mesh))
     out.push_back(point[mesh.source(h)]);
   return out;
@@ -73,7 +71,7 @@ std::vector<Vec3> CandidateSet::polygon(int f) const {
 }
 
 std::pair<int, int> CandidateSet::ends(const CandidateEdge& e) const {
-  const auto point = mesh.property_map<CandidateMesh::Vertex_index, int>("v:point").first;
+  const auto point = candidate_props::point.get(mesh);
   const int s = point[mesh.source(e.front())], t = point[mesh.target(e.front())];
   return {std::min(s, t), std::max(s, t)};
 }
@@ -232,10 +230,10 @@ struct Piece {
 // Returns per face the halfedge that leaves its first corner.
 std::vector<CandidateHalfedge> build_mesh(CandidateSet& cs, const std::vector<Piece>& pieces,
                                           const std::vector<std::vector<int>>& corners) {
-  auto support = cs.mesh.add_property_map<CandidateFace, int>("f:support", -1).first;
-  auto area = cs.mesh.add_property_map<CandidateFace, double>("f:area", 0.0).first;
-  auto centroid = cs.mesh.add_property_map<CandidateFace, Vec3>("f:centroid", Vec3::Zero()).first;
-  auto point = cs.mesh.add_property_map<CandidateMesh::Vertex_index, int>("v:point", -1).first;
+  auto support = candidate_props::support.add(cs.mesh);
+  auto area = candidate_props::area.add(cs.mesh);
+  auto centroid = candidate_props::centroid.add(cs.mesh);
+  auto point = candidate_props::point.add(cs.mesh);
   std::vector<CandidateMesh::Vertex_index> of_point(cs.vertices.size());
   std::vector<int> plane_of_vertex(cs.vertices.size(), -1);
   std::vector<CandidateHalfedge> first;
@@ -269,7 +267,7 @@ std::vector<CandidateHalfedge> build_mesh(CandidateSet& cs, const std::vector<Pi
 // edges in order of their first appearance (faces in order, each from its first corner,
 // `first`), the halfedges of each in face order.
 void build_fans(CandidateSet& cs, const std::vector<CandidateHalfedge>& first) {
-  const auto point = cs.mesh.property_map<CandidateMesh::Vertex_index, int>("v:point").first;
+  const auto point = candidate_props::point.get(cs.mesh);
   struct Side {
     int a, b;
     CandidateHalfedge h;

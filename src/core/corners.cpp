@@ -83,7 +83,7 @@ double side_of(const Mesh& mesh, const ModelSurface& wall, const Plane& facade) 
 // `side`, over the upper part of the facade's height [z0, z1] (ground and clutter below do not
 // count): the return the scanner saw where the facade turns the corner.
 bool shows_return(const PointCloud& cloud, const Plane& facade, const Plane& moved, double side, double z0, double z1,
-                  const PlaneConfig& prm) {
+                  const PlaneEvidence& prm) {
   const double on_plane = on_plane_band(prm);
   const double za = z0 + kLowBand * (z1 - z0);
   const double off = kOffPlaneEpsilons * prm.ransac_epsilon;
@@ -116,7 +116,7 @@ struct EndStrips {
 };
 
 EndStrips end_strips(const PointCloud& cloud, const Plane& facade, const Vec3& o, const Vec3& u, double s, double end,
-                     double ground, double z0, double z1, const PlaneConfig& prm) {
+                     double ground, double z0, double z1, const PlaneEvidence& prm) {
   const double za = z0 + kLowBand * (z1 - z0);
   const double on_plane = on_plane_band(prm);
   EndStrips e;
@@ -271,7 +271,7 @@ std::optional<double> one_edge(const std::vector<double>& ends, double stop) {
 // facade towards the corner): the wall's own points above a lower neighbour end there, top
 // bands down; or the points of a taller neighbour above the wall's top (`top`) start there.
 std::optional<double> flush_neighbour_edge(const PointCloud& cloud, const FacadeScan& f, const Plane& facade, double s,
-                                           double uc, double reach, double top, const PlaneConfig& prm) {
+                                           double uc, double reach, double top, const PlaneEvidence& prm) {
   std::vector<double> t(f.pu.size());
   for (std::size_t k = 0; k < t.size(); ++k) t[k] = s * f.pu[k];
   const int n = int(std::ceil((f.z1 - f.z0) / kHeightBand));
@@ -295,7 +295,7 @@ std::optional<double> flush_neighbour_edge(const PointCloud& cloud, const Facade
 // facade's points end, when the scan shows that corner.
 std::optional<CornerMove> corner_at(const Mesh& mesh, const FacadeScan& wall_scan, const ScannedWall& w, int a,
                                     const ModelSurface& as, const std::vector<std::pair<int, int>>& edges,
-                                    const PointCloud& cloud, const MatchConfig& prm, const PlaneConfig& detection) {
+                                    const PointCloud& cloud, const MatchConfig& prm, const PlaneEvidence& detection) {
   // The corner on the scanned plane, at mid height of the shared edge; the facade's points over
   // the edge's heights (the street's ground stays at the wall's foot).
   double zc = 0.0, ze0 = 1e300, ze1 = -1e300;
@@ -374,14 +374,14 @@ std::vector<CornerMove> agreed_moves(const std::map<int, std::vector<CornerMove>
 
 }  // namespace
 
-double on_plane_band(const PlaneConfig& prm) {
+double on_plane_band(const PlaneEvidence& prm) {
   return std::max(kCornerTolerance, kOffPlaneEpsilons * prm.ransac_epsilon);
 }
 
 std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
                                      const std::vector<ScannedWall>& scanned, const PointCloud& cloud,
                                      const std::vector<ScanPlane>& planes, const MatchConfig& prm,
-                                     const PlaneConfig& detection) {
+                                     const PlaneEvidence& detection) {
   const Adjacency shared = adjacent_surfaces(mesh, surfaces);
   std::set<int> is_scanned;
   for (const auto& w : scanned) is_scanned.insert(w.surface);

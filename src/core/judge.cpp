@@ -249,7 +249,7 @@ bool in_free_space(const Vec3& p, int plane, const std::vector<ScanPlane>& plane
 // line's within `reach` where it stands before no points of the face it faces (judge.h).
 std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const std::vector<JudgedWall>& walls,
                                     const PointCloud& cloud, const std::vector<ScanPlane>& planes, double cap,
-                                    double reach, double max_angle_deg, const PlaneConfig& detection) {
+                                    double reach, double max_angle_deg, const PlaneEvidence& detection) {
   const double on_plane = on_plane_band(detection);
   reach = std::max(reach, cap);
   const bool facade_lines = reach > cap;
@@ -304,7 +304,7 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
 }  // namespace
 
 Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vector<JudgedWall>& walls,
-                           const PointCloud& cloud, const MatchConfig& prm, const PlaneConfig& detection,
+                           const PointCloud& cloud, const MatchConfig& prm, const PlaneEvidence& detection,
                            const std::vector<ScanPlane>& planes, double facade_reach) {
   Judgement j;
   const double cap = prm.match_distance, changed = detection.ransac_epsilon;
@@ -313,7 +313,7 @@ Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vec
     points = judged_points(before, after, walls, cloud, planes, cap, facade_reach, prm.match_angle_deg, detection);
   } catch (const InputError& e) {
     j.ok = false;
-    j.check = "building";
+    j.check = JudgeCheck::Building;
     j.detail = e.what();
     return j;
   }
@@ -324,7 +324,7 @@ Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vec
   }
   if (const std::string why = worse_reason(j.building, kRmsSlack, true); !why.empty()) {
     j.ok = false;
-    j.check = "building";
+    j.check = JudgeCheck::Building;
     j.detail = why;
     return j;
   }
@@ -339,7 +339,7 @@ Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vec
     }
     if (!why.empty()) {
       j.ok = false;
-      j.check = "wall";
+      j.check = JudgeCheck::Wall;
       j.wall = int(k);
       j.detail = "moved wall " + std::to_string(k) + ": " + why;
       return j;
@@ -348,7 +348,7 @@ Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vec
   const auto wall_gained = [](const Judgement::Fit& f) { return f.rms_before - f.rms_after >= kMinRmsGain; };
   if (j.building.better < std::size_t(kMinGain) && std::none_of(j.walls.begin(), j.walls.end(), wall_gained)) {
     j.ok = false;
-    j.check = "gain";
+    j.check = JudgeCheck::Gain;
     j.detail = std::to_string(j.building.better) + " scan points closer than before (" + std::to_string(kMinGain) +
                " needed) and no moved wall's RMS down by 1 mm: the scan shows no change";
   }

@@ -29,12 +29,12 @@ LODREFINE_STAGES(LODREFINE_STAGE_VALIDATE)
 #undef LODREFINE_STAGE_VALIDATE
 
 void RefineConfig::validate() const {
-  RepairConfig::validate();
-  PlaneConfig::validate();
-  MatchConfig::validate();
-  if (w_normal + w_coverage <= 0) throw InputError("match: parameters w_normal + w_coverage must be > 0");
-  SelectionConfig::validate();
-  ConfidenceConfig::validate();
+  repair.validate();
+  plane.validate();
+  match.validate();
+  if (match.w_normal + match.w_coverage <= 0) throw InputError("match: parameters w_normal + w_coverage must be > 0");
+  selection.validate();
+  confidence.validate();
 }
 
 const std::vector<ParamInfo>& param_table() {
@@ -50,7 +50,7 @@ const std::vector<ParamInfo>& param_table() {
 
 const std::vector<StageInfo>& stage_table() {
   static const std::vector<StageInfo> table = {
-#define LODREFINE_STAGE_INFO(Config, stage, what, rows) {stage, what},
+#define LODREFINE_STAGE_INFO(Config, name, what, rows) {Config::stage, what},
       LODREFINE_STAGES(LODREFINE_STAGE_INFO)
 #undef LODREFINE_STAGE_INFO
   };

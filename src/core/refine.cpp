@@ -81,11 +81,11 @@ std::optional<Mesh> one_wall_at_a_time(const Mesh& start, const PointCloud& loca
   };
   for (int iter = 0; iter < max_steps; ++iter) {
     const auto ss = model_surfaces(step_mesh);
-    const MatchResult mi = match_surfaces(step_mesh, ss, local, planes, prm);
+    const MatchResult mi = match_surfaces(step_mesh, ss, local, planes, prm.match);
     const Match* next = nullptr;
     for (const auto& m : mi.matches) {
       if (tried.count({m.scan_plane, position(ss[m.surface])}) ||
-          surface_deviation(step_mesh, ss[m.surface], planes[m.scan_plane].plane) <= prm.change_tolerance)
+          surface_deviation(step_mesh, ss[m.surface], planes[m.scan_plane].plane) <= prm.match.change_tolerance)
         continue;
       if (next == nullptr || m.s_match > next->s_match) next = &m;
     }
@@ -100,7 +100,7 @@ std::optional<Mesh> one_wall_at_a_time(const Mesh& start, const PointCloud& loca
     step.moved_by = surface_deviation(step_mesh, surf, plane);
     step.method = "substitution";
     RefineTrace::Substitution attempt;
-    std::optional<Mesh> m = substitute_valid(step_mesh, ss, {{next->surface, plane}}, prm, attempt);
+    std::optional<Mesh> m = substitute_valid(step_mesh, ss, {{next->surface, plane}}, prm.repair, attempt);
     step.ok = bool(m);
     if (!m) step.reason = attempt.reason;
     steps.push_back(step);
@@ -179,16 +179,16 @@ std::optional<RefineResult> repair_or_stop(const Mesh& local_model, const Refine
   std::string invalid;
   try {
     RepairReport rr;
-    kept = repair_input(local_model, cfg, rr);
+    kept = repair_input(local_model, cfg.repair, rr);
     kept.id = local_model.id;
     trace.repair = rr;
-    const Validation v0 = validate_mesh(kept, cfg.planarity_tolerance);
+    const Validation v0 = validate_mesh(kept, cfg.repair.planarity_tolerance);
     trace.input_validation = v0;
     if (v0.valid()) {
       run.lap(RefineStage::Repair);
       return std::nullopt;
     }
-    if (v0.components > 1 && validate_mesh(kept, cfg.planarity_tolerance, true, false).valid()) {
+    if (v0.components > 1 && validate_mesh(kept, cfg.repair.planarity_tolerance, true, false).valid()) {
       run.lap(RefineStage::Repair);
       return run.finish(Outcome::Kept, std::to_string(v0.components) + " separate closed shells: kept whole", kept,
                         false);
@@ -200,12 +200,12 @@ std::optional<RefineResult> repair_or_stop(const Mesh& local_model, const Refine
   trace.invalid_input = invalid;
   ShellRebuild rb;
   try {
-    rb = rebuild_shell(welded_soup(local_model, cfg.weld_tolerance), cfg);
+    rb = rebuild_shell(welded_soup(local_model, cfg.repair.weld_tolerance), cfg);
   } catch (const InputError& e) {
     rb.reason = e.what();
   }
   run.lap(RefineStage::Repair);
-  if (rb.ok && rb.input_to_output > cfg.weld_tolerance) {
+  if (rb.ok && rb.input_to_output > cfg.repair.weld_tolerance) {
     rb.ok = false;
     char buf[160];
     if (rb.area_fins >= 0.5 * rb.area_uncovered)  // mostly a fin
@@ -257,7 +257,8 @@ std::optional<Mesh> starting_shell(const Mesh& current, const std::vector<ModelS
   for (const auto& c : corners) all.push_back(c.move);
   std::optional<Mesh> refined;
   if (!all.empty())
-    refined = substitute_valid(current, surfaces, all, prm, trace.substitution.emplace(RefineTrace::Substitution{}));
+    refined =
+        substitute_valid(current, surfaces, all, prm.repair, trace.substitution.emplace(RefineTrace::Substitution{}));
   auto describe_scan_moves = [&] {
     for (const auto& mv : moves) {
       trace.facades.push_back(describe_move(current, surfaces, mv, "scan"));
@@ -271,7 +272,7 @@ std::optional<Mesh> starting_shell(const Mesh& current, const std::vector<ModelS
       trace.facades.back().wall.flush_facade = c.flush_facade;
     }
   } else if (!corners.empty() && !moves.empty()) {
-    refined = substitute_valid(current, surfaces, moves, prm,
+    refined = substitute_valid(current, surfaces, moves, prm.repair,
                                trace.substitution_without_corners.emplace(RefineTrace::Substitution{}));
     if (refined) describe_scan_moves();
   }
@@ -306,10 +307,9 @@ RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::
   std::vector<JudgedWall> moved;
   for (const auto& f : trace.facades) moved.push_back(f.wall);
   const Judgement& verdict = trace.judgement.emplace(
-      judge_refinement(kept, shell, moved, local, prm, prm, planes, prm.match_distance + prm.bbox_margin));
+      judge_refinement(kept, shell, moved, local, prm.match, prm.plane, planes, prm.scan_reach()));
   run.lap(RefineStage::Judge);
-  if (!verdict.ok)
-    return run.finish(Outcome::Kept, "not written: never worse, " + verdict.check + " check: " + verdict.detail, kept);
+  if (!verdict.ok) return run.finish(Outcome::Kept, "not written: never worse, " + verdict.refusal(), kept);
   const std::string moved_walls = std::to_string(trace.facades.size()) + " wall(s) moved";
   if (!chosen.ok)
     return run.finish(Outcome::Refined,
@@ -323,22 +323,12 @@ RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::
 
 PointCloud cloud_near(const Mesh& local_model, const PointCloud& cloud, const Vec3& origin, const RefineConfig& prm) {
   const Eigen::AlignedBox3d box = bounding_box(local_model.vertices);
-  const Vec3 pad = Vec3::Constant(prm.match_distance + prm.bbox_margin) + prm.bbox_expand * box.sizes();
+  const Vec3 pad = Vec3::Constant(prm.scan_reach()) + prm.selection.bbox_expand * box.sizes();
   const Eigen::AlignedBox3d near(box.min() - pad, box.max() + pad);
   PointCloud local;
   for (const auto& p : cloud.points)
     if (near.contains(p - origin)) local.points.push_back(p - origin);
   return local;
-}
-
-const char* outcome_name(Outcome outcome) {
-  switch (outcome) {
-    case Outcome::Refined: return "refined";
-    case Outcome::Kept: return "kept";
-    case Outcome::Repaired: return "repaired";
-    case Outcome::KeptInvalid: return "kept-invalid";
-  }
-  return "?";
 }
 
 Vec3 local_origin(const Mesh& model) {
@@ -354,9 +344,9 @@ namespace {
 // facade planes that are relief moved to `relief`.
 std::vector<ScanPlane> scan_walls(const Mesh& model, PointCloud& local, const RefineConfig& prm,
                                   std::vector<ScanPlane>& relief) {
-  auto planes = detect_planes(local, prm);
+  auto planes = detect_planes(local, prm.plane);
   collapse_doubled_walls(local, planes);
-  return without_relief(std::move(planes), model, local, prm, &relief);
+  return without_relief(std::move(planes), model, local, prm.plane, &relief);
 }
 
 RefineTrace::Scan scan_summary(const std::vector<ScanPlane>& walls, const std::vector<ScanPlane>& relief,
@@ -389,7 +379,7 @@ RefineTrace::Scan scan_summary(const std::vector<ScanPlane>& walls, const std::v
 
 RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const RefineConfig& prm) {
   prm.validate();
-  Run run(model, prm.planarity_tolerance);
+  Run run(model, prm.repair.planarity_tolerance);
   RefineTrace& trace = run.trace();
   const Mesh local_model = translated(model, -run.origin());
   Mesh kept;
@@ -411,11 +401,11 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const R
   // ones move onto their planes, and unscanned walls at a scanned facade's end to where the
   // scan shows the corner.
   const auto surfaces = model_surfaces(current);
-  const MatchResult mr = match_surfaces(current, surfaces, local, planes, prm);
+  const MatchResult mr = match_surfaces(current, surfaces, local, planes, prm.match);
   std::vector<WallMove> moves;
   std::vector<ScannedWall> scanned;
-  outdated_walls(current, surfaces, mr, planes, local, prm, trace, moves, scanned);
-  const auto corners = corner_moves(current, surfaces, scanned, local, planes, prm, prm);
+  outdated_walls(current, surfaces, mr, planes, local, prm.match, trace, moves, scanned);
+  const auto corners = corner_moves(current, surfaces, scanned, local, planes, prm.match, prm.plane);
   run.lap(RefineStage::Matching);
 
   // The corners are the least certain evidence: a refinement the judge refuses with them is
@@ -438,20 +428,20 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const R
   };
   std::vector<CornerMove> kept_corners = corners;
   if (!corners.empty() && refused()) {
-    trace.corners_refused = trace.judgement->check + " check: " + trace.judgement->detail;
+    trace.corners_refused = trace.judgement->refusal();
     kept_corners.clear();
     result = again(kept_corners);
   }
   // A scan move whose own wall the judge refuses (its points got farther, or it has none: a
   // plane matched that is not the wall's) says nothing of the other walls: it is dropped and the
   // building refined again on theirs.
-  while (refused() && trace.judgement->check == "wall") {
+  while (refused() && trace.judgement->check == JudgeCheck::Wall) {
     const RefineTrace::FacadeMove& wall = trace.facades[std::size_t(trace.judgement->wall)];
     const auto dropped =
         std::remove_if(moves.begin(), moves.end(), [&](const WallMove& m) { return m.surface == wall.surface; });
     if (wall.surface < 0 || dropped == moves.end()) break;
     moves.erase(dropped, moves.end());
-    trace.walls_refused.push_back(trace.judgement->check + " check: " + trace.judgement->detail);
+    trace.walls_refused.push_back(trace.judgement->refusal());
     result = again(kept_corners);
   }
   return result;

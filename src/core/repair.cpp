@@ -20,7 +20,7 @@ namespace {
 
 constexpr double kHolePlanarity = 0.02;  // m: a boundary loop flatter than this becomes one face
 constexpr double kHorizontalDeg = 10.0;  // filled holes this close to horizontal are ground/roof
-// weld_tolerance may be 0 (Params allows it): welding, degenerate faces and T-junctions then
+// weld_tolerance may be 0 (RepairConfig allows it): welding, degenerate faces and T-junctions then
 // work at this floor, well above the rounding of coordinates in a local frame (m).
 constexpr double kMinWeldTolerance = 1e-9;
 // The fewest faces of a closed polyhedron (a tetrahedron).

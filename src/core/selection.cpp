@@ -182,7 +182,7 @@ std::vector<int> forced_by_edges(const CandidateSet& cs, std::vector<int> fixed,
 }
 
 // The program's view of the candidates: fixed values, and a GLPK column (1-based) per free
-// candidate, 0 for a fixed one (the face map "f:variable"); the answer in "f:selected".
+// candidate, 0 for a fixed one (the face map candidate_props::variable); the answer in selected.
 struct Columns {
   const SelectionProgram& pg;
   std::vector<int> fixed;  // pg.fixed and the faces the edges force (forced_by_edges)
@@ -197,13 +197,13 @@ struct Columns {
 };
 
 // Decides the variables: a column per free candidate; fixed ones take their value in
-// "f:selected".
+// candidate_props::selected.
 Columns candidate_columns(CandidateSet& cs, const SelectionProgram& pg, SelectionResult& res) {
   const int nf = cs.size();
   Columns c{pg,
             forced_by_edges(cs, pg.fixed.empty() ? std::vector<int>(nf, -1) : pg.fixed, pg.outside),
-            cs.mesh.add_property_map<CandidateFace, int>("f:variable", 0).first,
-            cs.mesh.add_property_map<CandidateFace, bool>("f:selected", false).first,
+            candidate_props::variable.add(cs.mesh),
+            candidate_props::selected.add(cs.mesh),
             nf,
             0};
   for (int f = 0; f < nf; ++f) {
@@ -471,7 +471,7 @@ SelectionResult select_faces(CandidateSet& cs, const SelectionProgram& program, 
 }
 
 std::vector<char> selected_faces(const CandidateSet& cs) {
-  const auto selected = cs.mesh.property_map<CandidateFace, bool>("f:selected");
+  const auto selected = candidate_props::selected.find(cs.mesh);
   std::vector<char> out(std::size_t(cs.size()), 0);
   if (selected.second)
     for (auto f : cs.mesh.faces()) out[std::size_t(f)] = char(selected.first[f]);

@@ -110,11 +110,11 @@ struct FitPoints {
   double area_per_point = 0.0;
 };
 
-FitPoints fit_points(const Supports& s, const std::vector<Frame2>& frames, const Params& prm) {
+FitPoints fit_points(const Supports& s, const std::vector<Frame2>& frames, const RefineConfig& prm) {
   FitPoints fp;
   const int np = int(s.planes.size());
   fp.at.resize(np), fp.weight.resize(np), fp.cells.resize(np);
-  const double tol = prm.ransac_epsilon + prm.merge_distance;
+  const double tol = prm.plane.ransac_epsilon + prm.selection.merge_distance;
   long long points = 0, occupied = 0;
   for (int k = 0; k < np; ++k) {
     for (const auto& p : s.points[k]) {
@@ -145,14 +145,48 @@ double fitted_area(const FitPoints& fp, int k, const std::vector<Vec2>& poly) {
   return sum * fp.area_per_point;
 }
 
-// What the program knows of each candidate, as face property maps of the candidate mesh:
-// "f:in_start" (bool: the starting shell has a face there), "f:source" (int: that face's source,
-// -1 without one), "f:confidence" (double: the data term's c), "f:in_zone" (bool: scan evidence
-// reaches it), "f:fit" (double: the data-fitting term's scanned area it explains, m²). The
-// selection adds "f:variable" (GLPK column, 0: fixed) and "f:selected".
 using FaceIndex = CandidateMesh::Face_index;
 
-void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s, const Params& prm) {
+// The face map `in` of a candidate set on the candidates kept_candidates(that set, keep): the
+// map `property` added to their mesh `to`, each kept face's value carried.
+template <class T>
+CandidateMap<T> carried(const CandidateMap<T>& in, const CandidateFaceProperty<T>& property, CandidateMesh& to,
+                        const std::vector<char>& keep) {
+  auto out = property.add(to);
+  int g = 0;
+  for (std::size_t f = 0; f < keep.size(); ++f)
+    if (keep[f]) out[FaceIndex(g++)] = in[FaceIndex(f)];
+  return out;
+}
+
+// What the program knows of each candidate, as face property maps of the candidate mesh (their
+// names: candidate_props): in_start (the starting shell has a face there), source (that face's
+// source, -1 without one; traced_shell gives it to the output's faces), confidence (the data
+// term's c), in_zone (scan evidence reaches it), fit (the data-fitting term's scanned area it
+// explains, m²). Added once (describe_candidates) and carried whole to the kept candidates. The
+// selection adds its own maps (variable, selected).
+struct FaceProps {
+  CandidateMap<bool> in_start;
+  CandidateMap<int> source;
+  CandidateMap<double> confidence;
+  CandidateMap<bool> in_zone;
+  CandidateMap<double> fit;
+
+  // The maps added to `mesh`, every face at each map's unset value.
+  static FaceProps add(CandidateMesh& mesh) {
+    return {candidate_props::in_start.add(mesh), candidate_props::source.add(mesh),
+            candidate_props::confidence.add(mesh), candidate_props::in_zone.add(mesh), candidate_props::fit.add(mesh)};
+  }
+  // The same maps on `to`, the mesh of kept_candidates(this mesh's set, keep), with the kept
+  // faces' values.
+  FaceProps carried_to(CandidateMesh& to, const std::vector<char>& keep) const {
+    return {carried(in_start, candidate_props::in_start, to, keep), carried(source, candidate_props::source, to, keep),
+            carried(confidence, candidate_props::confidence, to, keep),
+            carried(in_zone, candidate_props::in_zone, to, keep), carried(fit, candidate_props::fit, to, keep)};
+  }
+};
+
+FaceProps describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s, const RefineConfig& prm) {
   const int np = int(s.planes.size());
   std::vector<Frame2> frames;
   for (const auto& sp : s.planes) frames.push_back(frame_of(sp.plane, cs.region.center));
@@ -160,15 +194,15 @@ void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s,
   std::vector<CellSet> own(np), other(np);
   for (int k = 0; k < np; ++k) mark(own[k], s.points[k], frames[k]);
   for (int k = 0; k < np; ++k) {
-    if (!near_vertical(s.planes[k].plane)) continue;
+    if (!near_vertical(s.planes[k].plane, prm.plane.facade_max_tilt_deg)) continue;
     for (int j = 0; j < np; ++j) {
       if (j == k || s.points[j].empty() ||
-          unoriented_angle_deg(s.planes[k].plane.n, s.planes[j].plane.n) > prm.merge_angle_deg)
+          unoriented_angle_deg(s.planes[k].plane.n, s.planes[j].plane.n) > prm.selection.merge_angle_deg)
         continue;
       double sum = 0.0;
       for (const auto& p : s.points[j]) sum += std::abs(s.planes[k].plane.distance(p));
       const double d = sum / double(s.points[j].size());
-      if (d <= prm.merge_distance || d > kSeeThrough) continue;
+      if (d <= prm.selection.merge_distance || d > kSeeThrough) continue;
       mark(other[k], s.points[j], frames[k]);
     }
   }
@@ -185,7 +219,7 @@ void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s,
   // reach of the evidence (a wall the scan moves takes the roof edge above it along: the zone
   // spans the whole height). Candidates with a vertex in it are free; the others stay as the
   // starting shell has them (the program grows with the region: keep it to the evidence).
-  const double margin = prm.match_distance + prm.bbox_margin;
+  const double margin = prm.scan_reach();
   std::vector<Eigen::AlignedBox3d> zones;
   for (const auto& pts : s.points) {
     if (pts.empty()) continue;
@@ -195,11 +229,12 @@ void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s,
     zones.emplace_back(b.min() - grow, b.max() + grow);
   }
 
-  auto in_start = cs.mesh.add_property_map<FaceIndex, bool>("f:in_start", false).first;
-  auto source = cs.mesh.add_property_map<FaceIndex, int>("f:source", -1).first;
-  auto confidence = cs.mesh.add_property_map<FaceIndex, double>("f:confidence", 0.0).first;
-  auto in_zone = cs.mesh.add_property_map<FaceIndex, bool>("f:in_zone", false).first;
-  auto fit = cs.mesh.add_property_map<FaceIndex, double>("f:fit", 0.0).first;
+  FaceProps props = FaceProps::add(cs.mesh);
+  auto& in_start = props.in_start;
+  auto& source = props.source;
+  auto& confidence = props.confidence;
+  auto& in_zone = props.in_zone;
+  auto& fit = props.fit;
   const FitPoints fp = fit_points(s, frames, prm);
   const auto support = cs.supports();
   const auto centroid = cs.centroids();
@@ -229,21 +264,11 @@ void describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s,
       for (const auto& p : pts) reached = reached || z.contains(cs.region.axes.transpose() * p);
     in_zone[fi] = reached;
   }
+  return props;
 }
 
-// A face map of `from` on the candidates `to` = kept_candidates(from, keep).
-template <class T>
-void carry(const CandidateSet& from, CandidateSet& to, const std::vector<char>& keep, const std::string& name) {
-  const auto in = from.mesh.property_map<FaceIndex, T>(name).first;
-  auto out = to.mesh.add_property_map<FaceIndex, T>(name, T()).first;
-  int g = 0;
-  for (std::size_t f = 0; f < keep.size(); ++f)
-    if (keep[f]) out[FaceIndex(g++)] = in[FaceIndex(f)];
-}
-
-// A boolean face map as 0/1 per candidate (a selection).
-std::vector<char> face_flags(const CandidateSet& cs, const std::string& name) {
-  const auto map = cs.mesh.property_map<FaceIndex, bool>(name).first;
+// A boolean face map of `cs` as 0/1 per candidate (a selection).
+std::vector<char> face_flags(const CandidateSet& cs, const CandidateMap<bool>& map) {
   std::vector<char> out;
   for (auto f : cs.mesh.faces()) out.push_back(char(map[f]));
   return out;
@@ -379,7 +404,7 @@ std::vector<std::vector<int>> changed_pieces(const CandidateSet& cs, const std::
 // The changed candidates of the pieces that enclose scan points (see kEnclosedDepth): each
 // newly enclosed point counts for the piece with the changed candidate nearest to it.
 std::vector<int> enclosing_changes(const CandidateSet& cs, const std::vector<char>& changed, const Mesh& start,
-                                   const Mesh& shell, const std::vector<Vec3>& evidence, const Params& prm) {
+                                   const Mesh& shell, const std::vector<Vec3>& evidence, const PlaneEvidence& prm) {
   const auto pieces = changed_pieces(cs, changed);
   if (pieces.empty()) return {};
   Mesh changes;  // the changed candidates as one polygon soup, face i of piece piece_of[i]
@@ -428,7 +453,7 @@ struct MendScope {
   bool whole_last = false;   // at last, every candidate free
   double keep_weight = 1.0;  // a start candidate dropped costs this times its area, one added its area
 };
-std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_start, const Params& prm,
+std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_start, const SelectionConfig& prm,
                                const MendScope& scope = {}) {
   if (every_edge_used_0_or_2(cs, in_start)) return in_start;
   std::vector<char> near(cs.size(), 0);
@@ -474,7 +499,7 @@ std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_sta
 // Together they spend one work budget, shared evenly: the selection then costs at most twice it.
 // Returns the improved incumbent and counts the neighbourhoods that changed it.
 std::vector<char> improved_by_neighbourhoods(CandidateSet& cs, const SelectionProgram& pg, const Supports& s,
-                                             const Params& prm, int& improved) {
+                                             const SelectionConfig& prm, int& improved) {
   std::vector<char> current = pg.warm;
   const auto scanned = std::count_if(s.points.begin(), s.points.end(), [](const auto& p) { return !p.empty(); });
   SelectionConfig share = prm;
@@ -508,7 +533,7 @@ constexpr int kLocalSectionsFrom = 32;
 
 // Why the assembled shell cannot be written, or empty: validate_mesh's problem, or a face that
 // passes through one vertex twice (two pieces pinched together by the output weld or merge).
-std::string shell_problem(const Mesh& m, const Params& prm) {
+std::string shell_problem(const Mesh& m, const RepairConfig& prm) {
   const Validation v = validate_mesh(m, prm.planarity_tolerance);
   if (!v.valid()) return v.problem.empty() ? "invalid" : v.problem;
   for (const auto& f : m.faces) {
@@ -524,7 +549,7 @@ std::string shell_problem(const Mesh& m, const Params& prm) {
 // candidates (its pieces cannot be mended to close): select_shell then gives each sliver a plane
 // of its own, as it is.
 std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointCloud& cloud,
-                                              const std::vector<ScanPlane>& planes, const Params& prm,
+                                              const std::vector<ScanPlane>& planes, const RefineConfig& prm,
                                               double sliver_tolerance) {
   const auto t0 = Clock::now();
   ShellSelection out;
@@ -547,8 +572,8 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
   // the farthest a wall may move: a face reaches a moved neighbour, whose corner with the next
   // moved wall lies that far again; once measured lost a real building's refinement), so a large
   // building's program does not grow with the cube of its planes.
-  const Region region = detail::building_region(start, s);
-  const double reach = 2.0 * (prm.match_distance + prm.bbox_margin);
+  const Region region = detail::building_region(start, s, prm.plane.facade_max_tilt_deg);
+  const double reach = 2.0 * prm.scan_reach();
   CandidateSet all = build_candidates(
       s.planes, region,
       int(s.planes.size()) < kLocalSectionsFrom ? std::vector<Region>{} : detail::plane_reach(start, s, region, reach));
@@ -558,37 +583,30 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
     st.seconds = seconds_since(t0);
     return out;
   }
-  describe_candidates(all, start, s, prm);
-  const std::vector<char> all_warm = mended_start(all, face_flags(all, "f:in_start"), prm);
+  const FaceProps all_props = describe_candidates(all, start, s, prm);
+  const std::vector<char> all_warm = mended_start(all, face_flags(all, all_props.in_start), prm.selection);
   if (all_warm.empty() && s.slivers > 0) return std::nullopt;
-  const auto all_in_zone = all.mesh.property_map<FaceIndex, bool>("f:in_zone").first;
   std::vector<char> keep(all.size(), 1);
   if (!all_warm.empty())
-    for (std::size_t f = 0; f < keep.size(); ++f) keep[f] = all_in_zone[FaceIndex(f)] || all_warm[f];
+    for (std::size_t f = 0; f < keep.size(); ++f) keep[f] = all_props.in_zone[FaceIndex(f)] || all_warm[f];
   CandidateSet cs = kept_candidates(all, keep);
-  carry<bool>(all, cs, keep, "f:in_start");
-  carry<int>(all, cs, keep, "f:source");
-  carry<double>(all, cs, keep, "f:confidence");
-  carry<bool>(all, cs, keep, "f:in_zone");
-  carry<double>(all, cs, keep, "f:fit");
+  const FaceProps props = all_props.carried_to(cs.mesh, keep);
   const std::vector<char> warm = all_warm.empty() ? all_warm : kept(all_warm, keep);
   st.candidates = cs.size();
   st.candidates_pruned = all.size() - st.candidates;
   st.edges = int(cs.edges.size());
 
   SelectionProgram pg;
-  const auto confidence = cs.mesh.property_map<FaceIndex, double>("f:confidence").first;
-  const auto fit = cs.mesh.property_map<FaceIndex, double>("f:fit").first;
   const auto area = cs.areas();
   for (int f = 0; f < cs.size(); ++f) {
-    pg.cost.push_back(coverage_cost(area[FaceIndex(f)], confidence[FaceIndex(f)], prm.tau_cov));
-    pg.fit.push_back(fit[FaceIndex(f)]);
+    pg.cost.push_back(coverage_cost(area[FaceIndex(f)], props.confidence[FaceIndex(f)], prm.selection.tau_cov));
+    pg.fit.push_back(props.fit[FaceIndex(f)]);
   }
-  for (const auto& e : cs.edges) pg.sharp_cost.push_back(prm.lambda_complexity * cs.length(e) * kSharpEdgeWidth);
+  for (const auto& e : cs.edges)
+    pg.sharp_cost.push_back(prm.selection.lambda_complexity * cs.length(e) * kSharpEdgeWidth);
   if (!warm.empty()) {
     pg.warm = warm;
-    const auto in_zone = cs.mesh.property_map<FaceIndex, bool>("f:in_zone").first;
-    for (int f = 0; f < cs.size(); ++f) pg.fixed.push_back(in_zone[FaceIndex(f)] ? -1 : int(warm[f]));
+    for (int f = 0; f < cs.size(); ++f) pg.fixed.push_back(props.in_zone[FaceIndex(f)] ? -1 : int(warm[f]));
   }
   auto finish = [&](const std::string& reason) {
     out.reason = reason;
@@ -600,18 +618,18 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
   // A selection whose shell does not validate (two shells touching, faces meeting at a point)
   // is excluded: its changes from the starting shell are fixed back, and the program solved
   // again (at most kRetries times).
-  const std::vector<char> base = warm.empty() ? face_flags(cs, "f:in_start") : warm;
+  const std::vector<char> base = warm.empty() ? face_flags(cs, props.in_start) : warm;
   std::vector<Vec3> reach_of = st.evidence;
   const std::vector<Vec3> swept = detail::swept_evidence(start, s, prm, kEvidenceReach);
   reach_of.insert(reach_of.end(), swept.begin(), swept.end());
   const EvidenceReach evidence(reach_of);
   if (!warm.empty()) {
     for (int f : beyond_evidence(cs, evidence)) pg.fixed[f] = int(base[f]);
-    pg.warm = improved_by_neighbourhoods(cs, pg, s, prm, st.neighbourhoods_improved);
+    pg.warm = improved_by_neighbourhoods(cs, pg, s, prm.selection, st.neighbourhoods_improved);
   }
   std::string problem;
   for (int attempt = 0;; ++attempt) {
-    st.selection = select_faces(cs, pg, prm);
+    st.selection = select_faces(cs, pg, prm.selection);
     const auto& sel = st.selection;
     if (!sel.ok) return finish("face selection " + sel.status_text());
     const std::vector<char> selected = selected_faces(cs);
@@ -620,18 +638,18 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
     out.mesh = traced_shell(cs);
     out.mesh.id = start.id;
     st.faces_from_selection = int(out.mesh.faces.size());
-    problem = shell_problem(out.mesh, prm);
+    problem = shell_problem(out.mesh, prm.repair);
     std::vector<int> refused;  // the changes to fix back (all of them, unless said)
     if (problem.empty()) {
       Mesh snapped = snapped_to_start(out.mesh, start);
-      if (shell_problem(snapped, prm).empty()) out.mesh = std::move(snapped);
+      if (shell_problem(snapped, prm.repair).empty()) out.mesh = std::move(snapped);
       if (st.candidates_changed > 0 && moves_beyond_evidence(out.mesh, start, evidence))
         problem = "it moves the model where the scan shows nothing";
     }
     if (problem.empty() && st.candidates_changed > 0 && !warm.empty()) {
       std::vector<char> changed(cs.size());
       for (int f = 0; f < cs.size(); ++f) changed[f] = selected[f] != base[f];
-      refused = enclosing_changes(cs, changed, start, out.mesh, st.evidence, prm);
+      refused = enclosing_changes(cs, changed, start, out.mesh, st.evidence, prm.plane);
       if (!refused.empty()) problem = "it encloses scan points (a surface seen through it)";
     }
     if (problem.empty() || st.candidates_changed == 0 || warm.empty() || attempt == kRetries) break;
@@ -675,7 +693,7 @@ constexpr double kMaxRebuildSamples = 250000;
 constexpr double kMaxWindingTerms = 2e8;
 
 void set_selected(CandidateSet& cs, const std::vector<char>& chosen) {
-  auto map = cs.mesh.add_property_map<FaceIndex, bool>("f:selected", false).first;
+  auto map = candidate_props::selected.add(cs.mesh);
   for (int f = 0; f < cs.size(); ++f) map[FaceIndex(f)] = chosen[f] != 0;
 }
 
@@ -778,17 +796,17 @@ double uncovered(const Mesh& soup, const Mesh& shell, double tolerance, ShellReb
 
 }  // namespace
 
-ShellRebuild rebuild_shell(const Mesh& soup, const Params& prm) {
+ShellRebuild rebuild_shell(const Mesh& soup, const RefineConfig& prm) {
   ShellRebuild out;
   Supports s;
-  detail::add_start_planes(soup, prm.planarity_tolerance, s);
+  detail::add_start_planes(soup, prm.repair.planarity_tolerance, s);
   if (!detail::carries_ground(soup, s)) {
     out.reason = "it has no ground face: the foot of its walls would be invented";
     return out;
   }
   detail::add_hole_planes(soup, s);
   out.planes_added = s.hole_planes;
-  const Region region = detail::building_region(soup, s);
+  const Region region = detail::building_region(soup, s, prm.plane.facade_max_tilt_deg);
   CandidateSet cs = build_candidates(s.planes, region, {}, kRebuildWholeRegion);
   if (cs.capped) {
     std::vector<Vec3> open_ends;
@@ -802,9 +820,9 @@ ShellRebuild rebuild_shell(const Mesh& soup, const Params& prm) {
                  std::to_string(s.planes.size()) + " planes)";
     return out;
   }
-  describe_candidates(cs, soup, s, prm);
-  const std::vector<char> cover = face_flags(cs, "f:in_start");
-  const std::vector<char> chosen = mended_start(cs, cover, prm, {true, kKeepCover});
+  const FaceProps props = describe_candidates(cs, soup, s, prm);
+  const std::vector<char> cover = face_flags(cs, props.in_start);
+  const std::vector<char> chosen = mended_start(cs, cover, prm.selection, {true, kKeepCover});
   if (chosen.empty()) {
     out.reason = "its planes bound no closed shell";
     return out;
@@ -813,21 +831,21 @@ ShellRebuild rebuild_shell(const Mesh& soup, const Params& prm) {
   set_selected(cs, chosen);
   out.mesh = traced_shell(cs);
   out.mesh.id = soup.id;
-  if (const std::string problem = shell_problem(out.mesh, prm); !problem.empty()) {
+  if (const std::string problem = shell_problem(out.mesh, prm.repair); !problem.empty()) {
     out.reason = "the shell on its planes is invalid: " + problem;
     return out;
   }
   Mesh snapped = snapped_to_start(out.mesh, soup);
-  if (shell_problem(snapped, prm).empty()) out.mesh = std::move(snapped);
-  out.input_to_output = uncovered(soup, out.mesh, prm.weld_tolerance, out);
-  added_area(out.mesh, soup, prm.weld_tolerance, out);
+  if (shell_problem(snapped, prm.repair).empty()) out.mesh = std::move(snapped);
+  out.input_to_output = uncovered(soup, out.mesh, prm.repair.weld_tolerance, out);
+  added_area(out.mesh, soup, prm.repair.weld_tolerance, out);
   out.ok = true;
   return out;
 }
 
 ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
-                            const Params& prm) {
-  if (auto joined = select_shell_on(start, cloud, planes, prm, prm.planarity_tolerance)) return *joined;
+                            const RefineConfig& prm) {
+  if (auto joined = select_shell_on(start, cloud, planes, prm, prm.repair.planarity_tolerance)) return *joined;
   return *select_shell_on(start, cloud, planes, prm, -1.0);  // no slivers: always a selection
 }
 

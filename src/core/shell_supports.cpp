@@ -139,9 +139,10 @@ void add_start_planes(const Mesh& start, double planarity_tolerance, Supports& s
 // A facade farther before or behind the box (up to the building's depth) counts too where it
 // continues a scanned facade of the building across a step (steps_from): a facade line stepping
 // back or forward farther than the reach.
-void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& scan, const Params& prm,
-                     Supports& s) {
-  const double reach = prm.match_distance + prm.bbox_margin;  // a wall off by up to match_distance, plus a bay
+void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& scan,
+                     const RefineConfig& prm, Supports& s) {
+  const double reach = prm.scan_reach();  // a wall off by up to match_distance, plus a bay
+  const double tilt = prm.plane.facade_max_tilt_deg;
   auto attach = [&](int i, const std::vector<Vec3>& pts) {
     auto mean_distance = [&](const Plane& pl) {
       double sum = 0.0;
@@ -149,10 +150,10 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
       return sum / double(pts.size());
     };
     int k = -1;
-    double best = prm.merge_distance;
+    double best = prm.selection.merge_distance;
     for (int j = 0; j < int(s.planes.size()); ++j) {
-      if (!near_vertical(s.planes[j].plane) ||
-          unoriented_angle_deg(s.planes[j].plane.n, scan[i].plane.n) > prm.merge_angle_deg)
+      if (!near_vertical(s.planes[j].plane, tilt) ||
+          unoriented_angle_deg(s.planes[j].plane.n, scan[i].plane.n) > prm.selection.merge_angle_deg)
         continue;
       const double d = mean_distance(s.planes[j].plane);
       if (d <= best) best = d, k = j;
@@ -187,11 +188,11 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
       if (out <= reach) near.push_back(p);
       else if (out <= box.sizes().y()) beyond.push_back(p);
     }
-    if (int(near.size()) >= prm.ransac_min_points) attach(i, near);
-    else if (int(beyond.size()) >= prm.ransac_min_points) deep.emplace_back(i, std::move(beyond));
+    if (int(near.size()) >= prm.plane.ransac_min_points) attach(i, near);
+    else if (int(beyond.size()) >= prm.plane.ransac_min_points) deep.emplace_back(i, std::move(beyond));
   }
   for (const auto& [i, pts] : deep)
-    if (steps_from_any(start, s, pts, scan[i].plane.n, prm.merge_angle_deg)) attach(i, pts);
+    if (steps_from_any(start, s, pts, scan[i].plane.n, prm.selection.merge_angle_deg)) attach(i, pts);
 }
 
 // A facade line that steps, a recess or a bay needs the wall across the step, which the scan
@@ -200,11 +201,12 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
 // a hypothesis, and one at each nearby end of a parallel scanned facade's points (the other side
 // of the step, where the points usually end more sharply). The selection takes such a wall only
 // where it closes what the scan shows.
-void add_step_walls(const Mesh& start, const Params& prm, Supports& s) {
+void add_step_walls(const Mesh& start, const RefineConfig& prm, Supports& s) {
+  const double tilt = prm.plane.facade_max_tilt_deg;
   const int existing = int(s.planes.size());
   for (int j = s.start_planes; j < existing; ++j) {
     const Plane& pj = s.planes[j].plane;
-    if (!s.planes[j].from_scan || s.points[j].empty() || !near_vertical(pj)) continue;
+    if (!s.planes[j].from_scan || s.points[j].empty() || !near_vertical(pj, tilt)) continue;
     const Vec3 u = Vec3(-pj.n.y(), pj.n.x(), 0.0).normalized();
     const auto [lo, hi] = span_along(start, u);
     std::vector<double> ends;
@@ -214,7 +216,8 @@ void add_step_walls(const Mesh& start, const Params& prm, Supports& s) {
       if (e < lo + kSideClear || e > hi - kSideClear) continue;
       positions.push_back(e);
       for (int k = 0; k < existing; ++k) {
-        if (k == j || s.points[k].empty() || unoriented_angle_deg(s.planes[k].plane.n, pj.n) > prm.merge_angle_deg)
+        if (k == j || s.points[k].empty() ||
+            unoriented_angle_deg(s.planes[k].plane.n, pj.n) > prm.selection.merge_angle_deg)
           continue;
         for (const auto& r : runs_along(s.points[k], u))
           for (double f : {r.a, r.b})
@@ -228,7 +231,8 @@ void add_step_walls(const Mesh& start, const Params& prm, Supports& s) {
       const Vec3 x = c + (t - u.dot(c)) * u;
       bool there = false;
       for (const auto& sp : s.planes)
-        there = there || (near_vertical(sp.plane) && unoriented_angle_deg(sp.plane.n, u) <= prm.merge_angle_deg &&
+        there = there || (near_vertical(sp.plane, tilt) &&
+                          unoriented_angle_deg(sp.plane.n, u) <= prm.selection.merge_angle_deg &&
                           std::abs(sp.plane.distance(x)) <= kSameStep);
       if (there) continue;
       s.planes.push_back({Plane::through(x, u), Semantic::Wall, true, -1});
@@ -244,7 +248,8 @@ void add_step_walls(const Mesh& start, const Params& prm, Supports& s) {
 // face it stands before, sampled every `step` m (its endpoint included). Only a facade that
 // continues another scanned facade across a step (steps_from): a lone parallel facade before a
 // wall may be a neighbour's across an alley.
-std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const Params& prm, double step) {
+std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const RefineConfig& prm, double step) {
+  const double tilt = prm.plane.facade_max_tilt_deg;
   struct Wall {
     Plane plane;
     Vec3 u, v;
@@ -253,7 +258,7 @@ std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const Par
   std::vector<Wall> walls;
   for (std::size_t f = 0; f < start.faces.size(); ++f) {
     const int k = s.face_plane[f];
-    if (k < 0 || !near_vertical(s.planes[k].plane)) continue;
+    if (k < 0 || !near_vertical(s.planes[k].plane, tilt)) continue;
     Wall w{s.planes[k].plane, {}, {}, {}};
     std::tie(w.u, w.v) = w.plane.basis();
     for (int i : start.faces[f].v) w.poly.emplace_back(w.u.dot(start.vertices[i]), w.v.dot(start.vertices[i]));
@@ -261,12 +266,12 @@ std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const Par
   }
   std::vector<Vec3> out;
   for (int k = s.start_planes; k < int(s.planes.size()); ++k) {
-    if (s.points[k].empty() || !near_vertical(s.planes[k].plane) ||
-        !steps_from_any(start, s, s.points[k], s.planes[k].plane.n, prm.merge_angle_deg, k))
+    if (s.points[k].empty() || !near_vertical(s.planes[k].plane, tilt) ||
+        !steps_from_any(start, s, s.points[k], s.planes[k].plane.n, prm.selection.merge_angle_deg, k))
       continue;
     std::vector<const Wall*> parallel;
     for (const auto& w : walls)
-      if (unoriented_angle_deg(w.plane.n, s.planes[k].plane.n) <= prm.merge_angle_deg) parallel.push_back(&w);
+      if (unoriented_angle_deg(w.plane.n, s.planes[k].plane.n) <= prm.selection.merge_angle_deg) parallel.push_back(&w);
     for (const auto& p : s.points[k]) {
       const Wall* near = nullptr;
       double best = std::numeric_limits<double>::infinity();
@@ -328,10 +333,10 @@ bool carries_ground(const Mesh& soup, const Supports& s) {
 }
 
 // The region: the start and the scan evidence, in the axes of the start's largest wall.
-Region building_region(const Mesh& start, const Supports& s) {
+Region building_region(const Mesh& start, const Supports& s, double max_tilt_deg) {
   Vec3 n = Vec3::UnitY();
   for (const auto& sp : s.planes)  // the start's planes come in decreasing area: the first wall
-    if (!sp.from_scan && near_vertical(sp.plane)) {
+    if (!sp.from_scan && near_vertical(sp.plane, max_tilt_deg)) {
       n = Vec3(sp.plane.n.x(), sp.plane.n.y(), 0.0).normalized();
       break;
     }

@@ -26,10 +26,11 @@ struct Supports {
   int hole_planes = 0;  // planes no face of the start lies on (add_hole_planes)
 };
 
-// A plane whose normal is within this of horizontal is a wall's (deg): the contradiction and the
-// represented-facade tests apply to walls only.
-constexpr double kVerticalTiltDeg = 10.0;
-inline bool near_vertical(const Plane& pl) { return std::abs(pl.n.z()) < std::sin(radians(kVerticalTiltDeg)); }
+// A plane whose normal is within `max_tilt_deg` of horizontal (PlaneConfig::facade_max_tilt_deg)
+// is a wall's: the contradiction and the represented-facade tests apply to walls only.
+inline bool near_vertical(const Plane& pl, double max_tilt_deg) {
+  return std::abs(pl.n.z()) < std::sin(radians(max_tilt_deg));
+}
 
 // The start's planes, one per set of its surfaces within kSurfaceAngleDeg / kSurfaceDistance
 // (matching.h), largest first; a surface on none of them goes to the one nearest in angle of
@@ -39,8 +40,8 @@ void add_start_planes(const Mesh& start, double planarity_tolerance, Supports& s
 // facade no farther past the start's ends than the facade's own corner: a facade line running on
 // into a neighbour's is the neighbour's there), each on the supporting plane it lies on, else a
 // new one; ransac_min_points such points at least.
-void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& scan, const Params& prm,
-                     Supports& s);
+void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& scan,
+                     const RefineConfig& prm, Supports& s);
 // The planes a soup's holes need to close (after add_start_planes): the vertical plane through each
 // boundary edge (an edge of one face; through a vertical one, across the wall's end) unless a
 // supporting plane carries it already. No scan points.
@@ -49,14 +50,14 @@ void add_hole_planes(const Mesh& soup, Supports& s);
 // the ground its walls stand on.
 bool carries_ground(const Mesh& soup, const Supports& s);
 // Hypothesised walls across where a scanned facade's points end inside the footprint.
-void add_step_walls(const Mesh& start, const Params& prm, Supports& s);
+void add_step_walls(const Mesh& start, const RefineConfig& prm, Supports& s);
 // Where the scan-only facades that step from another scanned facade ask for a change: each point
 // swept along the normal of the nearest parallel start wall it stands before onto that wall (the
 // step, bay or recess between them), sampled every `step` m.
-std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const Params& prm, double step);
-// The region: the start and the scan evidence, in the axes of the start's largest wall, grown by
-// a margin.
-Region building_region(const Mesh& start, const Supports& s);
+std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const RefineConfig& prm, double step);
+// The region: the start and the scan evidence, in the axes of the start's largest wall (near_vertical
+// within `max_tilt_deg`), grown by a margin.
+Region building_region(const Mesh& start, const Supports& s, double max_tilt_deg);
 // Per supporting plane, the box (region's axes) its candidates need: its start faces and its
 // scan points, grown by `margin` (the farthest a wall may move); a plane with neither (a
 // hypothesised wall) those of the start and the evidence within `margin` of it. A scanned wall

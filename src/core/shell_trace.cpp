@@ -32,8 +32,8 @@ struct Trace {
 // kCollapsedEdge are one vertex, numbered by first appearance (its first point gives the
 // position), the faces in candidate order.
 void trace_faces(const CandidateSet& cs, Trace& t) {
-  const auto chosen = cs.mesh.property_map<FaceIndex, bool>("f:selected").first;
-  const auto source = cs.mesh.property_map<FaceIndex, int>("f:source");
+  const auto chosen = candidate_props::selected.get(cs.mesh);
+  const auto source = candidate_props::source.find(cs.mesh);
   const auto support = cs.supports();
   std::vector<std::vector<int>> pieces(cs.size());
   DisjointSets same(cs.vertices.size());
@@ -79,7 +79,7 @@ struct Meeting {
 std::vector<Meeting> meetings(const CandidateSet& cs, const Trace& t) {
   // Per output segment: its faces, each with whether it runs from a to b.
   std::map<std::pair<int, int>, std::vector<std::pair<int, bool>>> along;
-  const auto point = cs.mesh.property_map<CandidateMesh::Vertex_index, int>("v:point").first;
+  const auto point = candidate_props::point.get(cs.mesh);
   for (const auto& e : cs.edges) {
     const auto [ea, eb] = cs.ends(e);
     const int a = t.vertex_of[ea], b = t.vertex_of[eb];

@@ -70,7 +70,7 @@ std::optional<Vec3> volume_centroid(const Mesh& mesh) {
 
 // c_init / c_ref: the volume centroid; an open model (typical for exported originals) is
 // measured as the volume it describes, i.e. after repair, before falling back to its area.
-Vec3 model_centroid(const Mesh& mesh, const Params& params) {
+Vec3 model_centroid(const Mesh& mesh, const RepairConfig& params) {
   if (is_watertight(mesh))
     if (auto c = volume_centroid(mesh)) return *c;
   try {
@@ -117,7 +117,7 @@ std::optional<DistanceStats> stats_if_any(const std::vector<double>& d) {
 
 // Fills the "after" side: C2M, watertightness, centroid and truth distances of the refined model.
 void evaluate_refined(BuildingEval& e, const Mesh& refined, const std::vector<Vec3>& pts, const TruthSamples* samples,
-                      const Params& params) {
+                      const RepairConfig& params) {
   if (refined.faces.empty()) throw InputError("refined model has no faces");
   if (!pts.empty()) e.c2m_after = cloud_to_mesh(refined, pts);
   e.after = summarize_distances(e.c2m_after);
@@ -222,26 +222,26 @@ std::vector<int> scanned_walls(const Mesh& truth, const std::vector<Vec3>& point
 // share through --corner-gap, now the evaluation's own so tuning matching leaves it alone).
 constexpr double kFacadeMargin = 0.6;
 
-std::vector<int> select_facade_points(const Mesh& input, const PointCloud& cloud, const Params& prm) {
+std::vector<int> select_facade_points(const Mesh& input, const PointCloud& cloud, const RefineConfig& prm) {
   Mesh mesh = input;
   try {
-    mesh = repair_model(input, prm.weld_tolerance);
+    mesh = repair_model(input, prm.repair.weld_tolerance);
   } catch (const InputError&) {
     // No closed shell: the soup's own faces still say where its walls are.
   }
-  const auto planes = detect_planes(cloud, prm);
+  const auto planes = detect_planes(cloud, prm.plane);
   const auto surfaces = model_surfaces(mesh);
-  const auto matched = match_surfaces(mesh, surfaces, cloud, planes, prm);
+  const auto matched = match_surfaces(mesh, surfaces, cloud, planes, prm.match);
   return points_in_front(mesh, surfaces, planes, matched, cloud, kFacadeMargin);
 }
 
 BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const PointCloud& cloud, const Mesh* truth,
-                               const Params& params) {
+                               const RefineConfig& params) {
   return evaluate_building(original, refined, cloud, truth, params, nullptr);
 }
 
 BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const PointCloud& cloud, const Mesh* truth,
-                               const Params& params, const std::vector<int>* scanned_truth_faces) {
+                               const RefineConfig& params, const std::vector<int>* scanned_truth_faces) {
   BuildingEval e;
   e.id = original.id.empty() ? refined.id : original.id;
   e.facade_index = select_facade_points(original, cloud, params);
@@ -255,7 +255,7 @@ BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const 
   if (!pts.empty()) e.c2m_before = cloud_to_mesh(original, pts);
   e.before = summarize_distances(e.c2m_before);
   e.watertight_before = is_watertight(original);
-  e.c_init = model_centroid(original, params);
+  e.c_init = model_centroid(original, params.repair);
 
   std::optional<TruthSamples> samples;
   if (truth) {
@@ -266,7 +266,7 @@ BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const 
     e.truth_roof_before = stats_if_any(e.truth_roof_d_before);
   }
   try {
-    evaluate_refined(e, refined, pts, samples ? &*samples : nullptr, params);
+    evaluate_refined(e, refined, pts, samples ? &*samples : nullptr, params.repair);
   } catch (const InputError& err) {
     e.error = err.what();
     e.watertight_after = false;

@@ -124,9 +124,9 @@ struct Checker {
 
   void building(const BuildingFigures& now, const BuildingFigures& old) {
     if (outcome_rank(now.outcome) < outcome_rank(old.outcome))
-      return fail(
-          now.id, "baseline", "outcome",
-          "outcome " + old.outcome + " -> " + now.outcome + (now.reason.empty() ? "" : " (" + now.reason + ")"));
+      return fail(now.id, "baseline", "outcome",
+                  "outcome " + std::string(outcome_name(old.outcome)) + " -> " + outcome_name(now.outcome) +
+                      (now.reason.empty() ? "" : " (" + now.reason + ")"));
     for (const auto& [name, field] : kBuildingDistances) distance(now.id, "baseline", name, old.*field, now.*field);
     if (old.watertight && !now.watertight) fail(now.id, "baseline", "watertight", "watertight yes -> no");
   }
@@ -200,7 +200,8 @@ void add_missing(const RunFigures& run, const RunFigures& baseline, Checker& c) 
   for (const auto& b : baseline.buildings)
     if (!ids.count(b.id)) {
       c.verdict.buildings.push_back(b.id);
-      c.fail(b.id, "baseline", "missing", "missing from the run (baseline outcome " + b.outcome + ")");
+      c.fail(b.id, "baseline", "missing",
+             "missing from the run (baseline outcome " + std::string(outcome_name(b.outcome)) + ")");
     }
 }
 
@@ -223,10 +224,15 @@ RunFigures parse_baseline(const std::string& text, const std::string& source);
 
 }  // namespace
 
-int outcome_rank(const std::string& outcome) {
-  if (outcome == "refined") return 3;
-  if (outcome == "kept" || outcome == "repaired") return 2;
-  if (outcome == "kept-invalid") return 1;
+int outcome_rank(Outcome outcome) {
+  switch (outcome) {
+    case Outcome::Refined: return 3;
+    case Outcome::Kept:
+    case Outcome::Repaired: return 2;
+    case Outcome::KeptInvalid: return 1;
+    case Outcome::Untouched:
+    case Outcome::Failed: return 0;
+  }
   return 0;
 }
 
@@ -240,7 +246,7 @@ std::string baseline_json(const RunFigures& run) {
   json buildings = json::array();
   for (const BuildingFigures& b : run.buildings) {
     json j = {{"id", b.id},
-              {"outcome", b.outcome},
+              {"outcome", outcome_name(b.outcome)},
               {"reason", b.reason},
               {"watertight", b.watertight},
               {"facades_moved", b.facades_moved},
@@ -288,7 +294,8 @@ RunFigures parse_baseline(const std::string& text, const std::string& source) {
     b.id = j["id"].get<std::string>();
     if (!ids.insert(b.id).second) throw InputError(source + ": building " + shown_id(b.id) + " listed twice");
     const std::string where = source + ": building " + shown_id(b.id);
-    b.outcome = text_field(j, "outcome", where).value_or("failed");
+    // Absent, or a text no lodrefine writes: failed (ranked last, as any other text was).
+    b.outcome = parse_outcome(text_field(j, "outcome", where).value_or("failed")).value_or(Outcome::Failed);
     b.reason = text_field(j, "reason", where).value_or("");
     if (j.contains("watertight") && !j["watertight"].is_boolean())
       wrong_value(where, "watertight", "true or false", j["watertight"]);

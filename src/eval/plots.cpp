@@ -408,12 +408,12 @@ std::string svg_district_map(const std::vector<MapOutline>& buildings, const std
   const double plot_h = (maxy - miny) * v.scale;
   Svg svg(width, header + plot_h + footer);
   svg.title(title);
-  const std::pair<const char*, const char*> styles[] = {{"refined", kOrange},
-                                                        {"repaired", "#1f77b4"},
-                                                        {"kept", "#e6c229"},
-                                                        {"kept-invalid", "#d62728"},
-                                                        {"untouched", "#bbbbbb"}};
-  auto colour_of = [&](const std::string& outcome) {
+  const std::pair<Outcome, const char*> styles[] = {{Outcome::Refined, kOrange},
+                                                    {Outcome::Repaired, "#1f77b4"},
+                                                    {Outcome::Kept, "#e6c229"},
+                                                    {Outcome::KeptInvalid, "#d62728"},
+                                                    {Outcome::Untouched, "#bbbbbb"}};
+  auto colour_of = [&](Outcome outcome) {
     for (const auto& [name, colour] : styles)
       if (outcome == name) return colour;
     return styles[3].second;
@@ -423,7 +423,7 @@ std::string svg_district_map(const std::vector<MapOutline>& buildings, const std
     const auto n = std::count_if(buildings.begin(), buildings.end(), [&, name = name](const MapOutline& b) {
       return colour_of(b.outcome) == colour_of(name);
     });
-    const std::string label = std::string(name) + " (" + std::to_string(n) + ")";
+    const std::string label = std::string(outcome_name(name)) + " (" + std::to_string(n) + ")";
     legend_entry(svg, x, 46, colour, label);
     x += 40 + 7.0 * double(label.size());
   }
@@ -440,7 +440,7 @@ std::string svg_district_map(const std::vector<MapOutline>& buildings, const std
     std::string path = "<path d=\"" + d.str() + "\" fill=\"" + colour +
                        "\" fill-opacity=\"0.75\" stroke=\"#555\" "
                        "stroke-width=\"0.6\"><title>" +
-                       escape(b.id + ": " + b.outcome) + "</title></path>";
+                       escape(b.id + ": " + outcome_name(b.outcome)) + "</title></path>";
     if (b.linked) path = "<a href=\"#view-" + escape(b.id) + "\">" + path + "</a>";
     svg.raw(path);
   }

@@ -69,7 +69,7 @@ void add_scan(PolyfitInput& in, const PointCloud& scan, const std::vector<ScanPl
 
 // One plane per surface of the repaired model: samples every `spacing` m and the vertices of
 // its faces (at least three points off a line, so the smallest surface still fits a plane).
-void add_model(PolyfitInput& in, const Mesh& local_model, const Params& params, double spacing) {
+void add_model(PolyfitInput& in, const Mesh& local_model, const RepairConfig& params, double spacing) {
   RepairReport report;
   const Mesh mesh = merge_coplanar_faces(repair_input(local_model, params, report));
   for (const ModelSurface& s : model_surfaces(mesh)) {
@@ -151,7 +151,7 @@ void reconstruct(const PolyfitInput& in, const PolyfitOptions& options, const Ve
   r.status = PolyfitStatus::Closed;
 }
 
-void run(const Mesh& model, const PointCloud& cloud, const Params& params, const PolyfitOptions& options,
+void run(const Mesh& model, const PointCloud& cloud, const RefineConfig& params, const PolyfitOptions& options,
          PolyfitResult& r) {
   params.validate();
   const Vec3 origin = local_origin(model);
@@ -159,11 +159,11 @@ void run(const Mesh& model, const PointCloud& cloud, const Params& params, const
   if (local_model.vertices.empty()) throw InputError("the model has no vertices");
   const PointCloud scan = cloud_near(local_model, cloud, origin, params);
   const Clock::time_point t0 = Clock::now();
-  const std::vector<ScanPlane> planes = detect_planes(scan, params);
+  const std::vector<ScanPlane> planes = detect_planes(scan, params.plane);
   r.detection_seconds = seconds_since(t0);
   PolyfitInput in;
   add_scan(in, scan, planes);
-  if (options.planes == PolyfitPlanes::ModelAndScan) add_model(in, local_model, params, options.model_spacing);
+  if (options.planes == PolyfitPlanes::ModelAndScan) add_model(in, local_model, params.repair, options.model_spacing);
   r.planes = in.planes, r.model_planes = in.model_planes, r.points = in.points.size();
   reconstruct(in, options, origin, r);
 }
@@ -238,7 +238,7 @@ PolyfitResult decode(std::string bytes) {
 
 // The child: limits set, the baseline run, its result written, no return (no atexit handlers,
 // no stdio buffers of the parent flushed twice).
-[[noreturn]] void run_child(int out, const Mesh& model, const PointCloud& cloud, const Params& params,
+[[noreturn]] void run_child(int out, const Mesh& model, const PointCloud& cloud, const RefineConfig& params,
                             const PolyfitOptions& options) {
   const rlim_t cpu = rlim_t(std::ceil(options.cpu_limit));
   const rlimit cpu_limit{cpu, cpu + 1};  // SIGXCPU at the soft limit, SIGKILL a second later
@@ -320,7 +320,7 @@ const char* polyfit_status_name(PolyfitStatus status) {
   return "?";
 }
 
-PolyfitResult polyfit_baseline(const Mesh& model, const PointCloud& cloud, const Params& params,
+PolyfitResult polyfit_baseline(const Mesh& model, const PointCloud& cloud, const RefineConfig& params,
                                const PolyfitOptions& options) {
   const Clock::time_point t0 = Clock::now();
   PolyfitResult r;
@@ -335,7 +335,7 @@ PolyfitResult polyfit_baseline(const Mesh& model, const PointCloud& cloud, const
   return r;
 }
 
-PolyfitResult polyfit_baseline_isolated(const Mesh& model, const PointCloud& cloud, const Params& params,
+PolyfitResult polyfit_baseline_isolated(const Mesh& model, const PointCloud& cloud, const RefineConfig& params,
                                         const PolyfitOptions& options) {
   const Clock::time_point t0 = Clock::now();
   int fds[2];

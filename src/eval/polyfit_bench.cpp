@@ -102,7 +102,7 @@ BenchBuilding read_bench_building(const BuildingFiles& f) {
   return b;
 }
 
-BuildingEval evaluate_against_truth(const BenchBuilding& b, const Mesh& output, const Params& params) {
+BuildingEval evaluate_against_truth(const BenchBuilding& b, const Mesh& output, const RefineConfig& params) {
   const Vec3 o = local_origin(b.coarse);
   PointCloud cloud = b.cloud;
   for (auto& p : cloud.points) p -= o;
@@ -112,7 +112,8 @@ BuildingEval evaluate_against_truth(const BenchBuilding& b, const Mesh& output, 
                            b.scanned_truth_faces ? &*b.scanned_truth_faces : nullptr);
 }
 
-PolyfitComparisonRow compare_with_polyfit(const BenchBuilding& b, const Params& params, const PolyfitOptions& options) {
+PolyfitComparisonRow compare_with_polyfit(const BenchBuilding& b, const RefineConfig& params,
+                                          const PolyfitOptions& options) {
   PolyfitComparisonRow row;
   row.id = b.id, row.points = b.cloud.points.size();
   const Clock::time_point t0 = Clock::now();
@@ -121,7 +122,7 @@ PolyfitComparisonRow compare_with_polyfit(const BenchBuilding& b, const Params& 
   row.lodrefine.cpu_seconds = thread_cpu_seconds() - cpu0;
   row.lodrefine.seconds = seconds_since(t0);
   row.lodrefine.produced = true;
-  row.outcome = outcome_name(refined.outcome);
+  row.outcome = refined.outcome;
   row.baseline = polyfit_baseline_isolated(b.coarse, b.cloud, params, options);
   row.polyfit.seconds = row.baseline.seconds;
   row.polyfit.cpu_seconds = row.baseline.cpu_seconds;
@@ -186,7 +187,7 @@ void print_comparison_header(std::FILE* out) {
 void print_comparison_row(const PolyfitComparisonRow& r, std::FILE* out) {
   const PolyfitResult& p = r.baseline;
   std::fprintf(out, "%-22s %7zu | %8.3f %-12s | %8.3f %6d %7d %6.2f %-14s | %7.1f | %-7s %-7s %-7s | %-7s %-7s %-7s\n",
-               escaped_line(r.id).c_str(), r.points, r.lodrefine.seconds, r.outcome.c_str(), r.polyfit.seconds,
+               escaped_line(r.id).c_str(), r.points, r.lodrefine.seconds, outcome_name(r.outcome), r.polyfit.seconds,
                p.planes, p.candidates, p.polyfit_seconds, polyfit_status_name(p.status),
                r.lodrefine.seconds > 0 ? r.polyfit.seconds / r.lodrefine.seconds : kNaN,
                metres(r.coarse_facade).c_str(), metres(r.lodrefine.truth_facade).c_str(),

@@ -46,9 +46,12 @@ std::vector<T> thinned(const std::vector<T>& v, std::size_t cap) {
 std::vector<const CityReviewBuilding*> reached_worst_first(const CityReview& r) {
   std::vector<const CityReviewBuilding*> order;
   for (const auto& b : r.buildings)
-    if (b.outcome != "untouched") order.push_back(&b);
+    if (b.outcome != Outcome::Untouched) order.push_back(&b);
   auto key = [](const CityReviewBuilding* b) {
-    const int rank = b->outcome == "kept-invalid" ? 0 : b->outcome == "kept" ? 1 : b->outcome == "repaired" ? 2 : 3;
+    const int rank = b->outcome == Outcome::KeptInvalid ? 0
+                     : b->outcome == Outcome::Kept      ? 1
+                     : b->outcome == Outcome::Repaired  ? 2
+                                                        : 3;
     return std::make_tuple(rank, -b->fit_after.value_or(-1.0), b->id);
   };
   std::stable_sort(order.begin(), order.end(), [&](auto* a, auto* b) { return key(a) < key(b); });
@@ -67,7 +70,7 @@ const json kColumns = json::array({{"id", "building"},
 
 json row(const CityReviewBuilding& b) {
   return {{"id", b.id},
-          {"outcome", b.outcome},
+          {"outcome", outcome_name(b.outcome)},
           {"reason", b.reason},
           {"points", b.points},
           {"moved", b.facades_moved},
@@ -78,8 +81,8 @@ json row(const CityReviewBuilding& b) {
 }
 
 std::string caption(const CityReviewBuilding& b) {
-  std::string c = b.outcome + ", " + std::to_string(b.facades_moved) + " facade(s) moved (max " + fmt(b.moved_max) +
-                  " m), " + std::to_string(b.points) + " cloud points";
+  std::string c = outcome_name(b.outcome) + std::string(", ") + std::to_string(b.facades_moved) +
+                  " facade(s) moved (max " + fmt(b.moved_max) + " m), " + std::to_string(b.points) + " cloud points";
   if (b.fit_before) c += ", fit " + fmt(*b.fit_before) + " -> " + (b.fit_after ? fmt(*b.fit_after) : "-") + " m";
   return c;
 }
@@ -105,7 +108,8 @@ std::string check_of(const std::string& id, std::string reason) {
 std::string refusals_text(const CityReview& r) {
   std::map<std::string, std::size_t> count;
   for (const auto& b : r.buildings)
-    if (b.outcome == "kept" || b.outcome == "kept-invalid") ++count[b.outcome + ": " + check_of(b.id, b.reason)];
+    if (b.outcome == Outcome::Kept || b.outcome == Outcome::KeptInvalid)
+      ++count[outcome_name(b.outcome) + std::string(": ") + check_of(b.id, b.reason)];
   std::vector<std::pair<std::string, std::size_t>> sorted(count.begin(), count.end());
   std::stable_sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
   std::string out = "\nchecks that refused (kept buildings by reason):\n";

@@ -118,12 +118,12 @@ std::vector<MovedFacade> moved_facades(const json& report) {
 
 // Outcome, reason, moved facades and time of a report that is a JSON object.
 void read_report(RunRow& row, const json& report) {
-  row.outcome = row.refine_outcome == "refined" ? "refined" : "kept";
+  row.outcome = parse_outcome(row.refine_outcome) == Outcome::Refined ? Outcome::Refined : Outcome::Kept;
   const json reason = report.value("reason", json());
   row.reason = reason.is_string() ? escaped_line(reason.get<std::string>())
                : reason.is_null() ? std::string()
                                   : "report.json: \"reason\" is no text";
-  if (row.outcome == "refined") row.moved = moved_facades(report);  // a kept building's model moved nothing
+  if (row.outcome == Outcome::Refined) row.moved = moved_facades(report);  // a kept building's model moved nothing
   const json total = report.value("seconds", json::object()).value("total", json());
   if (total.is_number()) row.refine_seconds = total.get<double>();
 }
@@ -180,7 +180,7 @@ LocalBuilding read_local(const BuildingFiles& f, const std::optional<Vec3>& orig
   return b;
 }
 
-RunRow evaluate_building_files(const BuildingFiles& f, const Params& params, const std::string& svg_dir,
+RunRow evaluate_building_files(const BuildingFiles& f, const RefineConfig& params, const std::string& svg_dir,
                                const CloudOptions& cloud_options) {
   RunRow row;
   row.files = f;
@@ -219,11 +219,11 @@ void add_refine_record(RunRow& row, const json& report, const std::string& faile
   }
   if (!failed_line.empty()) row.eval.error = failed_line;
   if (!row.eval.ok()) {
-    row.outcome = "failed";
+    row.outcome = Outcome::Failed;
     row.reason = row.eval.error;
     return;
   }
-  row.outcome = "kept";
+  row.outcome = Outcome::Kept;
   if (!report.is_object()) {
     row.reason = "no report.json";
     return;
@@ -243,8 +243,8 @@ RunRow failure_row(const std::string& id, const std::string& error) {
   return row;
 }
 
-std::vector<RunRow> evaluate_run(const std::string& dir, const Params& params, const std::string& svg_dir, int jobs,
-                                 PooledSeries& series, Progress::Mode progress_mode,
+std::vector<RunRow> evaluate_run(const std::string& dir, const RefineConfig& params, const std::string& svg_dir,
+                                 int jobs, PooledSeries& series, Progress::Mode progress_mode,
                                  const CloudOptions& cloud_options) {
   const auto buildings = discover_run(dir);
   std::vector<RunRow> rows(buildings.size());

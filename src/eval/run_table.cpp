@@ -47,6 +47,9 @@ json number_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr
 
 json point_json(const Vec3& p) { return {p.x(), p.y(), p.z()}; }
 
+// The row's outcome as written: its name, "" without a refine record.
+const char* outcome_text(const RunRow& r) { return r.outcome ? outcome_name(*r.outcome) : ""; }
+
 json moved_json(const RunRow& r) {
   const MovedSummary m = summarize_moved(r.moved);
   json list = json::array();
@@ -60,7 +63,7 @@ json row_json(const RunRow& r) {
       {"id", e.id},
       {"status", e.ok() ? "ok" : "failed"},
       {"error", e.error},
-      {"outcome", r.outcome},
+      {"outcome", outcome_text(r)},
       {"reason", r.reason},
       {"facades_moved", moved_json(r)},
       {"refine_seconds", number_or_null(r.refine_seconds)},
@@ -129,7 +132,7 @@ std::string csv_line(const RunRow& r) {
   const BuildingEval& e = r.eval;
   const bool measured = e.facade_points > 0;
   const MovedSummary m = summarize_moved(r.moved);
-  return csv_field(e.id) + ',' + r.outcome + ',' + csv_field(r.reason) + ',' + std::to_string(m.count) + ',' +
+  return csv_field(e.id) + ',' + outcome_text(r) + ',' + csv_field(r.reason) + ',' + std::to_string(m.count) + ',' +
          csv_optional(m.max) + ',' + csv_optional(m.mean) + ',' + (e.watertight_before ? "1" : "0") + ',' +
          (e.ok() && e.watertight_after ? "1" : "0") + ',' + csv_optional(r.refine_seconds) + ',' +
          std::to_string(e.facade_points) + ',' + csv_stats(measured ? std::optional(e.before) : std::nullopt) + ',' +
@@ -154,7 +157,7 @@ RunTotals run_totals(const std::vector<RunRow>& rows) {
   RunTotals t;
   std::vector<MovedFacade> all;
   for (const RunRow& r : rows) {
-    ++t.outcomes[r.outcome];
+    ++t.outcomes[outcome_text(r)];
     all.insert(all.end(), r.moved.begin(), r.moved.end());
     if (std::isfinite(r.refine_seconds)) t.refine_seconds += r.refine_seconds;
   }
@@ -256,7 +259,7 @@ json html_row(const RunRow& r) {
   const MovedSummary m = summarize_moved(r.moved);
   const bool measured = e.facade_points > 0;
   return {{"id", e.id},
-          {"outcome", r.outcome},
+          {"outcome", outcome_text(r)},
           {"reason", r.reason},
           {"selection", r.selection},
           {"moved", m.count},
@@ -268,7 +271,7 @@ json html_row(const RunRow& r) {
           {"seconds", number_or_null(r.refine_seconds)}};
 }
 
-BuildingView html_view(const RunRow& r, const Params& params) {
+BuildingView html_view(const RunRow& r, const RefineConfig& params) {
   std::string refined_error;
   const LocalBuilding b = read_local(r.files, r.origin, refined_error);
   // A run drops each building's per-point series once pooled: the few shown are measured again
@@ -282,7 +285,7 @@ BuildingView html_view(const RunRow& r, const Params& params) {
   BuildingView v = make_building_view(e.id, b.original, b.refined, facade_points(e, b.cloud), c2m, kViewPoints);
   v.footprint_svg = building_footprint_svg(e, b, kFootprintPoints);
   v.caption =
-      r.outcome + (r.reason.empty() ? "" : " (" + r.reason + ")") + ", " + std::to_string(r.moved.size()) +
+      outcome_text(r) + (r.reason.empty() ? "" : " (" + r.reason + ")") + ", " + std::to_string(r.moved.size()) +
       " facade(s) moved" +
       (e.facade_points ? ", C2M RMSE " + fmt(e.before.rmse) + " -> " + (e.ok() ? fmt(e.after.rmse) : "-") + " m" : "");
   return v;
@@ -292,7 +295,9 @@ BuildingFigures building_figures(const RunRow& r) {
   const BuildingEval& e = r.eval;
   BuildingFigures b;
   b.id = e.id;
-  b.outcome = r.outcome == "kept" && r.refine_outcome == "kept-invalid" ? "kept-invalid" : r.outcome;
+  b.outcome = r.outcome == Outcome::Kept && parse_outcome(r.refine_outcome) == Outcome::KeptInvalid
+                  ? Outcome::KeptInvalid
+                  : r.outcome.value_or(Outcome::Failed);  // a run's rows all have one
   b.reason = r.reason;
   if (e.ok() && e.facade_points > 0) b.c2m_rmse = e.after.rmse, b.c2m_mae = e.after.mae;
   if (e.ok() && e.truth_facade_after) b.truth_facade_rmse = e.truth_facade_after->rmse;
@@ -308,8 +313,8 @@ RunFigures run_figures(const std::vector<RunRow>& rows, const PooledEval& p) {
   RunFigures run;
   for (const RunRow& r : rows) run.buildings.push_back(building_figures(r));
   run.failed = p.failed;
-  run.refined =
-      std::size_t(std::count_if(rows.begin(), rows.end(), [](const RunRow& r) { return r.outcome == "refined"; }));
+  run.refined = std::size_t(
+      std::count_if(rows.begin(), rows.end(), [](const RunRow& r) { return r.outcome == Outcome::Refined; }));
   run.watertight_rate = p.watertight_rate_after;
   if (p.before.count) run.c2m_rmse_original = p.before.rmse;
   if (p.after.count) run.c2m_rmse = p.after.rmse, run.c2m_mae = p.after.mae;

@@ -46,22 +46,22 @@ std::string text_member(const json& j, const char* key, const std::string& other
 CityBuildingOutcome classify(const RefineResult& r) {
   CityBuildingOutcome o;
   if (r.refined() && r.valid) {
-    o.outcome = "refined";
+    o.outcome = Outcome::Refined;
     o.facades_moved = int(r.trace.facades.size());
     return o;
   }
   if (r.outcome == Outcome::Repaired && r.valid) {
-    o.outcome = "repaired";
+    o.outcome = Outcome::Repaired;
     o.reason = r.reason;
     return o;
   }
-  o.outcome = (!r.valid || r.outcome == Outcome::KeptInvalid) ? "kept-invalid" : "kept";
+  o.outcome = (!r.valid || r.outcome == Outcome::KeptInvalid) ? Outcome::KeptInvalid : Outcome::Kept;
   o.reason = r.reason.empty() ? std::string(outcome_name(r.outcome)) : r.reason;
   if (r.trace.judgement && !r.trace.judgement->ok) o.refused_by = r.trace.judgement->check;
   // A crop that only grazes the building (its box's edge): no wall of it faces a scan plane.
   const bool no_facade =
       (r.trace.planes && r.trace.planes->empty()) || (r.trace.matching && r.trace.matching->walls.empty());
-  if (o.outcome == "kept" && no_facade) o.reason = "scan covers no facade of this building";
+  if (o.outcome == Outcome::Kept && no_facade) o.reason = "scan covers no facade of this building";
   if (!r.valid && r.outcome != Outcome::KeptInvalid)
     o.reason += " (not valid: " + r.trace.output_validation.problem + ")";
   return o;
@@ -97,7 +97,7 @@ struct BuildingJob {
   CityBuildingOutcome outcome;
 };
 
-void run_job(BuildingJob& job, const CityJsonBuilding& b, const Params& params) {
+void run_job(BuildingJob& job, const CityJsonBuilding& b, const RefineConfig& params) {
   if (!job.has_points) return;
   const auto t0 = Clock::now();
   try {
@@ -106,7 +106,7 @@ void run_job(BuildingJob& job, const CityJsonBuilding& b, const Params& params) 
     job.returned = true;
     job.outcome = classify(job.result);
   } catch (const std::exception& e) {  // never lose a building: keep it as read
-    job.outcome.outcome = "kept-invalid";
+    job.outcome.outcome = Outcome::KeptInvalid;
     job.outcome.reason = e.what();
   }
   job.outcome.id = b.mesh.id;
@@ -142,19 +142,19 @@ void apply_job(json& doc, const CityJsonTransform& tf, const CityJsonBuilding& b
   }
   CityBuildingOutcome& o = job.outcome;
   json& obj = doc["CityObjects"][b.mesh.id];
-  if (o.outcome == "refined" || o.outcome == "repaired") {
+  if (o.outcome == Outcome::Refined || o.outcome == Outcome::Repaired) {
     const std::string lod = obj["geometry"][std::size_t(b.geometry_index)]["lod"].is_string()
                                 ? obj["geometry"][std::size_t(b.geometry_index)]["lod"].get<std::string>()
                                 : b.lod;
     obj["geometry"][std::size_t(b.geometry_index)] =
         cityjson_solid(job.result.mesh, lod, tf.scale, tf.translate, doc["vertices"]);
-    ++(o.outcome == "refined" ? sum.refined : sum.repaired);
+    ++(o.outcome == Outcome::Refined ? sum.refined : sum.repaired);
   } else {
-    ++(o.outcome == "kept" ? sum.kept : sum.kept_invalid);
+    ++(o.outcome == Outcome::Kept ? sum.kept : sum.kept_invalid);
   }
-  if (!o.refused_by.empty()) ++sum.refused[o.refused_by];
+  if (o.refused_by != JudgeCheck::None) ++sum.refused[check_name(o.refused_by)];
   if (!obj.contains("attributes") || !obj["attributes"].is_object()) obj["attributes"] = json::object();
-  obj["attributes"]["lodrefine_outcome"] = o.outcome;
+  obj["attributes"]["lodrefine_outcome"] = outcome_name(o.outcome);
   obj["attributes"]["lodrefine_reason"] = o.reason;
   obj["attributes"]["lodrefine_facades_moved"] = o.facades_moved;
   if (hook) hook(index, b.mesh, &o, job.returned ? &job.result : nullptr, &job.cloud);
@@ -213,7 +213,7 @@ void merge_into(CityRefineSummary& sum, CityRefineSummary&& part) {
 // empty) is called after each building with the summary so far.
 void refine_document(json& doc, const CityJsonTransform& tf, const std::vector<CityJsonBuilding>& buildings,
                      std::vector<CropTarget>& targets, const std::vector<std::size_t>& target_of, std::size_t first,
-                     bool repair_all, const Params& params, int jobs, const CityBuildingHook& hook,
+                     bool repair_all, const RefineConfig& params, int jobs, const CityBuildingHook& hook,
                      CityRefineSummary& sum, const std::function<void(const CityRefineSummary&)>& progress) {
   std::size_t next = 0;
   in_order_pool<BuildingJob>(
@@ -374,7 +374,7 @@ json parse_feature(const std::string& line, const std::string& where) {
 // again, refines its buildings (features on the pool) and writes the lines out in order.
 CityRefineSummary refine_sequence(const json& header, const std::string& model_path,
                                   const std::vector<std::string>& cloud_paths, const std::string& out_path,
-                                  const Params& params, const CityRefineOptions& options) {
+                                  const RefineConfig& params, const CityRefineOptions& options) {
   CityRefineSummary sum;
   sum.input_format = "CityJSONSeq " + text_member(header, "version", "?");
   if (!header.contains("transform"))
@@ -506,7 +506,8 @@ json cityjson_solid(const Mesh& mesh, const std::string& lod, const Vec3& scale,
 }
 
 CityRefineSummary refine_city(const std::string& model_path, const std::vector<std::string>& cloud_paths,
-                              const std::string& out_path, const Params& params, const CityRefineOptions& options) {
+                              const std::string& out_path, const RefineConfig& params,
+                              const CityRefineOptions& options) {
   CityRefineSummary sum;
   auto t = Clock::now();
   json doc;

@@ -174,7 +174,7 @@ json refine_report(const RefineResult& r) {
     json walls = json::array();
     for (const auto& w : t.judgement->walls) walls.push_back(fit(w));
     rep["judgement"] = {{"ok", t.judgement->ok},
-                        {"check", t.judgement->check},
+                        {"check", check_name(t.judgement->check)},
                         {"detail", t.judgement->detail},
                         {"building", fit(t.judgement->building)},
                         {"walls", walls}};

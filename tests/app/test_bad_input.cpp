@@ -49,7 +49,7 @@
 using namespace lodrefine;
 
 // Validation at the parameter table's planarity tolerance.
-const double kPlanarity = Params{}.planarity_tolerance;
+const double kPlanarity = RefineConfig{}.repair.planarity_tolerance;
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
@@ -798,7 +798,7 @@ TEST(BadInputRegression, FaceListedTwiceOnAnEdgeDoesNotAbortTheSolver) {
   if (pid == 0) {
     ::close(2);  // GLPK prints its error before aborting
     CandidateSet cs = fixtures::hand_built({0, 0}, {1.0, 1.0}, {{0, 0, 1}});
-    const SelectionResult r = select_faces(cs, {-1.0, -1.0}, {0}, Params{});
+    const SelectionResult r = select_faces(cs, {-1.0, -1.0}, {0}, SelectionConfig{});
     ::_exit(r.status == SolveStatus::NotRun ? 1 : 0);
   }
   int st = 0;
@@ -839,7 +839,7 @@ TEST(BadInputSolver, InfeasibleProgramIsReportedNotSelected) {
   // Face 0 alone on two edges: once with the outside surface (x0 + 1 = 2 y0 -> x0 = 1), once
   // without (x0 = 2 y1 -> x0 = 0). No selection satisfies both.
   CandidateSet cs = fixtures::hand_built({0}, {1.0}, {{0}, {0}});
-  const SelectionResult r = select_faces(cs, {-1.0}, {1, 0}, Params{});
+  const SelectionResult r = select_faces(cs, {-1.0}, {1, 0}, SelectionConfig{});
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.status_text(), "infeasible");
   EXPECT_EQ(selected_faces(cs), std::vector<char>(1, 0));
@@ -848,7 +848,7 @@ TEST(BadInputSolver, InfeasibleProgramIsReportedNotSelected) {
 
 TEST(BadInputSolver, NoCandidatesIsReported) {
   CandidateSet none;
-  const SelectionResult r = select_faces(none, {}, {}, Params{});
+  const SelectionResult r = select_faces(none, {}, {}, SelectionConfig{});
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.status_text(), "no candidates");
 }
@@ -857,7 +857,7 @@ TEST(BadInputSolver, TimeLimitWithoutSolutionIsReported) {
   std::vector<double> cost;
   std::vector<int> outside;
   CandidateSet cs = hard_program(3000, 4000, 3, cost, outside);
-  Params prm;
+  SelectionConfig prm;
   prm.mip_time_limit = 0.01;
   const SelectionResult r = select_faces(cs, cost, outside, prm);
   EXPECT_NE(r.status_text().find("time limit"), std::string::npos) << r.status_text();
@@ -909,13 +909,13 @@ TEST(BadInputSolver, OneMillisecondLimitFailsEvenAnEasyProgram) {
   std::vector<int> outside;
   CandidateSet cs = cube_program(cost, outside);
   ASSERT_GE(cs.size(), 6);
-  const SelectionResult easy = select_faces(cs, cost, outside, Params{});
+  const SelectionResult easy = select_faces(cs, cost, outside, SelectionConfig{});
   ASSERT_TRUE(easy.ok) << easy.status_text();
   EXPECT_EQ(easy.status_text(), "optimal");
   const std::vector<char> chosen = selected_faces(cs);
   EXPECT_EQ(std::count(chosen.begin(), chosen.end(), 1), 6);
   // GLPK stops at its first time check when tm_lim <= 1 ms: a deterministic solver fault.
-  Params prm;
+  SelectionConfig prm;
   prm.mip_time_limit = 0.001;
   const SelectionResult r = select_faces(cs, cost, outside, prm);
   EXPECT_FALSE(r.ok);
@@ -936,8 +936,8 @@ TEST(BadInputSolver, RefineUnderAStarvedSolverWritesAValidShell) {
   const Mesh model = read_obj(dir + "/m.obj");
   PointCloud cloud;
   cloud.points = wall_scan();
-  Params prm;
-  prm.mip_time_limit = 0.001;
+  RefineConfig prm;
+  prm.selection.mip_time_limit = 0.001;
   const RefineResult r = refine_building(model, cloud, prm);
   const nlohmann::json report = refine_report(r);
   ASSERT_TRUE(r.valid) << report.dump(1);

@@ -20,7 +20,7 @@
 using namespace lodrefine;
 
 // Validation at the parameter table's planarity tolerance.
-const double kPlanarity = Params{}.planarity_tolerance;
+const double kPlanarity = RefineConfig{}.repair.planarity_tolerance;
 
 namespace fs = std::filesystem;
 
@@ -46,7 +46,7 @@ void run_tile(const std::string& tile, double max_pooled_rmse) {
     const Mesh coarse = read_obj(path.string());
     const Mesh truth = read_obj((dir / "truth" / (id + ".obj")).string());
     const PointCloud cloud = read_ply((dir / "clouds" / (id + ".ply")).string());
-    const RefineResult r = refine_building(coarse, cloud, Params{});
+    const RefineResult r = refine_building(coarse, cloud, RefineConfig{});
     SCOPED_TRACE(id + ": " + outcome_name(r.outcome) + " (" + r.reason + ")");
     ++buildings;
     EXPECT_NE(r.outcome, Outcome::KeptInvalid);

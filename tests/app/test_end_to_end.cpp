@@ -15,7 +15,7 @@
 using namespace lodrefine;
 
 // Validation at the parameter table's planarity tolerance.
-const double kPlanarity = Params{}.planarity_tolerance;
+const double kPlanarity = RefineConfig{}.repair.planarity_tolerance;
 
 namespace {
 
@@ -45,7 +45,7 @@ TEST_P(EndToEnd, ScannedFacadesLandOnTheTruthAndTheShellIsValid) {
     SynthOptions opt;
     opt.target_points = 20000;
     const SynthBuilding b = make_building(GetParam(), seed, opt);
-    const RefineResult r = refine_building(b.coarse, b.cloud, Params{});
+    const RefineResult r = refine_building(b.coarse, b.cloud, RefineConfig{});
     SCOPED_TRACE(b.id + ": " + outcome_name(r.outcome));
     ASSERT_TRUE(r.valid);
     const Vec3 o = local_origin(b.truth);
@@ -106,8 +106,8 @@ INSTANTIATE_TEST_SUITE_P(AllTypes, EndToEnd, ::testing::ValuesIn(shape_types()),
 
 TEST(EndToEndDeterminism, SameInputSameOutput) {
   const SynthBuilding b = make_building(BuildingType::Gable, 5);
-  const RefineResult r1 = refine_building(b.coarse, b.cloud, Params{});
-  const RefineResult r2 = refine_building(b.coarse, b.cloud, Params{});
+  const RefineResult r1 = refine_building(b.coarse, b.cloud, RefineConfig{});
+  const RefineResult r2 = refine_building(b.coarse, b.cloud, RefineConfig{});
   ASSERT_EQ(r1.mesh.vertices.size(), r2.mesh.vertices.size());
   for (std::size_t i = 0; i < r1.mesh.vertices.size(); ++i) EXPECT_EQ(r1.mesh.vertices[i], r2.mesh.vertices[i]);
 }

@@ -202,12 +202,12 @@ Row run_building(const Mesh& soup) {
   Row row;
   row.id = soup.id;
   row.faces = int(soup.faces.size());
-  const Params prm;
+  const RefineConfig prm;
   const Vec3 origin = local_origin(soup);
   const Mesh local = translated(soup, -origin);
   try {
     RepairReport rr;
-    repair_model(local, prm.weld_tolerance, &rr);
+    repair_model(local, prm.repair.weld_tolerance, &rr);
     row.closed = rr.closed;
   } catch (const InputError& e) {
     row.outcome = std::string("repair failed: ") + e.what();
@@ -377,7 +377,7 @@ TEST(RealData, RotterdamEveryBuildingKeptRepairedOrKeptInvalid) {
   const CityJsonFile f = read_cityjson(data_path.string());
   PointCloud far;
   for (int i = 0; i < 200; ++i) far.points.emplace_back(0.1 * i, 0.0, 0.0);
-  const Params prm;
+  const RefineConfig prm;
   std::map<std::string, int> outcomes;
   double worst = 0.0, worst_repaired = 0.0;
   for (const auto& b : f.buildings) {
@@ -403,8 +403,8 @@ TEST(RealData, RotterdamEveryBuildingKeptRepairedOrKeptInvalid) {
   EXPECT_EQ(outcomes["kept"] + outcomes["repaired"] + outcomes["kept-invalid"], int(f.buildings.size()));
   EXPECT_GT(outcomes["kept"], int(0.8 * f.buildings.size()));
   EXPECT_GE(outcomes["repaired"], 31);
-  EXPECT_LE(worst, prm.weld_tolerance);
-  EXPECT_LE(worst_repaired, prm.weld_tolerance);
+  EXPECT_LE(worst, prm.repair.weld_tolerance);
+  EXPECT_LE(worst_repaired, prm.repair.weld_tolerance);
 }
 
 // Real terraced houses: two Delfshaven buildings whose longest walls are flush and meet. The
@@ -442,7 +442,7 @@ void scan_wall(const std::vector<Vec3>& poly, const Plane& pl, double offset, do
 TEST(RealData, RotterdamCorrectTerracedHouseBesideAMisplacedOne) {
   REQUIRE_REALDATA("val3dity/data/rotterdam/3-20-DELFSHAVEN.city.json");
   const CityJsonFile f = read_cityjson(data_path.string());
-  const Params prm;
+  const RefineConfig prm;
   std::vector<Merged> ms;
   for (const auto& b : f.buildings) {
     const RefineResult base = refine_building(b.mesh, PointCloud{}, prm);
@@ -501,7 +501,7 @@ TEST(RealData, RotterdamCorrectTerracedHouseBesideAMisplacedOne) {
   EXPECT_NE(ra.outcome, Outcome::Refined) << ra.reason;
   double worst = 0.0;
   for (const auto& v : ra.mesh.vertices) worst = std::max(worst, nearest_vertex_distance(v, a.soup));
-  EXPECT_LE(worst, prm.weld_tolerance) << ra.reason;
+  EXPECT_LE(worst, prm.repair.weld_tolerance) << ra.reason;
 
   const RefineResult rb = refine_building(b.soup, scan, prm);
   EXPECT_TRUE(rb.refined()) << rb.reason;

@@ -55,14 +55,14 @@ struct Figures {
 // when refined; without it only the shell, the selection's status and never worse are asserted.
 Figures expect_selection_decided(const Mesh& coarse, const Mesh& truth, const PointCloud& cloud, bool on_truth = true) {
   Figures fig;
-  const RefineResult r = refine_building(coarse, cloud, Params{});
+  const RefineResult r = refine_building(coarse, cloud, RefineConfig{});
   SCOPED_TRACE(coarse.id + ": " + outcome_name(r.outcome) + " (" + r.reason + ")");
   EXPECT_TRUE(r.valid);
   if (!r.valid) return fig;
   const Vec3 o = local_origin(truth);
   const Mesh refined = translated(r.mesh, -o), local_truth = translated(truth, -o),
              local_coarse = translated(coarse, -o);
-  const Validation v = validate_mesh(refined, Params{}.planarity_tolerance);
+  const Validation v = validate_mesh(refined, RefineConfig{}.repair.planarity_tolerance);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_EQ(v.boundary_edges, 0);
   EXPECT_EQ(v.nonmanifold_edges, 0);
@@ -120,7 +120,7 @@ TEST(SelectionDecides, AScanMoveTheJudgeRefusesIsDroppedAndTheBuildingRefinedOnT
   const fs::path dir = fs::path(LODREFINE_SOURCE_DIR) / "data" / "samples" / "synth_stepped_1402";
   const Mesh coarse = read_obj((dir / "coarse.obj").string());
   const PointCloud cloud = read_cloud((dir / "cloud.ply").string());
-  const RefineResult r = refine_building(coarse, cloud, Params{});
+  const RefineResult r = refine_building(coarse, cloud, RefineConfig{});
   ASSERT_EQ(r.outcome, Outcome::Refined) << r.reason;
   ASSERT_EQ(r.trace.walls_refused.size(), 1u);
   EXPECT_NE(r.trace.walls_refused[0].find("wall check: moved wall 0"), std::string::npos) << r.trace.walls_refused[0];

@@ -46,13 +46,13 @@ TEST(Candidates, NearAxisAlignedPlanesGiveFiniteVertices) {
 }
 
 // The candidates are the faces of a Surface_mesh: face f is candidate f with its plane in
-// "f:support"; pieces of one plane share their edges (one component per plane), pieces of
+// candidate_props::support; pieces of one plane share their edges (one component per plane), pieces of
 // different planes never do (their edges meet only in the fans).
 TEST(Candidates, LiveOnASurfaceMeshOneComponentPerPlane) {
   const CandidateSet cs = build_candidates(box_planes(10, 8, 6), box_region(10, 8, 6));
   ASSERT_EQ(int(cs.mesh.number_of_faces()), cs.size());
   ASSERT_TRUE(CGAL::is_valid_polygon_mesh(cs.mesh));
-  const auto support = cs.mesh.property_map<CandidateMesh::Face_index, int>("f:support");
+  const auto support = candidate_props::support.find(cs.mesh);
   ASSERT_TRUE(support.second);
   for (int f = 0; f < cs.size(); ++f) EXPECT_EQ(support.first[CandidateMesh::Face_index(f)], plane_of(cs, f));
   int shared = 0;
@@ -67,7 +67,7 @@ TEST(Candidates, LiveOnASurfaceMeshOneComponentPerPlane) {
   // Every fan lists a halfedge of each face whose boundary runs along it: that halfedge runs
   // along the segment, and its face has the segment. Inside a component the two faces of a mesh
   // edge are in one fan, through the halfedge and its opposite.
-  const auto point = cs.mesh.property_map<CandidateMesh::Vertex_index, int>("v:point").first;
+  const auto point = candidate_props::point.get(cs.mesh);
   int opposite_pairs = 0;
   for (const auto& e : cs.edges) {
     const auto [ea, eb] = cs.ends(e);
@@ -108,12 +108,12 @@ TEST(Candidates, KeptCandidatesAreTheSameProgram) {
   EXPECT_EQ(box_edges, 12);
   std::vector<double> cost;
   for (int f = 0; f < k.size(); ++f) cost.push_back(-area_of(k, f));
-  const SelectionResult r = select_faces(k, cost, std::vector<int>(k.edges.size(), 0), Params{});
+  const SelectionResult r = select_faces(k, cost, std::vector<int>(k.edges.size(), 0), SelectionConfig{});
   ASSERT_TRUE(r.ok) << r.status_text();
   const std::vector<char> selected = selected_faces(k);
   EXPECT_EQ(std::count(selected.begin(), selected.end(), 1), 6);
   // The program's variables are face maps: a column for each of the six (none is fixed).
-  const auto variable = k.mesh.property_map<CandidateFace, int>("f:variable");
+  const auto variable = candidate_props::variable.find(k.mesh);
   ASSERT_TRUE(variable.second);
   std::set<int> columns;
   for (auto f : k.mesh.faces()) columns.insert(variable.first[f]);

@@ -22,7 +22,7 @@ TEST(Confidence, SigmoidCostChangesSignAtTau) {
 TEST(Confidence, BoxFacesAreFullyCoveredByTheirModelReferences) {
   const double a = 10, b = 8, c = 6;
   const CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
-  const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, Params{});
+  const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, ConfidenceConfig{});
   ASSERT_EQ(conf.size(), std::size_t(cs.size()));
   int full = 0;
   for (std::size_t f = 0; f < std::size_t(cs.size()); ++f) {
@@ -55,7 +55,7 @@ TEST(Confidence, CloudReferenceCoversTheShareItsPointsSpan) {
     return ref;
   };
   for (double y : {0.0, -0.1}) {
-    const auto conf = candidate_confidence(cs, {}, {half_front(y)}, Params{});
+    const auto conf = candidate_confidence(cs, {}, {half_front(y)}, ConfidenceConfig{});
     for (int f = 0; f < cs.size(); ++f) {
       if (f == front) continue;
       EXPECT_NEAR(conf[f].value, 0.0, 1e-9) << "face " << f;
@@ -64,7 +64,7 @@ TEST(Confidence, CloudReferenceCoversTheShareItsPointsSpan) {
     EXPECT_EQ(conf[front].cloud_ref, 0);
     EXPECT_EQ(conf[front].model_ref, -1);
   }
-  const auto far = candidate_confidence(cs, {}, {half_front(-0.3)}, Params{});
+  const auto far = candidate_confidence(cs, {}, {half_front(-0.3)}, ConfidenceConfig{});
   EXPECT_EQ(far[front].value, 0.0);
   EXPECT_EQ(far[front].cloud_ref, -1);
 }

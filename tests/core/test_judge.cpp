@@ -45,7 +45,7 @@ TEST(Judge, AWallMovedOntoItsScanIsBetter) {
   PointCloud cloud;
   scan_front(cloud, 0.0, 0.5, 11.5);
   const Judgement j = judge_refinement(coarse, refined, {front_wall(-0.5, 0.0)}, cloud, MatchConfig{}, PlaneConfig{});
-  EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
+  EXPECT_TRUE(j.ok) << j.refusal();
   EXPECT_EQ(j.wall, -1);
   EXPECT_EQ(j.building.points, cloud.points.size());
   EXPECT_NEAR(j.building.rms_before, 0.5, 0.01);
@@ -64,7 +64,7 @@ TEST(Judge, StreetGroundDoesNotCountAgainstAWallMovedInwards) {
   const std::size_t facade = cloud.points.size();
   scan_ground(cloud, -0.6);
   const Judgement j = judge_refinement(coarse, refined, {front_wall(-0.6, 0.0)}, cloud, MatchConfig{}, PlaneConfig{});
-  EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
+  EXPECT_TRUE(j.ok) << j.refusal();
   EXPECT_EQ(j.building.points, facade);
 }
 
@@ -78,13 +78,13 @@ TEST(Judge, AWallMovedOntoABaysPlaneIsRefused) {
   scan_front(cloud, 0.0, 7.0, 12.0, 3);
   const Judgement j = judge_refinement(coarse, refined, {front_wall(-0.2, -0.5)}, cloud, MatchConfig{}, PlaneConfig{});
   EXPECT_FALSE(j.ok);
-  EXPECT_EQ(j.check, "building");
+  EXPECT_EQ(j.check, JudgeCheck::Building);
   EXPECT_NE(j.detail.find("RMS"), std::string::npos) << j.detail;
   EXPECT_GT(j.building.rms_after, j.building.rms_before);
   // Onto the facade's own plane it is better.
   const Judgement k = judge_refinement(coarse, box({0, 0, 0}, {12, 8, 6}), {front_wall(-0.2, 0.0)}, cloud,
                                        MatchConfig{}, PlaneConfig{});
-  EXPECT_TRUE(k.ok) << k.check << ": " << k.detail;
+  EXPECT_TRUE(k.ok) << k.refusal();
   // A bay twice as wide: no plane of the model's wall fits better than where it is. The bay's
   // points lie outside both models: as a scan plane facing the wall, they are its evidence.
   PointCloud wide;
@@ -109,16 +109,16 @@ TEST(Judge, AnUnscannedWallMovesOnlyOnCornerEvidence) {
   side.to = Plane(kX, -11.3);
   const Judgement j = judge_refinement(coarse, refined, {side}, cloud, MatchConfig{}, PlaneConfig{});
   EXPECT_FALSE(j.ok);
-  EXPECT_EQ(j.check, "wall");
+  EXPECT_EQ(j.check, JudgeCheck::Wall);
   EXPECT_EQ(j.wall, 0);
   EXPECT_NE(j.detail.find("no corner evidence"), std::string::npos) << j.detail;
   side.corner = true;
   EXPECT_EQ(judge_refinement(coarse, refined, {side}, cloud, MatchConfig{}, PlaneConfig{}).check,
-            "gain");  // nothing shows it
+            JudgeCheck::Gain);  // nothing shows it
   // The return onto the side wall where the facade ends (corners.h): now the scan shows it.
   add_grid(cloud, wall_patch({11.3, 0.05, 0}, kY, 0.6, 1.0, 5.5), 0.05);
   const Judgement k = judge_refinement(coarse, refined, {side}, cloud, MatchConfig{}, PlaneConfig{});
-  EXPECT_TRUE(k.ok) << k.check << ": " << k.detail;
+  EXPECT_TRUE(k.ok) << k.refusal();
 }
 
 // The front moves onto its scan and the side wall (x = 12) 0.7 m in on corner evidence, while a
@@ -137,7 +137,7 @@ TEST(Judge, OnlyPointsOnAWallsOldOrNewPlaneJudgeTheWall) {
   side.corner = true;
   const std::vector<JudgedWall> walls = {front_wall(-0.5, 0.0), side};
   const Judgement j = judge_refinement(coarse, refined, walls, cloud, MatchConfig{}, PlaneConfig{});
-  EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
+  EXPECT_TRUE(j.ok) << j.refusal();
   ASSERT_EQ(j.walls.size(), 2u);
   EXPECT_EQ(j.walls[1].points, 0u);
   EXPECT_EQ(j.building.worse, 0u);  // the neighbour's points stand in space both models leave empty
@@ -145,7 +145,7 @@ TEST(Judge, OnlyPointsOnAWallsOldOrNewPlaneJudgeTheWall) {
   add_grid(cloud, wall_patch({12, 1, 0}, kY, 6.0, 0.5, 5.5), 0.1);
   const Judgement k = judge_refinement(coarse, refined, walls, cloud, MatchConfig{}, PlaneConfig{});
   EXPECT_FALSE(k.ok);
-  EXPECT_EQ(k.check, "wall");
+  EXPECT_EQ(k.check, JudgeCheck::Wall);
   EXPECT_NE(k.detail.find("moved wall 1: RMS"), std::string::npos) << k.detail;
   EXPECT_EQ(k.wall, 1);  // which one, for refine to drop its move
   EXPECT_NEAR(k.walls[1].rms_after, 0.7, 0.01);
@@ -166,7 +166,7 @@ TEST(Judge, ReturnsInSpaceBothModelsLeaveEmptyAreNotJudged) {
   ASSERT_GT(cloud.points.size() - wall, 2 * wall);
   const Judgement j = judge_refinement(coarse, refined, {front_wall(-0.7, 0.0)}, cloud, MatchConfig{}, PlaneConfig{},
                                        {own, next}, MatchConfig{}.match_distance + 1.0);
-  EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
+  EXPECT_TRUE(j.ok) << j.refusal();
   EXPECT_EQ(j.building.points, wall);
   EXPECT_EQ(j.building.worse, 0u);
   EXPECT_LT(j.building.rms_after, 0.01);
@@ -183,7 +183,7 @@ TEST(Judge, AWallMovedAwayFromItsPointsIsRefused) {
   left.to = Plane(-kX, 1.0);
   const Judgement j = judge_refinement(coarse, refined, {left}, cloud, MatchConfig{}, PlaneConfig{});
   EXPECT_FALSE(j.ok);
-  EXPECT_EQ(j.check, "building");
+  EXPECT_EQ(j.check, JudgeCheck::Building);
   EXPECT_EQ(j.building.worse, cloud.points.size());
   EXPECT_NEAR(j.building.rms_after, 1.0, 0.01);
 }
@@ -195,7 +195,7 @@ TEST(Judge, NoPointsNearTheBuildingChangesNothingButAMovedWallNeedsEvidence) {
   const Judgement j = judge_refinement(coarse, refined, {front_wall(-0.5, 0.0)}, cloud, MatchConfig{}, PlaneConfig{});
   EXPECT_EQ(j.building.points, 0u);
   EXPECT_FALSE(j.ok);
-  EXPECT_EQ(j.check, "wall");
+  EXPECT_EQ(j.check, JudgeCheck::Wall);
 }
 
 // A correct wall refitted 2.5 cm off (its windows pull the plane): no point is clearly closer.
@@ -205,7 +205,7 @@ TEST(Judge, AMoveWithinTheScansNoiseIsNoGain) {
   scan_front(cloud, -0.0125, 0.5, 11.5);  // halfway: as far from either
   const Judgement j = judge_refinement(coarse, refined, {front_wall(0.0, -0.025)}, cloud, MatchConfig{}, PlaneConfig{});
   EXPECT_FALSE(j.ok);
-  EXPECT_EQ(j.check, "gain");
+  EXPECT_EQ(j.check, JudgeCheck::Gain);
   EXPECT_EQ(j.building.better, 0u);
 }
 
@@ -228,7 +228,7 @@ TEST(Judge, AFlushNeighboursPointsPastThePartyWallAreNotJudged) {
   EXPECT_FALSE(refused.ok) << "without the party wall's evidence the neighbour's points count";
   party.flush_facade = Plane(-kY, 0.0);
   const Judgement j = judge_refinement(coarse, refined, {party}, cloud, MatchConfig{}, PlaneConfig{});
-  EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
+  EXPECT_TRUE(j.ok) << j.refusal();
   EXPECT_EQ(j.building.worse, 0u);
   EXPECT_LT(j.building.points, refused.building.points);
 }
@@ -248,7 +248,7 @@ TEST(Judge, AMoveAwayFromAFacadeLineBeyondMatchDistanceIsRefused) {
   const Judgement j =
       judge_refinement(coarse, refined, {front_wall(0.0, 0.3)}, cloud, match, PlaneConfig{}, {front, rear}, reach);
   EXPECT_FALSE(j.ok);
-  EXPECT_EQ(j.check, "building");
+  EXPECT_EQ(j.check, JudgeCheck::Building);
   EXPECT_EQ(j.building.points, cloud.points.size());
   EXPECT_GT(j.building.rms_after, j.building.rms_before + 0.1);
   EXPECT_GE(j.building.worse, front.inliers.size());
@@ -278,7 +278,7 @@ std::pair<Judgement, std::size_t> judge_move_past_a_line(double line_x, double l
 // the move onto the wall's own scan is written.
 TEST(Judge, AParallelLineBesideTheBuildingAndATreeBeyondMatchDistanceAreNotJudged) {
   const auto [j, facade] = judge_move_past_a_line(12.5, 6.0, true);
-  EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
+  EXPECT_TRUE(j.ok) << j.refusal();
   EXPECT_EQ(j.building.points, facade);
 }
 
@@ -288,7 +288,7 @@ TEST(Judge, AParallelLineBesideTheBuildingAndATreeBeyondMatchDistanceAreNotJudge
 // (a setback's front line stands where the rear line has no points).
 TEST(Judge, AFacadeLineBeforeTheWallsOwnPointsIsNotJudged) {
   const auto [j, facade] = judge_move_past_a_line(3.0, 5.0, false);
-  EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
+  EXPECT_TRUE(j.ok) << j.refusal();
   EXPECT_EQ(j.building.points, facade);
 }
 
@@ -310,7 +310,7 @@ TEST(Judge, ReturnsFromARoomSeenThroughGlassAreNotJudged) {
   add_grid(cloud, wall_patch({2.1, 1.0, 0}, kX, 7.8, 0.7, 3.0), 0.03, 0.005);  // the shop's back, through the glass
   const Judgement j = judge_refinement(coarse, refined, {front_wall(0.5, 0.0)}, cloud, MatchConfig{}, PlaneConfig{},
                                        {front}, MatchConfig{}.match_distance + 1.0);
-  EXPECT_TRUE(j.ok) << j.check << ": " << j.detail;
+  EXPECT_TRUE(j.ok) << j.refusal();
   EXPECT_EQ(j.building.points, wall);
   EXPECT_LT(j.building.rms_after, 0.02);
 }

@@ -41,7 +41,9 @@ struct Scene {
   }
   // A scan parallel to the front, at y, from x0 to x1.
   int front_scan(double y, double x0, double x1) { return scan({x0, y, 0}, Vec3::UnitX(), x1 - x0); }
-  MatchResult match(const Params& prm = Params{}) const { return match_surfaces(mesh, surfaces, cloud, planes, prm); }
+  MatchResult match(const MatchConfig& prm = MatchConfig{}) const {
+    return match_surfaces(mesh, surfaces, cloud, planes, prm);
+  }
 };
 
 // The building with its front scanned at y from x0 to x1.
@@ -178,7 +180,7 @@ TEST(Matching, DetectedPlanesOfTwoScannedWallsMatchTheirWalls) {
   const auto right =
       add_grid(s.cloud, {{12.4, 0, 0}, Vec3::UnitY(), Vec3::UnitZ(), -0.3, 8.0, 0.0, 5.0}, kStep, 0.01, 2);
   add_grid(s.cloud, {{0, 0, 0}, Vec3::UnitX(), Vec3::UnitY(), 0.0, 12.4, -3.0, -0.5}, kStep, 0.01, 3);
-  s.planes = detect_planes(s.cloud, Params{});
+  s.planes = detect_planes(s.cloud, PlaneConfig{});
   ASSERT_EQ(s.planes.size(), 3u);
   const MatchResult r = s.match();
   EXPECT_TRUE(r.rejected.empty()) << joined(r.rejected);
@@ -203,7 +205,7 @@ TEST(Matching, DetectedPlanesOfTwoScannedWallsMatchTheirWalls) {
 TEST(Matching, PlaneBeyondMatchDistanceIsNotMatched) {
   Scene s = front_scanned(-2.0, 0.0, 12.0);
   EXPECT_TRUE(s.match().matches.empty());
-  Params far;
+  MatchConfig far;
   far.match_distance = 2.5;
   const MatchResult r = s.match(far);
   ASSERT_TRUE(only_front_match(r));
@@ -243,7 +245,7 @@ TEST(Matching, PlaneTurnedBeyondMatchAngleIsNotMatched) {
 
   const Scene twenty = turned(20.0);
   EXPECT_TRUE(twenty.match().matches.empty());
-  Params wide;
+  MatchConfig wide;
   wide.match_angle_deg = 25.0;
   const MatchResult r = twenty.match(wide);
   ASSERT_TRUE(only_front_match(r));

@@ -9,19 +9,19 @@
 using namespace lodrefine;
 
 TEST(Params, DefaultsAreValidAndMatchThePaper) {
-  Params p;
+  RefineConfig p;
   EXPECT_NO_THROW(p.validate());
-  EXPECT_DOUBLE_EQ(p.tau_cov, 0.3);
-  EXPECT_DOUBLE_EQ(p.merge_angle_deg, 5.0);
-  EXPECT_DOUBLE_EQ(p.conf_angle_deg, 5.0);
-  EXPECT_DOUBLE_EQ(p.conf_cloud_distance, 0.2);
-  EXPECT_DOUBLE_EQ(p.conf_bbox_iou, 0.3);
-  EXPECT_DOUBLE_EQ(p.bbox_expand, 0.1);
+  EXPECT_DOUBLE_EQ(p.selection.tau_cov, 0.3);
+  EXPECT_DOUBLE_EQ(p.selection.merge_angle_deg, 5.0);
+  EXPECT_DOUBLE_EQ(p.confidence.conf_angle_deg, 5.0);
+  EXPECT_DOUBLE_EQ(p.confidence.conf_cloud_distance, 0.2);
+  EXPECT_DOUBLE_EQ(p.confidence.conf_bbox_iou, 0.3);
+  EXPECT_DOUBLE_EQ(p.selection.bbox_expand, 0.1);
 }
 
 TEST(Params, OutOfRangeIsRejectedWithTheName) {
-  Params p;
-  p.tau_cov = 1.5;
+  RefineConfig p;
+  p.selection.tau_cov = 1.5;
   try {
     p.validate();
     FAIL();
@@ -41,7 +41,7 @@ TEST(Params, TableListsEveryParameter) {
 
 TEST(Params, ValidateNamesTheStage) {
   RefineConfig c;
-  c.ransac_epsilon = 5.0;
+  c.plane.ransac_epsilon = 5.0;
   try {
     c.validate();
     FAIL();
@@ -49,9 +49,9 @@ TEST(Params, ValidateNamesTheStage) {
     EXPECT_EQ(std::string(e.what()).rfind("plane: parameter ransac_epsilon = 5 ", 0), 0u) << e.what();
   }
   c = RefineConfig{};
-  c.conf_bbox_iou = -1.0;
-  EXPECT_THROW(c.confidence().validate(), InputError);
-  EXPECT_NO_THROW(c.plane().validate());  // a stage checks only its own rows
+  c.confidence.conf_bbox_iou = -1.0;
+  EXPECT_THROW(c.confidence.validate(), InputError);
+  EXPECT_NO_THROW(c.plane.validate());  // a stage checks only its own rows
   try {
     c.validate();
     FAIL();
@@ -76,8 +76,8 @@ TEST(Params, EveryRowBelongsToOneStageInPipelineOrder) {
 
 TEST(Params, ForEachFieldVisitsEveryRowWithItsValue) {
   RefineConfig c;
-  c.match_distance = 2.5;
-  c.seed = 7;
+  c.match.match_distance = 2.5;
+  c.plane.seed = 7;
   std::size_t n = 0;
   for_each_field(c, [&](const auto& field, auto& value) {
     EXPECT_EQ(field.name, param_table()[n].name);
@@ -92,8 +92,20 @@ TEST(Params, ForEachFieldVisitsEveryRowWithItsValue) {
     ++n;
   });
   EXPECT_EQ(n, param_table().size());
-  EXPECT_DOUBLE_EQ(c.match_distance, 3.0);
+  EXPECT_DOUBLE_EQ(c.match.match_distance, 3.0);
   std::size_t in_match = 0;
-  for_each_field(c.match(), [&](const auto& field, auto) { in_match += std::string(field.stage) == "match"; });
+  for_each_field(c.match, [&](const auto& field, auto) { in_match += std::string(field.stage) == "match"; });
   EXPECT_EQ(in_match, 8u);  // a stage config visits its own rows only
+}
+
+TEST(Params, EachStageConfigIsTheMemberOfItsName) {
+  EXPECT_STREQ(decltype(RefineConfig::repair)::stage, "repair");
+  EXPECT_STREQ(decltype(RefineConfig::plane)::stage, "plane");
+  EXPECT_STREQ(decltype(RefineConfig::match)::stage, "match");
+  EXPECT_STREQ(decltype(RefineConfig::selection)::stage, "selection");
+  EXPECT_STREQ(decltype(RefineConfig::confidence)::stage, "confidence");
+  RefineConfig c;
+  c.match.match_distance = 2.0;
+  c.selection.bbox_margin = 0.5;
+  EXPECT_DOUBLE_EQ(c.scan_reach(), 2.5);
 }

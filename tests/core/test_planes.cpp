@@ -83,7 +83,7 @@ std::size_t count_of(const std::vector<int>& inliers, const std::vector<int>& po
 
 // detect_planes finishes within `seconds` and finds no plane: run in a child process, so a hang
 // fails the test instead of stalling the suite.
-void expect_no_plane_and_no_hang(const PointCloud& cloud, const Params& prm, unsigned seconds) {
+void expect_no_plane_and_no_hang(const PointCloud& cloud, const PlaneConfig& prm, unsigned seconds) {
   EXPECT_EXIT(
       {
         ::alarm(seconds);
@@ -98,8 +98,8 @@ void expect_no_plane_and_no_hang(const PointCloud& cloud, const Params& prm, uns
 // growing (--ransac 0).
 class Planes : public testing::TestWithParam<int> {
  protected:
-  Params params() const {
-    Params p;
+  PlaneConfig params() const {
+    PlaneConfig p;
     p.ransac = GetParam();
     return p;
   }
@@ -146,7 +146,7 @@ TEST_P(Planes, BoxCornerGivesItsThreePlanes) {
 
 TEST_P(Planes, SameSeedSameResult) {
   const Corner c = box_corner();
-  Params prm = params();
+  PlaneConfig prm = params();
   prm.seed = 7;
   const auto a = detect_planes(c.cloud, prm);
   const auto b = detect_planes(c.cloud, prm);
@@ -171,7 +171,7 @@ TEST_P(Planes, SameSeedSameResult) {
 TEST_P(Planes, VoxelDetectionOfOneFacadeTakesBackItsPoints) {
   PointCloud cloud;
   const Truth wall = add_patch(cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 6.0, 0.0, 4.0), 1);
-  Params prm = params();
+  PlaneConfig prm = params();
   prm.detect_voxel = 0.2;
   const auto planes = detect_planes(cloud, prm);
   ASSERT_EQ(planes.size(), 1u);
@@ -188,7 +188,7 @@ TEST_P(Planes, VoxelDetectionOfOneFacadeTakesBackItsPoints) {
 // of 2000, ground 859 of 1830; the ground's hull 8.6 instead of 17.4 m²).
 TEST_P(Planes, VoxelDetectionTakesBackEveryPointOfItsPlanes) {
   const Corner c = box_corner();
-  Params prm = params();
+  PlaneConfig prm = params();
   prm.detect_voxel = 0.2;
   const auto planes = detect_planes(c.cloud, prm);
   ASSERT_EQ(planes.size(), 3u);
@@ -212,7 +212,7 @@ TEST_P(Planes, VoxelDetectionKeepsTheMinimumOfPointsOfTheFullCloud) {
   const auto small =
       add_grid(sparse, {{20, 0, 0}, Vec3::UnitY(), Vec3::UnitZ(), 0.0, 2.75, 0.0, 2.25}, 0.25, kNoise, 2);
   for (int i : small) cloud.points.push_back(sparse.points[i]);
-  Params prm = params();
+  PlaneConfig prm = params();
   prm.detect_voxel = 0.2;
   const auto planes = detect_planes(cloud, prm);
   ASSERT_EQ(planes.size(), 1u);
@@ -235,7 +235,7 @@ TEST_P(Planes, DefaultDetectionIsThinnedAndFindsThePlanesOfFullDetection) {
   dense(wall_patch({0, 0, 0}, Vec3::UnitX(), 5.9, 0.1, 4.0), 1);
   dense({{6, 0, 0}, Vec3::UnitY(), Vec3::UnitZ(), 0.1, 5.0, 0.1, 4.0}, 2);
   dense({{0, 0, 0}, Vec3::UnitX(), Vec3::UnitY(), 0.0, 6.0, -3.0, -0.1}, 3);
-  Params thin = params(), all = params();
+  PlaneConfig thin = params(), all = params();
   thin.detect_voxel = std::sqrt(thin.min_plane_area / double(thin.normal_neighbors + 1));
   all.detect_voxel = 0.0;
   const auto thinned = detect_planes(cloud, params());
@@ -337,7 +337,7 @@ TEST_P(Planes, FewerPointsThanRansacMinPointsGiveNoPlane) {
   add_grid(cloud, {{0, 0, 0}, Vec3::UnitX(), Vec3::UnitZ(), 0.0, 1.4, 0.0, 0.9}, kStep);  // 15 × 10
   cloud.points.pop_back();
   ASSERT_EQ(cloud.points.size(), 149u);
-  Params prm = params();
+  PlaneConfig prm = params();
   EXPECT_TRUE(detect_planes(cloud, prm).empty());  // ransac_min_points = 150
   // Copies of points do not count: 149 distinct points stay too few.
   PointCloud doubled = cloud;

@@ -18,7 +18,7 @@ using namespace lodrefine;
 using namespace lodrefine::fixtures;
 
 // Validation at the parameter table's planarity tolerance.
-const double kPlanarity = Params{}.planarity_tolerance;
+const double kPlanarity = RefineConfig{}.repair.planarity_tolerance;
 
 namespace {
 
@@ -66,7 +66,7 @@ double max_abs_y_of_front(const Mesh& m, double expect_y) {
 TEST(Refine, MovesAnOutdatedFacadeOntoTheScan) {
   const Mesh coarse = box_soup(0, 12, -0.5, 8, 7);  // front wall 0.5 m too far out
   const PointCloud cloud = scan_front(0.0, 0.5, 11.5, 5.0, 1);
-  Params prm;
+  RefineConfig prm;
   const RefineResult r = refine_building(coarse, cloud, prm);
   ASSERT_TRUE(r.valid) << r.reason;
   EXPECT_TRUE(r.refined()) << r.reason;
@@ -89,7 +89,7 @@ TEST(Refine, ACornerMoveTheJudgeRefusesIsDroppedAndTheFacadeStillMoves) {
     for (double y = -6.0; y < -0.3; y += 0.1) cloud.points.push_back(Vec3(x, y, 0.0) + kOrigin);
   for (double y = 0.2; y < 1.9; y += 0.2)
     for (double z = 1.0; z < 5.1; z += 0.4) cloud.points.push_back(Vec3(12.0, y, z) + kOrigin);
-  const RefineResult r = refine_building(coarse, cloud, Params{});
+  const RefineResult r = refine_building(coarse, cloud, RefineConfig{});
   ASSERT_TRUE(r.valid) << r.reason;
   ASSERT_EQ(r.outcome, Outcome::Refined) << r.reason;
   ASSERT_TRUE(r.trace.corners_refused.has_value());
@@ -103,7 +103,7 @@ TEST(Refine, ACornerMoveTheJudgeRefusesIsDroppedAndTheFacadeStillMoves) {
 TEST(Refine, MovesAFacadeInwardsAndKeepsTheRest) {
   const Mesh coarse = box_soup(0, 12, 0.6, 8, 7);  // front wall 0.6 m too far in
   const PointCloud cloud = scan_front(0.0, 0.5, 11.5, 5.0, 2);
-  const RefineResult r = refine_building(coarse, cloud, Params{});
+  const RefineResult r = refine_building(coarse, cloud, RefineConfig{});
   ASSERT_TRUE(r.valid);
   EXPECT_TRUE(r.refined()) << r.reason;
   EXPECT_LT(max_abs_y_of_front(r.mesh, 0.0), 0.02) << r.reason;
@@ -114,7 +114,7 @@ TEST(Refine, NoScanFallsBackToTheRepairedOriginal) {
   const Mesh coarse = box_soup(0, 12, 0, 8, 7);
   PointCloud cloud;
   cloud.points.push_back(kOrigin + Vec3(100, 100, 0));
-  const RefineResult r = refine_building(coarse, cloud, Params{});
+  const RefineResult r = refine_building(coarse, cloud, RefineConfig{});
   ASSERT_TRUE(r.valid);
   EXPECT_FALSE(r.refined());
   EXPECT_EQ(r.outcome, Outcome::Kept);
@@ -129,12 +129,12 @@ TEST(Refine, NoScanFallsBackToTheRepairedOriginal) {
 TEST(Refine, ACorrectTerracedHouseBesideAMisplacedOneIsLeftAsItIs) {
   PointCloud cloud = fixtures::terraced_street_scan(-0.6, 24.6, 5);
   for (auto& p : cloud.points) p += kOrigin;
-  const Params prm;
+  const RefineConfig prm;
   const Mesh a = box_soup(0, 12, 0, 8, 7), b = box_soup(12, 24, -0.5, 8, 7);
   const RefineResult ra = refine_building(a, cloud, prm);
   ASSERT_TRUE(ra.valid) << ra.reason;
   EXPECT_FALSE(ra.refined()) << ra.reason;
-  EXPECT_LE(fixtures::largest_vertex_move(ra.mesh, a), prm.weld_tolerance) << ra.reason;
+  EXPECT_LE(fixtures::largest_vertex_move(ra.mesh, a), prm.repair.weld_tolerance) << ra.reason;
 
   const RefineResult rb = refine_building(b, cloud, prm);
   ASSERT_TRUE(rb.valid) << rb.reason;
@@ -142,7 +142,7 @@ TEST(Refine, ACorrectTerracedHouseBesideAMisplacedOneIsLeftAsItIs) {
   EXPECT_LT(max_abs_y_of_front(rb.mesh, 0.0), 0.02);
   for (const auto& p : rb.mesh.vertices) {  // the side walls stay at x = 12 and x = 24
     const double x = p.x() - kOrigin.x();
-    EXPECT_TRUE(std::abs(x - 12) <= prm.weld_tolerance || std::abs(x - 24) <= prm.weld_tolerance) << x;
+    EXPECT_TRUE(std::abs(x - 12) <= prm.repair.weld_tolerance || std::abs(x - 24) <= prm.repair.weld_tolerance) << x;
   }
 }
 
@@ -194,7 +194,7 @@ TEST(Refine, ABuildingBeyondTheCandidateCapIsRefinedBySubstitutionQuickly) {
   const Mesh coarse = pyramid_roofed_block(12, 8);
   const PointCloud cloud = scan_front(0.0, 0.5, 11.5, 5.0, 1);
   const auto t0 = std::chrono::steady_clock::now();
-  const RefineResult r = refine_building(coarse, cloud, Params{});
+  const RefineResult r = refine_building(coarse, cloud, RefineConfig{});
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ASSERT_TRUE(r.valid) << r.reason;
   EXPECT_EQ(r.outcome, Outcome::Refined) << r.reason;
@@ -229,7 +229,7 @@ PointCloud far_cloud() {
 // every vertex one of the input's.
 TEST(Refine, AHouseMissingThreeWallsIsRepairedOnItsPlanes) {
   const Mesh coarse = box_soup_with(0.0, {0, 1, 3});
-  const RefineResult r = refine_building(coarse, far_cloud(), Params{});
+  const RefineResult r = refine_building(coarse, far_cloud(), RefineConfig{});
   ASSERT_EQ(r.outcome, Outcome::Repaired) << r.reason;
   EXPECT_TRUE(r.valid) << r.trace.output_validation.problem;
   EXPECT_EQ(r.reason.rfind("shell rebuilt on its planes", 0), 0u) << r.reason;
@@ -243,7 +243,7 @@ TEST(Refine, AHouseMissingThreeWallsIsRepairedOnItsPlanes) {
 // start of the refinement, which moves the facade.
 TEST(Refine, ARepairedHouseIsRefinedOnItsScan) {
   const Mesh coarse = box_soup_with(-0.5, {0, 1, 2});  // the front wall kept, 0.5 m too far out
-  const RefineResult r = refine_building(coarse, scan_front(0.0, 0.5, 11.5, 5.0, 7), Params{});
+  const RefineResult r = refine_building(coarse, scan_front(0.0, 0.5, 11.5, 5.0, 7), RefineConfig{});
   ASSERT_EQ(r.outcome, Outcome::Refined) << r.reason;
   EXPECT_TRUE(r.valid) << r.trace.output_validation.problem;
   ASSERT_TRUE(r.trace.rebuild.has_value());
@@ -259,10 +259,19 @@ TEST(Refine, AHouseWithAFinIsKeptInvalidAsRead) {
   for (const Vec3& p : {Vec3(0, 0, 7), Vec3(0, 8, 7), Vec3(0, 8, 10), Vec3(0, 0, 10)})
     coarse.vertices.push_back(p + kOrigin);
   coarse.faces.push_back({{n, n + 1, n + 2, n + 3}, Semantic::Wall, 6});
-  const RefineResult r = refine_building(coarse, far_cloud(), Params{});
+  const RefineResult r = refine_building(coarse, far_cloud(), RefineConfig{});
   ASSERT_EQ(r.outcome, Outcome::KeptInvalid) << r.reason;
   const std::size_t at = r.reason.find("uncovered by up to ");
   ASSERT_NE(at, std::string::npos) << r.reason;
   EXPECT_NEAR(std::stod(r.reason.substr(at + 19)), 3.0, 0.05) << r.reason;
   EXPECT_EQ(r.mesh.faces.size(), coarse.faces.size());
+}
+
+TEST(Refine, OutcomeNamesReadBack) {
+  for (Outcome o :
+       {Outcome::Refined, Outcome::Kept, Outcome::Repaired, Outcome::KeptInvalid, Outcome::Untouched, Outcome::Failed})
+    EXPECT_EQ(parse_outcome(outcome_name(o)), o) << outcome_name(o);
+  EXPECT_EQ(std::string(outcome_name(Outcome::KeptInvalid)), "kept-invalid");
+  EXPECT_FALSE(parse_outcome("Refined").has_value());
+  EXPECT_FALSE(parse_outcome("").has_value());
 }

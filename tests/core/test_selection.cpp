@@ -16,8 +16,8 @@ using namespace lodrefine::fixtures;
 TEST(Selection, RecoversTheClosedBoxFromConfidence) {
   const double a = 10, b = 8, c = 6;
   CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
-  Params prm;
-  const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, prm);
+  SelectionConfig prm;
+  const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, ConfidenceConfig{});
   std::vector<double> cost;
   int full = 0;
   for (std::size_t f = 0; f < std::size_t(cs.size()); ++f) {
@@ -55,7 +55,7 @@ TEST(Selection, InfeasibleBoundaryIsReportedNotCrashed) {
   ASSERT_EQ(cs.size(), 1);
   std::vector<int> outside(cs.edges.size(), 0);
   outside[0] = 1;  // one continuing edge: the face must be selected, then 3 edges are open
-  Params prm;
+  SelectionConfig prm;
   const SelectionResult sel = select_faces(cs, {-1.0}, outside, prm);
   EXPECT_FALSE(sel.ok);
   EXPECT_EQ(sel.status_text(), "infeasible");
@@ -64,8 +64,8 @@ TEST(Selection, InfeasibleBoundaryIsReportedNotCrashed) {
 TEST(Selection, StartsFromAClosedWarmStartAndRefusesAnOpenOne) {
   const double a = 10, b = 8, c = 6;
   CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
-  Params prm;
-  const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, prm);
+  SelectionConfig prm;
+  const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, ConfidenceConfig{});
   SelectionProgram pg;
   std::vector<char> box(std::size_t(cs.size()), 0);
   for (std::size_t f = 0; f < std::size_t(cs.size()); ++f) {
@@ -100,7 +100,7 @@ TEST(Selection, StartsFromAClosedWarmStartAndRefusesAnOpenOne) {
 TEST(Selection, FixedFacesAreConstantsOfTheProgram) {
   const double a = 10, b = 8, c = 6;
   CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
-  Params prm;
+  SelectionConfig prm;
   SelectionProgram pg;
   std::vector<char> box(std::size_t(cs.size()), 0);
   int inside = 0;
@@ -166,7 +166,7 @@ TEST(Selection, TheWorkBudgetEndsTheSearchAtTheSamePointUnderAnyLoad) {
   SelectionProgram pg;
   CandidateSet cs = crossed_box_program(pg);
   ASSERT_TRUE(every_edge_used_0_or_2(cs, pg.warm));
-  Params prm;
+  SelectionConfig prm;
   prm.mip_work_limit = 2.0;
   const SelectionResult quiet = select_faces(cs, pg, prm);
   const std::vector<char> quiet_selected = selected_faces(cs);
@@ -207,7 +207,7 @@ TEST(Selection, TheWorkBudgetEndsTheSearchAtTheSamePointUnderAnyLoad) {
 TEST(Selection, AtTheBudgetBeforeTheSearchTheWarmStartIsTaken) {
   SelectionProgram pg;
   CandidateSet cs = crossed_box_program(pg);
-  Params prm;
+  SelectionConfig prm;
   prm.mip_work_limit = 0.0;
   const SelectionResult r = select_faces(cs, pg, prm);
   ASSERT_TRUE(r.ok) << r.status_text();

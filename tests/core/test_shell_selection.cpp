@@ -51,7 +51,7 @@ bool every_edge_twice(const Mesh& m) {
 TEST(ShellSelection, AddsARecessTheModelLacks) {
   const Mesh start = box({0, 0, 0}, {10, 8, 6});
   const Scan scan = facade_with_feature(0.8);
-  Params prm;
+  RefineConfig prm;
   const ShellSelection r = select_shell(start, scan.cloud, scan.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
   EXPECT_EQ(r.stats.scan_planes_added, 3);
@@ -60,7 +60,7 @@ TEST(ShellSelection, AddsARecessTheModelLacks) {
   EXPECT_EQ(r.stats.selection.warm_given, true);
   EXPECT_EQ(r.stats.selection.warm_feasible, true);
   EXPECT_TRUE(every_edge_twice(r.mesh));
-  const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
+  const Validation v = validate_mesh(r.mesh, prm.repair.planarity_tolerance);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_NEAR(v.volume, 10 * 8 * 6 - 2 * 0.8 * 6, 1e-6);
   // Box 6 faces + back wall and two returns; the street facade split in two.
@@ -78,10 +78,10 @@ TEST(ShellSelection, AddsARecessTheModelLacks) {
 TEST(ShellSelection, AddsABayTheModelLacks) {
   const Mesh start = box({0, 0, 0}, {10, 8, 6});
   const Scan scan = facade_with_feature(-0.9);
-  Params prm;
+  RefineConfig prm;
   const ShellSelection r = select_shell(start, scan.cloud, scan.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
-  const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
+  const Validation v = validate_mesh(r.mesh, prm.repair.planarity_tolerance);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_NEAR(v.volume, 10 * 8 * 6 + 2 * 0.9 * 6, 1e-6);
   EXPECT_EQ(r.mesh.faces.size(), 10u);
@@ -108,33 +108,33 @@ Scan sparsely_scanned_bay() {
 TEST(ShellSelection, AddsASparselyScannedBay) {
   const Mesh start = box({0, 0, 0}, {10, 8, 6});
   const Scan scan = sparsely_scanned_bay();
-  Params prm;
+  RefineConfig prm;
   const ShellSelection r = select_shell(start, scan.cloud, scan.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
   EXPECT_TRUE(every_edge_twice(r.mesh));
-  const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
+  const Validation v = validate_mesh(r.mesh, prm.repair.planarity_tolerance);
   EXPECT_NEAR(v.volume, 10 * 8 * 6 + 2.5 * 0.9 * 6, 1e-6);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_EQ(r.mesh.faces.size(), 10u);
   EXPECT_GT(r.stats.step_walls, 0);  // the unscanned side
   // Without the data-fitting term the program keeps the box: the term is what takes the bay.
-  prm.lambda_data = 0.0;
+  prm.selection.lambda_data = 0.0;
   const ShellSelection coverage_only = select_shell(start, scan.cloud, scan.planes, prm);
   ASSERT_TRUE(coverage_only.ok) << coverage_only.reason;
-  EXPECT_NEAR(validate_mesh(coverage_only.mesh, prm.planarity_tolerance).volume, 480.0, 1e-6);
+  EXPECT_NEAR(validate_mesh(coverage_only.mesh, prm.repair.planarity_tolerance).volume, 480.0, 1e-6);
 }
 
 TEST(ShellSelection, KeepsTheModelWhereTheScanAgrees) {
   const Mesh start = box({0, 0, 0}, {10, 8, 6});
   Scan s;
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 10.0, 0.0, 6.0), kStep));
-  Params prm;
+  RefineConfig prm;
   const ShellSelection r = select_shell(start, s.cloud, s.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
   EXPECT_EQ(r.stats.scan_planes_added, 0);
   EXPECT_EQ(r.stats.candidates_changed, 0);
   EXPECT_EQ(r.mesh.faces.size(), 6u);
-  EXPECT_NEAR(validate_mesh(r.mesh, prm.planarity_tolerance).volume, 480.0, 1e-6);
+  EXPECT_NEAR(validate_mesh(r.mesh, prm.repair.planarity_tolerance).volume, 480.0, 1e-6);
 }
 
 TEST(ShellSelection, MovesAWallOntoItsScanWithoutAStartingMove) {
@@ -142,11 +142,11 @@ TEST(ShellSelection, MovesAWallOntoItsScanWithoutAStartingMove) {
   const Mesh start = box({0, -0.5, 0}, {10, 8, 6});
   Scan s;
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 10.0, 0.0, 6.0), kStep));
-  Params prm;
+  RefineConfig prm;
   const ShellSelection r = select_shell(start, s.cloud, s.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
   EXPECT_EQ(r.stats.scan_planes_added, 1);
-  const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
+  const Validation v = validate_mesh(r.mesh, prm.repair.planarity_tolerance);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_NEAR(v.volume, 480.0, 1e-6);
 }
@@ -165,10 +165,10 @@ Scan stepped_facade(double left, double right) {
 
 // The volume of the selection's shell for `start` and the scan `s`, asserted valid and closed.
 double selected_volume(const Mesh& start, const Scan& s) {
-  Params prm;
+  RefineConfig prm;
   const ShellSelection r = select_shell(start, s.cloud, s.planes, prm);
   EXPECT_TRUE(r.ok) << r.reason;
-  const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
+  const Validation v = validate_mesh(r.mesh, prm.repair.planarity_tolerance);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_TRUE(every_edge_twice(r.mesh));
   return v.volume;
@@ -197,11 +197,11 @@ TEST(ShellSelection, KeepsAnUnscannedEndWallBeforeANeighboursWall) {
   Scan s;
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 10.0, 0.0, 6.0), kStep));
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({12.2, 8, 0}, -Vec3::UnitY(), 8.0, 0.0, 6.0), kStep));
-  Params prm;
+  RefineConfig prm;
   const ShellSelection r = select_shell(box({0, 0, 0}, {10, 8, 6}), s.cloud, s.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
   EXPECT_EQ(r.stats.candidates_changed, 0);
-  EXPECT_NEAR(validate_mesh(r.mesh, prm.planarity_tolerance).volume, 480.0, 1e-6);
+  EXPECT_NEAR(validate_mesh(r.mesh, prm.repair.planarity_tolerance).volume, 480.0, 1e-6);
 }
 
 // A correct building whose facade line runs on, 0.3 m forward, into its neighbour's: the party
@@ -214,11 +214,11 @@ TEST(ShellSelection, KeepsTheModelWhereTheFacadeLineRunsOnIntoANeighbour) {
     Scan s;
     s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 0, 0}, Vec3::UnitX(), 10.0, 0.0, 6.0), kStep));
     s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({10, offset, 0}, Vec3::UnitX(), 10.0, 0.0, 6.0), kStep));
-    Params prm;
+    RefineConfig prm;
     const ShellSelection r = select_shell(box({0, 0, 0}, {10, 8, 6}), s.cloud, s.planes, prm);
     ASSERT_TRUE(r.ok) << r.reason;
     EXPECT_EQ(r.stats.candidates_changed, 0);
-    EXPECT_NEAR(validate_mesh(r.mesh, prm.planarity_tolerance).volume, 480.0, 1e-6);
+    EXPECT_NEAR(validate_mesh(r.mesh, prm.repair.planarity_tolerance).volume, 480.0, 1e-6);
   }
 }
 
@@ -229,10 +229,10 @@ TEST(ShellSelection, ExtendsAFacadeToItsOwnCornerPastTheModelsEnd) {
   Scan s;
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, -0.4, 0}, Vec3::UnitX(), 11.0, 0.0, 6.0), kStep));
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({11, -0.4, 0}, Vec3::UnitY(), 6.0, 0.0, 6.0), kStep));
-  Params prm;
+  RefineConfig prm;
   const ShellSelection r = select_shell(box({0, 0, 0}, {10, 8, 6}), s.cloud, s.planes, prm);
   ASSERT_TRUE(r.ok) << r.reason;
-  EXPECT_GT(validate_mesh(r.mesh, prm.planarity_tolerance).volume, 480.0 + 1.0);
+  EXPECT_GT(validate_mesh(r.mesh, prm.repair.planarity_tolerance).volume, 480.0 + 1.0);
 }
 
 // A program its budget stops at the root keeps its warm start, though moving the walls onto
@@ -249,13 +249,13 @@ TEST(ShellSelection, MovesWallsWhenTheBudgetEndsTheSearchAtTheRoot) {
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({10, 8, 0}, -x, 10.0, 0.0, 6.0), kStep));
   s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, 8, 0}, -y, 8.0, 0.0, 6.0), kStep));
   for (const double budget : {0.07, 0.075}) {  // the whole program's root needs 0.08
-    Params prm;
-    prm.mip_work_limit = budget;
+    RefineConfig prm;
+    prm.selection.mip_work_limit = budget;
     const ShellSelection r = select_shell(start, s.cloud, s.planes, prm);
     ASSERT_TRUE(r.ok) << r.reason;
     EXPECT_EQ(r.stats.selection.status, SolveStatus::FeasibleBudget);
     EXPECT_EQ(r.stats.neighbourhoods_improved, 4);
-    const Validation v = validate_mesh(r.mesh, prm.planarity_tolerance);
+    const Validation v = validate_mesh(r.mesh, prm.repair.planarity_tolerance);
     EXPECT_TRUE(v.valid()) << v.problem;
     EXPECT_NEAR(v.volume, 480.0, 1e-6) << "budget " << budget;  // the start: 11.6 x 9.6 x 6 = 668.16
   }
@@ -275,10 +275,10 @@ Mesh box_faces(std::initializer_list<int> keep) { return only_faces(box(Vec3(0, 
 // through the hole's edges, the input's faces kept where they were.
 TEST(RebuildShell, WallsMissingAlongTheFootprintAreAdded) {
   const Mesh soup = box_faces({0, 1, 3});
-  const Params prm;
-  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
+  const RefineConfig prm;
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
   ASSERT_TRUE(rb.ok) << rb.reason;
-  const Validation v = validate_mesh(rb.mesh, prm.planarity_tolerance);
+  const Validation v = validate_mesh(rb.mesh, prm.repair.planarity_tolerance);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_NEAR(v.volume, 480.0, 1e-6);
   EXPECT_EQ(rb.planes_added, 3);  // walls y = 0, y = 8, x = 0
@@ -296,8 +296,8 @@ TEST(RebuildShell, WallsMissingAlongTheFootprintAreAdded) {
 TEST(RebuildShell, AHugeSoupIsSampledWithinBounds) {
   Mesh soup = box_faces({0, 1, 3});
   for (Vec3& p : soup.vertices) p = p.cwiseProduct(Vec3(200.0, 250.0, 1.0));
-  const Params prm;
-  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
+  const RefineConfig prm;
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
   ASSERT_TRUE(rb.ok) << rb.reason;
   EXPECT_GT(rb.sampling, 5.0);
   const double kept = 2 * 2000.0 * 2000.0 + 2000.0 * 6.0;
@@ -311,8 +311,8 @@ TEST(RebuildShell, AFinLeavesTheInputUncovered) {
   const int n = int(soup.vertices.size());
   for (const Vec3& p : {Vec3(0, 0, 6), Vec3(0, 8, 6), Vec3(0, 8, 9), Vec3(0, 0, 9)}) soup.vertices.push_back(p);
   soup.faces.push_back({{n, n + 1, n + 2, n + 3}, Semantic::Wall, 6});
-  const Params prm;
-  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
+  const RefineConfig prm;
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
   ASSERT_TRUE(rb.ok) << rb.reason;
   EXPECT_NEAR(rb.input_to_output, 3.0, 0.05);
   EXPECT_EQ(rb.area_dropped, 0.0);
@@ -323,13 +323,13 @@ TEST(RebuildShell, AFinLeavesTheInputUncovered) {
 // covers everything else.
 TEST(RebuildShell, PartitionsBetweenOverlappingPartsAreJoined) {
   const Mesh soup = merged(box_faces({0, 1, 2, 3, 4, 5}), as_soup(box(Vec3(6, 4, 0), Vec3(14, 12, 6))));
-  const Params prm;
-  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
+  const RefineConfig prm;
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
   ASSERT_TRUE(rb.ok) << rb.reason;
-  const Validation v = validate_mesh(rb.mesh, prm.planarity_tolerance);
+  const Validation v = validate_mesh(rb.mesh, prm.repair.planarity_tolerance);
   EXPECT_TRUE(v.valid()) << v.problem;
   EXPECT_NEAR(v.volume, 6.0 * (80.0 + 64.0 - 16.0), 1e-6);
-  EXPECT_LE(rb.input_to_output, prm.weld_tolerance);
+  EXPECT_LE(rb.input_to_output, prm.repair.weld_tolerance);
   EXPECT_NEAR(rb.area_dropped, 2 * (4.0 + 4.0) * 6.0, 6.0);  // each box's two walls inside the other
 }
 
@@ -337,19 +337,19 @@ TEST(RebuildShell, PartitionsBetweenOverlappingPartsAreJoined) {
 // at the corner (no partition: outside on one side). Not rebuilt; the walls stay uncovered.
 TEST(RebuildShell, PartsTouchingAlongAnEdgeAreNotSwallowed) {
   const Mesh soup = merged(box_faces({0, 1, 2, 3, 4, 5}), as_soup(box(Vec3(10, 8, 0), Vec3(16, 14, 5))));
-  const Params prm;
-  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
-  EXPECT_TRUE(!rb.ok || rb.input_to_output > prm.weld_tolerance) << rb.input_to_output;
+  const RefineConfig prm;
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
+  EXPECT_TRUE(!rb.ok || rb.input_to_output > prm.repair.weld_tolerance) << rb.input_to_output;
 }
 
 // A roof alone (or with one wall) has no ground: closing it would invent the foot of every wall.
 TEST(RebuildShell, ARoofWithoutAGroundIsNotClosed) {
-  const Params prm;
-  const ShellRebuild with_wall = rebuild_shell(welded_soup(box_faces({1, 3}), prm.weld_tolerance), prm);
+  const RefineConfig prm;
+  const ShellRebuild with_wall = rebuild_shell(welded_soup(box_faces({1, 3}), prm.repair.weld_tolerance), prm);
   EXPECT_FALSE(with_wall.ok);
   EXPECT_EQ(with_wall.reason, "it has no ground face: the foot of its walls would be invented");
   // A flat roof alone is its own lowest plane: nothing closes it.
-  EXPECT_FALSE(rebuild_shell(welded_soup(box_faces({1}), prm.weld_tolerance), prm).ok);
+  EXPECT_FALSE(rebuild_shell(welded_soup(box_faces({1}), prm.repair.weld_tolerance), prm).ok);
 }
 
 // Thirty rotated boxes overlapping one another (180 planes, an attacker's soup well within
@@ -363,8 +363,8 @@ TEST(RebuildShell, AnArrangementTooLargeForABuildingIsRefused) {
     for (Vec3& p : b.vertices) p = r * p + Vec3(0.5 * k, 0.3 * k, 0);
     soup = merged(soup, b);
   }
-  const Params prm;
-  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.weld_tolerance), prm);
+  const RefineConfig prm;
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
   EXPECT_FALSE(rb.ok);
   EXPECT_EQ(rb.reason.rfind("too many candidate faces (over 10000", 0), 0u) << rb.reason;
 }

@@ -39,8 +39,8 @@ std::vector<SupportPlane> recess_planes() {
 // `eps` m off the centroid); each candidate's source is its plane's.
 template <class Solid>
 void choose_boundary(CandidateSet& cs, Solid solid, double eps) {
-  auto chosen = cs.mesh.add_property_map<FaceIndex, bool>("f:selected", false).first;
-  auto source = cs.mesh.add_property_map<FaceIndex, int>("f:source", -1).first;
+  auto chosen = candidate_props::selected.add(cs.mesh);
+  auto source = candidate_props::source.add(cs.mesh);
   for (int f = 0; f < cs.size(); ++f) {
     const Vec3& c = centroid_of(cs, f);
     const Vec3 n = cs.planes[plane_of(cs, f)].plane.n;
@@ -125,7 +125,7 @@ TEST(ShellTrace, RecessIsClosedManifoldOutward) {
   EXPECT_TRUE(CGAL::Polygon_mesh_processing::is_outward_oriented(sm));
 }
 
-// Semantics from the supporting plane, sources from "f:source" (a merged polygon takes its
+// Semantics from the supporting plane, sources from candidate_props::source (a merged polygon takes its
 // largest piece's: here all pieces of a plane share it).
 TEST(ShellTrace, FacesCarrySemanticAndSource) {
   const Mesh m = traced_shell(recess_selection());
@@ -142,7 +142,7 @@ TEST(ShellTrace, FacesCarrySemanticAndSource) {
 // not mend): the open edges are boundary edges of the output.
 TEST(ShellTrace, OpenSelectionStaysOpen) {
   CandidateSet cs = recess_selection();
-  auto chosen = cs.mesh.property_map<FaceIndex, bool>("f:selected").first;
+  auto chosen = candidate_props::selected.get(cs.mesh);
   for (int f = 0; f < cs.size(); ++f)
     if (plane_of(cs, f) == 5) chosen[FaceIndex(f)] = false;
   const Mesh m = traced_shell(cs);

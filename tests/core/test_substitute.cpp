@@ -13,7 +13,7 @@ using namespace lodrefine;
 using namespace lodrefine::fixtures;
 
 // Validation at the parameter table's planarity tolerance.
-const double kPlanarity = Params{}.planarity_tolerance;
+const double kPlanarity = RefineConfig{}.repair.planarity_tolerance;
 
 namespace {
 

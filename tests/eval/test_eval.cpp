@@ -118,7 +118,7 @@ TEST(EvalBuilding, ShiftedBoxBeforeAndAfter) {
     for (double z = 0.025; z < 6; z += 0.05) cloud.points.push_back({u, 0.0, z});
   for (double u = 0.025; u < 8; u += 0.05)
     for (double z = 0.025; z < 6; z += 0.05) cloud.points.push_back({0.0, u, z});
-  const BuildingEval e = evaluate_building(original, truth, cloud, &truth, Params{});
+  const BuildingEval e = evaluate_building(original, truth, cloud, &truth, RefineConfig{});
   ASSERT_TRUE(e.ok()) << e.error;
   ASSERT_GT(e.facade_points, cloud.points.size() * 9 / 10);
   EXPECT_EQ(e.id, "b1");
@@ -142,7 +142,7 @@ TEST(EvalBuilding, ShiftedBoxBeforeAndAfter) {
 
 TEST(EvalBuilding, EmptyRefinedModelIsAFailureRow) {
   const Mesh truth = box({0, 0, 0}, {10, 8, 6});
-  const BuildingEval e = evaluate_building(truth, Mesh{}, PointCloud{}, nullptr, Params{});
+  const BuildingEval e = evaluate_building(truth, Mesh{}, PointCloud{}, nullptr, RefineConfig{});
   EXPECT_FALSE(e.ok());
   EXPECT_FALSE(e.watertight_after);
   EXPECT_TRUE(e.watertight_before);

@@ -13,20 +13,21 @@ using namespace lodrefine;
 
 namespace {
 
-BuildingFigures building(const std::string& id, const std::string& outcome, double c2m) {
+BuildingFigures building(const std::string& id, Outcome outcome, double c2m) {
   BuildingFigures b;
   b.id = id;
   b.outcome = outcome;
   b.c2m_rmse = c2m;
   b.c2m_mae = c2m * 0.8;
   b.watertight = true;
-  b.facades_moved = outcome == "refined" ? 2 : 0;
+  b.facades_moved = outcome == Outcome::Refined ? 2 : 0;
   return b;
 }
 
 RunFigures sample_run() {
   RunFigures r;
-  r.buildings = {building("a", "refined", 0.012), building("b", "kept", 0.030), building("c", "refined", 0.020)};
+  r.buildings = {building("a", Outcome::Refined, 0.012), building("b", Outcome::Kept, 0.030),
+                 building("c", Outcome::Refined, 0.020)};
   r.buildings[0].truth_facade_rmse = 0.010;
   r.refined = 2;
   r.watertight_rate = 1.0;
@@ -69,7 +70,7 @@ TEST(Gate, BaselineRoundTripsAndAnUnchangedRunPasses) {
   const RunFigures back = read_baseline(baseline_json(run), "base.json");
   ASSERT_EQ(back.buildings.size(), 3u);
   EXPECT_EQ(back.buildings[0].id, "a");
-  EXPECT_EQ(back.buildings[1].outcome, "kept");
+  EXPECT_EQ(back.buildings[1].outcome, Outcome::Kept);
   EXPECT_DOUBLE_EQ(*back.buildings[0].truth_facade_rmse, 0.010);
   EXPECT_FALSE(back.buildings[1].truth_facade_rmse.has_value());
   EXPECT_EQ(back.buildings[0].facades_moved, 2u);
@@ -94,13 +95,13 @@ TEST(Gate, IdsThatAreNotUtf8MatchTheBaselineTheyWrote) {
 TEST(Gate, EachRegressionNamesBuildingFigureAndValues) {
   const RunFigures base = sample_run();
   RunFigures run = sample_run();
-  run.buildings[0].c2m_rmse = 0.301;  // a: moved by 0.3 m
-  run.buildings[2].outcome = "kept";  // c: refined -> kept
+  run.buildings[0].c2m_rmse = 0.301;         // a: moved by 0.3 m
+  run.buildings[2].outcome = Outcome::Kept;  // c: refined -> kept
   run.buildings[2].reason = "no facade matched";
-  run.buildings[2].c2m_rmse = 0.5;                          // not compared again: the outcome says it
-  run.buildings[1].c2m_rmse = 0.034;                        // b: worse by 4 mm, within the tolerance
-  run.buildings.push_back(building("d", "refined", 0.01));  // new: listed, not failed
-  run.buildings.erase(run.buildings.begin() + 1);           // b gone
+  run.buildings[2].c2m_rmse = 0.5;                                 // not compared again: the outcome says it
+  run.buildings[1].c2m_rmse = 0.034;                               // b: worse by 4 mm, within the tolerance
+  run.buildings.push_back(building("d", Outcome::Refined, 0.01));  // new: listed, not failed
+  run.buildings.erase(run.buildings.begin() + 1);                  // b gone
   const GateVerdict v = check_run(run, &base, nullptr, 0.005);
   const auto t = texts(v);
   ASSERT_EQ(t.size(), 3u) << ::testing::PrintToString(t);
@@ -123,7 +124,7 @@ TEST(Gate, LostMeasuresWatertightnessAndPooledFiguresFail) {
   RunFigures run = sample_run();
   run.buildings[0].truth_facade_rmse.reset();
   run.buildings[2].watertight = false;
-  run.buildings[2].outcome = "failed";
+  run.buildings[2].outcome = Outcome::Failed;
   run.failed = 1;
   run.watertight_rate = 2.0 / 3.0;
   run.c2m_rmse = 0.05;
@@ -134,8 +135,8 @@ TEST(Gate, LostMeasuresWatertightnessAndPooledFiguresFail) {
   EXPECT_EQ(t[2], "pooled: c2m_rmse 0.0210 m -> 0.0500 m (worse by 0.0290 m, tolerance 0.0050 m)");
   EXPECT_EQ(t[3], "pooled: failed 0 -> 1");
   EXPECT_EQ(t[4], "pooled: watertight_rate 1.000 -> 0.667");
-  EXPECT_LT(outcome_rank("kept-invalid"), outcome_rank("kept"));
-  EXPECT_LT(outcome_rank("failed"), outcome_rank("kept-invalid"));
+  EXPECT_LT(outcome_rank(Outcome::KeptInvalid), outcome_rank(Outcome::Kept));
+  EXPECT_LT(outcome_rank(Outcome::Failed), outcome_rank(Outcome::KeptInvalid));
 }
 
 TEST(Gate, GatesBreachedPooledAndPerBuilding) {
@@ -197,10 +198,10 @@ TEST(Gate, XmlEscapeKeepsOnlyWhatXml10Allows) {
 TEST(Gate, JunitHasOneTestcasePerBuildingAndParsesWithHostileIds) {
   RunFigures base = sample_run();
   const std::string hostile = std::string("</testcase><script>alert(\"x\")</script>'\x01\xFF\n]]>");
-  base.buildings.push_back(building(hostile, "refined", 0.01));
+  base.buildings.push_back(building(hostile, Outcome::Refined, 0.01));
   RunFigures run = base;
   run.buildings[3].c2m_rmse = 0.31;  // the hostile one regressed
-  run.buildings.push_back(building("new", "kept", 0.01));
+  run.buildings.push_back(building("new", Outcome::Kept, 0.01));
   const Gates g = {{"max_failed_buildings", 0}};
   const GateVerdict v = check_run(run, &base, &g, 0.005);
   const std::string xml = junit_xml(v, "samples");
@@ -238,7 +239,7 @@ TEST(GateFiles, DeepNestingAndControlCharactersFailInOneLine) {
   EXPECT_NE(nested.find("nested deeper than"), std::string::npos) << nested.substr(0, 200);
 
   RunFigures run;
-  run.buildings = {building("a\nlodrefine: error: injected", "refined", 0.1)};
+  run.buildings = {building("a\nlodrefine: error: injected", Outcome::Refined, 0.1)};
   run.buildings.push_back(run.buildings.front());
   const std::string twice = refusal([&] { read_baseline(baseline_json(run), "twice.json"); });
   EXPECT_NE(twice.find("listed twice"), std::string::npos) << twice;
@@ -249,16 +250,19 @@ TEST(GateFiles, DeepNestingAndControlCharactersFailInOneLine) {
   EXPECT_EQ(gate.find_first_of("\n\x1b"), std::string::npos) << gate;
 }
 
-// A gate line quotes outcomes and reasons from the run's reports and the baseline: their control
+// A gate line quotes ids and reasons from the run's reports and the baseline: their control
 // characters are escaped, as a CR and escape codes printed "gate: … passed" over the verdict.
+// An outcome is no quote: a baseline's is read as one lodrefine writes, any other text as failed.
 TEST(Gate, LinesQuotingReportsAndBaselinesStayOneLine) {
-  const RunFigures base = sample_run();
   RunFigures run = sample_run();
-  run.buildings[2].outcome = "kept";
+  run.buildings[2].outcome = Outcome::Kept;
   run.buildings[2].reason = "judge\r\x1b[2K\ngate: 0 building(s): passed\x1b[8m";
-  RunFigures old = base;
-  old.buildings[1].outcome = "refined\r\x1b[2Kgate: all good\n";
-  old.buildings.push_back(building("gone", "kept\rpassed", 0.01));
+  const RunFigures old = read_baseline(R"({"format": "lodrefine-baseline", "version": 1, "buildings": [
+      {"id": "a", "outcome": "refined"}, {"id": "b", "outcome": "refined\r\u001b[2Kgate: all good\n"},
+      {"id": "c", "outcome": "refined"}, {"id": "gone\rpassed", "outcome": "kept"}]})",
+                                       "base.json");
+  ASSERT_EQ(old.buildings.size(), 4u);
+  EXPECT_EQ(old.buildings[1].outcome, Outcome::Failed);
   const GateVerdict v = check_run(run, &old, nullptr, 0.005);
   ASSERT_GE(v.failures.size(), 2u);
   for (const auto& l : v.failures) {

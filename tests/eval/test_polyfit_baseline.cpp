@@ -57,7 +57,7 @@ void expect_box(const PolyfitResult& r, const Mesh& truth) {
 
 TEST(PolyfitBaseline, ScanPlanesCloseTheBoxOnTheTruth) {
   const Mesh truth = truth_box();
-  const PolyfitResult r = polyfit_baseline(coarse_box(), full_scan(truth), Params{}, {PolyfitPlanes::Scan});
+  const PolyfitResult r = polyfit_baseline(coarse_box(), full_scan(truth), RefineConfig{}, {PolyfitPlanes::Scan});
   expect_box(r, truth);
   EXPECT_EQ(r.model_planes, 0);
   EXPECT_GT(r.points, 20000u);
@@ -66,7 +66,7 @@ TEST(PolyfitBaseline, ScanPlanesCloseTheBoxOnTheTruth) {
 // The moved model wall is a plane too, but the scan's points outweigh its samples.
 TEST(PolyfitBaseline, ModelAndScanPlanesFollowTheScan) {
   const Mesh truth = truth_box();
-  const PolyfitResult r = polyfit_baseline(coarse_box(), full_scan(truth), Params{}, {});
+  const PolyfitResult r = polyfit_baseline(coarse_box(), full_scan(truth), RefineConfig{}, {});
   expect_box(r, truth);
   EXPECT_EQ(r.model_planes, 6);
   EXPECT_GT(truth_rms(coarse_box(), truth), 0.1);  // the coarse model is off
@@ -75,8 +75,8 @@ TEST(PolyfitBaseline, ModelAndScanPlanesFollowTheScan) {
 TEST(PolyfitBaseline, IsolatedChildGivesTheSameMesh) {
   const Mesh truth = truth_box();
   const PointCloud cloud = full_scan(truth);
-  const PolyfitResult in_process = polyfit_baseline(coarse_box(), cloud, Params{}, {});
-  const PolyfitResult isolated = polyfit_baseline_isolated(coarse_box(), cloud, Params{}, {});
+  const PolyfitResult in_process = polyfit_baseline(coarse_box(), cloud, RefineConfig{}, {});
+  const PolyfitResult isolated = polyfit_baseline_isolated(coarse_box(), cloud, RefineConfig{}, {});
   expect_box(isolated, truth);
   // CGAL orders planes by address (std::set of pointers), so a corner may come from another
   // plane triple in another process: equal to rounding.
@@ -91,7 +91,7 @@ TEST(PolyfitBaseline, IsolatedChildGivesTheSameMesh) {
 // Failures are statuses with a reason: nothing thrown, no mesh claimed closed.
 TEST(PolyfitBaseline, TooFewPlanesIsAStatus) {
   const Mesh truth = truth_box();
-  const PolyfitResult r = polyfit_baseline(truth, scan_of(truth, {2, 3}), Params{}, {PolyfitPlanes::Scan});
+  const PolyfitResult r = polyfit_baseline(truth, scan_of(truth, {2, 3}), RefineConfig{}, {PolyfitPlanes::Scan});
   EXPECT_EQ(r.status, PolyfitStatus::TooFewPlanes);
   EXPECT_NE(r.reason.find("at least 4"), std::string::npos) << r.reason;
   EXPECT_EQ(r.planes, 2);
@@ -99,11 +99,11 @@ TEST(PolyfitBaseline, TooFewPlanesIsAStatus) {
 }
 
 TEST(PolyfitBaseline, UnusableModelIsAnError) {
-  const PolyfitResult r = polyfit_baseline(Mesh{}, full_scan(truth_box()), Params{}, {});
+  const PolyfitResult r = polyfit_baseline(Mesh{}, full_scan(truth_box()), RefineConfig{}, {});
   EXPECT_EQ(r.status, PolyfitStatus::Error);
   EXPECT_FALSE(r.reason.empty());
-  Params bad;
-  bad.ransac_epsilon = -1;  // out of the parameter table's range
+  RefineConfig bad;
+  bad.plane.ransac_epsilon = -1;  // out of the parameter table's range
   EXPECT_EQ(polyfit_baseline(truth_box(), PointCloud{}, bad, {}).status, PolyfitStatus::Error);
 }
 
@@ -121,7 +121,7 @@ TEST(PolyfitBaseline, IsolatedChildStopsAtItsCpuLimit) {
   PolyfitOptions options{PolyfitPlanes::Scan};
   options.cpu_limit = 1.0;
   const Mesh model = translated(box(Vec3::Zero(), Vec3(20, 20, 20)), kOrigin);
-  const PolyfitResult r = polyfit_baseline_isolated(model, cloud, Params{}, options);
+  const PolyfitResult r = polyfit_baseline_isolated(model, cloud, RefineConfig{}, options);
   EXPECT_EQ(r.status, PolyfitStatus::TimeLimit) << polyfit_status_name(r.status) << ": " << r.reason;
   EXPECT_NE(r.reason.find("1 s CPU"), std::string::npos) << r.reason;
   EXPECT_TRUE(r.mesh.faces.empty());
@@ -137,7 +137,7 @@ TEST(PolyfitBench, CompareMeasuresBothMethodsOnTheTruth) {
   b.truth = truth_box();
   b.coarse = coarse_box();
   b.cloud = full_scan(b.truth);
-  const PolyfitComparisonRow row = compare_with_polyfit(b, Params{}, {});
+  const PolyfitComparisonRow row = compare_with_polyfit(b, RefineConfig{}, {});
   EXPECT_EQ(row.id, "box");
   ASSERT_TRUE(row.coarse_facade && row.lodrefine.truth_facade && row.polyfit.truth_facade);
   EXPECT_GT(row.coarse_facade->rmse, 0.1);
@@ -184,7 +184,7 @@ TEST(PolyfitBench, SummaryCountsFailuresAndPoolsOverClosedBuildings) {
 TEST(PolyfitBench, RowsEscapeIdsAndReasons) {
   PolyfitComparisonRow row;
   row.id = "B\r\x1b[2KALL GOOD";
-  row.outcome = "kept";
+  row.outcome = Outcome::Kept;
   row.baseline.status = PolyfitStatus::TooFewPlanes;
   row.baseline.reason = "few\rplanes";
   std::FILE* f = std::tmpfile();

@@ -27,16 +27,16 @@ namespace {
 
 const std::string kHostile = "</script><script>document.title='pwned'</script>\"'<!--\xE2\x80\xA8&";
 
-CityReviewBuilding reviewed(const std::string& id, const std::string& outcome, double fit_after, double x) {
+CityReviewBuilding reviewed(const std::string& id, Outcome outcome, double fit_after, double x) {
   CityReviewBuilding b;
   b.id = id;
   b.outcome = outcome;
-  b.reason = outcome == "refined" ? "" : "the refinement does not fit the scan better (RMS 0.1 -> 0.2 m)";
+  b.reason = outcome == Outcome::Refined ? "" : "the refinement does not fit the scan better (RMS 0.1 -> 0.2 m)";
   b.fit_before = 0.2;
   b.fit_after = fit_after;
   const Mesh m = fixtures::box({x, 0, 0}, {x + 8, 6, 5});
   b.outline = review_outline(m, Vec3::Zero());
-  if (outcome == "refined") b.view = review_view(id, m, fixtures::box({x + 0.3, 0, 0}, {x + 8, 6, 5}), {}, 100);
+  if (outcome == Outcome::Refined) b.view = review_view(id, m, fixtures::box({x + 0.3, 0, 0}, {x + 8, 6, 5}), {}, 100);
   return b;
 }
 
@@ -46,11 +46,12 @@ TEST(Review, HostileIdsEscapedAndTableWorstFirst) {
   CityReview r;
   r.title = "city <b>";
   r.summary = "2 refined";
-  r.buildings = {reviewed("good", "refined", 0.01, 0), reviewed(kHostile, "refined", 0.05, 20),
-                 reviewed("k1", "kept", 0.3, 40), reviewed("k2", "kept", 0.3, 60), reviewed("u", "untouched", 0, 80)};
+  r.buildings = {reviewed("good", Outcome::Refined, 0.01, 0), reviewed(kHostile, Outcome::Refined, 0.05, 20),
+                 reviewed("k1", Outcome::Kept, 0.3, 40), reviewed("k2", Outcome::Kept, 0.3, 60),
+                 reviewed("u", Outcome::Untouched, 0, 80)};
   r.buildings[3].reason = "no wall matched a scan plane";
   for (const std::string id : {"i1", "i2"}) {
-    r.buildings.push_back(reviewed(id, "kept-invalid", 0.3, 100));
+    r.buildings.push_back(reviewed(id, Outcome::KeptInvalid, 0.3, 100));
     r.buildings.back().reason = "building " + id + ": not closable: 2 non-manifold edges (more than two faces)";
   }
   const std::string h = city_review_html(r);

@@ -31,7 +31,7 @@ TEST(RunRecord, RefinedReportGivesItsFacadesTimeAndSelection) {
   json report = run_report("refined");
   report["facades"].push_back({{"input_faces", {3, 4}}, {"evidence", "corner"}, {"max_move", 0.25}});
   const RunRow r = record_of(report);
-  EXPECT_EQ(r.outcome, "refined");
+  EXPECT_EQ(r.outcome, Outcome::Refined);
   EXPECT_EQ(r.refine_outcome, "refined");
   EXPECT_EQ(r.reason, "");
   EXPECT_EQ(r.selection, "optimal");
@@ -47,11 +47,11 @@ TEST(RunRecord, KeptBuildingMovedNothingAndKeepsItsReason) {
   json report = run_report("kept", "judge refused (gain): 12 points closer");
   report["facades"].push_back({{"input_faces", {1}}, {"max_move", 0.9}});
   const RunRow r = record_of(report);
-  EXPECT_EQ(r.outcome, "kept");
+  EXPECT_EQ(r.outcome, Outcome::Kept);
   EXPECT_EQ(r.reason, "judge refused (gain): 12 points closer");
   EXPECT_TRUE(r.moved.empty());
   const RunRow invalid = record_of(run_report("kept-invalid", "not closed"));
-  EXPECT_EQ(invalid.outcome, "kept");
+  EXPECT_EQ(invalid.outcome, Outcome::Kept);
   EXPECT_EQ(invalid.refine_outcome, "kept-invalid");
 }
 
@@ -68,7 +68,7 @@ TEST(RunRecord, RetiredSpellingsCountForNothing) {
   EXPECT_TRUE(record_of(report).moved.empty());
 
   const RunRow bracketed = record_of(run_report("refined (2 walls moved)"));
-  EXPECT_EQ(bracketed.outcome, "kept");
+  EXPECT_EQ(bracketed.outcome, Outcome::Kept);
   EXPECT_EQ(bracketed.reason, "");
   EXPECT_TRUE(bracketed.moved.empty());
 }
@@ -77,7 +77,7 @@ TEST(RunRecord, ReportWithoutVersionIsReadAsVersionOne) {
   json report = run_report("refined");
   report.erase("report_version");
   const RunRow r = record_of(report);
-  EXPECT_EQ(r.outcome, "refined");
+  EXPECT_EQ(r.outcome, Outcome::Refined);
   ASSERT_EQ(r.moved.size(), 1u);
   EXPECT_DOUBLE_EQ(r.moved[0].displacement, kRunWallOffset);
 }
@@ -99,19 +99,19 @@ TEST(RunRecord, ReportOfAnotherVersionIsRefusedInOneLine) {
 
 TEST(RunRecord, FailedFileMissingReportAndWrongTypes) {
   const RunRow failed = record_of(run_report("refined"), "lodrefine: error: cloud.ply: truncated");
-  EXPECT_EQ(failed.outcome, "failed");
+  EXPECT_EQ(failed.outcome, Outcome::Failed);
   EXPECT_EQ(failed.reason, "lodrefine: error: cloud.ply: truncated");
   EXPECT_TRUE(failed.moved.empty());
   EXPECT_EQ(failed.selection, "optimal");  // what the report says is still shown
 
   const RunRow none = record_of(nullptr);
-  EXPECT_EQ(none.outcome, "kept");
+  EXPECT_EQ(none.outcome, Outcome::Kept);
   EXPECT_EQ(none.reason, "no report.json");
 
   json report = run_report("kept");
   report["reason"] = 42;
   const RunRow odd = record_of(report);
-  EXPECT_EQ(odd.outcome, "kept");
+  EXPECT_EQ(odd.outcome, Outcome::Kept);
   EXPECT_EQ(odd.reason, "report.json: \"reason\" is no text");
   report["reason"] = "kept";
   report["seconds"] = 5;  // not an object: the report is unreadable, in our words
@@ -147,7 +147,7 @@ TEST(RunEvaluate, RowsInIdOrderWithFiguresAndFailures) {
   std::ofstream(run / "c" / "cloud.ply") << "ply\nformat nonsense\n";
   for (int jobs : {1, 3}) {
     PooledSeries series;
-    const auto rows = evaluate_run(run.string(), Params{}, "", jobs, series, Progress::Mode::Off);
+    const auto rows = evaluate_run(run.string(), RefineConfig{}, "", jobs, series, Progress::Mode::Off);
     ASSERT_EQ(rows.size(), 3u);
     EXPECT_EQ(rows[0].eval.id, "a");
     EXPECT_EQ(rows[1].eval.id, "b");
@@ -161,11 +161,11 @@ TEST(RunEvaluate, RowsInIdOrderWithFiguresAndFailures) {
     EXPECT_TRUE(a.c2m_after.empty()) << "the series go into the bins and are dropped";
     EXPECT_EQ(series.c2m_after.count(), a.facade_points);
     EXPECT_NEAR((rows[0].origin - kRunOrigin).norm(), 0.0, 1e-9);
-    EXPECT_EQ(rows[0].outcome, "refined");
+    EXPECT_EQ(rows[0].outcome, Outcome::Refined);
     ASSERT_EQ(rows[0].moved.size(), 1u);
-    EXPECT_EQ(rows[1].outcome, "failed");
+    EXPECT_EQ(rows[1].outcome, Outcome::Failed);
     EXPECT_NE(rows[1].reason.find("refined model missing"), std::string::npos) << rows[1].reason;
-    EXPECT_EQ(rows[2].outcome, "failed");
+    EXPECT_EQ(rows[2].outcome, Outcome::Failed);
     EXPECT_NE(rows[2].reason.find("cloud.ply"), std::string::npos) << rows[2].reason;
   }
 }
@@ -177,5 +177,5 @@ TEST(RunEvaluate, ANewerReportStopsTheRun) {
   newer["report_version"] = kRefineReportVersion + 1;
   write_run_building(run, "b", true, newer);
   PooledSeries series;
-  EXPECT_THROW(evaluate_run(run.string(), Params{}, "", 2, series, Progress::Mode::Off), InputError);
+  EXPECT_THROW(evaluate_run(run.string(), RefineConfig{}, "", 2, series, Progress::Mode::Off), InputError);
 }

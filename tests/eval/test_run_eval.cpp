@@ -122,5 +122,7 @@ TEST(RunEval, OneBuildingWithoutARefinedModelIsAFailedRow) {
   EXPECT_EQ(r.out.find("outcomes:"), std::string::npos) << "one building has no run totals";
   const json j = json::parse(cli_fixtures::slurp(o.json_out));
   EXPECT_EQ(j["buildings"][0]["status"], "failed");
+  EXPECT_EQ(j["buildings"][0]["outcome"], "") << "no refine record: no outcome";
+  EXPECT_EQ(j["pooled"]["outcomes"], json({{"", 1}, {"failed", 0}, {"kept", 0}, {"refined", 0}}));
   EXPECT_FALSE(j.contains("run_dir"));
 }

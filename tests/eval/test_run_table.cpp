@@ -23,14 +23,14 @@ RunRow row(const std::string& id, double rmse_before, double rmse_after, bool wa
   r.eval.watertight_before = true;
   r.eval.watertight_after = watertight;
   r.eval.delta_d = 0.25;
-  r.outcome = "refined";
+  r.outcome = Outcome::Refined;
   r.refine_outcome = "refined";
   return r;
 }
 
 RunRow failed_row(const std::string& id) {
   RunRow r = failure_row(id, "refined model missing");
-  r.outcome = "failed";
+  r.outcome = Outcome::Failed;
   r.reason = r.eval.error;
   return r;
 }
@@ -66,7 +66,7 @@ TEST(RunTable, TotalsCountOutcomesMovesAndSeconds) {
   std::vector<RunRow> rows = {row("a", 0.4, 0.01, true), row("b", 0.4, 0.01, true), failed_row("c")};
   rows[0].moved = {{json({2}), 0.4}, {json({3}), 0.2}};
   rows[0].refine_seconds = 2.0;
-  rows[1].outcome = "kept";
+  rows[1].outcome = Outcome::Kept;
   rows[1].refine_seconds = 0.5;
   const RunTotals t = run_totals(rows);
   EXPECT_EQ(t.outcomes.at("refined"), 1u);
@@ -162,13 +162,13 @@ TEST(RunTable, HtmlRowAndGateFigures) {
   for (const auto& column : html_columns()) EXPECT_TRUE(h.contains(column[0].get<std::string>())) << column;
 
   const BuildingFigures f = building_figures(r);
-  EXPECT_EQ(f.outcome, "refined");
+  EXPECT_EQ(f.outcome, Outcome::Refined);
   EXPECT_EQ(f.facades_moved, 2u);
   EXPECT_DOUBLE_EQ(*f.moved_max, 0.4);
   EXPECT_DOUBLE_EQ(*f.c2m_rmse, 0.01);
   RunRow invalid = row("b", 0.4, 0.4, false);
-  invalid.outcome = "kept", invalid.refine_outcome = "kept-invalid";
-  EXPECT_EQ(building_figures(invalid).outcome, "kept-invalid");
+  invalid.outcome = Outcome::Kept, invalid.refine_outcome = "kept-invalid";
+  EXPECT_EQ(building_figures(invalid).outcome, Outcome::KeptInvalid);
   EXPECT_FALSE(building_figures(invalid).watertight);
   EXPECT_FALSE(building_figures(failed_row("c")).c2m_rmse);
 

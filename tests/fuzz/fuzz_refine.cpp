@@ -38,13 +38,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return 0;
   }
 
-  Params prm;
-  prm.mip_time_limit = 1.0;
+  RefineConfig prm;
+  prm.selection.mip_time_limit = 1.0;
   if (tiny) {
-    prm.ransac_min_points = 20;
-    prm.min_plane_area = 0.2;
-    prm.normal_neighbors = 6;
-    prm.ransac_cluster_epsilon = 1.0;  // seed clouds are sparse (0.5 m spacing)
+    prm.plane.ransac_min_points = 20;
+    prm.plane.min_plane_area = 0.2;
+    prm.plane.normal_neighbors = 6;
+    prm.plane.ransac_cluster_epsilon = 1.0;  // seed clouds are sparse (0.5 m spacing)
   }
   RefineResult r;
   try {

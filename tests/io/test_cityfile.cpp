@@ -35,7 +35,7 @@
 using namespace lodrefine;
 
 // Validation at the parameter table's planarity tolerance.
-const double kPlanarity = Params{}.planarity_tolerance;
+const double kPlanarity = RefineConfig{}.repair.planarity_tolerance;
 
 namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
@@ -140,7 +140,7 @@ void check_city_output(const json& in, const std::string& out_path, const CityRe
   ASSERT_EQ(out["CityObjects"].size(), in["CityObjects"].size());
   EXPECT_EQ(s.refined + s.repaired + s.kept + s.kept_invalid + s.untouched, s.buildings);
   std::map<std::string, std::string> outcome;
-  for (const auto& o : s.outcomes) outcome[o.id] = o.outcome;
+  for (const auto& o : s.outcomes) outcome[o.id] = outcome_name(o.outcome);
   int identical = 0;
   std::size_t vertex_mismatches = 0;
   for (const auto& [id, obj] : in["CityObjects"].items()) {
@@ -224,21 +224,21 @@ TEST(CityFile, GeneratedCityRefinedIntoCityJson2) {
   write_ply(dir + "/cloud.ply", cloud);
 
   const CityRefineSummary s =
-      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", Params{}, {});
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", RefineConfig{}, {});
   EXPECT_EQ(s.buildings, 4);
   EXPECT_EQ(s.untouched, 1);  // the Hip building has no points
   EXPECT_EQ(s.outcomes.size(), 3u);
   EXPECT_GE(s.refined, 2);
   EXPECT_EQ(s.cloud_points, cloud.points.size());
   for (const auto& o : s.outcomes)
-    if (o.outcome == "refined") {
+    if (o.outcome == Outcome::Refined) {
       EXPECT_GE(o.facades_moved, 1) << o.id;
     }
   check_city_output(in, dir + "/out.city.json", s);
   // The refined LoD 2.2 geometry replaced in place; the LoD 1 geometry before it kept.
   const json out = load(dir + "/out.city.json");
   for (const auto& o : s.outcomes) {
-    if (o.outcome != "refined") continue;
+    if (o.outcome != Outcome::Refined) continue;
     EXPECT_EQ(out["CityObjects"][o.id]["geometry"][0], in["CityObjects"][o.id]["geometry"][0]);
     EXPECT_EQ(out["CityObjects"][o.id]["geometry"][1]["lod"], "2.2");
     EXPECT_EQ(out["CityObjects"][o.id]["geometry"][1]["type"], "Solid");
@@ -248,7 +248,7 @@ TEST(CityFile, GeneratedCityRefinedIntoCityJson2) {
   CityRefineOptions one;
   one.building = bs[1].id;
   const CityRefineSummary s1 =
-      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/one.city.json", Params{}, one);
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/one.city.json", RefineConfig{}, one);
   ASSERT_EQ(s1.outcomes.size(), 1u);
   EXPECT_EQ(s1.outcomes[0].id, bs[1].id);
   EXPECT_EQ(s1.untouched, 3);
@@ -273,14 +273,14 @@ TEST(CityFile, OnlyTheMisplacedTerracedHouseChanges) {
   PointCloud cloud = fixtures::terraced_street_scan(-0.6, 24.6, 5);
   for (auto& p : cloud.points) p += origin;
   write_ply(dir + "/terraced.ply", cloud);
-  const CityRefineSummary s =
-      refine_city(dir + "/terraced.city.json", {dir + "/terraced.ply"}, dir + "/terraced.out.city.json", Params{}, {});
+  const CityRefineSummary s = refine_city(dir + "/terraced.city.json", {dir + "/terraced.ply"},
+                                          dir + "/terraced.out.city.json", RefineConfig{}, {});
   ASSERT_EQ(s.outcomes.size(), 3u);
   std::map<std::string, CityBuildingOutcome> by_id;
   for (const auto& o : s.outcomes) by_id[o.id] = o;
-  EXPECT_EQ(by_id["A"].outcome, "kept") << by_id["A"].reason;
-  EXPECT_EQ(by_id["B"].outcome, "refined") << by_id["B"].reason;
-  EXPECT_EQ(by_id["G"].outcome, "kept");
+  EXPECT_EQ(by_id["A"].outcome, Outcome::Kept) << by_id["A"].reason;
+  EXPECT_EQ(by_id["B"].outcome, Outcome::Refined) << by_id["B"].reason;
+  EXPECT_EQ(by_id["G"].outcome, Outcome::Kept);
   EXPECT_EQ(by_id["G"].reason, "scan covers no facade of this building");
   EXPECT_EQ(s.refused.size(), 0u);
   check_city_output(in, dir + "/terraced.out.city.json", s);  // A and G exactly as read
@@ -316,10 +316,10 @@ TEST(CityFile, ErrorsAndBuildingsThatCannotBeRefined) {
   for (int i = 0; i < 500; ++i) cloud.points.push_back(Vec3(93005.0 + 0.002 * i, 436005.5, 0.5));
   write_ply(dir + "/cloud.ply", cloud);
   const CityRefineSummary s =
-      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", Params{}, {});
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", RefineConfig{}, {});
   ASSERT_EQ(s.outcomes.size(), 2u);
   EXPECT_EQ(s.outcomes[1].id, "broken");
-  EXPECT_EQ(s.outcomes[1].outcome, "kept-invalid");
+  EXPECT_EQ(s.outcomes[1].outcome, Outcome::KeptInvalid);
   EXPECT_FALSE(s.outcomes[1].reason.empty());
   check_city_output(in, dir + "/out.city.json", s);
 
@@ -387,7 +387,7 @@ TEST(CityFile, RotterdamDelfshaven) {
   s.buildings = rep["buildings"], s.refined = rep["refined"], s.kept = rep["kept"];
   s.kept_invalid = rep["kept_invalid"], s.untouched = rep["untouched"];
   for (const auto& o : rep["outcomes"])
-    s.outcomes.push_back({o["id"], o["outcome"], o["reason"], o["facades_moved"], {}});
+    s.outcomes.push_back({o["id"], parse_outcome(o["outcome"]).value(), o["reason"], o["facades_moved"], {}});
   EXPECT_EQ(s.buildings, 853);
   EXPECT_GE(s.refined, 1);
   check_city_output(load(path.string()), dir + "/rotterdam.city.json", s);
@@ -418,7 +418,7 @@ TEST(CityFile, RepairAllMendsTheBuildingsTheCloudDoesNotReach) {
   write_ply(dir + "/cloud.ply", bs[0].cloud);
 
   const CityRefineSummary plain =
-      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/plain.city.json", Params{}, {});
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/plain.city.json", RefineConfig{}, {});
   EXPECT_EQ(plain.untouched, 2);
   EXPECT_EQ(plain.repaired, 0);
   check_city_output(in, dir + "/plain.city.json", plain);
@@ -426,13 +426,13 @@ TEST(CityFile, RepairAllMendsTheBuildingsTheCloudDoesNotReach) {
   CityRefineOptions all;
   all.repair_all = true;
   const CityRefineSummary s =
-      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/all.city.json", Params{}, all);
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/all.city.json", RefineConfig{}, all);
   ASSERT_EQ(s.outcomes.size(), 3u);
   EXPECT_EQ(s.untouched, 0);
   EXPECT_EQ(s.outcomes[1].id, "open");
-  EXPECT_EQ(s.outcomes[1].outcome, "repaired") << s.outcomes[1].reason;
+  EXPECT_EQ(s.outcomes[1].outcome, Outcome::Repaired) << s.outcomes[1].reason;
   EXPECT_EQ(s.outcomes[1].reason.rfind("shell rebuilt on its planes", 0), 0u) << s.outcomes[1].reason;
-  EXPECT_EQ(s.outcomes[2].outcome, "kept") << s.outcomes[2].reason;
+  EXPECT_EQ(s.outcomes[2].outcome, Outcome::Kept) << s.outcomes[2].reason;
   check_city_output(in, dir + "/all.city.json", s);
   const CityJsonFile back = read_cityjson(dir + "/all.city.json");
   for (const auto& b : back.buildings)
@@ -458,7 +458,8 @@ TEST(CityFile, DenHaagCityGml) {
       moved = moved || big;
     }
   write_ply(dir + "/scan.ply", cloud);
-  const CityRefineSummary s = refine_city(path.string(), {dir + "/scan.ply"}, dir + "/denhaag.city.json", Params{}, {});
+  const CityRefineSummary s =
+      refine_city(path.string(), {dir + "/scan.ply"}, dir + "/denhaag.city.json", RefineConfig{}, {});
   EXPECT_EQ(s.input_format, "CityGML 1.0");
   EXPECT_EQ(s.buildings, 6);
   EXPECT_GE(s.outcomes.size(), 1u);
@@ -471,7 +472,7 @@ TEST(CityFile, DenHaagCityGml) {
   CityRefineOptions all;
   all.repair_all = true;
   const CityRefineSummary r =
-      refine_city(path.string(), {dir + "/scan.ply"}, dir + "/denhaag_all.city.json", Params{}, all);
+      refine_city(path.string(), {dir + "/scan.ply"}, dir + "/denhaag_all.city.json", RefineConfig{}, all);
   EXPECT_EQ(int(r.outcomes.size()), r.buildings);
   EXPECT_EQ(r.repaired, 0);
   EXPECT_EQ(r.kept_invalid, 0);
@@ -500,7 +501,7 @@ TEST(CityFile, CityJsonSeqStreamedThrough) {
   write_file_atomic(dir + "/city.city.jsonl", text);
   write_ply(dir + "/cloud.ply", cloud);
   const CityRefineSummary s =
-      refine_city(dir + "/city.city.jsonl", {dir + "/cloud.ply"}, dir + "/out.city.jsonl", Params{}, {});
+      refine_city(dir + "/city.city.jsonl", {dir + "/cloud.ply"}, dir + "/out.city.jsonl", RefineConfig{}, {});
   EXPECT_EQ(s.input_format, "CityJSONSeq 2.0");
   EXPECT_EQ(s.buildings, 3);
   EXPECT_EQ(s.untouched, 1);
@@ -516,7 +517,7 @@ TEST(CityFile, CityJsonSeqStreamedThrough) {
   ASSERT_EQ(back.buildings.size(), 3u);
   for (const auto& o : s.outcomes)
     for (const auto& b : back.buildings)
-      if (b.mesh.id == o.id && o.outcome == "refined") {
+      if (b.mesh.id == o.id && o.outcome == Outcome::Refined) {
         EXPECT_EQ(geometry_problem(b.mesh), "") << b.mesh.id;
       }
   const fs::path schemas = shared_dir() / "schemas" / "cityjson-2.0.2";
@@ -546,7 +547,7 @@ TEST(CityFile, CityJson1xUpgradedTo2) {
   write_file_atomic(dir + "/city.json", in.dump());
   write_ply(dir + "/cloud.ply", cloud);
   const CityRefineSummary s =
-      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", Params{}, {});
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", RefineConfig{}, {});
   EXPECT_EQ(s.input_format, "CityJSON 1.1");
   EXPECT_EQ(s.untouched, 1);
   const json out = load(dir + "/out.city.json");
@@ -592,17 +593,19 @@ TEST(CityFile, LodPicksTheGeometryToRefine) {
     write_ply(dir + "/c.ply", cloud);
     CityRefineOptions o;
     o.lod = lod;
-    const CityRefineSummary s = refine_city(path.string(), {dir + "/c.ply"}, dir + "/out.city.json", Params{}, o);
+    const CityRefineSummary s = refine_city(path.string(), {dir + "/c.ply"}, dir + "/out.city.json", RefineConfig{}, o);
     ASSERT_EQ(s.outcomes.size(), 1u);
     const json out = load(dir + "/out.city.json");
     for (std::size_t k = 0; k < in["CityObjects"][id]["geometry"].size(); ++k) {
       const json& before = in["CityObjects"][id]["geometry"][k];
       const json& after = out["CityObjects"][id]["geometry"][k];
       EXPECT_EQ(after["lod"], before["lod"]);
-      if (int(k) != index || s.outcomes[0].outcome != "refined") EXPECT_EQ(after, before) << "LoD " << before["lod"];
+      if (int(k) != index || s.outcomes[0].outcome != Outcome::Refined)
+        EXPECT_EQ(after, before) << "LoD " << before["lod"];
       else EXPECT_EQ(after["type"], "Solid");
     }
-    std::printf("  --lod %s: %s (%s)\n", lod.c_str(), s.outcomes[0].outcome.c_str(), s.outcomes[0].reason.c_str());
+    std::printf("  --lod %s: %s (%s)\n", lod.c_str(), outcome_name(s.outcomes[0].outcome),
+                s.outcomes[0].reason.c_str());
     // convert --lod writes that LoD's faces.
     const Cli c =
         run_cli("convert --cityjson " + path.string() + " --lod " + lod + " --out-dir " + dir + "/obj_" + lod, dir);
@@ -683,7 +686,7 @@ TEST(CityFile, JobsWriteTheSameBytesAsOneAtATime) {
         EXPECT_EQ(s.buildings, int(bs.size()));
       };
       const std::string out = dir + "/out" + std::to_string(jobs) + "." + name;
-      const CityRefineSummary s = refine_city(dir + "/" + name, {dir + "/cloud.ply"}, out, Params{}, o);
+      const CityRefineSummary s = refine_city(dir + "/" + name, {dir + "/cloud.ply"}, out, RefineConfig{}, o);
       EXPECT_EQ(s.refined + s.kept + s.kept_invalid, 6);
       EXPECT_GE(s.refined, 4) << name;
       ASSERT_EQ(done.size(), bs.size()) << name;
@@ -708,8 +711,8 @@ TEST(CityFile, JobsWriteTheSameBytesWhenSelectionsEndAtTheBudget) {
       {BuildingType::LShape, BuildingType::TShape, BuildingType::Stepped, BuildingType::Hip}, 43, 5000, 4, cloud);
   write_file_atomic(dir + "/city.json", synth_city(bs, Vec3(93000, 436000, 0)).dump());
   write_ply(dir + "/cloud.ply", cloud);
-  Params prm;
-  prm.mip_work_limit = 0.02;
+  RefineConfig prm;
+  prm.selection.mip_work_limit = 0.02;
   fixtures::CpuBurners burners(2);
   std::map<int, std::string> written;
   int at_budget = 0;
@@ -784,11 +787,11 @@ TEST(CityFileSecurity, FlatAndStrayBuildingsAreKeptInvalidTheRunGoesOn) {
   write_file_atomic(dir + "/city.json", in.dump());
   write_ply(dir + "/cloud.ply", cloud);
   const CityRefineSummary s =
-      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", Params{}, {});
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", RefineConfig{}, {});
   ASSERT_EQ(s.outcomes.size(), 3u);
-  EXPECT_NE(s.outcomes[0].outcome, "kept-invalid") << s.outcomes[0].reason;
-  EXPECT_EQ(s.outcomes[1].outcome, "kept-invalid");
-  EXPECT_EQ(s.outcomes[2].outcome, "kept-invalid");
+  EXPECT_NE(s.outcomes[0].outcome, Outcome::KeptInvalid) << s.outcomes[0].reason;
+  EXPECT_EQ(s.outcomes[1].outcome, Outcome::KeptInvalid);
+  EXPECT_EQ(s.outcomes[2].outcome, Outcome::KeptInvalid);
   EXPECT_NE(s.outcomes[2].reason.find("spans 1000 km, more than a building can"), std::string::npos)
       << s.outcomes[2].reason;
   EXPECT_EQ(s.outcomes[2].points, 0u);
@@ -862,7 +865,7 @@ TEST(CityFile, HookSeesEveryBuildingOnceWithItsIndex) {
     const std::lock_guard<std::mutex> lock(m);
     EXPECT_TRUE(seen.emplace(index, model.id).second) << index;
   };
-  refine_city(dir + "/city.city.jsonl", {dir + "/cloud.ply"}, dir + "/out.city.jsonl", Params{}, o);
+  refine_city(dir + "/city.city.jsonl", {dir + "/cloud.ply"}, dir + "/out.city.jsonl", RefineConfig{}, o);
   ASSERT_EQ(seen.size(), bs.size());
   for (std::size_t i = 0; i < bs.size(); ++i) EXPECT_EQ(seen[i], bs[i].id);
 }
@@ -885,7 +888,7 @@ TEST(CityFile, SequenceWithAnIdTwiceIsRefused) {
     EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
   }
   try {
-    refine_city(dir + "/city.city.jsonl", {dir + "/cloud.ply"}, dir + "/out.city.jsonl", Params{}, {});
+    refine_city(dir + "/city.city.jsonl", {dir + "/cloud.ply"}, dir + "/out.city.jsonl", RefineConfig{}, {});
     ADD_FAILURE() << "refined";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
@@ -904,7 +907,7 @@ TEST(CityFile, AttributesThatAreNoObjectAreRefusedNotReplaced) {
   write_file_atomic(dir + "/city.json", doc.dump());
   write_ply(dir + "/cloud.ply", cloud);
   try {
-    refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", Params{}, {});
+    refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", RefineConfig{}, {});
     ADD_FAILURE() << "refined";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("object " + bs[0].id + ": \"attributes\" is not a JSON object"),

@@ -29,7 +29,7 @@ struct Scene {
 
 TEST(RefineReport, RefinedBuildingHasEveryStage) {
   const Scene s;
-  const RefineResult r = refine_building(s.model, s.scan, Params{});
+  const RefineResult r = refine_building(s.model, s.scan, RefineConfig{});
   ASSERT_EQ(r.outcome, Outcome::Refined) << r.reason;
   const nlohmann::json j = refine_report(r);
   EXPECT_EQ(j["id"], "box");
@@ -88,7 +88,7 @@ TEST(RefineReport, ABuildingStoppedAtRepairHasOnlyWhatItReached) {
   Scene s;
   // Two opposite walls: no weld closes a shell, nor do their planes (nothing across their ends).
   s.model.faces = {s.model.faces[2], s.model.faces[4]};
-  const RefineResult r = refine_building(s.model, s.scan, Params{});
+  const RefineResult r = refine_building(s.model, s.scan, RefineConfig{});
   ASSERT_EQ(r.outcome, Outcome::KeptInvalid);
   const nlohmann::json j = refine_report(r);
   EXPECT_EQ(j["outcome"], "kept-invalid");
@@ -117,8 +117,8 @@ TEST(RefineReport, ValidationJsonNamesTheProblem) {
 
 TEST(RefineReport, ParamsJsonHasEveryRowByNameWithItsValue) {
   RefineConfig c;
-  c.corner_gap = 0.75;
-  c.seed = 3;
+  c.match.corner_gap = 0.75;
+  c.plane.seed = 3;
   const nlohmann::json j = params_json(c);
   EXPECT_EQ(j.size(), param_table().size());
   for (const auto& p : param_table()) EXPECT_TRUE(j.contains(p.name)) << p.name;

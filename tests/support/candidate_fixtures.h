@@ -46,10 +46,10 @@ inline Vec3 centroid_of(const CandidateSet& cs, int f) { return cs.centroids()[C
 inline CandidateSet hand_built(const std::vector<int>& plane, const std::vector<double>& area,
                                const std::vector<std::vector<int>>& edges) {
   CandidateSet cs;
-  auto support = cs.mesh.add_property_map<CandidateFace, int>("f:support", -1).first;
-  auto areas = cs.mesh.add_property_map<CandidateFace, double>("f:area", 0.0).first;
-  cs.mesh.add_property_map<CandidateFace, Vec3>("f:centroid", Vec3::Zero());
-  auto point = cs.mesh.add_property_map<CandidateMesh::Vertex_index, int>("v:point", -1).first;
+  auto support = candidate_props::support.add(cs.mesh);
+  auto areas = candidate_props::area.add(cs.mesh);
+  candidate_props::centroid.add(cs.mesh);
+  auto point = candidate_props::point.add(cs.mesh);
   std::vector<std::size_t> uses(plane.size(), 0);
   for (const auto& e : edges)
     for (int f : e) ++uses[std::size_t(f)];

@@ -44,6 +44,45 @@ using CandidateMap = CandidateMesh::Property_map<CandidateFace, T>;
 
 using CandidateHalfedge = CandidateMesh::Halfedge_index;
 
+// A property map of the candidate mesh: its name and its value where unset. Every map the code
+// keeps on a candidate mesh is one in candidate_props below, so each name is written once.
+template <class Key, class T>
+struct CandidateProperty {
+  using Map = CandidateMesh::Property_map<Key, T>;
+  const char* name;
+  T unset;
+  // The map on `mesh`, added (every element `unset`) when it has none.
+  Map add(CandidateMesh& mesh) const { return mesh.add_property_map<Key, T>(name, unset).first; }
+  // The map on `mesh` and whether it has one.
+  std::pair<Map, bool> find(const CandidateMesh& mesh) const { return mesh.property_map<Key, T>(name); }
+  // The map on `mesh`, which must have it.
+  Map get(const CandidateMesh& mesh) const { return find(mesh).first; }
+};
+template <class T>
+using CandidateFaceProperty = CandidateProperty<CandidateFace, T>;
+
+// The candidate mesh's property maps, by what sets them:
+// - build_candidates / kept_candidates: `support` (int: a face's plane, an index into `planes`),
+//   `area` (double, m^2), `centroid` (Vec3), and per vertex `point` (its index in `vertices`,
+//   the same point in every component);
+// - select_faces (selection.h): `variable` (int: a face's GLPK column, 1-based; 0 when fixed)
+//   and `selected` (bool: chosen);
+// - select_shell / rebuild_shell (shell_selection.cpp's FaceProps): `in_start`, `source` (read
+//   by traced_shell, shell_trace.h), `confidence`, `in_zone`, `fit`.
+namespace candidate_props {
+inline const CandidateFaceProperty<int> support{"f:support", -1};
+inline const CandidateFaceProperty<double> area{"f:area", 0.0};
+inline const CandidateFaceProperty<Vec3> centroid{"f:centroid", Vec3::Zero()};
+inline const CandidateProperty<CandidateMesh::Vertex_index, int> point{"v:point", -1};
+inline const CandidateFaceProperty<int> variable{"f:variable", 0};
+inline const CandidateFaceProperty<bool> selected{"f:selected", false};
+inline const CandidateFaceProperty<bool> in_start{"f:in_start", false};
+inline const CandidateFaceProperty<int> source{"f:source", -1};
+inline const CandidateFaceProperty<double> confidence{"f:confidence", 0.0};
+inline const CandidateFaceProperty<bool> in_zone{"f:in_zone", false};
+inline const CandidateFaceProperty<double> fit{"f:fit", 0.0};
+}  // namespace candidate_props
+
 // One segment of the arrangement and the candidates along it, as CGAL's hypothesis has it (its
 // Intersection): the halfedges of the faces along the segment, one per face (a face along it
 // twice, twice), in face order, each running as its face does. 2 in a plane's interior (a
@@ -51,11 +90,9 @@ using CandidateHalfedge = CandidateMesh::Halfedge_index;
 using CandidateEdge = std::vector<CandidateHalfedge>;
 
 // The candidates. `mesh` holds them: face f is candidate f, CCW about its plane's normal, with
-// the property maps "f:support" (int: its plane, an index into `planes`), "f:area" (double, m^2),
-// "f:centroid" (Vec3) and "v:point" (the vertex's index in `vertices`, the same point in every
-// component). Adjacency is the halfedge structure's: `edges` are the fans (CandidateEdge) in
-// order of first appearance (faces in order, each from its first corner), the constraints of
-// the selection (selection.h).
+// the property maps candidate_props::support, area, centroid and point. Adjacency is the halfedge structure's: `edges`
+// are the fans (CandidateEdge) in order of first appearance (faces in order, each from its first corner), the
+// constraints of the selection (selection.h).
 struct CandidateSet {
   std::vector<SupportPlane> planes;
   Region region;

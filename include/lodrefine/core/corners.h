@@ -44,11 +44,11 @@ struct CornerMove {
 
 // A point within this of a scan plane lies on it (m): the plane's noise band (two RANSAC
 // epsilons), at least the corners' tolerance of 5 cm.
-double on_plane_band(const PlaneConfig& detection);
+double on_plane_band(const PlaneEvidence& detection);
 
 std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
                                      const std::vector<ScannedWall>& scanned, const PointCloud& cloud,
                                      const std::vector<ScanPlane>& planes, const MatchConfig& match,
-                                     const PlaneConfig& detection);
+                                     const PlaneEvidence& detection);
 
 }  // namespace lodrefine

@@ -45,6 +45,19 @@ struct JudgedWall {
   std::optional<Plane> flush_facade;
 };
 
+// The never-worse check that refused a refinement (None: none did).
+enum class JudgeCheck { None, Building, Wall, Gain };
+// Its name in reports and reasons: "building", "wall", "gain"; "" for None.
+inline const char* check_name(JudgeCheck check) {
+  switch (check) {
+    case JudgeCheck::None: return "";
+    case JudgeCheck::Building: return "building";
+    case JudgeCheck::Wall: return "wall";
+    case JudgeCheck::Gain: return "gain";
+  }
+  return "?";
+}
+
 struct Judgement {
   struct Fit {
     std::size_t points = 0;                    // judged points
@@ -52,16 +65,18 @@ struct Judgement {
     double rms_before = 0.0, rms_after = 0.0;  // of the capped distances
   };
   bool ok = true;
-  std::string check;       // the check that refused: "building", "wall" or "gain"; empty when ok
-  std::string detail;      // one line with the figures of the refusal; empty when ok
-  int wall = -1;           // the refused wall (index into the JudgedWalls) when check == "wall"
-  Fit building;            // every judged point
-  std::vector<Fit> walls;  // per JudgedWall, its region
+  JudgeCheck check = JudgeCheck::None;  // the check that refused; None when ok
+  std::string detail;                   // one line with the figures of the refusal; empty when ok
+  int wall = -1;                        // the refused wall (index into the JudgedWalls) when check is Wall
+  Fit building;                         // every judged point
+  std::vector<Fit> walls;               // per JudgedWall, its region
+  // "<check> check: <detail>", the refusal in a reason.
+  std::string refusal() const { return check_name(check) + std::string(" check: ") + detail; }
 };
 
 // Whether `after` may replace `before` (both closed meshes, same frame as `cloud`). `planes`:
 // the scan planes detected in `cloud` (indices into it), for the facade lines beyond
-// match_distance, judged up to `facade_reach` (m; refine: match_distance + bbox_margin, the
+// match_distance, judged up to `facade_reach` (m; refine: RefineConfig::scan_reach, the
 // reach of the selection's scan supports); without them every point is capped at match_distance.
 // - building: refused when the capped RMS of every judged point grows by more than kRmsSlack,
 //   or when more than kWorseShare of the points that changed (by more than
@@ -84,7 +99,7 @@ constexpr double kWorseShare = 0.25;
 constexpr int kMinGain = 50;
 constexpr double kMinRmsGain = 0.001;  // m
 Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vector<JudgedWall>& walls,
-                           const PointCloud& cloud, const MatchConfig& match, const PlaneConfig& detection,
+                           const PointCloud& cloud, const MatchConfig& match, const PlaneEvidence& detection,
                            const std::vector<ScanPlane>& planes = {}, double facade_reach = 0.0);
 
 }  // namespace lodrefine

@@ -79,14 +79,15 @@ namespace lodrefine {
   X(double, conf_cloud_distance, 0.2, 0.0, 10.0, "confidence: max mean/std point distance to a cloud reference (m)") \
   X(double, conf_bbox_iou, 0.3, 0.0, 1.0, "confidence: min bbox IoU or coverage ratio to a model reference")
 
-// S(Config, stage name, what the stage does, rows)
-#define LODREFINE_STAGES(S)                                                                                       \
-  S(RepairConfig, "repair", "repair the exported soup into a closed shell, validate it", LODREFINE_REPAIR_PARAMS) \
-  S(PlaneConfig, "plane", "detect planes in the scan near the model (RANSAC)", LODREFINE_PLANE_PARAMS)            \
-  S(MatchConfig, "match", "match scan planes to walls; decide which walls are outdated", LODREFINE_MATCH_PARAMS)  \
-  S(SelectionConfig, "selection", "candidate faces and the GLPK program that selects the shell",                  \
-    LODREFINE_SELECTION_PARAMS)                                                                                   \
-  S(ConfidenceConfig, "confidence", "confidence of candidate faces from model and cloud references",              \
+// S(Config, stage, what the stage does, rows). `stage` names the stage: its Config::stage, the
+// RefineConfig member that holds its config, its CLI help group.
+#define LODREFINE_STAGES(S)                                                                                     \
+  S(RepairConfig, repair, "repair the exported soup into a closed shell, validate it", LODREFINE_REPAIR_PARAMS) \
+  S(PlaneConfig, plane, "detect planes in the scan near the model (RANSAC)", LODREFINE_PLANE_PARAMS)            \
+  S(MatchConfig, match, "match scan planes to walls; decide which walls are outdated", LODREFINE_MATCH_PARAMS)  \
+  S(SelectionConfig, selection, "candidate faces and the GLPK program that selects the shell",                  \
+    LODREFINE_SELECTION_PARAMS)                                                                                 \
+  S(ConfidenceConfig, confidence, "confidence of candidate faces from model and cloud references",              \
     LODREFINE_CONFIDENCE_PARAMS)
 
 // Every row of every stage, in pipeline order.
@@ -112,7 +113,7 @@ struct ConfigField {
 #define LODREFINE_CONFIG_STRUCT(Config, stage_name, what, ROWS)                      \
   struct Config {                                                                    \
     using Self = Config;                                                             \
-    static constexpr const char* stage = stage_name;                                 \
+    static constexpr const char* stage = #stage_name;                                \
     static constexpr const char* summary = what;                                     \
     ROWS(LODREFINE_CONFIG_MEMBER)                                                    \
     /* Calls visit(ConfigField) for each row, in table order. */                     \
@@ -128,31 +129,46 @@ LODREFINE_STAGES(LODREFINE_CONFIG_STRUCT)
 #undef LODREFINE_CONFIG_VISIT
 #undef LODREFINE_CONFIG_MEMBER
 
-// The whole method's configuration: every stage's config. A stage function takes its own
-// (a RefineConfig converts to each: `detect_planes(cloud, config)` passes its PlaneConfig),
-// so its signature says which knobs it reads; the orchestrator reads across stages.
-struct RefineConfig : RepairConfig, PlaneConfig, MatchConfig, SelectionConfig, ConfidenceConfig {
-  const RepairConfig& repair() const { return *this; }
-  const PlaneConfig& plane() const { return *this; }
-  const MatchConfig& match() const { return *this; }
-  const SelectionConfig& selection() const { return *this; }
-  const ConfidenceConfig& confidence() const { return *this; }
-  // Every stage's fields, stage by stage in pipeline order.
+// What other stages read of the plane stage's rows, named here once (each row keeps its
+// meaning): a point within ransac_epsilon of a scan plane lies on it (a RANSAC inlier's
+// farthest), and ransac_min_points such points are a scanned surface (a plane's fewest). The
+// match stage's corner_moves and judge_refinement take it beside their MatchConfig, the
+// selection's test for enclosed scan points alone; a PlaneConfig converts to it. (The other
+// borrowed value is RefineConfig::scan_reach.)
+struct PlaneEvidence {
+  double ransac_epsilon;
+  int ransac_min_points;
+  PlaneEvidence(const PlaneConfig& plane)
+      : ransac_epsilon(plane.ransac_epsilon), ransac_min_points(plane.ransac_min_points) {}
+};
+
+// The whole method's configuration: one member per stage, named after it
+// (`config.plane.ransac_epsilon`). A stage function takes its own config (`detect_planes(cloud,
+// config.plane)`), so its signature says which knobs it reads; a function that reads several
+// stages' (the orchestrator, the selection of the whole shell) takes the RefineConfig.
+struct RefineConfig {
+#define LODREFINE_STAGE_MEMBER(Config, stage, what, rows) Config stage;
+  LODREFINE_STAGES(LODREFINE_STAGE_MEMBER)
+#undef LODREFINE_STAGE_MEMBER
+
+  // The scan's reach around the model (m): a wall off by up to match_distance, plus the
+  // selection's bbox_margin (a bay). The cloud is cropped to it (with bbox_expand), and the
+  // selection's scan supports and evidence zone and the judge's facade lines reach that far.
+  double scan_reach() const { return match.match_distance + selection.bbox_margin; }
+
+  // Every stage's fields (ConfigFields of that stage's config), stage by stage in pipeline order.
   template <class Visitor>
   static void visit_fields(Visitor&& visit) {
-    RepairConfig::visit_fields(visit);
-    PlaneConfig::visit_fields(visit);
-    MatchConfig::visit_fields(visit);
-    SelectionConfig::visit_fields(visit);
-    ConfidenceConfig::visit_fields(visit);
+#define LODREFINE_STAGE_VISIT(Config, stage, what, rows) Config::visit_fields(visit);
+    LODREFINE_STAGES(LODREFINE_STAGE_VISIT)
+#undef LODREFINE_STAGE_VISIT
   }
   // Each stage's validate() (the error names the stage), then the rules across rows.
   void validate() const;
 };
-// The former name of the whole configuration.
-using Params = RefineConfig;
 
-// visitor(field, value) for each field of `config` (a stage config or the RefineConfig).
+// visitor(field, value) for each field of `config`, a stage config (its ConfigFields' members
+// are its own)...
 template <class Config, class Visitor>
 void for_each_field(const Config& config, Visitor&& visitor) {
   Config::visit_fields([&](const auto& field) { visitor(field, config.*(field.member)); });
@@ -161,6 +177,17 @@ template <class Config, class Visitor>
 void for_each_field(Config& config, Visitor&& visitor) {
   Config::visit_fields([&](const auto& field) { visitor(field, config.*(field.member)); });
 }
+// ... or the RefineConfig: each stage's, stage by stage in pipeline order.
+#define LODREFINE_STAGE_FIELDS(Config, stage, what, rows) for_each_field(config.stage, visitor);
+template <class Visitor>
+void for_each_field(const RefineConfig& config, Visitor&& visitor) {
+  LODREFINE_STAGES(LODREFINE_STAGE_FIELDS)
+}
+template <class Visitor>
+void for_each_field(RefineConfig& config, Visitor&& visitor) {
+  LODREFINE_STAGES(LODREFINE_STAGE_FIELDS)
+}
+#undef LODREFINE_STAGE_FIELDS
 
 // Read-only description of one parameter, for CLI and docs.
 struct ParamInfo {

@@ -12,6 +12,7 @@
 
 #include "lodrefine/core/judge.h"
 #include "lodrefine/core/matching.h"
+#include "lodrefine/core/outcome.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/planes.h"
 #include "lodrefine/core/repair.h"
@@ -20,15 +21,6 @@
 #include "lodrefine/core/validate.h"
 
 namespace lodrefine {
-
-// "refined": walls moved, validated, and never worse: the scan points near the building and
-// each moved wall's own points fit better than before (judge.h);
-// "kept": the repaired input (nothing to change, or the judge refused the refinement);
-// "repaired": as kept, but the input was no valid solid and its shell was rebuilt on its own
-// planes (rebuild_shell, shell_selection.h): faces added, split or dropped, nothing moved;
-// "kept-invalid": the input cannot be made a valid solid and the output is it as read.
-enum class Outcome { Refined, Kept, Repaired, KeptInvalid };
-const char* outcome_name(Outcome outcome);
 
 // The stages a refinement times (RefineTrace::seconds), in pipeline order; "total" follows
 // them. A building's run stops after any of them (a refusal, nothing to change).
@@ -137,7 +129,7 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const R
 
 // The scan points refine_building works on, in the model's local frame (`origin` subtracted;
 // crops may carry whole streets): those inside the model's bounding box grown by
-// match_distance + bbox_margin (m) and bbox_expand of its size on each side. `local_model` is in
+// RefineConfig::scan_reach (m) and bbox_expand of its size on each side. `local_model` is in
 // the local frame already.
 PointCloud cloud_near(const Mesh& local_model, const PointCloud& cloud, const Vec3& origin, const RefineConfig& prm);
 

@@ -78,8 +78,8 @@ struct SelectionProgram {
 // (wall-clock s, > 0), explicit so that a caller that solved before passes what is left of
 // mip_time_limit. Either way the best selection found, at least a feasible warm start, is taken.
 // Writes the program's variables and its answer as face maps of `cs.mesh` (replacing those of an
-// earlier solve): "f:variable" (int: the candidate's GLPK column, 1-based; 0 when fixed) and
-// "f:selected" (bool: chosen; all false when the result is not ok).
+// earlier solve): candidate_props::variable (int: the candidate's GLPK column, 1-based; 0 when
+// fixed) and candidate_props::selected (bool: chosen; all false when the result is not ok).
 SelectionResult select_faces(CandidateSet& cs, const SelectionProgram& program, const SelectionConfig& config,
                              double time_limit);
 // The same with the whole budget, config.mip_time_limit.
@@ -94,7 +94,7 @@ bool every_edge_used_0_or_2(const CandidateSet& cs, const std::vector<char>& sel
 SelectionResult select_faces(CandidateSet& cs, const std::vector<double>& cost, const std::vector<int>& outside,
                              const SelectionConfig& config, const std::vector<int>* fixed = nullptr);
 
-// The face map "f:selected" of `cs.mesh` as 0/1 per candidate (all 0 without it).
+// The face map candidate_props::selected of `cs.mesh` as 0/1 per candidate (all 0 without it).
 std::vector<char> selected_faces(const CandidateSet& cs);
 
 }  // namespace lodrefine

@@ -61,7 +61,7 @@ struct ShellSelection {
 // piece of that plane, unless the start then cannot be expressed in the candidates. Never throws
 // for geometry; !ok with the reason when the program has no solution or no valid shell.
 ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
-                            const Params& params);
+                            const RefineConfig& params);
 
 // Repair by reconstruction: the closed shell a polygon soup that is no valid solid (faces crossing,
 // missing or doubled, parts touching along an edge) stands for, from the same arrangement and
@@ -97,6 +97,6 @@ struct ShellRebuild {
 // face each is. Not ok when its planes bound no valid shell, when it has no ground face (the
 // walls' foot would be invented: a roof alone is no building), or when its arrangement would
 // exceed 10,000 candidates. Never throws for geometry.
-ShellRebuild rebuild_shell(const Mesh& soup, const Params& params);
+ShellRebuild rebuild_shell(const Mesh& soup, const RefineConfig& params);
 
 }  // namespace lodrefine

@@ -1,7 +1,7 @@
 // Stage 4c: the output shell traced on the candidate mesh (candidates.h) from the faces the
 // selection chose, as CGAL's Polygonal_surface_reconstruction reads its model off the hypothesis:
 // no geometric weld and no repair pass.
-// - Vertices are the mesh's: a corner of a chosen face is its vertex's point (the "v:point" map,
+// - Vertices are the mesh's: a corner of a chosen face is its vertex's point (candidate_props::point,
 //   one point for every component through it); a chosen edge shorter than kCollapsedEdge joins
 //   its two ends.
 // - Which chosen faces meet along a segment, and in which direction each runs along it, comes
@@ -22,10 +22,10 @@ struct CandidateSet;  // candidates.h
 // of fractions of a millimetre, which CityJSON's millimetre grid or a reader's weld collapses.
 constexpr double kCollapsedEdge = 1e-3;
 
-// The polygon mesh of the candidates chosen in `cs.mesh`'s "f:selected" (bool, required: the
+// The polygon mesh of the candidates chosen in `cs.mesh`'s candidate_props::selected (bool, required: the
 // selection's answer, select_faces).
 // Per output face: the semantic of its supporting plane (CandidateSet::planes[].sem) and the
-// source in the face map "f:source" (int, optional: -1 without it); a merged polygon takes its
+// source in the face map candidate_props::source (int, optional: -1 without it); a merged polygon takes its
 // largest piece's. Vertex positions are CandidateSet::vertices (same frame). The mesh is
 // closed, 2-manifold and outward when the selection uses every edge 0 or 2 times and its
 // pieces meet only along edges; it is not validated here (validate_mesh).

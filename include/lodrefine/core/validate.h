@@ -36,7 +36,7 @@ inline constexpr std::size_t kMaxFaceCorners = 20000;
 std::string size_problem(const Mesh& mesh);
 
 // Checks closed, 2-manifold (edges and vertices), consistently and outward oriented, planar
-// faces within `planarity_tolerance` (Params::planarity_tolerance; no default here, the
+// faces within `planarity_tolerance` (RepairConfig::planarity_tolerance; no default here, the
 // parameter table holds it), one component, no self-intersections (CGAL PMP on the triangulated
 // faces). Expects shared vertices. A mesh beyond size_problem's bounds is invalid unchecked.
 // `single_component` false accepts a building of several closed shells (a multi-part export).

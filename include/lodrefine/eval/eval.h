@@ -39,7 +39,7 @@ bool is_watertight(const Mesh& mesh);
 // walls (no ground, clutter or neighbours), in front of their wall. The model is repaired first
 // (matching needs the walls' adjacency, which a soup lacks); one no weld closes is matched as
 // read. Mesh and cloud in the same (local) frame.
-std::vector<int> select_facade_points(const Mesh& mesh, const PointCloud& cloud, const Params& params);
+std::vector<int> select_facade_points(const Mesh& mesh, const PointCloud& cloud, const RefineConfig& params);
 
 // Wall faces of `truth` with at least `min_points` of `points` within `distance` of them
 // (nearest face) — the walls the scanner saw.
@@ -73,11 +73,11 @@ struct BuildingEval {
 // select_facade_points() of the ORIGINAL model, so both models are measured on the same points.
 // A refined mesh without faces marks the building failed (see BuildingEval::error).
 BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const PointCloud& cloud, const Mesh* truth,
-                               const Params& params);
+                               const RefineConfig& params);
 // As above; `scanned_truth_faces` (indices into truth->faces, e.g. from the generator's
 // meta.json) replaces the detection of scanned walls when given.
 BuildingEval evaluate_building(const Mesh& original, const Mesh& refined, const PointCloud& cloud, const Mesh* truth,
-                               const Params& params, const std::vector<int>* scanned_truth_faces);
+                               const RefineConfig& params, const std::vector<int>* scanned_truth_faces);
 
 // Figures over a whole run.
 struct PooledEval {

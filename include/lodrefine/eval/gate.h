@@ -9,15 +9,17 @@
 #include <string>
 #include <vector>
 
+#include "lodrefine/core/outcome.h"
+
 namespace lodrefine {
 
 // What a run measured of one building, refined model side. Distances in metres; an absent value
 // was not measured (no facade points, no truth, a failed building).
 struct BuildingFigures {
   std::string id;
-  std::string outcome;                      // "refined", "kept", "kept-invalid" or "failed" (best to worst)
-  std::string reason;                       // why kept / failed (informative only)
-  std::optional<double> c2m_rmse, c2m_mae;  // facade points to the refined model
+  Outcome outcome = Outcome::Failed;                         // refined, kept, kept-invalid or failed (best to worst)
+  std::string reason;                                        // why kept / failed (informative only)
+  std::optional<double> c2m_rmse, c2m_mae;                   // facade points to the refined model
   std::optional<double> truth_facade_rmse, truth_roof_rmse;  // truth samples to the refined model
   bool watertight = false;                                   // the refined model
   std::size_t facades_moved = 0;
@@ -33,9 +35,9 @@ struct RunFigures {
   std::optional<double> c2m_rmse_original, c2m_rmse, c2m_mae, truth_facade_rmse, truth_roof_rmse;
 };
 
-// Rank of an outcome, higher is better: refined 3, kept or repaired 2, kept-invalid 1, failed (or anything
-// else) 0.
-int outcome_rank(const std::string& outcome);
+// Rank of an outcome, higher is better: refined 3, kept or repaired 2, kept-invalid 1, failed (or
+// untouched) 0.
+int outcome_rank(Outcome outcome);
 
 // The baseline file: {"format": "lodrefine-baseline", "version": 1, "pooled": {...},
 // "buildings": [{...}]}, absent figures as null. Strings that are not UTF-8 are written with

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "lodrefine/core/outcome.h"
 #include "lodrefine/core/types.h"
 #include "lodrefine/eval/histogram.h"
 
@@ -34,7 +35,7 @@ std::string svg_footprint(const Mesh& original, const Mesh& refined, const std::
 // One building of a district map: its XY outline rings (any common frame, metres) and outcome.
 struct MapOutline {
   std::string id;
-  std::string outcome;  // "refined", "repaired", "kept", "kept-invalid", anything else drawn as untouched
+  Outcome outcome = Outcome::Untouched;  // refined, repaired, kept, kept-invalid, untouched; any other as kept-invalid
   std::vector<std::vector<Vec2>> rings;
   bool linked = false;  // a link to "#view-<id>" (its view on the same page)
 };

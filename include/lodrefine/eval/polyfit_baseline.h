@@ -66,14 +66,14 @@ struct PolyfitResult {
 // + bbox_margin and bbox_expand), with detect_planes(params) as lodrefine's plane stage; each
 // point's normal is its plane's. With ModelAndScan the model is repaired (repair_input) and each
 // of its surfaces (model_surfaces) adds a plane. Returns the mesh in the input frame.
-PolyfitResult polyfit_baseline(const Mesh& model, const PointCloud& cloud, const Params& params,
+PolyfitResult polyfit_baseline(const Mesh& model, const PointCloud& cloud, const RefineConfig& params,
                                const PolyfitOptions& options = {});
 
 // The same in a forked child process with options.cpu_limit and memory_limit_mb, so that no
 // building can hang, exhaust memory or crash the caller: a child killed at its limit is
 // TimeLimit, one ended by another signal Error ("ended by signal N"). Call it from a
 // single-threaded process (fork copies only the calling thread). POSIX only.
-PolyfitResult polyfit_baseline_isolated(const Mesh& model, const PointCloud& cloud, const Params& params,
+PolyfitResult polyfit_baseline_isolated(const Mesh& model, const PointCloud& cloud, const RefineConfig& params,
                                         const PolyfitOptions& options = {});
 
 }  // namespace lodrefine

@@ -34,7 +34,7 @@ BenchBuilding read_bench_building(const BuildingFiles& files);
 // A method's output for `b` (input frame) against its coarse model and truth, measured in the
 // coarse model's local frame: evaluate_building with the scan, the truth when it has faces and
 // the scanned truth faces when known.
-BuildingEval evaluate_against_truth(const BenchBuilding& b, const Mesh& output, const Params& params);
+BuildingEval evaluate_against_truth(const BenchBuilding& b, const Mesh& output, const RefineConfig& params);
 
 // What one method gave for a building.
 struct MethodRun {
@@ -47,8 +47,8 @@ struct MethodRun {
 
 struct PolyfitComparisonRow {
   std::string id;
-  std::size_t points = 0;  // of the cloud
-  std::string outcome;     // lodrefine's (refine.h's outcome_name)
+  std::size_t points = 0;             // of the cloud
+  Outcome outcome = Outcome::Failed;  // lodrefine's
   std::optional<DistanceStats> coarse_facade, coarse_roof;
   MethodRun lodrefine, polyfit;
   PolyfitResult baseline;  // the mesh dropped; status, reason, planes, candidates, times
@@ -57,7 +57,8 @@ struct PolyfitComparisonRow {
 // Refines `b` with refine_building and reconstructs it with polyfit_baseline_isolated (same params, one
 // after the other), and measures the coarse model and both outputs against its truth in its
 // local frame (evaluate_building: truth facade and roof distances, watertightness).
-PolyfitComparisonRow compare_with_polyfit(const BenchBuilding& b, const Params& params, const PolyfitOptions& options);
+PolyfitComparisonRow compare_with_polyfit(const BenchBuilding& b, const RefineConfig& params,
+                                          const PolyfitOptions& options);
 
 struct PolyfitComparison {
   int buildings = 0, polyfit_closed = 0, lodrefine_watertight = 0, polyfit_watertight = 0;

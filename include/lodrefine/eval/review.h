@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "lodrefine/core/outcome.h"
 #include "lodrefine/core/types.h"
 #include "lodrefine/eval/report.h"
 
@@ -16,9 +17,9 @@ namespace lodrefine {
 
 struct CityReviewBuilding {
   std::string id;
-  std::string outcome;     // "refined", "repaired", "kept", "kept-invalid" or "untouched" (no cloud points)
-  std::string reason;      // why kept
-  std::size_t points = 0;  // cloud points in its crop
+  Outcome outcome = Outcome::Untouched;  // refined, repaired, kept, kept-invalid or untouched (no cloud points)
+  std::string reason;                    // why kept
+  std::size_t points = 0;                // cloud points in its crop
   std::size_t facades_moved = 0;
   double moved_max = std::nan(""), moved_mean = std::nan("");  // facade displacement (m), NaN if none moved
   std::optional<double> fit_before,

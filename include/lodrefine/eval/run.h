@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lodrefine/core/outcome.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/types.h"
 #include "lodrefine/eval/eval.h"
@@ -43,10 +44,12 @@ struct RunRow {
   BuildingEval eval;
   Vec3 origin = Vec3::Zero();      // local frame origin (added back to centroids in the JSON)
   std::string truth_faces_source;  // "meta.json", "detected" or empty (no truth)
-  std::string refine_outcome;      // the refine report's "outcome" as written, if any
+  std::string refine_outcome;      // the refine report's "outcome" as written, if any (echoed; parse_outcome reads it)
   std::string selection;           // the report's selection.status (empty when none ran)
   // What the refine step recorded (report.json or FAILED).
-  std::string outcome;             // "refined", "kept" (anything else written) or "failed"
+  // Refined, kept (anything else written) or failed; none without a refine record (one building's
+  // eval: written as "").
+  std::optional<Outcome> outcome;
   std::string reason;              // why kept / why failed
   std::vector<MovedFacade> moved;  // facades replaced in the written model
   double refine_seconds = std::numeric_limits<double>::quiet_NaN();
@@ -73,7 +76,7 @@ std::string building_footprint_svg(const BuildingEval& e, const LocalBuilding& b
 // faces meta.json lists when it lists walls of the truth). Writes its footprint SVG into
 // `svg_dir` unless that is empty. The row's refine record is left empty (add_refine_record).
 // Throws InputError when the original model or the cloud cannot be read.
-RunRow evaluate_building_files(const BuildingFiles& files, const Params& params, const std::string& svg_dir,
+RunRow evaluate_building_files(const BuildingFiles& files, const RefineConfig& params, const std::string& svg_dir,
                                const CloudOptions& cloud_options = {});
 
 // Fills the refine record of `row` (evaluated already) from what refine left: `failed_line`, the
@@ -100,8 +103,8 @@ Mesh read_eval_model(const std::string& path);
 // the run and is rethrown. Each building's per-point series go into `series` as it finishes and
 // are then dropped (memory: the bins, not the run's points); a progress line counts the
 // buildings (`progress_mode`). Each building's cloud is read with `cloud_options` (max_points).
-std::vector<RunRow> evaluate_run(const std::string& dir, const Params& params, const std::string& svg_dir, int jobs,
-                                 PooledSeries& series, Progress::Mode progress_mode,
+std::vector<RunRow> evaluate_run(const std::string& dir, const RefineConfig& params, const std::string& svg_dir,
+                                 int jobs, PooledSeries& series, Progress::Mode progress_mode,
                                  const CloudOptions& cloud_options = {});
 
 }  // namespace lodrefine

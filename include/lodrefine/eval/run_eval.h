@@ -26,7 +26,7 @@ struct EvalOptions {
   double tolerance = 0.005;  // m a distance may grow by against the baseline
   int jobs = 1;              // buildings evaluated at once
   bool quiet = false;        // no progress line on stderr
-  Params params;
+  RefineConfig params;
   nlohmann::json params_json;  // the parameters as --json records them ("params")
   CloudOptions cloud_options;  // one building only (a run folder holds cropped PLYs)
 };

@@ -60,7 +60,7 @@ nlohmann::json html_row(const RunRow& row);
 // The 3D + footprint view of one building, read again from its files (measured again when its
 // per-point series were dropped: the evaluation is deterministic). Throws InputError when its
 // inputs cannot be read.
-BuildingView html_view(const RunRow& row, const Params& params);
+BuildingView html_view(const RunRow& row, const RefineConfig& params);
 
 // A row's figures for the gate: its outcome in refine's words ("kept-invalid" kept apart).
 BuildingFigures building_figures(const RunRow& row);

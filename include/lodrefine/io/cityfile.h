@@ -22,6 +22,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lodrefine/core/judge.h"
+#include "lodrefine/core/outcome.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/io/cloud.h"
 
@@ -68,11 +70,11 @@ struct CityRefineOptions {
 
 struct CityBuildingOutcome {
   std::string id;
-  std::string outcome;  // "refined", "repaired", "kept", "kept-invalid"
-  std::string reason;   // why repaired / kept / kept-invalid (empty when refined)
+  Outcome outcome = Outcome::KeptInvalid;  // refined, repaired, kept or kept-invalid (outcome_name: the text)
+  std::string reason;                      // why repaired / kept / kept-invalid (empty when refined)
   int facades_moved = 0;
-  std::string refused_by;  // the never-worse check that refused its refinement (judge.h), or empty
-  std::size_t points = 0;  // cloud points in the building's crop box
+  JudgeCheck refused_by = JudgeCheck::None;  // the never-worse check that refused its refinement (judge.h)
+  std::size_t points = 0;                    // cloud points in the building's crop box
   double seconds = 0.0;
 };
 
@@ -100,7 +102,8 @@ struct CityRefineSummary {
 // reason. `cloud_paths` are files (cloud_files expands folders), read in that order as one cloud:
 // the output is that of one file holding their points in that order.
 CityRefineSummary refine_city(const std::string& model_path, const std::vector<std::string>& cloud_paths,
-                              const std::string& out_path, const Params& params, const CityRefineOptions& options);
+                              const std::string& out_path, const RefineConfig& params,
+                              const CityRefineOptions& options);
 
 // The refined mesh as a CityJSON Solid geometry of LoD `lod` with semantics, its vertices
 // appended to `vertices` quantised by the document's transform (`scale`, `translate`).

@@ -1,0 +1,24 @@
+#include "lodrefine/core/outcome.h"
+
+namespace lodrefine {
+
+const char* outcome_name(Outcome outcome) {
+  switch (outcome) {
+    case Outcome::Refined: return "refined";
+    case Outcome::Kept: return "kept";
+    case Outcome::Repaired: return "repaired";
+    case Outcome::KeptInvalid: return "kept-invalid";
+    case Outcome::Untouched: return "untouched";
+    case Outcome::Failed: return "failed";
+  }
+  return "?";
+}
+
+std::optional<Outcome> parse_outcome(const std::string& name) {
+  for (Outcome o :
+       {Outcome::Refined, Outcome::Kept, Outcome::Repaired, Outcome::KeptInvalid, Outcome::Untouched, Outcome::Failed})
+    if (name == outcome_name(o)) return o;
+  return std::nullopt;
+}
+
+}  // namespace lodrefine
