@@ -3,14 +3,16 @@
 // faces in opposite directions), its report's selection solved, its faces are the selection's,
 // it is nowhere worse than the coarse model on the truth's scanned walls, and the walls the
 // scan moved sit on the truth. The street-facade types (recess, bay, setback) need faces the
-// model lacks: SelectionAddsFaces runs ten of each (some seeds are marked KNOWN SHORT there).
+// model lacks: SelectionAddsFaces runs ten of each, one test per seed (KNOWN SHORT seeds are
+// skipped after the checks that still hold).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <map>
 #include <set>
+#include <tuple>
+#include <utility>
 
 #include "lodrefine/core/distance.h"
 #include "lodrefine/core/geometry.h"
@@ -146,12 +148,14 @@ INSTANTIATE_TEST_SUITE_P(AllTypes, SelectionDecidesType, ::testing::ValuesIn(all
 // The street-facade types: the truth has faces the coarse model lacks (a recess's back wall and
 // returns, a bay's front and sides, a facade line stepping back). Moving the model's walls
 // cannot reach them; the selection must add them: each building is refined, its scanned walls
-// within kOnTruth of the truth.
+// within kOnTruth of the truth. One test per type and seed (StreetFacades/...<type>_seed_<n>),
+// so a seed that breaks fails on its own and no other seed can make up for it.
 //
 // KNOWN SHORT (measured 2026-12-04, target_points 20000): the pipeline does not reach the
-// truth on this seed. It is still checked for a valid, closed, 2-manifold shell, a solved
-// selection and never worse, but NOT for being refined or on the truth; its figures are
-// printed. Truth facade RMSE coarse -> output: recess 9: 0.402 -> 0.406 m.
+// truth on this seed. Its test (KnownShort_<type>_seed_<n>) still checks a valid, closed,
+// 2-manifold shell, a solved selection and never worse, then is skipped with its figures; it
+// fails once the seed reaches the truth, to be made a regular seed. Truth facade RMSE coarse ->
+// output: recess 9: 0.402 -> 0.406 m.
 // (bay 1 and 7 and setback 4, 7 and 8 reach the truth since each scanned plane's neighbourhood is
 // solved before the whole program, its answer the warm start: their programs ended at the work
 // budget, or at a first solve whose shell was refused, on the start.)
@@ -159,32 +163,40 @@ INSTANTIATE_TEST_SUITE_P(AllTypes, SelectionDecidesType, ::testing::ValuesIn(all
 //   recess 9: the back wall 1.34 m behind the start's and both returns unscanned (hypothesised,
 //     12.4 m² each at confidence 0, +0.93 each): at lambda_data 0.3 the program takes the
 //     recess (its back wall's points explain 20 m²; the truth not measured), at 0.1 not.
-// Remove a seed from kKnownShort when the pipeline reaches it (the test prints "now reaches").
-const std::map<BuildingType, std::set<std::uint64_t>> kKnownShort{
-    {BuildingType::Recess, {9}}, {BuildingType::Bay, {}}, {BuildingType::Setback, {}}};
+const std::set<std::pair<BuildingType, std::uint64_t>> kKnownShort{{BuildingType::Recess, 9}};
 constexpr std::uint64_t kStreetSeeds = 10;
 
-class SelectionAddsFaces : public ::testing::TestWithParam<BuildingType> {};
+class SelectionAddsFaces : public ::testing::TestWithParam<std::tuple<BuildingType, std::uint64_t>> {};
 
 TEST_P(SelectionAddsFaces, RefinedOntoTheTruth) {
+  const auto [type, seed] = GetParam();
   SynthOptions opt;
   opt.target_points = 20000;
-  int reached = 0;
-  for (std::uint64_t seed = 1; seed <= kStreetSeeds; ++seed) {
-    const SynthBuilding b = make_building(GetParam(), seed, opt);
-    SCOPED_TRACE(b.id);
-    const bool known_short = kKnownShort.at(GetParam()).count(seed) > 0;
-    const Figures fig = expect_selection_decided(b.coarse, b.truth, b.cloud, !known_short);
-    const bool on_truth = fig.refined && fig.after < kOnTruth;
-    reached += on_truth;
-    if (known_short)
-      std::printf("KNOWN SHORT %s: %s %.3f -> %.3f m%s\n", b.id.c_str(), fig.refined ? "refined" : "kept", fig.before,
-                  fig.after, on_truth ? " (now reaches the truth: remove it from kKnownShort)" : "");
-    else EXPECT_TRUE(fig.refined) << "truth facade RMSE " << fig.before;
+  const SynthBuilding b = make_building(type, seed, opt);
+  SCOPED_TRACE(b.id);
+  const bool known_short = kKnownShort.count({type, seed}) > 0;
+  const Figures fig = expect_selection_decided(b.coarse, b.truth, b.cloud, !known_short);
+  if (!known_short) {
+    EXPECT_TRUE(fig.refined) << "truth facade RMSE " << fig.before;
+    return;
   }
-  EXPECT_GE(reached, int(kStreetSeeds - kKnownShort.at(GetParam()).size()));
+  const bool on_truth = fig.refined && fig.after < kOnTruth;
+  EXPECT_FALSE(on_truth) << b.id << " now reaches the truth (" << fig.before << " -> " << fig.after
+                         << " m): remove it from kKnownShort";
+  if (!HasFailure())
+    GTEST_SKIP() << "known short: " << b.id << " " << (fig.refined ? "refined" : "kept") << " " << fig.before << " -> "
+                 << fig.after << " m (kKnownShort)";
+}
+
+// recess_seed_3, or KnownShort_recess_seed_9 for a seed of kKnownShort.
+std::string street_case_name(const ::testing::TestParamInfo<SelectionAddsFaces::ParamType>& info) {
+  const auto [type, seed] = info.param;
+  return std::string(kKnownShort.count({type, seed}) ? "KnownShort_" : "") + building_type_name(type) + "_seed_" +
+         std::to_string(seed);
 }
 
 INSTANTIATE_TEST_SUITE_P(StreetFacades, SelectionAddsFaces,
-                         ::testing::Values(BuildingType::Recess, BuildingType::Bay, BuildingType::Setback),
-                         [](const auto& info) { return std::string(building_type_name(info.param)); });
+                         ::testing::Combine(::testing::Values(BuildingType::Recess, BuildingType::Bay,
+                                                              BuildingType::Setback),
+                                            ::testing::Range<std::uint64_t>(1, kStreetSeeds + 1)),
+                         street_case_name);

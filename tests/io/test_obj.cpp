@@ -196,3 +196,27 @@ TEST(IoObj, CoordinatesBeyondAMillionKilometresAreRefused) {
     EXPECT_NE(std::string(e.what()).find("beyond 1e9 m"), std::string::npos) << e.what();
   }
 }
+
+// tests/fuzz/regressions/fuzz_obj/writer_huge_coordinate.obj: read_obj accepts any finite
+// coordinate, so write_obj must print any finite coordinate readably.
+TEST(BadInputRegression, ObjWriterRoundTripsHugeCoordinates) {
+  // The writer prints any finite double readably; the reader refuses such a file in one line.
+  const std::string path = temp_path("h.obj");
+  Mesh m;
+  m.id = "huge";
+  m.vertices = {{1e60, 0, 0}, {0, 1, 0}, {0, 0, -1.7e308}};
+  Face f;
+  f.v = {0, 1, 2};
+  m.faces = {f};
+  write_obj(path, m);
+  std::ifstream in(path, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (unsigned char c : text) EXPECT_TRUE(c == '\n' || (c >= 32 && c < 127)) << "byte " << int(c);
+  EXPECT_GT(text.size(), 309u);  // -1.7e308 printed in full (309 digits)
+  try {
+    read_obj(path);
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("beyond 1e9 m"), std::string::npos) << e.what();
+  }
+}
