@@ -1,5 +1,5 @@
 // Atomic writes, exclusive temporaries, safe names and telling formats apart by content.
-#include "lodrefine/io/files.h"
+#include "lodrefine/base/files.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -16,7 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "text.h"
+#include "lodrefine/base/text.h"
 
 namespace lodrefine {
 

@@ -1,4 +1,4 @@
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
 
 #include <Eigen/Dense>
 #include <Eigen/Eigenvalues>

@@ -1,6 +1,6 @@
-#include "text.h"
+#include "lodrefine/base/text.h"
 
-#include "lodrefine/io/files.h"
+#include "lodrefine/base/files.h"
 
 #include <cctype>
 #include <cerrno>

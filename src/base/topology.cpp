@@ -1,5 +1,5 @@
 // Mesh topology helpers (see topology.h).
-#include "lodrefine/core/topology.h"
+#include "lodrefine/base/topology.h"
 
 #include <cmath>
 #include <numeric>

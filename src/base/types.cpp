@@ -1,4 +1,4 @@
-#include "lodrefine/core/types.h"
+#include "lodrefine/base/types.h"
 
 #include <algorithm>
 #include <cctype>

@@ -1,5 +1,5 @@
 // City file in, city file out (see cityfile.h).
-#include "lodrefine/io/cityfile.h"
+#include "lodrefine/city/cityfile.h"
 
 #include <chrono>
 #include <cmath>
@@ -13,12 +13,12 @@
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
+#include "lodrefine/base/files.h"
+#include "lodrefine/city/crop.h"
 #include "lodrefine/core/refine.h"
-#include "lodrefine/io/citygml.h"
-#include "lodrefine/io/cityjson.h"
-#include "lodrefine/io/cityjson_write.h"
-#include "lodrefine/io/crop.h"
-#include "lodrefine/io/files.h"
+#include "lodrefine/formats/citygml.h"
+#include "lodrefine/formats/cityjson.h"
+#include "lodrefine/formats/cityjson_write.h"
 
 namespace lodrefine {
 namespace {

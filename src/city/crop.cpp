@@ -1,4 +1,4 @@
-#include "lodrefine/io/crop.h"
+#include "lodrefine/city/crop.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -14,10 +14,10 @@
 #include <string>
 #include <unordered_map>
 
-#include "lodrefine/core/geometry.h"
-#include "lodrefine/core/topology.h"
-#include "lodrefine/io/files.h"
-#include "lodrefine/io/ply.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/base/topology.h"
+#include "lodrefine/formats/ply.h"
 
 namespace lodrefine {
 

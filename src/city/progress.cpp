@@ -1,5 +1,5 @@
 // The progress line (see progress.h).
-#include "lodrefine/io/progress.h"
+#include "lodrefine/city/progress.h"
 
 #include <unistd.h>
 

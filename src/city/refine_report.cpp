@@ -1,5 +1,5 @@
 // The refine report: RefineResult's trace as JSON (see refine_report.h).
-#include "lodrefine/io/refine_report.h"
+#include "lodrefine/city/refine_report.h"
 
 namespace lodrefine {
 namespace {

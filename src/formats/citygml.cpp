@@ -1,7 +1,7 @@
 // CityGML: the file is checked here (kind, xml_guard, version); libcitygml reads it in the module
-// lodrefine_citygml.so (src/io/citygml_module/), loaded only now (citygml_module.h), which turns
+// lodrefine_citygml.so (src/formats/citygml_module/), loaded only now (citygml_module.h), which turns
 // the buildings into a CityJSON document for the CityJSON reader.
-#include "lodrefine/io/citygml.h"
+#include "lodrefine/formats/citygml.h"
 
 #include <fstream>
 #include <regex>
@@ -9,8 +9,8 @@
 #include <unordered_map>
 
 #include "citygml_module.h"
-#include "lodrefine/io/files.h"
-#include "text.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/base/text.h"
 #include "xml_guard.h"
 
 namespace lodrefine {

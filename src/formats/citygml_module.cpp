@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <system_error>
 
-#include "lodrefine/core/types.h"
+#include "lodrefine/base/types.h"
 
 #ifndef LODREFINE_CITYGML_MODULE_RELDIR
 #error \

@@ -1,5 +1,5 @@
-// Internal to the io library: the CityGML reader's libcitygml part lives in a module,
-// lodrefine_citygml.so (src/io/citygml_module/), loaded with dlopen only when a CityGML file is
+// Internal to the formats library: the CityGML reader's libcitygml part lives in a module,
+// lodrefine_citygml.so (src/formats/citygml_module/), loaded with dlopen only when a CityGML file is
 // read. libcitygml brings Xerces-C, GDAL and ~110 shared libraries whose symbol relocations cost
 // every process start ~0.1 s, CityGML or not; lodrefine runs once per building over districts.
 #pragma once

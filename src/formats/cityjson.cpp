@@ -1,5 +1,5 @@
 // CityJSON / CityJSONSeq reader: LoD 2.x Buildings and BuildingParts as polygon soups.
-#include "lodrefine/io/cityjson.h"
+#include "lodrefine/formats/cityjson.h"
 
 #include <algorithm>
 #include <cmath>
@@ -13,8 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "lodrefine/core/geometry.h"
-#include "lodrefine/io/files.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/base/geometry.h"
 
 namespace lodrefine {
 

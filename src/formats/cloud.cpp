@@ -1,5 +1,5 @@
 // Format dispatch for point clouds: PLY (io) or LAS (las), by content; a cloud of several files.
-#include "lodrefine/io/cloud.h"
+#include "lodrefine/formats/cloud.h"
 
 #include <sys/stat.h>
 
@@ -9,9 +9,9 @@
 #include <map>
 #include <utility>
 
-#include "lodrefine/io/files.h"
-#include "lodrefine/io/las.h"
-#include "lodrefine/io/ply.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/formats/las.h"
+#include "lodrefine/formats/ply.h"
 
 namespace lodrefine {
 

@@ -16,7 +16,7 @@
 // indices) and must agree with the check's.
 //
 // Writing is ours: fixed 6 decimals via <charconv>, so a C locale change cannot break files.
-#include "lodrefine/io/obj.h"
+#include "lodrefine/formats/obj.h"
 
 #include <tiny_obj_loader.h>
 
@@ -30,8 +30,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "lodrefine/io/files.h"
-#include "text.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/base/text.h"
 
 #ifndef TINYOBJLOADER_USE_DOUBLE
 #error "tinyobjloader must be the double build (CMakeLists.txt defines TINYOBJLOADER_USE_DOUBLE)"

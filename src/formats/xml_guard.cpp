@@ -7,7 +7,7 @@
 #include <optional>
 #include <string_view>
 
-#include "text.h"
+#include "lodrefine/base/text.h"
 
 namespace lodrefine::io_xml {
 namespace {

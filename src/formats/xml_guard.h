@@ -1,4 +1,4 @@
-// Internal to the io library: the XML text libcitygml is given. libcitygml builds its Xerces-C
+// Internal to the formats library: the XML text libcitygml is given. libcitygml builds its Xerces-C
 // parser itself and offers no hook for entity resolution, DTD loading or its SAX handler, so
 // what it must not see is taken out here, before it parses anything.
 #pragma once

@@ -2,14 +2,14 @@
 // chunk table, and the chunk by chunk streaming of records. The decoding itself: laz_coder.h
 // (arithmetic decoder and models), laz_items.h (shared field decoders), laz_pointwise.cpp
 // (compressor 2) and laz_layered.cpp (compressor 3).
-#include "laz.h"
+#include "lodrefine/laz/laz.h"
 
 #include <algorithm>
 #include <array>
 #include <optional>
 
 #include "laz_items.h"
-#include "text.h"
+#include "lodrefine/base/text.h"
 
 namespace lodrefine::laz {
 namespace {

@@ -1,4 +1,4 @@
-// Internal to the io library's LAZ codec (laz.h, laz_write.cpp): LASzip's arithmetic decoder and
+// Internal to the laz library's LAZ codec (laz.h, laz_write.cpp): LASzip's arithmetic decoder and
 // encoder, their shared adaptive bit and symbol models and the integer coder (one set of
 // models, decoded from or encoded into), after the published LASzip format, plus the byte
 // reader they decode from. All state is unsigned where the format wraps (corrector sums), so no
@@ -11,7 +11,7 @@
 #include <memory>
 #include <vector>
 
-#include "text.h"
+#include "lodrefine/base/text.h"
 
 namespace lodrefine::laz {
 

@@ -1,4 +1,4 @@
-// Internal to the io library's LAZ decoder (laz.h): the item types, the field decoders both
+// Internal to the laz library's LAZ decoder (laz.h): the item types, the field decoders both
 // compressors share (the x/y medians, GPS time, RGB) and the two chunk decoders: laz_pointwise.cpp
 // (compressor 2, point formats 0-3) and laz_layered.cpp (compressor 3, formats 6-8). GPS time
 // bits and coordinates are unsigned where the format wraps, so no input overflows a signed value.
@@ -10,8 +10,8 @@
 #include <memory>
 #include <vector>
 
-#include "laz.h"
 #include "laz_coder.h"
+#include "lodrefine/laz/laz.h"
 
 namespace lodrefine::laz {
 

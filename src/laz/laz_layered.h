@@ -1,4 +1,4 @@
-// Internal to the io library's LAZ codec: the state LASzip's layered compressor (compressor 3,
+// Internal to the laz library's LAZ codec: the state LASzip's layered compressor (compressor 3,
 // point formats 6-8) keeps per scanner channel, shared by the decoder (laz_layered.cpp) and the
 // encoder (laz_layered_write.cpp): context tables, POINT14's per-channel models, and the
 // channel bookkeeping of RGB14, RGBNIR14 and BYTE14.

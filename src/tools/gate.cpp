@@ -1,4 +1,4 @@
-#include "lodrefine/eval/gate.h"
+#include "lodrefine/tools/gate.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,9 +7,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "lodrefine/core/types.h"
-#include "lodrefine/io/cityjson.h"
-#include "lodrefine/io/files.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/base/types.h"
+#include "lodrefine/formats/cityjson.h"
 
 namespace lodrefine {
 namespace {

@@ -1,6 +1,6 @@
 // CGAL's PolyFit as a baseline (polyfit_baseline.h): the points and planes lodrefine would see,
 // handed to CGAL::Polygonal_surface_reconstruction as they are.
-#include "lodrefine/eval/polyfit_baseline.h"
+#include "lodrefine/tools/polyfit_baseline.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/GLPK_mixed_integer_program_traits.h>
@@ -25,13 +25,13 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/base/topology.h"
 #include "lodrefine/core/distance.h"
-#include "lodrefine/core/geometry.h"
 #include "lodrefine/core/matching.h"
 #include "lodrefine/core/planes.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/core/repair.h"
-#include "lodrefine/core/topology.h"
 
 namespace lodrefine {
 namespace {

@@ -1,5 +1,5 @@
 // lodrefine and CGAL's PolyFit on the same buildings (polyfit_bench.h).
-#include "lodrefine/eval/polyfit_bench.h"
+#include "lodrefine/tools/polyfit_bench.h"
 
 #include <time.h>
 
@@ -9,12 +9,12 @@
 #include <limits>
 #include <map>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/base/geometry.h"
 #include "lodrefine/core/refine.h"
-#include "lodrefine/eval/run.h"
-#include "lodrefine/io/cloud.h"
-#include "lodrefine/io/files.h"
-#include "lodrefine/io/obj.h"
+#include "lodrefine/formats/cloud.h"
+#include "lodrefine/formats/obj.h"
+#include "lodrefine/tools/run.h"
 
 namespace lodrefine {
 namespace {

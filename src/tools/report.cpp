@@ -1,9 +1,9 @@
-#include "lodrefine/eval/report.h"
+#include "lodrefine/tools/report.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
 
 namespace lodrefine {
 

@@ -1,4 +1,4 @@
-#include "lodrefine/eval/review.h"
+#include "lodrefine/tools/review.h"
 
 #include <algorithm>
 #include <cctype>
@@ -8,8 +8,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lodrefine/base/geometry.h"
 #include "lodrefine/core/distance.h"
-#include "lodrefine/core/geometry.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/eval/plots.h"
 

@@ -1,6 +1,6 @@
 // A run folder evaluated building by building: discovery, reading into a local frame, the refine
 // record of each building, and the buildings on a TBB pool.
-#include "lodrefine/eval/run.h"
+#include "lodrefine/tools/run.h"
 
 #include <algorithm>
 #include <climits>
@@ -16,14 +16,14 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/city/refine_report.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/core/validate.h"
 #include "lodrefine/eval/plots.h"
-#include "lodrefine/io/cityjson.h"
-#include "lodrefine/io/files.h"
-#include "lodrefine/io/obj.h"
-#include "lodrefine/io/refine_report.h"
+#include "lodrefine/formats/cityjson.h"
+#include "lodrefine/formats/obj.h"
 
 namespace lodrefine {
 namespace {

@@ -1,16 +1,16 @@
 // `lodrefine eval` as one call: evaluate, print, write, gate.
-#include "lodrefine/eval/run_eval.h"
+#include "lodrefine/tools/run_eval.h"
 
 #include <filesystem>
 #include <optional>
 #include <vector>
 
-#include "lodrefine/eval/gate.h"
+#include "lodrefine/base/files.h"
 #include "lodrefine/eval/plots.h"
-#include "lodrefine/eval/report.h"
-#include "lodrefine/eval/run.h"
-#include "lodrefine/eval/run_table.h"
-#include "lodrefine/io/files.h"
+#include "lodrefine/tools/gate.h"
+#include "lodrefine/tools/report.h"
+#include "lodrefine/tools/run.h"
+#include "lodrefine/tools/run_table.h"
 
 namespace lodrefine {
 namespace {

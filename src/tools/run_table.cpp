@@ -1,6 +1,6 @@
 // What `lodrefine eval` writes of evaluated buildings: Table 1, the tile table (JSON, CSV), the
 // HTML page's rows and views, and the gate's figures.
-#include "lodrefine/eval/run_table.h"
+#include "lodrefine/tools/run_table.h"
 
 #include <algorithm>
 #include <cmath>

@@ -35,15 +35,15 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lodrefine/base/files.h"
+#include "lodrefine/city/refine_report.h"
 #include "lodrefine/core/candidates.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/core/selection.h"
 #include "lodrefine/core/validate.h"
-#include "lodrefine/io/files.h"
-#include "lodrefine/io/obj.h"
-#include "lodrefine/io/ply.h"
-#include "lodrefine/io/refine_report.h"
+#include "lodrefine/formats/obj.h"
+#include "lodrefine/formats/ply.h"
 #include "support/candidate_fixtures.h"
 
 using namespace lodrefine;

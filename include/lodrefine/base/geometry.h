@@ -4,7 +4,7 @@
 #include <optional>
 #include <vector>
 
-#include "lodrefine/core/types.h"
+#include "lodrefine/base/types.h"
 
 namespace lodrefine {
 

@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "lodrefine/core/types.h"
+#include "lodrefine/base/types.h"
 
 namespace lodrefine {
 

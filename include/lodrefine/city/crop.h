@@ -3,8 +3,8 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/core/types.h"
-#include "lodrefine/io/cloud.h"
+#include "lodrefine/base/types.h"
+#include "lodrefine/formats/cloud.h"
 
 namespace lodrefine {
 

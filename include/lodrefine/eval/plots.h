@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/core/types.h"
+#include "lodrefine/base/types.h"
 #include "lodrefine/eval/histogram.h"
 
 namespace lodrefine {

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/io/cityjson.h"
+#include "lodrefine/formats/cityjson.h"
 
 namespace lodrefine {
 

@@ -17,7 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "lodrefine/core/types.h"
+#include "lodrefine/base/types.h"
 
 namespace lodrefine {
 

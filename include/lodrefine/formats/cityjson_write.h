@@ -3,7 +3,7 @@
 #include <array>
 #include <cmath>
 
-#include "lodrefine/core/types.h"
+#include "lodrefine/base/types.h"
 
 namespace lodrefine {
 

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/core/geometry.h"  // bounding_box, for overlap_problem
-#include "lodrefine/core/types.h"
+#include "lodrefine/base/geometry.h"  // bounding_box, for overlap_problem
+#include "lodrefine/base/types.h"
 
 namespace lodrefine {
 

@@ -3,8 +3,8 @@
 #pragma once
 #include <string>
 
-#include "lodrefine/core/types.h"
-#include "lodrefine/io/files.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/base/types.h"
 
 namespace lodrefine {
 

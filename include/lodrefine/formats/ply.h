@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/core/types.h"
-#include "lodrefine/io/files.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/base/types.h"
 
 namespace lodrefine {
 

@@ -1,5 +1,5 @@
-// Writing LAS point records as LAZ (LASzip-compressed; our own encoder, src/io/laz_write.cpp and
-// the *_write parts of src/io/laz_*.cpp, the inverse of the decoder stream_las_records uses) or
+// Writing LAS point records as LAZ (LASzip-compressed; our own encoder, src/laz/laz_write.cpp and
+// the *_write parts of src/laz/laz_*.cpp, the inverse of the decoder stream_las_records uses) or
 // as plain LAS. LAZ is LASzip's chunked format as LASzip writes it: point formats 0–5 with
 // compressor 2 (POINT10, GPSTIME11, RGB12 and BYTE items in version 2, WAVEPACKET13 in version
 // 1), formats 6–10 with compressor 3 (the layered POINT14, RGB14, RGBNIR14, WAVEPACKET14 and
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/core/types.h"
+#include "lodrefine/base/types.h"
 
 namespace lodrefine {
 

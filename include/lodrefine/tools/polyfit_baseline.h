@@ -6,8 +6,8 @@
 #pragma once
 #include <string>
 
+#include "lodrefine/base/types.h"
 #include "lodrefine/core/params.h"
-#include "lodrefine/core/types.h"
 
 namespace lodrefine {
 

@@ -8,11 +8,11 @@
 #include <string>
 #include <vector>
 
+#include "lodrefine/base/types.h"
 #include "lodrefine/core/params.h"
-#include "lodrefine/core/types.h"
 #include "lodrefine/eval/eval.h"
-#include "lodrefine/eval/polyfit_baseline.h"
-#include "lodrefine/eval/run.h"
+#include "lodrefine/tools/polyfit_baseline.h"
+#include "lodrefine/tools/run.h"
 
 namespace lodrefine {
 

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/core/types.h"
-#include "lodrefine/eval/report.h"
+#include "lodrefine/base/types.h"
+#include "lodrefine/tools/report.h"
 
 namespace lodrefine {
 

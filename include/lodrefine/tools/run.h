@@ -9,11 +9,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lodrefine/base/types.h"
+#include "lodrefine/city/progress.h"
 #include "lodrefine/core/params.h"
-#include "lodrefine/core/types.h"
 #include "lodrefine/eval/eval.h"
-#include "lodrefine/io/cloud.h"
-#include "lodrefine/io/progress.h"
+#include "lodrefine/formats/cloud.h"
 
 namespace lodrefine {
 

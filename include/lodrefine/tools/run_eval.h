@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lodrefine/core/params.h"
-#include "lodrefine/io/cloud.h"
+#include "lodrefine/formats/cloud.h"
 
 namespace lodrefine {
 

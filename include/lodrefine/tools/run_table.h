@@ -14,9 +14,9 @@
 
 #include "lodrefine/core/params.h"
 #include "lodrefine/eval/eval.h"
-#include "lodrefine/eval/gate.h"
-#include "lodrefine/eval/report.h"
-#include "lodrefine/eval/run.h"
+#include "lodrefine/tools/gate.h"
+#include "lodrefine/tools/report.h"
+#include "lodrefine/tools/run.h"
 
 namespace lodrefine {
 

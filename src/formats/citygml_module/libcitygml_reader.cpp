@@ -1,5 +1,5 @@
 // The libcitygml part of the CityGML reader, built as the module lodrefine_citygml.so and loaded
-// by src/io/citygml_module.cpp only when a CityGML file is read (citygml_module.h). The buildings
+// by src/formats/citygml_module.cpp only when a CityGML file is read (citygml_module.h). The buildings
 // are turned into a CityJSON document that the CityJSON reader reads, so both formats give the
 // same meshes (ring splitting, degenerate and inner rings, semantics) and the city-file writer
 // can treat a CityGML input like a CityJSON one.
@@ -21,9 +21,9 @@
 #include <unordered_map>
 
 #include "../citygml_module.h"
-#include "lodrefine/core/topology.h"
-#include "lodrefine/io/cityjson_write.h"
-#include "lodrefine/io/files.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/base/topology.h"
+#include "lodrefine/formats/cityjson_write.h"
 
 namespace lodrefine {
 namespace {
