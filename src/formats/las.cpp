@@ -1,7 +1,7 @@
 // LAS reader and writer (ASPRS LAS 1.4 R15; 1.0–1.3 are prefixes of the same header); LAZ
 // point data goes through our decoder (laz.h). All fields are little-endian and read
 // byte-wise, so the code does not depend on the host.
-#include "lodrefine/io/las.h"
+#include "lodrefine/formats/las.h"
 
 #include <algorithm>
 #include <array>
@@ -11,17 +11,18 @@
 #include <fstream>
 #include <optional>
 
-#include "laz.h"
-#include "lodrefine/core/geometry.h"
-#include "lodrefine/io/files.h"
-#include "text.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/base/text.h"
+#include "lodrefine/laz/laz.h"
 
 namespace lodrefine {
 namespace {
 
-// Public header block sizes by version: 1.0–1.2 end after the bounding box, 1.3 adds the
-// waveform data offset, 1.4 the extended VLRs and 64-bit counts.
-constexpr std::uint32_t kHeaderSize12 = 227, kHeaderSize13 = 235, kHeaderSize14 = 375;
+// Public header block sizes by version (las_header.h).
+using laz::kHeaderSize12;
+using laz::kHeaderSize13;
+using laz::kHeaderSize14;
 constexpr std::uint32_t kVlrHeaderSize = 54;
 // Point data format ids with bit 7 (LASzip) or bit 6 (older LASzip) set mark compressed data.
 constexpr int kCompressedBits = 0xC0;
@@ -31,15 +32,8 @@ constexpr std::size_t kChunkBytes = 1 << 20;
 using io_text::fail;
 using io_text::get_le;
 using io_text::open_input;
+using io_text::put_le;
 using io_text::read_at;
-
-template <class T>
-void put_le(std::string& out, T v) {
-  std::uint64_t bits = 0;
-  if constexpr (std::is_same_v<T, double>) std::memcpy(&bits, &v, 8);
-  else bits = std::uint64_t(v);
-  for (std::size_t i = 0; i < sizeof(T); ++i) out += char((bits >> (8 * i)) & 0xff);
-}
 
 Vec3 get_vec(const unsigned char* p, int stride) {
   return {get_le<double>(p), get_le<double>(p + stride), get_le<double>(p + 2 * stride)};
@@ -149,49 +143,6 @@ Parsed parse_header(const std::string& path, std::ifstream& in, std::uint64_t fi
 }
 
 }  // namespace
-
-std::string laz::las_header_block(const laz::HeaderBlock& b) {
-  const std::uint32_t header = b.version_minor == 4   ? kHeaderSize14
-                               : b.version_minor == 3 ? kHeaderSize13
-                                                      : kHeaderSize12;
-  std::string out;
-  out += "LASF";
-  put_le<std::uint16_t>(out, 0);  // file source id
-  put_le<std::uint16_t>(out, 0);  // global encoding
-  out.append(16, '\0');           // GUID
-  out += char(1), out += char(b.version_minor);
-  std::string sys = "lodrefine";
-  sys.resize(32, '\0');
-  out += sys + sys;  // system identifier, generating software
-  put_le<std::uint16_t>(out, 1);
-  put_le<std::uint16_t>(out, 2026);
-  put_le<std::uint16_t>(out, std::uint16_t(header));
-  put_le<std::uint32_t>(out, b.point_offset);
-  put_le<std::uint32_t>(out, b.vlr_count);
-  out += char(b.format_byte);
-  put_le<std::uint16_t>(out, std::uint16_t(b.record_length));
-  // Formats 6–10 must leave the legacy counts at 0 (LAS 1.4); others fill them when they fit.
-  const bool legacy_ok = (b.format_byte & 0x3f) < 6 && b.count <= 0xffffffffu;
-  put_le<std::uint32_t>(out, legacy_ok ? std::uint32_t(b.count) : 0);
-  for (int i = 0; i < 5; ++i) put_le<std::uint32_t>(out, legacy_ok ? std::uint32_t(b.by_return[i]) : 0);
-  for (int a = 0; a < 3; ++a) put_le<double>(out, b.scale[a]);
-  for (int a = 0; a < 3; ++a) put_le<double>(out, b.offset[a]);
-  for (int a = 0; a < 3; ++a) put_le<double>(out, b.max[a]), put_le<double>(out, b.min[a]);
-  if (b.version_minor >= 3) put_le<std::uint64_t>(out, 0);  // waveform data packet record
-  if (b.version_minor >= 4) {
-    put_le<std::uint64_t>(out, 0);  // first EVLR
-    put_le<std::uint32_t>(out, 0);  // EVLR count
-    put_le<std::uint64_t>(out, b.count);
-    for (std::uint64_t r : b.by_return) put_le<std::uint64_t>(out, r);
-  }
-  return out;
-}
-
-std::uint32_t las_min_record_length(int point_format) {
-  static constexpr std::array<std::uint32_t, 11> kLength = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
-  if (point_format < 0 || point_format > 10) throw std::invalid_argument("LAS point format out of range");
-  return kLength[std::size_t(point_format)];
-}
 
 LasHeader read_las_header(const std::string& path) {
   std::uint64_t size = 0;

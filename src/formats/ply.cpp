@@ -1,5 +1,5 @@
 // PLY reading (ascii, binary little/big endian, streamed) and writing.
-#include "lodrefine/io/ply.h"
+#include "lodrefine/formats/ply.h"
 
 #include <algorithm>
 #include <array>
@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "text.h"
+#include "lodrefine/base/text.h"
 
 namespace lodrefine {
 
@@ -340,14 +340,6 @@ class PlyReader {
   std::array<std::size_t, 3> xyz_{};
   std::string tok_;
 };
-
-template <class T>
-void put_le(std::string& out, T v) {
-  static_assert(sizeof(T) == 4 || sizeof(T) == 8);
-  std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint64_t> bits;
-  std::memcpy(&bits, &v, sizeof(T));
-  for (std::size_t i = 0; i < sizeof(T); ++i) out += char((bits >> (8 * i)) & 0xff);
-}
 
 }  // namespace
 

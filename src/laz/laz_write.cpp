@@ -1,17 +1,17 @@
-// LAS and LAZ writer (lodrefine/io/laz_write.h): the header block (las.cpp), the LASzip VLR,
+// LAS and LAZ writer (lodrefine/laz/laz_write.h): the header block (las_header.cpp), the LASzip VLR,
 // the chunks (the chunk encoders of laz_pointwise.cpp and laz_layered_write.cpp) and the chunk
 // table, coded as read_layout reads it.
-#include "lodrefine/io/laz_write.h"
+#include "lodrefine/laz/laz_write.h"
 
 #include <algorithm>
 #include <limits>
 #include <stdexcept>
 #include <utility>
 
-#include "laz.h"
 #include "laz_items.h"
-#include "lodrefine/io/files.h"
-#include "lodrefine/io/las.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/laz/las_header.h"
+#include "lodrefine/laz/laz.h"
 
 namespace lodrefine {
 namespace {

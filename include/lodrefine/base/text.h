@@ -1,5 +1,5 @@
-// Internal to the io library: the small text and file helpers its readers and writers share
-// (messages, tokens, numbers). Not a public header: nothing outside src/io/ includes it.
+// The small text and file helpers the readers and writers of the laz and formats libraries share
+// (messages, tokens, numbers, little-endian fields). Not meant for the libraries' users.
 #pragma once
 #include <charconv>
 #include <cstdint>
@@ -11,7 +11,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "lodrefine/core/types.h"
+#include "lodrefine/base/types.h"
 
 namespace lodrefine::io_text {
 
@@ -43,7 +43,7 @@ std::optional<T> parse_number(std::string_view t) {
 std::ifstream open_input(const std::string& path, std::uint64_t* size = nullptr);
 std::string read_whole_file(const std::string& path);
 
-// Little-endian binary fields (LAS, LAZ), read byte-wise so nothing depends on the host.
+// Little-endian binary fields (LAS, LAZ), read and written byte-wise so nothing depends on the host.
 template <class T>
 T get_le(const unsigned char* p) {
   std::uint64_t bits = 0;
@@ -55,6 +55,20 @@ T get_le(const unsigned char* p) {
   } else {
     return T(bits);
   }
+}
+
+template <class T>
+void put_le(std::string& out, T v) {  // integers, float and double
+  std::uint64_t bits = 0;
+  if constexpr (std::is_floating_point_v<T>) {
+    static_assert(sizeof(T) == 4 || sizeof(T) == 8);
+    std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint64_t> raw;
+    std::memcpy(&raw, &v, sizeof(T));
+    bits = raw;
+  } else {
+    bits = std::uint64_t(v);
+  }
+  for (std::size_t i = 0; i < sizeof(T); ++i) out += char((bits >> (8 * i)) & 0xff);
 }
 
 // Reads n bytes at byte offset pos; false when the file is shorter.

@@ -1,5 +1,5 @@
 // Reading ASPRS LAS point clouds: versions 1.0–1.4, point data record formats 0–10,
-// uncompressed, and LASzip-compressed LAZ of point formats 0–10 (our own decoder, src/io/laz.cpp:
+// uncompressed, and LASzip-compressed LAZ of point formats 0–10 (our own decoder, src/laz/laz.cpp:
 // Debian ships no LAS library, no PDAL, LASlib, liblas, LASzip or laz-perf). A small reader of
 // the public header block and the point records; other LAZ is refused with one line.
 #pragma once
@@ -8,25 +8,12 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/core/types.h"
+#include "lodrefine/base/types.h"
+#include "lodrefine/laz/las_header.h"
 
 namespace lodrefine {
 
-// The public header block fields the reader uses, validated against the file.
-struct LasHeader {
-  int version_major = 1, version_minor = 2;
-  int point_format = 0;             // 0..10
-  std::uint32_t record_length = 0;  // bytes per point record (>= the format's minimum; extra bytes are skipped)
-  std::uint32_t header_size = 0;
-  std::uint64_t point_offset = 0;  // byte offset of the first point record
-  std::uint64_t point_count = 0;   // LAS 1.4: the 64-bit count; before: the 32-bit legacy count
-  Vec3 scale = Vec3::Ones(), offset = Vec3::Zero();
-  Vec3 min = Vec3::Zero(), max = Vec3::Zero();  // bounding box as declared by the writer
-  bool compressed = false;                      // LAZ: point format bit 7 or 6, or a "laszip encoded" VLR
-};
-
-// Smallest record length of point data format 0..10 (ASPRS LAS 1.4 R15, Tables 7–17).
-std::uint32_t las_min_record_length(int point_format);
+// LasHeader and las_min_record_length: las_header.h (the laz library's, which the decoder shares).
 
 // Reads and checks the header: 'LASF' signature, version 1.0–1.4, header size, point data
 // offset and record length within the file, point format 0–10, record length at least the

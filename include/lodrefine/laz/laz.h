@@ -1,7 +1,8 @@
-// Internal to the io library: our own decoder of LASzip-compressed point data (LAZ), written
-// from the LASzip format as published (rapidlasso's LAZ specification, with laz-perf as the
-// reference implementation it was checked against bit for bit). Not a public header: las.cpp
-// calls it for files whose header or VLRs say "compressed".
+// The laz library's decoder of LASzip-compressed point data (LAZ), written from the LASzip
+// format as published (rapidlasso's LAZ specification, with laz-perf as the reference
+// implementation it was checked against bit for bit). For the formats library: its LAS reader
+// (src/formats/las.cpp) calls it for files whose header or VLRs say "compressed"; other users
+// read LAZ through las.h.
 //
 // Supported: the "laszip encoded" VLR (user id "laszip encoded", record 22204); compressor 2
 // (chunked, pointwise) with items POINT10, GPSTIME11, RGB12 and BYTE in version 2 and
@@ -19,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/io/las.h"
+#include "lodrefine/laz/las_header.h"
 
 namespace lodrefine::laz {
 
@@ -52,7 +53,7 @@ Layout read_layout(const std::string& path, std::ifstream& in, std::uint64_t fil
 void stream_records(const std::string& path, std::ifstream& in, std::uint64_t file_size, const LasHeader& header,
                     const Layout& layout, const std::function<void(const unsigned char*)>& on_record);
 
-// The fields of a LAS 1.2–1.4 public header block that the writers set (las.cpp).
+// The fields of a LAS 1.2–1.4 public header block that the writers set (las_header.cpp).
 struct HeaderBlock {
   int version_minor = 2;
   int format_byte = 0;  // the point format, with bit 7 set for LAZ
