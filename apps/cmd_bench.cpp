@@ -16,11 +16,11 @@
 #include <vector>
 
 #include "commands.h"
+#include "lodrefine/base/files.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/eval/eval.h"
-#include "lodrefine/eval/polyfit_bench.h"
-#include "lodrefine/io/files.h"
 #include "lodrefine/synth/synth.h"
+#include "lodrefine/tools/polyfit_bench.h"
 #include "options.h"
 
 namespace lodrefine::app {

@@ -6,9 +6,9 @@
 #include <set>
 
 #include "commands.h"
-#include "lodrefine/io/citygml.h"
-#include "lodrefine/io/files.h"
-#include "lodrefine/io/obj.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/formats/citygml.h"
+#include "lodrefine/formats/obj.h"
 #include "options.h"
 
 namespace lodrefine::app {

@@ -8,10 +8,10 @@
 #include <tuple>
 
 #include "commands.h"
-#include "lodrefine/io/crop.h"
-#include "lodrefine/io/files.h"
-#include "lodrefine/io/obj.h"
-#include "lodrefine/io/progress.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/city/crop.h"
+#include "lodrefine/city/progress.h"
+#include "lodrefine/formats/obj.h"
 #include "options.h"
 
 namespace lodrefine::app {

@@ -6,8 +6,8 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
-#include "lodrefine/eval/run_eval.h"
-#include "lodrefine/io/refine_report.h"
+#include "lodrefine/city/refine_report.h"
+#include "lodrefine/tools/run_eval.h"
 #include "options.h"
 
 namespace lodrefine::app {

@@ -8,14 +8,14 @@
 #include <optional>
 
 #include "commands.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/city/cityfile.h"
+#include "lodrefine/city/progress.h"
+#include "lodrefine/city/refine_report.h"
 #include "lodrefine/core/refine.h"
-#include "lodrefine/eval/review.h"
-#include "lodrefine/io/cityfile.h"
-#include "lodrefine/io/cloud.h"
-#include "lodrefine/io/files.h"
-#include "lodrefine/io/obj.h"
-#include "lodrefine/io/progress.h"
-#include "lodrefine/io/refine_report.h"
+#include "lodrefine/formats/cloud.h"
+#include "lodrefine/formats/obj.h"
+#include "lodrefine/tools/review.h"
 #include "options.h"
 
 namespace lodrefine::app {

@@ -3,7 +3,7 @@
 #include <string>
 
 #include "commands.h"
-#include "lodrefine/io/progress.h"
+#include "lodrefine/city/progress.h"
 #include "lodrefine/synth/synth.h"
 #include "options.h"
 

@@ -8,8 +8,8 @@
 #include <new>
 
 #include "commands.h"
-#include "lodrefine/core/types.h"
-#include "lodrefine/io/files.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/base/types.h"
 #include "lodrefine/version.h"
 #include "options.h"
 

@@ -8,8 +8,8 @@
 #include <CLI/CLI.hpp>
 
 #include "lodrefine/core/params.h"
-#include "lodrefine/io/cityjson.h"
-#include "lodrefine/io/cloud.h"
+#include "lodrefine/formats/cityjson.h"
+#include "lodrefine/formats/cloud.h"
 
 namespace lodrefine::app {
 

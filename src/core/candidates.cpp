@@ -6,7 +6,7 @@
 #include <limits>
 #include <numeric>
 
-#include "lodrefine/core/topology.h"
+#include "lodrefine/base/topology.h"
 
 namespace lodrefine {
 namespace {

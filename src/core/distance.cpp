@@ -11,7 +11,7 @@
 #include <deque>
 #include <limits>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
 
 namespace lodrefine {
 namespace {

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "lodrefine/core/types.h"
+#include "lodrefine/base/types.h"
 
 namespace lodrefine {
 namespace {

@@ -10,9 +10,9 @@
 #include <queue>
 #include <set>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/base/topology.h"
 #include "lodrefine/core/params.h"
-#include "lodrefine/core/topology.h"
 #include "lodrefine/core/validate.h"
 
 namespace lodrefine {

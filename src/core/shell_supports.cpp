@@ -6,8 +6,8 @@
 #include <limits>
 #include <tuple>
 
+#include "lodrefine/base/topology.h"
 #include "lodrefine/core/matching.h"
-#include "lodrefine/core/topology.h"
 
 namespace lodrefine::detail {
 namespace {

@@ -4,11 +4,11 @@
 #pragma once
 #include <vector>
 
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/base/types.h"
 #include "lodrefine/core/candidates.h"
-#include "lodrefine/core/geometry.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/planes.h"
-#include "lodrefine/core/types.h"
 
 namespace lodrefine::detail {
 

@@ -7,10 +7,10 @@
 #include <set>
 #include <utility>
 
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/base/topology.h"
 #include "lodrefine/core/candidates.h"
-#include "lodrefine/core/geometry.h"
 #include "lodrefine/core/repair.h"
-#include "lodrefine/core/topology.h"
 #include "lodrefine/core/validate.h"
 
 namespace lodrefine {

@@ -18,8 +18,8 @@
 #include <set>
 #include <sstream>
 
-#include "lodrefine/core/geometry.h"
-#include "lodrefine/core/topology.h"
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/base/topology.h"
 
 namespace lodrefine {
 namespace {

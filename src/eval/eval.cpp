@@ -7,12 +7,12 @@
 #include <limits>
 #include <map>
 
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/base/topology.h"
 #include "lodrefine/core/distance.h"
-#include "lodrefine/core/geometry.h"
 #include "lodrefine/core/matching.h"
 #include "lodrefine/core/planes.h"
 #include "lodrefine/core/repair.h"
-#include "lodrefine/core/topology.h"
 #include "lodrefine/core/validate.h"
 
 namespace lodrefine {

@@ -6,7 +6,7 @@
 #include <set>
 #include <stdexcept>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
 
 namespace lodrefine::synth {
 

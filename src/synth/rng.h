@@ -4,8 +4,8 @@
 #include <cstdint>
 #include <random>
 
-#include "lodrefine/core/geometry.h"
-#include "lodrefine/core/types.h"
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/base/types.h"
 
 namespace lodrefine::synth {
 

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <set>
 
-#include "lodrefine/core/geometry.h"
-#include "lodrefine/core/topology.h"
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/base/topology.h"
 
 namespace lodrefine::synth {
 

@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
 #include "lodrefine/core/repair.h"
 #include "shapes.h"
 

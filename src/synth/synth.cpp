@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
 #include "perturb.h"
 #include "scan.h"
 #include "shapes.h"

@@ -9,7 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
 
 namespace lodrefine::synth {
 

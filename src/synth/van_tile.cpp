@@ -4,11 +4,11 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
-#include "lodrefine/core/geometry.h"
-#include "lodrefine/io/cityjson.h"
-#include "lodrefine/io/crop.h"
-#include "lodrefine/io/files.h"
-#include "lodrefine/io/obj.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/city/crop.h"
+#include "lodrefine/formats/cityjson.h"
+#include "lodrefine/formats/obj.h"
 #include "lodrefine/synth/synth.h"
 #include "van.h"
 

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/io/files.h"
-#include "lodrefine/io/obj.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/formats/obj.h"
 #include "support/bad_input_fixtures.h"
 
 using namespace lodrefine;

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/io/files.h"
+#include "lodrefine/base/files.h"
 #include "support/bad_input_fixtures.h"
 
 using namespace lodrefine;

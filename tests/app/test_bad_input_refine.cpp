@@ -29,8 +29,8 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/core/geometry.h"
-#include "lodrefine/io/obj.h"
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/formats/obj.h"
 #include "support/bad_input_fixtures.h"
 
 using namespace lodrefine;

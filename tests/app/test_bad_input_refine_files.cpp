@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/io/ply.h"
+#include "lodrefine/formats/ply.h"
 #include "support/bad_input_fixtures.h"
 
 using namespace lodrefine;

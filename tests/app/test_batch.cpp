@@ -9,8 +9,8 @@
 #include <set>
 #include <thread>
 
-#include "lodrefine/io/files.h"
-#include "lodrefine/io/obj.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/formats/obj.h"
 #include "support/batch_fixtures.h"
 
 using namespace lodrefine::batch_fixtures;

@@ -11,11 +11,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "lodrefine/core/geometry.h"
-#include "lodrefine/io/cloud.h"
-#include "lodrefine/io/las.h"
-#include "lodrefine/io/obj.h"
-#include "lodrefine/io/ply.h"
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/formats/cloud.h"
+#include "lodrefine/formats/las.h"
+#include "lodrefine/formats/obj.h"
+#include "lodrefine/formats/ply.h"
 #include "lodrefine/synth/synth.h"
 #include "support/cli_fixtures.h"
 #include "support/io_fixtures.h"

@@ -9,13 +9,13 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/core/validate.h"
 #include "lodrefine/eval/eval.h"
-#include "lodrefine/io/obj.h"
-#include "lodrefine/io/ply.h"
+#include "lodrefine/formats/obj.h"
+#include "lodrefine/formats/ply.h"
 
 using namespace lodrefine;
 

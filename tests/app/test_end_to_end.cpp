@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/core/validate.h"

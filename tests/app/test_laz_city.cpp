@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "lodrefine/io/las.h"
+#include "lodrefine/formats/las.h"
 #include "support/cli_fixtures.h"
 #include "support/realdata.h"
 

@@ -17,15 +17,15 @@
 #include <map>
 #include <random>
 
+#include "lodrefine/base/files.h"
+#include "lodrefine/base/geometry.h"
 #include "lodrefine/core/distance.h"
-#include "lodrefine/core/geometry.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/core/repair.h"
 #include "lodrefine/core/validate.h"
-#include "lodrefine/io/cityjson.h"
-#include "lodrefine/io/files.h"
-#include "lodrefine/io/obj.h"
-#include "lodrefine/io/ply.h"
+#include "lodrefine/formats/cityjson.h"
+#include "lodrefine/formats/obj.h"
+#include "lodrefine/formats/ply.h"
 #include "support/realdata.h"
 
 using namespace lodrefine;

@@ -14,14 +14,14 @@
 #include <tuple>
 #include <utility>
 
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/base/topology.h"
 #include "lodrefine/core/distance.h"
-#include "lodrefine/core/geometry.h"
 #include "lodrefine/core/refine.h"
-#include "lodrefine/core/topology.h"
 #include "lodrefine/core/validate.h"
 #include "lodrefine/eval/eval.h"
-#include "lodrefine/io/cloud.h"
-#include "lodrefine/io/obj.h"
+#include "lodrefine/formats/cloud.h"
+#include "lodrefine/formats/obj.h"
 #include "lodrefine/synth/synth.h"
 
 using namespace lodrefine;

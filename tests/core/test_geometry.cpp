@@ -4,7 +4,7 @@
 #include <cmath>
 #include <random>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
 
 using namespace lodrefine;
 

@@ -3,8 +3,8 @@
 #include <set>
 #include <string>
 
+#include "lodrefine/base/types.h"
 #include "lodrefine/core/params.h"
-#include "lodrefine/core/types.h"
 
 using namespace lodrefine;
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <random>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
 #include "lodrefine/core/repair.h"
 #include "lodrefine/core/validate.h"
 #include "support/hang_guard.h"

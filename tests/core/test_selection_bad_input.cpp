@@ -13,12 +13,12 @@
 #include <string>
 #include <vector>
 
+#include "lodrefine/city/refine_report.h"
 #include "lodrefine/core/candidates.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/core/selection.h"
 #include "lodrefine/core/validate.h"
-#include "lodrefine/io/obj.h"
-#include "lodrefine/io/refine_report.h"
+#include "lodrefine/formats/obj.h"
 #include "support/bad_input_fixtures.h"
 #include "support/candidate_fixtures.h"
 

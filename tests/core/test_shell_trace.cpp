@@ -7,9 +7,9 @@
 #include <algorithm>
 #include <set>
 
+#include "lodrefine/base/topology.h"
 #include "lodrefine/core/candidates.h"
 #include "lodrefine/core/shell_trace.h"
-#include "lodrefine/core/topology.h"
 #include "lodrefine/core/validate.h"
 #include "support/candidate_fixtures.h"
 

@@ -2,7 +2,7 @@
 
 #include <vector>
 
-#include "lodrefine/core/topology.h"
+#include "lodrefine/base/topology.h"
 
 using namespace lodrefine;
 

@@ -4,9 +4,9 @@
 #include <algorithm>
 #include <map>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/base/topology.h"
 #include "lodrefine/core/params.h"
-#include "lodrefine/core/topology.h"
 #include "lodrefine/core/validate.h"
 
 using namespace lodrefine;

@@ -13,7 +13,7 @@
 #include <random>
 #include <sstream>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
 #include "lodrefine/eval/eval.h"
 #include "support/mesh_fixtures.h"
 

@@ -6,8 +6,8 @@
 #include <fstream>
 #include <functional>
 
-#include "lodrefine/core/types.h"
-#include "lodrefine/eval/gate.h"
+#include "lodrefine/base/types.h"
+#include "lodrefine/tools/gate.h"
 
 using namespace lodrefine;
 

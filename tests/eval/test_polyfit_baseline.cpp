@@ -7,11 +7,11 @@
 #include <cmath>
 #include <random>
 
+#include "lodrefine/base/geometry.h"
 #include "lodrefine/core/distance.h"
-#include "lodrefine/core/geometry.h"
 #include "lodrefine/eval/eval.h"
-#include "lodrefine/eval/polyfit_baseline.h"
-#include "lodrefine/eval/polyfit_bench.h"
+#include "lodrefine/tools/polyfit_baseline.h"
+#include "lodrefine/tools/polyfit_bench.h"
 #include "support/mesh_fixtures.h"
 #include "support/scan_fixtures.h"
 

@@ -9,10 +9,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "lodrefine/core/geometry.h"
-#include "lodrefine/eval/review.h"
-#include "lodrefine/io/cityjson.h"
-#include "lodrefine/io/ply.h"
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/formats/cityjson.h"
+#include "lodrefine/formats/ply.h"
+#include "lodrefine/tools/review.h"
 #include "support/batch_fixtures.h"
 #include "support/browser_fixtures.h"
 #include "support/mesh_fixtures.h"

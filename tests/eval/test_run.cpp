@@ -5,8 +5,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "lodrefine/eval/run.h"
-#include "lodrefine/io/refine_report.h"
+#include "lodrefine/city/refine_report.h"
+#include "lodrefine/tools/run.h"
 #include "support/cli_fixtures.h"
 #include "support/run_fixtures.h"
 

@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "lodrefine/eval/run_eval.h"
+#include "lodrefine/tools/run_eval.h"
 #include "support/cli_fixtures.h"
 #include "support/run_fixtures.h"
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "lodrefine/eval/run_table.h"
+#include "lodrefine/tools/run_table.h"
 
 using namespace lodrefine;
 using nlohmann::json;

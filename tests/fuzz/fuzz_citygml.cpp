@@ -8,7 +8,7 @@
 #include <string>
 
 #include "fuzz_common.h"
-#include "lodrefine/io/citygml.h"
+#include "lodrefine/formats/citygml.h"
 
 using namespace lodrefine;
 

@@ -8,8 +8,8 @@
 #include <string>
 
 #include "fuzz_common.h"
-#include "lodrefine/io/cityjson.h"
-#include "lodrefine/io/files.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/formats/cityjson.h"
 
 using namespace lodrefine;
 

@@ -6,8 +6,8 @@
 #include <string>
 
 #include "fuzz_las_common.h"
-#include "lodrefine/io/cloud.h"
-#include "lodrefine/io/files.h"  // kMaxCoordinate
+#include "lodrefine/base/files.h"  // kMaxCoordinate
+#include "lodrefine/formats/cloud.h"
 
 using namespace lodrefine;
 

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "fuzz_common.h"
-#include "lodrefine/core/types.h"
-#include "lodrefine/io/las.h"
+#include "lodrefine/base/types.h"
+#include "lodrefine/formats/las.h"
 
 namespace lodrefine::fuzz {
 

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "fuzz_common.h"
-#include "lodrefine/io/obj.h"
+#include "lodrefine/formats/obj.h"
 
 using namespace lodrefine;
 

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "fuzz_common.h"
-#include "lodrefine/io/ply.h"
+#include "lodrefine/formats/ply.h"
 
 using namespace lodrefine;
 

@@ -10,10 +10,10 @@
 #include <string>
 
 #include "fuzz_common.h"
+#include "lodrefine/city/refine_report.h"
 #include "lodrefine/core/refine.h"
-#include "lodrefine/io/obj.h"
-#include "lodrefine/io/ply.h"
-#include "lodrefine/io/refine_report.h"
+#include "lodrefine/formats/obj.h"
+#include "lodrefine/formats/ply.h"
 
 using namespace lodrefine;
 

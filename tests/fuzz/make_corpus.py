@@ -56,7 +56,7 @@ MIN_RECORD = [20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67]
 
 
 def las(points, minor=2, fmt=1, extra=0, classes=None, offset=(85000.0, 447000.0, 0.0)):
-    """Uncompressed LAS 1.minor, point format fmt, scale 1 mm (as write_las in src/io/las.cpp)."""
+    """Uncompressed LAS 1.minor, point format fmt, scale 1 mm (as write_las in src/formats/las.cpp)."""
     header = {2: 227, 3: 235, 4: 375}[minor]
     rec = MIN_RECORD[fmt] + extra
     n = len(points)

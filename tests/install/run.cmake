@@ -15,8 +15,10 @@ function(run what)
 endfunction()
 
 run("install" ${CMAKE_COMMAND} --install ${BUILD} --prefix ${WORK}/prefix)
-foreach(f include/lodrefine/version.h include/lodrefine/core/types.h include/lodrefine/io/obj.h
-          include/lodrefine/eval/eval.h lib/cmake/lodrefine/lodrefineConfig.cmake bin/lodrefine)
+foreach(f include/lodrefine/version.h include/lodrefine/base/types.h include/lodrefine/laz/laz_write.h
+          include/lodrefine/formats/obj.h include/lodrefine/core/validate.h include/lodrefine/city/cityfile.h
+          include/lodrefine/eval/eval.h include/lodrefine/tools/report.h lib/cmake/lodrefine/lodrefineConfig.cmake
+          bin/lodrefine)
   if(NOT EXISTS ${WORK}/prefix/${f})
     message(FATAL_ERROR "install test: ${f} not installed")
   endif()

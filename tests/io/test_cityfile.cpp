@@ -18,18 +18,18 @@
 #include <mutex>
 #include <random>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/city/cityfile.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/core/selection.h"
 #include "lodrefine/core/validate.h"
-#include "lodrefine/io/cityfile.h"
-#include "lodrefine/io/citygml.h"
-#include "lodrefine/io/cityjson.h"
-#include "lodrefine/io/files.h"
-#include "lodrefine/io/las.h"
-#include "lodrefine/io/obj.h"
-#include "lodrefine/io/ply.h"
+#include "lodrefine/formats/citygml.h"
+#include "lodrefine/formats/cityjson.h"
+#include "lodrefine/formats/las.h"
+#include "lodrefine/formats/obj.h"
+#include "lodrefine/formats/ply.h"
 #include "lodrefine/synth/synth.h"
 
 using namespace lodrefine;

@@ -12,7 +12,7 @@
 #include <fstream>
 #include <map>
 
-#include "lodrefine/io/citygml.h"
+#include "lodrefine/formats/citygml.h"
 #include "support/hang_guard.h"
 
 using namespace lodrefine;

@@ -1,4 +1,4 @@
-// The CityGML reader's module (src/io/citygml_module.h): libcitygml and what it brings are no
+// The CityGML reader's module (src/formats/citygml_module.h): libcitygml and what it brings are no
 // NEEDED entry of the executable; the module is found beside the executable or in the installed
 // layout only (never through LD_LIBRARY_PATH or the current folder); without it, CityGML input
 // is one line and a non-zero exit, with nothing written, while the other formats still work.

@@ -13,10 +13,10 @@
 #include <filesystem>
 #include <map>
 
-#include "lodrefine/io/cityjson.h"
-#include "lodrefine/io/cityjson_write.h"
-#include "lodrefine/io/files.h"
-#include "lodrefine/io/obj.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/formats/cityjson.h"
+#include "lodrefine/formats/cityjson_write.h"
+#include "lodrefine/formats/obj.h"
 #include "support/hang_guard.h"
 #include "support/realdata.h"
 

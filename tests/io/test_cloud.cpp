@@ -8,9 +8,9 @@
 #include <filesystem>
 #include <fstream>
 
-#include "lodrefine/io/cloud.h"
-#include "lodrefine/io/las.h"
-#include "lodrefine/io/ply.h"
+#include "lodrefine/formats/cloud.h"
+#include "lodrefine/formats/las.h"
+#include "lodrefine/formats/ply.h"
 
 using namespace lodrefine;
 namespace fs = std::filesystem;

@@ -9,9 +9,9 @@
 #include <functional>
 #include <stdexcept>
 
-#include "lodrefine/core/geometry.h"
-#include "lodrefine/io/crop.h"
-#include "lodrefine/io/ply.h"
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/city/crop.h"
+#include "lodrefine/formats/ply.h"
 #include "lodrefine/synth/synth.h"
 #include "support/io_fixtures.h"
 

@@ -14,9 +14,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "lodrefine/io/files.h"
-#include "lodrefine/io/obj.h"
-#include "lodrefine/io/ply.h"
+#include "lodrefine/base/files.h"
+#include "lodrefine/formats/obj.h"
+#include "lodrefine/formats/ply.h"
 #include "support/io_fixtures.h"
 
 using namespace lodrefine;

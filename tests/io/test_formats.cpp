@@ -9,9 +9,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "lodrefine/io/las.h"
-#include "lodrefine/io/obj.h"
-#include "lodrefine/io/ply.h"
+#include "lodrefine/formats/las.h"
+#include "lodrefine/formats/obj.h"
+#include "lodrefine/formats/ply.h"
 #include "lodrefine/synth/synth.h"
 
 using namespace lodrefine;

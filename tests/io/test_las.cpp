@@ -13,10 +13,10 @@
 #include <limits>
 #include <tuple>
 
-#include "lodrefine/io/cloud.h"
-#include "lodrefine/io/las.h"
-#include "lodrefine/io/obj.h"
-#include "lodrefine/io/ply.h"
+#include "lodrefine/formats/cloud.h"
+#include "lodrefine/formats/las.h"
+#include "lodrefine/formats/obj.h"
+#include "lodrefine/formats/ply.h"
 #include "lodrefine/synth/synth.h"
 
 using namespace lodrefine;

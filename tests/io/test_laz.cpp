@@ -1,4 +1,4 @@
-// LAZ reading (src/io/laz.cpp): the real AHN3 tiles' header, bounds and class histogram; every
+// LAZ reading (src/laz/laz.cpp): the real AHN3 tiles' header, bounds and class histogram; every
 // decoded record byte for byte equal to an independent decoder's (the npm package laz-perf,
 // LASzip compiled to WASM, run by node); lying VLRs, chunk tables and truncated chunks give one
 // line naming the file. Tests needing ../shared, node or laz-perf skip cleanly without them.
@@ -18,9 +18,9 @@
 #include <random>
 #include <vector>
 
-#include "lodrefine/io/cloud.h"
-#include "lodrefine/io/las.h"
-#include "lodrefine/io/laz_write.h"
+#include "lodrefine/formats/cloud.h"
+#include "lodrefine/formats/las.h"
+#include "lodrefine/laz/laz_write.h"
 #include "support/cli_fixtures.h"
 #include "support/io_fixtures.h"
 #include "support/laz_fixtures.h"

@@ -1,4 +1,4 @@
-// LAZ writing (lodrefine/io/laz_write.h): for every point format the encoder supports, records
+// LAZ writing (lodrefine/laz/laz_write.h): for every point format the encoder supports, records
 // with varied fields (georeferenced coordinates, returns, classes and flags, scanner channels,
 // GPS time sequences, colour, near infrared, extra bytes) go LAS -> LAZ -> our decoder with every
 // byte equal; chunk boundaries; the LAZ we write decoded by an independent decoder (the npm
@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/io/cloud.h"
-#include "lodrefine/io/las.h"
-#include "lodrefine/io/laz_write.h"
+#include "lodrefine/formats/cloud.h"
+#include "lodrefine/formats/las.h"
+#include "lodrefine/laz/laz_write.h"
 #include "support/cli_fixtures.h"
 #include "support/io_fixtures.h"
 #include "support/laz_fixtures.h"

@@ -10,7 +10,7 @@
 #include <iterator>
 #include <limits>
 
-#include "lodrefine/io/obj.h"
+#include "lodrefine/formats/obj.h"
 #include "support/io_fixtures.h"
 
 using namespace lodrefine;

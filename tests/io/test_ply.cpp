@@ -10,7 +10,7 @@
 #include <iterator>
 #include <limits>
 
-#include "lodrefine/io/ply.h"
+#include "lodrefine/formats/ply.h"
 #include "support/io_fixtures.h"
 #include "support/ply_fixtures.h"
 

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/io/progress.h"
+#include "lodrefine/city/progress.h"
 
 using namespace lodrefine;
 

@@ -1,8 +1,8 @@
 // The refine report: built from RefineResult after the fact, with a key per stage reached.
 #include <gtest/gtest.h>
 
+#include "lodrefine/city/refine_report.h"
 #include "lodrefine/core/refine.h"
-#include "lodrefine/io/refine_report.h"
 #include "support/mesh_fixtures.h"
 #include "support/scan_fixtures.h"
 

@@ -27,7 +27,7 @@
 
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/validate.h"
-#include "lodrefine/io/obj.h"
+#include "lodrefine/formats/obj.h"
 #include "support/ply_fixtures.h"
 
 namespace lodrefine::bad_input {

@@ -12,8 +12,8 @@
 #include <utility>
 #include <vector>
 
-#include "lodrefine/core/types.h"
-#include "lodrefine/io/ply.h"
+#include "lodrefine/base/types.h"
+#include "lodrefine/formats/ply.h"
 
 namespace lodrefine::fixtures {
 

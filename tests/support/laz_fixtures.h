@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <string>
 
-#include "lodrefine/io/las.h"
+#include "lodrefine/formats/las.h"
 
 namespace lodrefine::fixtures {
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "lodrefine/core/types.h"
+#include "lodrefine/base/types.h"
 
 namespace lodrefine::fixtures {
 

@@ -7,8 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "lodrefine/io/obj.h"
-#include "lodrefine/io/ply.h"
+#include "lodrefine/formats/obj.h"
+#include "lodrefine/formats/ply.h"
 #include "support/mesh_fixtures.h"
 #include "support/scan_fixtures.h"
 

@@ -4,7 +4,7 @@
 #include <random>
 #include <vector>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
 #include "lodrefine/core/planes.h"
 
 namespace lodrefine::fixtures {

@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/synth/synth.h"
 

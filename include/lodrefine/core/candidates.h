@@ -14,8 +14,8 @@
 #include <utility>
 #include <vector>
 
-#include "lodrefine/core/geometry.h"
-#include "lodrefine/core/types.h"
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/base/types.h"
 
 namespace lodrefine {
 

@@ -19,11 +19,11 @@
 #include <optional>
 #include <vector>
 
+#include "lodrefine/base/types.h"
 #include "lodrefine/core/matching.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/planes.h"
 #include "lodrefine/core/substitute.h"
-#include "lodrefine/core/types.h"
 
 namespace lodrefine {
 

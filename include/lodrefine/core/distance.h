@@ -4,7 +4,7 @@
 #include <memory>
 #include <vector>
 
-#include "lodrefine/core/types.h"
+#include "lodrefine/base/types.h"
 
 namespace lodrefine {
 

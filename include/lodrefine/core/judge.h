@@ -26,10 +26,10 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/base/types.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/planes.h"
-#include "lodrefine/core/types.h"
 
 namespace lodrefine {
 

@@ -3,9 +3,9 @@
 #pragma once
 #include <vector>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/base/types.h"
 #include "lodrefine/core/params.h"
-#include "lodrefine/core/types.h"
 
 namespace lodrefine {
 

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "lodrefine/base/types.h"
 #include "lodrefine/core/judge.h"
 #include "lodrefine/core/matching.h"
 #include "lodrefine/core/outcome.h"
@@ -17,7 +18,6 @@
 #include "lodrefine/core/planes.h"
 #include "lodrefine/core/repair.h"
 #include "lodrefine/core/shell_selection.h"
-#include "lodrefine/core/types.h"
 #include "lodrefine/core/validate.h"
 
 namespace lodrefine {

@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "lodrefine/base/types.h"
 #include "lodrefine/core/params.h"
-#include "lodrefine/core/types.h"
 
 namespace lodrefine {
 

@@ -21,10 +21,10 @@
 #include <string>
 #include <vector>
 
+#include "lodrefine/base/types.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/planes.h"
 #include "lodrefine/core/selection.h"
-#include "lodrefine/core/types.h"
 
 namespace lodrefine {
 

@@ -12,7 +12,7 @@
 //   polygon when their outline is one simple loop (else they stay apart); a corner then used by
 //   only two faces lies on the line of their planes' meet and is dropped.
 #pragma once
-#include "lodrefine/core/types.h"
+#include "lodrefine/base/types.h"
 
 namespace lodrefine {
 

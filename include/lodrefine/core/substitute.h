@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/core/geometry.h"
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/base/types.h"
 #include "lodrefine/core/matching.h"
-#include "lodrefine/core/types.h"
 
 namespace lodrefine {
 

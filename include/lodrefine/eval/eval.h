@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
+#include "lodrefine/base/types.h"
 #include "lodrefine/core/distance.h"  // cloud_to_mesh, sample_faces: the measures used here
 #include "lodrefine/core/params.h"
-#include "lodrefine/core/types.h"
 #include "lodrefine/eval/histogram.h"
 
 namespace lodrefine {

@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "lodrefine/base/types.h"
 #include "lodrefine/core/outcome.h"
-#include "lodrefine/core/types.h"
 #include "lodrefine/eval/histogram.h"
 
 namespace lodrefine {

@@ -1,14 +1,14 @@
-// Uses one function of each installed library: a 2 x 3 x 4 m box written and read back as OBJ
-// (io), checked valid and measured (core), its watertightness (eval). Exit 0 only when every
+// Uses the installed libraries: a 2 x 3 x 4 m box written and read back as OBJ (formats),
+// measured (base), checked valid (core), its watertightness (eval). Exit 0 only when every
 // figure is as built.
 #include <cmath>
 #include <cstdio>
 #include <string>
 
-#include "lodrefine/core/types.h"
+#include "lodrefine/base/types.h"
 #include "lodrefine/core/validate.h"
 #include "lodrefine/eval/eval.h"
-#include "lodrefine/io/obj.h"
+#include "lodrefine/formats/obj.h"
 #include "lodrefine/version.h"
 
 int main(int argc, char** argv) {

@@ -1,0 +1,27 @@
+// Building models as OBJ polygon soups (the per-building CityGML export). The reader throws
+// InputError with a one-line message on malformed input; the writer is atomic.
+#pragma once
+#include <string>
+
+#include "lodrefine/base/files.h"
+#include "lodrefine/base/types.h"
+
+namespace lodrefine {
+
+// Reads an OBJ polygon soup as exported per building from CityGML: `g WallSurface` /
+// `g RoofSurface` / `g GroundSurface` groups (also `usemtl`), polygons of 3+ vertices,
+// georeferenced doubles. Building id from `o NAME`, else a `# id: X` comment, else the file
+// stem. Faces are kept as given (no welding); Face::source is the face's index in the file.
+Mesh read_obj(const std::string& path);
+// Same, also reporting how many `f` statements with fewer than 3 vertices were skipped (they
+// are no polygons and get no Face::source number; the file is rejected only when no face
+// remains). Positive indices may refer to vertices defined later in the file; negative ones
+// are relative to the vertices so far.
+Mesh read_obj(const std::string& path, int* skipped_faces);
+
+// Writes polygons grouped by semantic (`g WallSurface` ...), `o <id>`, vertices offset by
+// `origin` (the local frame's origin) and printed with enough digits for < 0.1 mm at 7-digit
+// magnitudes. Atomic (temp + rename). Throws std::runtime_error if the target is not writable.
+void write_obj(const std::string& path, const Mesh& mesh, const Vec3& origin = Vec3::Zero());
+
+}  // namespace lodrefine

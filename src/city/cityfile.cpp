@@ -1,0 +1,560 @@
+// City file in, city file out (see cityfile.h).
+#include "lodrefine/city/cityfile.h"
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include <tbb/global_control.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
+
+#include "lodrefine/base/files.h"
+#include "lodrefine/city/crop.h"
+#include "lodrefine/core/refine.h"
+#include "lodrefine/formats/citygml.h"
+#include "lodrefine/formats/cityjson.h"
+#include "lodrefine/formats/cityjson_write.h"
+
+namespace lodrefine {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+// A CityJSONSeq header line holds metadata and the transform, never objects: a first line
+// longer than this is a one-line CityJSON file, not parsed twice to find out.
+constexpr std::size_t kMaxSequenceHeader = 1 << 20;
+// Buildings in flight per thread of the pool (see in_order_pool).
+constexpr int kItemsPerJob = 16;
+
+// A string member of an untrusted object; `otherwise` when it is absent or no string (the
+// reader refuses a "version" or "type" that is no string, with the file's name; value() would
+// throw a raw type_error).
+std::string text_member(const json& j, const char* key, const std::string& otherwise = "") {
+  if (!j.is_object()) return otherwise;
+  const auto it = j.find(key);
+  return it != j.end() && it->is_string() ? it->get<std::string>() : otherwise;
+}
+
+// The outcome of one building in the words of the report, with its reason: a valid refined or
+// repaired building is written; anything else is kept (its original geometry stays), and a kept
+// building whose repaired original is not valid either is kept-invalid.
+CityBuildingOutcome classify(const RefineResult& r) {
+  CityBuildingOutcome o;
+  if (r.refined() && r.valid) {
+    o.outcome = Outcome::Refined;
+    o.facades_moved = int(r.trace.facades.size());
+    return o;
+  }
+  if (r.outcome == Outcome::Repaired && r.valid) {
+    o.outcome = Outcome::Repaired;
+    o.reason = r.reason;
+    return o;
+  }
+  o.outcome = (!r.valid || r.outcome == Outcome::KeptInvalid) ? Outcome::KeptInvalid : Outcome::Kept;
+  o.reason = r.reason.empty() ? std::string(outcome_name(r.outcome)) : r.reason;
+  if (r.trace.judgement && !r.trace.judgement->ok) o.refused_by = r.trace.judgement->check;
+  // A crop that only grazes the building (its box's edge): no wall of it faces a scan plane.
+  const bool no_facade =
+      (r.trace.planes && r.trace.planes->empty()) || (r.trace.matching && r.trace.matching->walls.empty());
+  if (o.outcome == Outcome::Kept && no_facade) o.reason = "scan covers no facade of this building";
+  if (!r.valid && r.outcome != Outcome::KeptInvalid)
+    o.reason += " (not valid: " + r.trace.output_validation.problem + ")";
+  return o;
+}
+
+Eigen::AlignedBox3d model_box(const std::vector<CityJsonBuilding>& buildings) {
+  Eigen::AlignedBox3d box;
+  for (const auto& b : buildings)
+    for (const auto& v : b.mesh.vertices) box.extend(v);
+  return box;
+}
+
+// The transform of a CityJSON header (validated by the reader before this is used).
+CityJsonTransform transform_of(const json& header) {
+  CityJsonTransform t;
+  const json& j = header.at("transform");
+  t.scale = Vec3(j.at("scale")[0].get<double>(), j.at("scale")[1].get<double>(), j.at("scale")[2].get<double>());
+  t.translate =
+      Vec3(j.at("translate")[0].get<double>(), j.at("translate")[1].get<double>(), j.at("translate")[2].get<double>());
+  return t;
+}
+
+// One building's refinement: the part that runs on the pool. Touches nothing shared (the
+// crop is its own, refine_building keeps its state per call: CGAL's default random generator
+// and GLPK's environment are thread-local, see ARCHITECTURE.md).
+struct BuildingJob {
+  std::size_t index = 0;    // in the document's buildings
+  bool has_points = false;  // or refused, or every building is to be repaired: it gets an outcome
+  std::string refused;      // why its crop target was refused (e.g. an absurd extent)
+  PointCloud cloud;
+  RefineResult result;
+  bool returned = false;  // refine_building returned (result is set)
+  CityBuildingOutcome outcome;
+};
+
+void run_job(BuildingJob& job, const CityJsonBuilding& b, const RefineConfig& params) {
+  if (!job.has_points) return;
+  const auto t0 = Clock::now();
+  try {
+    if (!job.refused.empty()) throw InputError(job.refused);
+    job.result = refine_building(b.mesh, job.cloud, params);
+    job.returned = true;
+    job.outcome = classify(job.result);
+  } catch (const std::exception& e) {  // never lose a building: keep it as read
+    job.outcome.outcome = Outcome::KeptInvalid;
+    job.outcome.reason = e.what();
+  }
+  job.outcome.id = b.mesh.id;
+  job.outcome.points = job.cloud.points.size();
+  job.outcome.seconds = seconds_since(t0);
+}
+
+// Takes building i's crop out of the targets (npos target: not asked for; no points: nothing to
+// refine, unless `repair_all`).
+BuildingJob take_job(std::size_t i, std::vector<CropTarget>& targets, const std::vector<std::size_t>& target_of,
+                     std::size_t first, bool repair_all) {
+  BuildingJob job;
+  job.index = i;
+  const std::size_t ti = target_of[first + i];
+  if (ti == std::string::npos || (targets[ti].cloud.points.empty() && targets[ti].refused.empty() && !repair_all))
+    return job;
+  job.has_points = true;
+  job.refused = targets[ti].refused;
+  job.cloud = std::move(targets[ti].cloud);
+  targets[ti].cloud = PointCloud();
+  return job;
+}
+
+// Writes a finished job into the document (in input order: new vertices are appended).
+// `hook` (may be empty) sees the building (`index` over the file), its outcome, result and crop;
+// the crop is freed after.
+void apply_job(json& doc, const CityJsonTransform& tf, const CityJsonBuilding& b, std::size_t index, BuildingJob&& job,
+               const CityBuildingHook& hook, CityRefineSummary& sum) {
+  if (!job.has_points) {
+    ++sum.untouched;
+    if (hook) hook(index, b.mesh, nullptr, nullptr, nullptr);
+    return;
+  }
+  CityBuildingOutcome& o = job.outcome;
+  json& obj = doc["CityObjects"][b.mesh.id];
+  if (o.outcome == Outcome::Refined || o.outcome == Outcome::Repaired) {
+    const std::string lod = obj["geometry"][std::size_t(b.geometry_index)]["lod"].is_string()
+                                ? obj["geometry"][std::size_t(b.geometry_index)]["lod"].get<std::string>()
+                                : b.lod;
+    obj["geometry"][std::size_t(b.geometry_index)] =
+        cityjson_solid(job.result.mesh, lod, tf.scale, tf.translate, doc["vertices"]);
+    ++(o.outcome == Outcome::Refined ? sum.refined : sum.repaired);
+  } else {
+    ++(o.outcome == Outcome::Kept ? sum.kept : sum.kept_invalid);
+  }
+  if (o.refused_by != JudgeCheck::None) ++sum.refused[check_name(o.refused_by)];
+  if (!obj.contains("attributes") || !obj["attributes"].is_object()) obj["attributes"] = json::object();
+  obj["attributes"]["lodrefine_outcome"] = outcome_name(o.outcome);
+  obj["attributes"]["lodrefine_reason"] = o.reason;
+  obj["attributes"]["lodrefine_facades_moved"] = o.facades_moved;
+  if (hook) hook(index, b.mesh, &o, job.returned ? &job.result : nullptr, &job.cloud);
+  job.cloud = PointCloud();  // the crop is no longer needed: free it now
+  sum.outcomes.push_back(std::move(o));
+}
+
+// Calls take() for items in order until it returns null, work() on up to `jobs` items at once on
+// a pool of `jobs` threads, and give() on the calling order's thread one at a time, in the order
+// take() made them. At most kItemsPerJob x jobs items are alive at once: enough that one slow
+// building does not idle the other threads while its successors wait to be given in order
+// (the crops are in memory anyway; what waits is their refined meshes).
+template <class Item>
+void in_order_pool(int jobs, const std::function<std::shared_ptr<Item>()>& take, const std::function<void(Item&)>& work,
+                   const std::function<void(Item&)>& give) {
+  if (jobs <= 1) {
+    while (auto item = take()) {
+      work(*item);
+      give(*item);
+    }
+    return;
+  }
+  using Ptr = std::shared_ptr<Item>;
+  // TBB caps its threads at the cores (and says so on stderr): --jobs asks for exactly `jobs`.
+  const tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(jobs));
+  tbb::task_arena arena(jobs);
+  arena.execute([&] {
+    tbb::parallel_pipeline(
+        std::size_t(kItemsPerJob * jobs),
+        tbb::make_filter<void, Ptr>(tbb::filter_mode::serial_in_order, [&](tbb::flow_control& fc) {
+          Ptr item = take();
+          if (!item) fc.stop();
+          return item;
+        }) & tbb::make_filter<Ptr, Ptr>(tbb::filter_mode::parallel, [&](Ptr item) {
+          work(*item);
+          return item;
+        }) & tbb::make_filter<Ptr, void>(tbb::filter_mode::serial_in_order, [&](Ptr item) { give(*item); }));
+  });
+}
+
+// Adds a feature's counts and outcomes to the file's.
+void merge_into(CityRefineSummary& sum, CityRefineSummary&& part) {
+  sum.refined += part.refined;
+  sum.kept += part.kept;
+  sum.kept_invalid += part.kept_invalid;
+  sum.repaired += part.repaired;
+  sum.untouched += part.untouched;
+  for (const auto& [check, n] : part.refused) sum.refused[check] += n;
+  for (auto& o : part.outcomes) sum.outcomes.push_back(std::move(o));
+}
+
+// Refines the buildings of `doc` (a CityJSON file or one CityJSONFeature: "CityObjects" and
+// "vertices") that have points on `jobs` threads, and writes the results into `doc` in input
+// order (the same bytes whatever `jobs`). `buildings` are the doc's buildings in order;
+// `target_of[first + i]` is building i's crop target (npos: not asked for). `progress` (may be
+// empty) is called after each building with the summary so far.
+void refine_document(json& doc, const CityJsonTransform& tf, const std::vector<CityJsonBuilding>& buildings,
+                     std::vector<CropTarget>& targets, const std::vector<std::size_t>& target_of, std::size_t first,
+                     bool repair_all, const RefineConfig& params, int jobs, const CityBuildingHook& hook,
+                     CityRefineSummary& sum, const std::function<void(const CityRefineSummary&)>& progress) {
+  std::size_t next = 0;
+  in_order_pool<BuildingJob>(
+      jobs,
+      [&]() -> std::shared_ptr<BuildingJob> {
+        if (next == buildings.size()) return nullptr;
+        const std::size_t i = next++;
+        return std::make_shared<BuildingJob>(take_job(i, targets, target_of, first, repair_all));
+      },
+      [&](BuildingJob& job) { run_job(job, buildings[job.index], params); },
+      [&](BuildingJob& job) {
+        apply_job(doc, tf, buildings[job.index], first + job.index, std::move(job), hook, sum);
+        if (progress) progress(sum);
+      });
+}
+
+// CityJSON 1.0 / 1.1 objects as 2.0 wants them: "lod" a string (1.0 wrote numbers), the
+// GenericCityObject extension type now core. A 2.0 input is not touched.
+void upgrade_objects(json& objects) {
+  for (auto& [id, obj] : objects.items()) {
+    if (text_member(obj, "type") == "+GenericCityObject") obj["type"] = "GenericCityObject";
+    if (!obj.contains("geometry") || !obj["geometry"].is_array()) continue;
+    for (auto& g : obj["geometry"])
+      if (g.is_object() && g.contains("lod") && g["lod"].is_number()) {
+        std::ostringstream s;
+        s << g["lod"].get<double>();
+        g["lod"] = s.str();
+      }
+  }
+}
+
+// The 1.x header fields 2.0 changed: the CRS as a URL, a point of contact's address an object.
+void upgrade_header(json& doc) {
+  json& md = doc["metadata"];
+  if (!md.is_object()) {
+    doc.erase("metadata");
+    return;
+  }
+  if (md.contains("referenceSystem") && md["referenceSystem"].is_string())
+    md["referenceSystem"] = crs_url(md["referenceSystem"].get<std::string>());
+  if (md.contains("pointOfContact") && md["pointOfContact"].is_object()) {
+    json& poc = md["pointOfContact"];
+    if (poc.contains("address") && poc["address"].is_string()) poc["address"] = {{"addressLine", poc["address"]}};
+  }
+}
+
+// CityJSON 1.x without a transform: 2.0 needs integer vertices, so one is made (0.1 mm).
+void ensure_transform(json& doc) {
+  if (doc.contains("transform")) return;
+  Eigen::AlignedBox3d box;
+  for (const auto& v : doc["vertices"]) box.extend(Vec3(v[0].get<double>(), v[1].get<double>(), v[2].get<double>()));
+  const Vec3 translate = box.isEmpty() ? Vec3::Zero() : Vec3(box.min().array().floor());
+  const double scale = kCityGmlResolution;
+  for (auto& v : doc["vertices"])
+    for (int a = 0; a < 3; ++a) v[a] = std::llround((v[a].get<double>() - translate[a]) / scale);
+  doc["transform"] = {{"scale", {scale, scale, scale}}, {"translate", {translate.x(), translate.y(), translate.z()}}};
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open the file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Adds the buildings to refine and their crop boxes (appending to target_of).
+void add_targets(const std::vector<CityJsonBuilding>& buildings, const CityRefineOptions& o,
+                 std::vector<CropTarget>& targets, std::vector<std::size_t>& target_of) {
+  for (const auto& b : buildings) {
+    if (!o.building.empty() && b.mesh.id != o.building) {
+      target_of.push_back(std::string::npos);
+      continue;
+    }
+    target_of.push_back(targets.size());
+    try {
+      targets.push_back(crop_target(b.mesh, o.crop_expand, o.crop_margin));
+    } catch (const InputError& e) {  // a building too wide to crop: kept-invalid, the run goes on
+      CropTarget t;
+      t.id = b.mesh.id;
+      t.lo = Vec3::Constant(1.0);
+      t.hi = Vec3::Zero();  // an empty box: no point reaches it
+      t.refused = e.what();
+      targets.push_back(std::move(t));
+    }
+  }
+}
+
+void check_targets(const std::vector<CropTarget>& targets, const std::string& model_path, const CityRefineOptions& o) {
+  if (targets.empty()) throw InputError(model_path + ": no building '" + o.building + "' with the LoD asked for");
+}
+
+[[noreturn]] void fail_no_lod(const std::string& model_path, const CityRefineOptions& o, int without) {
+  throw InputError(model_path + ": no Building/BuildingPart with " +
+                   (o.lod.empty() ? std::string("an LoD 2.x") : "an LoD " + o.lod) + " geometry (" +
+                   std::to_string(without) + " building object(s) without one); nothing to refine");
+}
+
+// The cloud pass: one stream over the cloud files fills the targets' crops and the summary's
+// cloud figures. Throws when no point reaches a building's box; a file whose bounds miss the city
+// model while others reach it gets a warning of its own.
+void crop_clouds(const std::vector<std::string>& cloud_paths, std::vector<CropTarget>& targets,
+                 const Eigen::AlignedBox3d& city_box, const CityRefineOptions& o, CityRefineSummary& sum) {
+  sum.cloud_points = crop_tile(cloud_paths, targets, o.cloud, &sum.clouds, o.crop_progress, o.max_crop_points);
+  std::uint64_t held = 0;
+  for (const auto& t : targets) held += t.cloud.points.size();
+  Eigen::AlignedBox3d cloud_box;
+  for (const auto& f : sum.clouds) cloud_box.extend(f.bounds);
+  if (held == 0) {
+    std::string why = overlap_problem(cloud_box, city_box, "the city model");
+    if (why.empty()) why = "the cloud has no point within " + std::to_string(targets.size()) + " building box(es)";
+    throw InputError(cloud_files_text(cloud_paths) + ": " + why);
+  }
+  sum.warnings = overlap_problems(sum.clouds, city_box, "the city model");
+  sum.cropped_points = held;
+}
+
+// A CityJSONSeq feature as a CityJSON document the reader takes: the header's transform
+// with the feature's objects and vertices.
+json feature_document(const json& header, json feature) {
+  json d = {
+      {"type", "CityJSON"}, {"version", text_member(header, "version", "2.0")}, {"transform", header.at("transform")}};
+  d["CityObjects"] = std::move(feature["CityObjects"]);
+  d["vertices"] = std::move(feature["vertices"]);
+  return d;
+}
+
+// The first line of a file when it is a CityJSONSeq header (a "CityJSON" object on one line);
+// null otherwise.
+json sequence_header(const std::string& model_path) {
+  std::ifstream in(model_path, std::ios::binary);
+  std::string line;
+  if (!in || !std::getline(in, line) || line.size() > kMaxSequenceHeader) return nullptr;
+  json first;
+  try {
+    first = parse_city_json(line, model_path);
+  } catch (const InputError&) {
+    return nullptr;  // not a sequence header: the whole file is parsed, and refused with the reason
+  }
+  if (!first.is_object() || text_member(first, "type") != "CityJSON" ||
+      (first.contains("CityObjects") && !first["CityObjects"].empty()))
+    return nullptr;
+  while (std::getline(in, line))
+    if (line.find_first_not_of(" \t\r") != std::string::npos) return first;
+  return nullptr;
+}
+
+// One line of a CityJSONSeq after the header; `where` names it in the error.
+json parse_feature(const std::string& line, const std::string& where) {
+  json feature = parse_city_json(line, where);
+  if (!feature.is_object() || text_member(feature, "type") != "CityJSONFeature")
+    throw InputError(where + ": expected a CityJSONFeature object");
+  return feature;
+}
+
+// CityJSONSeq in, CityJSONSeq out, streamed: pass 1 reads each feature's buildings for the
+// crop boxes (keeping only the boxes), the cloud pass fills them, pass 2 reads each feature
+// again, refines its buildings (features on the pool) and writes the lines out in order.
+CityRefineSummary refine_sequence(const json& header, const std::string& model_path,
+                                  const std::vector<std::string>& cloud_paths, const std::string& out_path,
+                                  const RefineConfig& params, const CityRefineOptions& options) {
+  CityRefineSummary sum;
+  sum.input_format = "CityJSONSeq " + text_member(header, "version", "?");
+  if (!header.contains("transform"))
+    throw InputError(model_path + ": line 1: a CityJSONSeq header needs a \"transform\"");
+  // The header checked by the reader (transform shape, scale) before transform_of trusts it.
+  read_cityjson_document(feature_document(header, {{"CityObjects", json::object()}, {"vertices", json::array()}}),
+                         model_path + ": line 1");
+  const CityJsonTransform tf = transform_of(header);
+  auto t = Clock::now();
+  std::vector<CropTarget> targets;
+  std::vector<std::size_t> target_of;
+  std::vector<std::size_t> feature_buildings;  // per feature line, for pass 2's building indices
+  std::size_t features = 0;
+  Eigen::AlignedBox3d city_box;
+  const auto for_each_feature = [&](const std::function<void(int, json&&)>& f) {
+    std::ifstream in(model_path, std::ios::binary);
+    std::string line;
+    std::getline(in, line);
+    for (int n = 2; std::getline(in, line); ++n) {
+      if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+      f(n, parse_feature(line, model_path + ": line " + std::to_string(n)));
+    }
+  };
+  std::unordered_set<std::string> ids;
+  for_each_feature([&](int n, json&& feature) {
+    add_feature_ids(feature, ids, model_path + ": line " + std::to_string(n));
+    const CityJsonFile f = read_cityjson_document(feature_document(header, std::move(feature)),
+                                                  model_path + ": line " + std::to_string(n), options.lod);
+    sum.buildings += int(f.buildings.size());
+    feature_buildings.push_back(f.buildings.size());
+    sum.objects_without_lod += f.objects_without_lod2;
+    city_box.extend(model_box(f.buildings));
+    add_targets(f.buildings, options, targets, target_of);
+  });
+  if (sum.buildings == 0) fail_no_lod(model_path, options, sum.objects_without_lod);
+  check_targets(targets, model_path, options);
+  sum.seconds_read = seconds_since(t);
+
+  t = Clock::now();
+  crop_clouds(cloud_paths, targets, city_box, options, sum);
+  sum.seconds_crop = seconds_since(t);
+
+  t = Clock::now();
+  AtomicFile out(out_path);
+  json h = header;
+  const bool upgrade = text_member(header, "version") != "2.0";
+  if (upgrade) upgrade_header(h);
+  h["version"] = "2.0";
+  out.write(h.dump(-1, ' ', false, json::error_handler_t::replace) + "\n");
+  // Pass 2 on the pool, one feature an item: its line is parsed, refined and dumped on a
+  // worker, and written here in file order.
+  struct FeatureJob {
+    int line = 0;
+    std::string text;
+    std::size_t first = 0;  // its first building's index over the file
+    CityRefineSummary part;
+  };
+  std::ifstream in(model_path, std::ios::binary);
+  std::string line;
+  std::getline(in, line);
+  int n = 1;
+  std::size_t first = 0;
+  in_order_pool<FeatureJob>(
+      options.jobs,
+      [&]() -> std::shared_ptr<FeatureJob> {
+        while (std::getline(in, line)) {
+          ++n;
+          if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+          auto job = std::make_shared<FeatureJob>();
+          job->line = n;
+          job->text = std::move(line);
+          job->first = first;
+          if (feature_buildings.size() <= features) throw InputError(model_path + ": changed while being read");
+          first += feature_buildings[features++];
+          return job;
+        }
+        return nullptr;
+      },
+      [&](FeatureJob& job) {
+        const std::string where = model_path + ": line " + std::to_string(job.line);
+        json feature = parse_feature(job.text, where);
+        const CityJsonFile f = read_cityjson_document(feature_document(header, feature), where, options.lod);
+        if (upgrade) upgrade_objects(feature["CityObjects"]);
+        refine_document(feature, tf, f.buildings, targets, target_of, job.first, options.repair_all, params, 1,
+                        options.on_building, job.part, {});
+        job.text = feature.dump(-1, ' ', false, json::error_handler_t::replace) + "\n";
+      },
+      [&](FeatureJob& job) {
+        out.write(job.text);
+        merge_into(sum, std::move(job.part));
+        if (options.progress) options.progress(sum);
+      });
+  out.commit();
+  sum.seconds_refine = seconds_since(t);
+  return sum;
+}
+
+}  // namespace
+
+json cityjson_solid(const Mesh& mesh, const std::string& lod, const Vec3& scale, const Vec3& translate,
+                    json& vertices) {
+  const long long base = (long long)vertices.size();
+  for (const auto& p : mesh.vertices) {
+    json q = json::array();
+    for (int a = 0; a < 3; ++a) q.push_back(std::llround((p[a] - translate[a]) / scale[a]));
+    vertices.push_back(std::move(q));
+  }
+  json shell = json::array(), values = json::array();
+  std::map<Semantic, int> surface_of;
+  json surfaces = json::array();
+  for (const Face& f : mesh.faces) {
+    json ring = json::array();
+    for (int v : f.v) ring.push_back(base + v);
+    shell.push_back(json::array({std::move(ring)}));
+    if (f.sem == Semantic::Other) {
+      values.push_back(nullptr);
+      continue;
+    }
+    auto it = surface_of.find(f.sem);
+    if (it == surface_of.end()) {
+      it = surface_of.emplace(f.sem, int(surfaces.size())).first;
+      surfaces.push_back({{"type", semantic_name(f.sem)}});
+    }
+    values.push_back(it->second);
+  }
+  json g = {{"type", "Solid"}, {"lod", lod}, {"boundaries", json::array({std::move(shell)})}};
+  g["semantics"] = {{"surfaces", std::move(surfaces)}, {"values", json::array({std::move(values)})}};
+  return g;
+}
+
+CityRefineSummary refine_city(const std::string& model_path, const std::vector<std::string>& cloud_paths,
+                              const std::string& out_path, const RefineConfig& params,
+                              const CityRefineOptions& options) {
+  CityRefineSummary sum;
+  auto t = Clock::now();
+  json doc;
+  std::string format;
+  if (sniff_file(model_path) != FileKind::Xml) {
+    const json header = sequence_header(model_path);
+    if (!header.is_null()) return refine_sequence(header, model_path, cloud_paths, out_path, params, options);
+  }
+  if (sniff_file(model_path) == FileKind::Xml) {
+    std::string version;
+    doc = citygml_to_cityjson(model_path, &version);
+    format = "CityGML " + version;
+  } else {
+    const std::string text = read_text(model_path);
+    doc = parse_city_json(text, model_path);
+    format = "CityJSON " + text_member(doc, "version", "?");
+  }
+  const CityJsonFile file = read_cityjson_document(doc, model_path, options.lod);
+  sum.input_format = format;
+  sum.buildings = int(file.buildings.size());
+  sum.objects_without_lod = file.objects_without_lod2;
+  if (file.buildings.empty()) fail_no_lod(model_path, options, file.objects_without_lod2);
+  std::vector<std::size_t> target_of;
+  std::vector<CropTarget> targets;
+  add_targets(file.buildings, options, targets, target_of);
+  check_targets(targets, model_path, options);
+  sum.seconds_read = seconds_since(t);
+
+  t = Clock::now();
+  crop_clouds(cloud_paths, targets, model_box(file.buildings), options, sum);
+  sum.seconds_crop = seconds_since(t);
+
+  t = Clock::now();
+  if (text_member(doc, "version") != "2.0") {
+    upgrade_header(doc);
+    upgrade_objects(doc["CityObjects"]);
+  }
+  ensure_transform(doc);
+  refine_document(doc, transform_of(doc), file.buildings, targets, target_of, 0, options.repair_all, params,
+                  options.jobs, options.on_building, sum, options.progress);
+  sum.seconds_refine = seconds_since(t);
+
+  t = Clock::now();
+  doc["version"] = "2.0";
+  write_file_atomic(out_path, doc.dump(-1, ' ', false, json::error_handler_t::replace) + "\n");
+  sum.seconds_write = seconds_since(t);
+  return sum;
+}
+
+}  // namespace lodrefine

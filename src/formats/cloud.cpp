@@ -1,0 +1,191 @@
+// Format dispatch for point clouds: PLY (io) or LAS (las), by content; a cloud of several files.
+#include "lodrefine/formats/cloud.h"
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <utility>
+
+#include "lodrefine/base/files.h"
+#include "lodrefine/formats/las.h"
+#include "lodrefine/formats/ply.h"
+
+namespace lodrefine {
+
+CloudFormat cloud_format(const std::string& path) {
+  const FileKind kind = sniff_file(path);
+  if (kind == FileKind::Las) return CloudFormat::Las;
+  if (kind == FileKind::Xml || kind == FileKind::Json)
+    throw InputError(path + ": not a PLY or LAS point cloud: the file is " + file_kind_text(kind));
+  return CloudFormat::Ply;  // the PLY reader reports any other content ("not a PLY file")
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::uint64_t saturated_sum(std::uint64_t a, std::uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
+
+// What a file's header declares: its points, and the points worth reserving room for before
+// reading them. A LAS count is bounded by the file size (checked in the header), a LAZ count
+// only by what its chunks decode to, so beyond a few million points the vector grows as points
+// arrive.
+struct Declared {
+  std::uint64_t points = 0, reserve = 0;
+};
+
+Declared declared(const std::string& path) {
+  constexpr std::uint64_t kReserveLimit = std::uint64_t(1) << 22;
+  if (cloud_format(path) == CloudFormat::Las) {
+    const LasHeader h = read_las_header(path);
+    return {h.point_count, h.compressed ? std::min(h.point_count, kReserveLimit) : h.point_count};
+  }
+  const std::uint64_t n = ply_vertex_count(path);
+  return {n, n};
+}
+
+// A folder's cloud files (see cloud_files), sorted by name.
+std::vector<std::string> folder_clouds(const std::string& folder, const std::string& option) {
+  std::vector<std::string> found;
+  std::size_t skipped = 0;
+  std::error_code ec;
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string path = it->path().string(), name = it->path().filename().string();
+    const FileKind kind = name.rfind(kTempPrefix, 0) == 0 ? FileKind::Other : sniff_file(path);
+    if (kind == FileKind::Ply || kind == FileKind::Las) found.push_back(path);
+    else ++skipped;
+  }
+  if (ec) throw InputError(folder + ": cannot list the folder (" + ec.message() + ")");
+  if (found.empty())
+    throw InputError(folder + ": no PLY, LAS or LAZ cloud in the " + option + " folder" +
+                     (skipped == 0   ? std::string(" (empty)")
+                      : skipped == 1 ? std::string(" (1 other entry)")
+                                     : " (" + std::to_string(skipped) + " other entries)"));
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+}  // namespace
+
+std::vector<std::string> cloud_files(const std::vector<std::string>& values, const std::string& option) {
+  std::vector<std::string> files;
+  for (const std::string& value : values) {
+    std::error_code ec;
+    const fs::file_status status = fs::status(value, ec);
+    if (fs::is_directory(status)) {
+      const std::vector<std::string> found = folder_clouds(value, option);
+      files.insert(files.end(), found.begin(), found.end());
+    } else if (fs::exists(status)) {
+      files.push_back(value);
+    } else {
+      const bool missing = status.type() == fs::file_type::not_found || !ec;
+      throw InputError(value + ": " + (missing ? std::string("no such file or folder") : ec.message()) + " (" + option +
+                       ")");
+    }
+  }
+  if (files.empty()) throw InputError(option + ": no cloud given");
+  std::map<std::pair<dev_t, ino_t>, std::size_t> seen;  // each file's first place in the list
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    struct stat st {};
+    if (::stat(files[i].c_str(), &st) != 0) continue;  // gone: its reader says so
+    const auto [it, added] = seen.emplace(std::make_pair(st.st_dev, st.st_ino), i);
+    if (!added)
+      throw InputError(files[i] + ": the same file as " + files[it->second] + "; " + option +
+                       " may name each cloud file once");
+  }
+  return files;
+}
+
+std::string cloud_files_text(const std::vector<std::string>& paths) {
+  if (paths.size() <= 1) return paths.empty() ? std::string() : paths.front();
+  const std::size_t others = paths.size() - 1;
+  return paths.front() + " and " + std::to_string(others) + " other cloud file" + (others > 1 ? "s" : "");
+}
+
+std::uint64_t cloud_point_count(const std::vector<std::string>& paths) {
+  std::uint64_t n = 0;
+  for (const std::string& path : paths) n = saturated_sum(n, declared(path).points);
+  return n;
+}
+
+void stream_cloud(const std::vector<std::string>& paths, const CloudOptions& options,
+                  const std::function<void(const Vec3&)>& on_point, std::vector<CloudFileRead>* read) {
+  std::vector<CloudFormat> formats;
+  for (const std::string& path : paths) {
+    formats.push_back(cloud_format(path));
+    if (formats.back() == CloudFormat::Ply && !options.classes.empty())
+      throw InputError(path + ": a PLY cloud has no classification; --classes needs a LAS cloud");
+    declared(path);  // its header checked: a broken last tile is refused before the first is read
+  }
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    CloudFileRead* file = nullptr;
+    if (read) file = &read->emplace_back(CloudFileRead{paths[i], 0, {}});
+    const std::function<void(const Vec3&)> counted = [&](const Vec3& p) {
+      ++file->points;
+      file->bounds.extend(p);
+      on_point(p);
+    };
+    const auto& visit = file ? counted : on_point;
+    read_naming_memory(paths[i], [&] {
+      if (formats[i] == CloudFormat::Las) stream_las(paths[i], options.classes, visit);
+      else stream_ply(paths[i], visit);
+    });
+  }
+}
+
+PointCloud read_cloud(const std::vector<std::string>& paths, const CloudOptions& options,
+                      std::vector<CloudFileRead>* read) {
+  Declared total;
+  for (const std::string& path : paths) {
+    const Declared d = declared(path);
+    total.points = saturated_sum(total.points, d.points);
+    total.reserve = saturated_sum(total.reserve, d.reserve);
+  }
+  if (total.points > options.max_points)
+    throw InputError(cloud_files_text(paths) + ": " + std::to_string(total.points) + " points" +
+                     (paths.size() > 1 ? " together" : "") + ", more than --max-points " +
+                     std::to_string(options.max_points) + "; cut a crop per building first (lodrefine crop)");
+  PointCloud cloud;
+  // The reservation is most of the memory a cloud takes. With a class filter most points may be
+  // dropped, so the vector grows as they come.
+  if (options.classes.empty())
+    read_naming_memory(cloud_files_text(paths), [&] { cloud.points.reserve(total.reserve); });
+  stream_cloud(
+      paths, options, [&](const Vec3& p) { cloud.points.push_back(p); }, read);
+  return cloud;
+}
+
+std::string overlap_problem(const Eigen::AlignedBox3d& cloud, const Eigen::AlignedBox3d& model, const std::string& what,
+                            double margin) {
+  if (cloud.isEmpty() || model.isEmpty()) return {};
+  const Eigen::AlignedBox2d c(cloud.min().head<2>(), cloud.max().head<2>());
+  const Eigen::AlignedBox2d m(model.min().head<2>() - Vec2::Constant(margin),
+                              model.max().head<2>() + Vec2::Constant(margin));
+  if (c.intersects(m)) return {};
+  const auto range = [](const Eigen::AlignedBox3d& b) {
+    char s[160];
+    std::snprintf(s, sizeof s, "x %.1f..%.1f y %.1f..%.1f", b.min().x(), b.max().x(), b.min().y(), b.max().y());
+    return std::string(s);
+  };
+  return "cloud " + range(cloud) + " does not overlap " + what + " " + range(model) + ": wrong CRS or tile?";
+}
+
+std::vector<std::string> overlap_problems(const std::vector<CloudFileRead>& files, const Eigen::AlignedBox3d& model,
+                                          const std::string& what, double margin) {
+  std::vector<std::string> lines;
+  for (const CloudFileRead& f : files)
+    if (const std::string why = overlap_problem(f.bounds, model, what, margin); !why.empty())
+      lines.push_back(f.path + ": " + why);
+  return lines;
+}
+
+std::string classes_text(const std::vector<int>& classes) {
+  std::string s;
+  for (int c : classes) s += (s.empty() ? "" : ",") + std::to_string(c);
+  return s;
+}
+
+}  // namespace lodrefine
