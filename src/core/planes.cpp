@@ -58,54 +58,6 @@ constexpr double kMinExtentEpsilons = 10.0;
 // Bits per axis of a voxel key (three in a 64-bit key).
 constexpr int kVoxelKeyBits = 21;
 
-// Vertical least-squares plane: PCA of the horizontal coordinates only.
-Plane fit_vertical_plane(const std::vector<Vec3>& pts) {
-  Vec2 c = Vec2::Zero();
-  for (const auto& p : pts) c += p.head<2>();
-  c /= double(pts.size());
-  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
-  for (const auto& p : pts) {
-    const Vec2 q = p.head<2>() - c;
-    cov += q * q.transpose();
-  }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(cov);
-  const Vec2 n2 = es.eigenvectors().col(0);
-  return Plane::through(Vec3(c.x(), c.y(), 0.0), Vec3(n2.x(), n2.y(), 0.0));
-}
-
-}  // namespace
-
-namespace detail {
-
-ScanPlane describe_plane(const std::vector<Vec3>& all, std::vector<int> inliers, const PlaneConfig& prm) {
-  ScanPlane sp;
-  sp.inliers = std::move(inliers);
-  std::vector<Vec3> pts;
-  pts.reserve(sp.inliers.size());
-  for (int i : sp.inliers) pts.push_back(all[i]);
-  sp.plane = fit_plane(pts);
-  const double tilt = 90.0 - unoriented_angle_deg(sp.plane.n, Vec3::UnitZ());
-  sp.facade = tilt <= prm.facade_max_tilt_deg;
-  if (tilt <= prm.vertical_snap_deg) sp.plane = fit_vertical_plane(pts);
-  double ss = 0.0;
-  for (const auto& p : pts) {
-    sp.centroid += p;
-    ss += sp.plane.distance(p) * sp.plane.distance(p);
-  }
-  sp.centroid /= double(pts.size());
-  sp.rms = std::sqrt(ss / double(pts.size()));
-  const auto [u, v] = sp.plane.basis();
-  std::vector<Vec2> uv;
-  uv.reserve(pts.size());
-  for (const auto& p : pts) uv.emplace_back((p - sp.centroid).dot(u), (p - sp.centroid).dot(v));
-  sp.hull_area = std::abs(signed_area_2d(convex_hull_2d(std::move(uv))));
-  return sp;
-}
-
-}  // namespace detail
-
-namespace {
-
 using detail::describe_plane;
 
 // RANSAC's connectivity split one facade into pieces wherever a gap (a window column, an

@@ -1,5 +1,5 @@
-// Stage 1, after the shape detection: a wall seen twice by two drives is one plane midway, and
-// facade planes that stand over only part of a wall's height are relief (planes.h).
+// Stage 1 besides the shape detection: the plane fitted to a point set; a wall seen twice by two
+// drives is one plane midway; facade planes over only part of a wall's height are relief.
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include "lodrefine/base/geometry.h"
@@ -16,6 +17,21 @@
 
 namespace lodrefine {
 namespace {
+
+// Vertical least-squares plane: PCA of the horizontal coordinates only.
+Plane fit_vertical_plane(const std::vector<Vec3>& pts) {
+  Vec2 c = Vec2::Zero();
+  for (const auto& p : pts) c += p.head<2>();
+  c /= double(pts.size());
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+  for (const auto& p : pts) {
+    const Vec2 q = p.head<2>() - c;
+    cov += q * q.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(cov);
+  const Vec2 n2 = es.eigenvectors().col(0);
+  return Plane::through(Vec3(c.x(), c.y(), 0.0), Vec3(n2.x(), n2.y(), 0.0));
+}
 
 // A facade seen by two drives registered apart: the points near its plane and inside its
 // extent, split in two layers by their signed distance (two-means, from the quartiles). The
@@ -102,6 +118,32 @@ Layers two_layers(const std::vector<double>& d, const std::vector<Vec2>& uv, dou
 
 namespace detail {
 
+// The scan plane fitted to `inliers` of `all` (wall_layers.h).
+ScanPlane describe_plane(const std::vector<Vec3>& all, std::vector<int> inliers, const PlaneConfig& prm) {
+  ScanPlane sp;
+  sp.inliers = std::move(inliers);
+  std::vector<Vec3> pts;
+  pts.reserve(sp.inliers.size());
+  for (int i : sp.inliers) pts.push_back(all[i]);
+  sp.plane = fit_plane(pts);
+  const double tilt = 90.0 - unoriented_angle_deg(sp.plane.n, Vec3::UnitZ());
+  sp.facade = tilt <= prm.facade_max_tilt_deg;
+  if (tilt <= prm.vertical_snap_deg) sp.plane = fit_vertical_plane(pts);
+  double ss = 0.0;
+  for (const auto& p : pts) {
+    sp.centroid += p;
+    ss += sp.plane.distance(p) * sp.plane.distance(p);
+  }
+  sp.centroid /= double(pts.size());
+  sp.rms = std::sqrt(ss / double(pts.size()));
+  const auto [u, v] = sp.plane.basis();
+  std::vector<Vec2> uv;
+  uv.reserve(pts.size());
+  for (const auto& p : pts) uv.emplace_back((p - sp.centroid).dot(u), (p - sp.centroid).dot(v));
+  sp.hull_area = std::abs(signed_area_2d(convex_hull_2d(std::move(uv))));
+  return sp;
+}
+
 // Each facade, largest first, that two drives saw apart becomes one plane midway between its
 // copies, holding both; the points it takes leave the other planes (the second copy's pieces),
 // which are dropped when too few or too small remain.
@@ -175,7 +217,6 @@ std::vector<ScanPlane> join_doubled_walls(std::vector<ScanPlane> planes, const s
 }
 
 }  // namespace detail
-
 
 void collapse_doubled_walls(PointCloud& cloud, const std::vector<ScanPlane>& planes) {
   for (const ScanPlane& p : planes) {
