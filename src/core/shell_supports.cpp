@@ -5,8 +5,10 @@
 #include <cmath>
 #include <limits>
 #include <tuple>
+#include <unordered_map>
 
 #include "lodrefine/base/topology.h"
+#include "lodrefine/core/distance.h"
 #include "lodrefine/core/matching.h"
 
 namespace lodrefine::detail {
@@ -384,6 +386,81 @@ std::vector<Region> plane_reach(const Mesh& start, const Supports& s, const Regi
       out[k].half.z() = region.half.z();
     }
   }
+  return out;
+}
+
+namespace {
+
+// A selection that puts solid where the scan saw through: points of the supporting planes
+// (surfaces the scanner saw from outside) that end up deeper than kEnclosedDepth inside the
+// shell, though not inside the start, would have been hidden by it. A neighbour's wall across a
+// gap beyond the building's end became the front of a box filling the gap (the front wall's
+// points behind it then inside): a change made of those. Deeper than a window recess or a
+// moved wall's noise; as many as a plane needs (ransac_min_points).
+constexpr double kEnclosedDepth = 0.5;
+
+// The changed candidates in connected pieces (sharing an edge): each piece alone leaves every
+// edge used 0 or 2 times, as the whole selection does.
+std::vector<std::vector<int>> changed_pieces(const CandidateSet& cs, const std::vector<char>& changed) {
+  DisjointSets sets(std::size_t(cs.size()));
+  for (const auto& e : cs.edges) {
+    int first = -1;
+    for (auto h : e) {
+      const int f = cs.face(h);
+      if (!changed[f]) continue;
+      if (first < 0) first = f;
+      else sets.unite(f, first);
+    }
+  }
+  std::unordered_map<int, int> piece_of_root;
+  std::vector<std::vector<int>> pieces;
+  for (int f = 0; f < cs.size(); ++f) {
+    if (!changed[f]) continue;
+    const auto [it, added] = piece_of_root.emplace(sets.find(f), int(pieces.size()));
+    if (added) pieces.emplace_back();
+    pieces[std::size_t(it->second)].push_back(f);
+  }
+  return pieces;
+}
+
+}  // namespace
+
+// The changed candidates of the pieces that enclose scan points (see kEnclosedDepth): each
+// newly enclosed point counts for the piece with the changed candidate nearest to it.
+std::vector<int> enclosing_changes(const CandidateSet& cs, const std::vector<char>& changed, const Mesh& start,
+                                   const Mesh& shell, const std::vector<Vec3>& evidence, const PlaneEvidence& prm) {
+  const auto pieces = changed_pieces(cs, changed);
+  if (pieces.empty()) return {};
+  Mesh changes;  // the changed candidates as one polygon soup, face i of piece piece_of[i]
+  std::vector<int> piece_of;
+  Eigen::AlignedBox3d box;
+  for (int k = 0; k < int(pieces.size()); ++k)
+    for (int f : pieces[k]) {
+      Face face;
+      for (const Vec3& p : cs.polygon(f)) {
+        face.v.push_back(int(changes.vertices.size()));
+        changes.vertices.push_back(p);
+        box.extend(p);
+      }
+      changes.faces.push_back(std::move(face));
+      piece_of.push_back(k);
+    }
+  // A point newly enclosed lies inside the changed candidates' box or within kEnclosedDepth of
+  // a removed one (the start's surface, by which it was less deep).
+  box.extend(box.min() - Vec3::Constant(kEnclosedDepth + kSurfaceDistance));
+  box.extend(box.max() + Vec3::Constant(kEnclosedDepth + kSurfaceDistance));
+  std::vector<Vec3> enclosed;
+  const MeshDistance to_shell(shell), to_start(start);
+  for (const Vec3& p : evidence)
+    if (box.contains(p) && to_shell.distance(p, true) < -kEnclosedDepth &&
+        to_start.distance(p, true) >= -kEnclosedDepth)
+      enclosed.push_back(p);
+  if (int(enclosed.size()) < prm.ransac_min_points) return {};
+  std::vector<int> count(pieces.size(), 0);
+  for (const auto& n : MeshDistance(changes).nearest_all(enclosed)) ++count[piece_of[n.face]];
+  std::vector<int> out;
+  for (int k = 0; k < int(pieces.size()); ++k)
+    if (count[k] >= prm.ransac_min_points) out.insert(out.end(), pieces[k].begin(), pieces[k].end());
   return out;
 }
 
