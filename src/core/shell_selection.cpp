@@ -242,12 +242,42 @@ std::string shell_problem(const Mesh& m, const RepairConfig& prm) {
 // (negative: none); nothing when some are and the starting shell then cannot be expressed in the
 // candidates (its pieces cannot be mended to close): select_shell then gives each sliver a plane
 // of its own, as it is.
-std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointCloud& cloud,
-                                              const std::vector<ScanPlane>& planes, const RefineConfig& prm,
-                                              double sliver_tolerance) {
-  const auto t0 = Clock::now();
-  ShellSelection out;
-  auto& st = out.stats;
+// A selection as the refusal of its shell sees it: the candidates selected, the start's, and
+// whether the start was a warm start (enclosing changes are then fixed back alone).
+struct SelectedCandidates {
+  const std::vector<char>& selected;
+  const std::vector<char>& base;
+  bool warm;
+};
+
+// Why the selected shell cannot be written (empty when it can): it does not validate, it moves
+// the model beyond the `evidence`, or a change encloses the supports' points (`scan_points`; those
+// changes in `refused`). A valid shell is snapped onto the start where it still validates.
+std::string shell_refusal(Mesh& shell, const Mesh& start, CandidateSet& cs, const SelectedCandidates& sel,
+                          const EvidenceReach& evidence, const std::vector<Vec3>& scan_points, const RefineConfig& prm,
+                          std::vector<int>& refused) {
+  std::string problem = shell_problem(shell, prm.repair);
+  int changes = 0;
+  for (int f = 0; f < cs.size(); ++f) changes += sel.selected[f] != sel.base[f];
+  if (problem.empty()) {
+    Mesh snapped = snapped_to_start(shell, start);
+    if (shell_problem(snapped, prm.repair).empty()) shell = std::move(snapped);
+    if (changes > 0 && moves_beyond_evidence(shell, start, evidence))
+      problem = "it moves the model where the scan shows nothing";
+  }
+  if (problem.empty() && changes > 0 && sel.warm) {
+    std::vector<char> changed(cs.size());
+    for (int f = 0; f < cs.size(); ++f) changed[f] = sel.selected[f] != sel.base[f];
+    refused = enclosing_changes(cs, changed, start, shell, scan_points, prm.plane);
+    if (!refused.empty()) problem = "it encloses scan points (a surface seen through it)";
+  }
+  return problem;
+}
+
+// The supporting planes of a selection: the starting shell's (`sliver_tolerance`: see
+// add_start_planes), the scan's and the step walls, counted in `st` with the evidence they hold.
+Supports supports_of(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
+                     const RefineConfig& prm, double sliver_tolerance, ShellSelectionStats& st) {
   Supports s;
   detail::add_start_planes(start, sliver_tolerance, s);
   detail::add_scan_planes(start, cloud, planes, prm, s);
@@ -257,15 +287,65 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
   st.supporting_planes = int(s.planes.size());
   st.scan_planes_added = s.added;
   for (const auto& pts : s.points) st.evidence.insert(st.evidence.end(), pts.begin(), pts.end());
+  return s;
+}
 
-  // The starting shell (mended where it does not close on the candidates) is GLPK's first
-  // incumbent, and what no evidence reaches is fixed to it; without one everything is free.
-  // Candidates fixed unselected that way (no support's evidence reaches them, the starting shell
-  // has none there) are pruned: the program over the others is the same.
-  // Each plane is cut to where its faces can be (its start faces and scan points, grown by twice
-  // the farthest a wall may move: a face reaches a moved neighbour, whose corner with the next
-  // moved wall lies that far again; once measured lost a real building's refinement), so a large
-  // building's program does not grow with the cube of its planes.
+// The program over the candidates: coverage and data-fitting terms, sharp edges; with a `warm`
+// start, it is the first incumbent and every candidate no evidence reaches is fixed to it.
+SelectionProgram program_of(CandidateSet& cs, const FaceProps& props, const std::vector<char>& warm,
+                            const SelectionConfig& prm) {
+  SelectionProgram pg;
+  const auto area = cs.areas();
+  for (int f = 0; f < cs.size(); ++f) {
+    pg.cost.push_back(coverage_cost(area[FaceIndex(f)], props.confidence[FaceIndex(f)], prm.tau_cov));
+    pg.fit.push_back(props.fit[FaceIndex(f)]);
+  }
+  for (const auto& e : cs.edges) pg.sharp_cost.push_back(prm.lambda_complexity * cs.length(e) * kSharpEdgeWidth);
+  if (!warm.empty()) {
+    pg.warm = warm;
+    for (int f = 0; f < cs.size(); ++f) pg.fixed.push_back(props.in_zone[FaceIndex(f)] ? -1 : int(warm[f]));
+  }
+  return pg;
+}
+
+// The candidates the program needs (with their FaceProps and the warm start on them): with a
+// warm start, those fixed unselected (no support's evidence reaches them, the starting shell has
+// none there) are pruned, and the program over the others is the same. Counted in `st`.
+struct Pruned {
+  CandidateSet cs;
+  FaceProps props;
+  std::vector<char> warm;
+};
+Pruned pruned(CandidateSet& all, const FaceProps& all_props, const std::vector<char>& all_warm,
+              ShellSelectionStats& st) {
+  std::vector<char> keep(all.size(), 1);
+  if (!all_warm.empty())
+    for (std::size_t f = 0; f < keep.size(); ++f) keep[f] = all_props.in_zone[FaceIndex(f)] || all_warm[f];
+  CandidateSet cs = kept_candidates(all, keep);
+  const FaceProps props = all_props.carried_to(cs.mesh, keep);
+  std::vector<char> warm = all_warm.empty() ? all_warm : kept(all_warm, keep);
+  st.candidates = cs.size();
+  st.candidates_pruned = all.size() - st.candidates;
+  st.edges = int(cs.edges.size());
+  return {std::move(cs), props, std::move(warm)};
+}
+
+// The selection from `start` (sliver_tolerance: add_start_planes'); nullopt when its start cannot
+// be mended while it has slivers (select_shell tries again without). The starting shell (mended
+// where it does not close on the candidates) is GLPK's first incumbent, and what no evidence
+// reaches is fixed to it; without one everything is free. Each plane is cut to where its faces can
+// be (its start faces and scan points, grown by twice the farthest a wall may move: a face reaches
+// a moved neighbour, whose corner with the next moved wall lies that far again; once measured lost
+// a real building's refinement), so a large building's program does not grow with the cube of its
+// planes.
+std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointCloud& cloud,
+                                              const std::vector<ScanPlane>& planes, const RefineConfig& prm,
+                                              double sliver_tolerance) {
+  const auto t0 = Clock::now();
+  ShellSelection out;
+  auto& st = out.stats;
+  const Supports s = supports_of(start, cloud, planes, prm, sliver_tolerance, st);
+
   const Region region = detail::building_region(start, s, prm.plane.facade_max_tilt_deg);
   const double reach = 2.0 * prm.scan_reach();
   CandidateSet all = build_candidates(
@@ -280,28 +360,9 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
   const FaceProps all_props = describe_candidates(all, start, s, prm);
   const std::vector<char> all_warm = mended_start(all, face_flags(all, all_props.in_start), prm.selection);
   if (all_warm.empty() && s.slivers > 0) return std::nullopt;
-  std::vector<char> keep(all.size(), 1);
-  if (!all_warm.empty())
-    for (std::size_t f = 0; f < keep.size(); ++f) keep[f] = all_props.in_zone[FaceIndex(f)] || all_warm[f];
-  CandidateSet cs = kept_candidates(all, keep);
-  const FaceProps props = all_props.carried_to(cs.mesh, keep);
-  const std::vector<char> warm = all_warm.empty() ? all_warm : kept(all_warm, keep);
-  st.candidates = cs.size();
-  st.candidates_pruned = all.size() - st.candidates;
-  st.edges = int(cs.edges.size());
+  auto [cs, props, warm] = pruned(all, all_props, all_warm, st);
 
-  SelectionProgram pg;
-  const auto area = cs.areas();
-  for (int f = 0; f < cs.size(); ++f) {
-    pg.cost.push_back(coverage_cost(area[FaceIndex(f)], props.confidence[FaceIndex(f)], prm.selection.tau_cov));
-    pg.fit.push_back(props.fit[FaceIndex(f)]);
-  }
-  for (const auto& e : cs.edges)
-    pg.sharp_cost.push_back(prm.selection.lambda_complexity * cs.length(e) * kSharpEdgeWidth);
-  if (!warm.empty()) {
-    pg.warm = warm;
-    for (int f = 0; f < cs.size(); ++f) pg.fixed.push_back(props.in_zone[FaceIndex(f)] ? -1 : int(warm[f]));
-  }
+  SelectionProgram pg = program_of(cs, props, warm, prm.selection);
   auto finish = [&](const std::string& reason) {
     out.reason = reason;
     st.seconds = seconds_since(t0);
@@ -332,20 +393,8 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
     out.mesh = traced_shell(cs);
     out.mesh.id = start.id;
     st.faces_from_selection = int(out.mesh.faces.size());
-    problem = shell_problem(out.mesh, prm.repair);
     std::vector<int> refused;  // the changes to fix back (all of them, unless said)
-    if (problem.empty()) {
-      Mesh snapped = snapped_to_start(out.mesh, start);
-      if (shell_problem(snapped, prm.repair).empty()) out.mesh = std::move(snapped);
-      if (st.candidates_changed > 0 && moves_beyond_evidence(out.mesh, start, evidence))
-        problem = "it moves the model where the scan shows nothing";
-    }
-    if (problem.empty() && st.candidates_changed > 0 && !warm.empty()) {
-      std::vector<char> changed(cs.size());
-      for (int f = 0; f < cs.size(); ++f) changed[f] = selected[f] != base[f];
-      refused = enclosing_changes(cs, changed, start, out.mesh, st.evidence, prm.plane);
-      if (!refused.empty()) problem = "it encloses scan points (a surface seen through it)";
-    }
+    problem = shell_refusal(out.mesh, start, cs, {selected, base, !warm.empty()}, evidence, st.evidence, prm, refused);
     if (problem.empty() || st.candidates_changed == 0 || warm.empty() || attempt == kRetries) break;
     if (refused.empty())
       for (int f = 0; f < cs.size(); ++f)
