@@ -51,6 +51,81 @@ json selection_json(const ShellSelectionStats& st, const std::string& reason) {
   return j;
 }
 
+json repair_json(const RepairReport& rr) {
+  return {{"welded_vertices", rr.welded_vertices},
+          {"removed_degenerate_faces", rr.removed_degenerate_faces},
+          {"removed_duplicate_faces", rr.removed_duplicate_faces},
+          {"split_t_junctions", rr.split_t_junctions},
+          {"flipped_faces", rr.flipped_faces},
+          {"filled_holes", rr.filled_holes},
+          {"split_warped_faces", rr.split_warped_faces},
+          {"notes", rr.notes}};
+}
+
+json rebuild_json(const ShellRebuild& rb, const std::string& why) {
+  return {{"why", why},
+          {"ok", rb.ok},
+          {"reason", rb.reason},
+          {"planes_added", rb.planes_added},
+          {"area_added", rb.area_added},
+          {"area_kept", rb.area_kept},
+          {"area_dropped", rb.area_dropped},
+          {"area_uncovered", rb.area_uncovered},
+          {"area_fins", rb.area_fins},
+          {"sampling", rb.sampling},
+          {"candidates_changed", rb.candidates_changed},
+          {"hausdorff_input_to_output", rb.input_to_output},
+          {"hausdorff_output_to_input", rb.output_to_input}};
+}
+
+json planes_json(const std::vector<ScanPlane>& planes) {
+  json out = json::array();
+  for (const auto& p : planes)
+    out.push_back({{"normal", {p.plane.n.x(), p.plane.n.y(), p.plane.n.z()}},
+                   {"d", p.plane.d},
+                   {"inliers", p.inliers.size()},
+                   {"rms", p.rms},
+                   {"area", p.hull_area},
+                   {"facade", p.facade},
+                   {"doubled", p.doubled}});
+  return out;
+}
+
+json matches_json(const RefineTrace::Matching& matching) {
+  json matches = json::array();
+  for (const auto& w : matching.walls) {
+    const Match& m = w.match;
+    matches.push_back({{"scan_plane", m.scan_plane},
+                       {"surface", m.surface},
+                       {"s_normal", m.s_normal},
+                       {"d_centroid", m.d_centroid},
+                       {"c_bbox", m.c_bbox},
+                       {"s_match", m.s_match},
+                       {"points", m.owned.size()},
+                       {"deviation", w.deviation},
+                       {"faces", w.faces}});
+  }
+  return matches;
+}
+
+json fit_json(const Judgement::Fit& f) {
+  return json{{"points", f.points},
+              {"better", f.better},
+              {"worse", f.worse},
+              {"rms_before", f.rms_before},
+              {"rms_after", f.rms_after}};
+}
+
+json judgement_json(const Judgement& j) {
+  json walls = json::array();
+  for (const auto& w : j.walls) walls.push_back(fit_json(w));
+  return {{"ok", j.ok},
+          {"check", check_name(j.check)},
+          {"detail", j.detail},
+          {"building", fit_json(j.building)},
+          {"walls", walls}};
+}
+
 }  // namespace
 
 json validation_json(const Validation& v) {
@@ -79,47 +154,10 @@ json refine_report(const RefineResult& r) {
   json seconds = json::object();
   for (const auto& [stage, s] : t.seconds) seconds[stage] = seconds.value(stage, 0.0) + s;  // a retry's laps add up
   rep["seconds"] = seconds;
-  if (t.repair) {
-    const RepairReport& rr = *t.repair;
-    rep["repair"] = {{"welded_vertices", rr.welded_vertices},
-                     {"removed_degenerate_faces", rr.removed_degenerate_faces},
-                     {"removed_duplicate_faces", rr.removed_duplicate_faces},
-                     {"split_t_junctions", rr.split_t_junctions},
-                     {"flipped_faces", rr.flipped_faces},
-                     {"filled_holes", rr.filled_holes},
-                     {"split_warped_faces", rr.split_warped_faces},
-                     {"notes", rr.notes}};
-  }
+  if (t.repair) rep["repair"] = repair_json(*t.repair);
   if (t.input_validation) rep["input_validation"] = validation_json(*t.input_validation);
-  if (t.rebuild) {
-    const ShellRebuild& rb = *t.rebuild;
-    rep["rebuild"] = {{"why", t.invalid_input},
-                      {"ok", rb.ok},
-                      {"reason", rb.reason},
-                      {"planes_added", rb.planes_added},
-                      {"area_added", rb.area_added},
-                      {"area_kept", rb.area_kept},
-                      {"area_dropped", rb.area_dropped},
-                      {"area_uncovered", rb.area_uncovered},
-                      {"area_fins", rb.area_fins},
-                      {"sampling", rb.sampling},
-                      {"candidates_changed", rb.candidates_changed},
-                      {"hausdorff_input_to_output", rb.input_to_output},
-                      {"hausdorff_output_to_input", rb.output_to_input}};
-  }
+  if (t.rebuild) rep["rebuild"] = rebuild_json(*t.rebuild, t.invalid_input);
   if (t.cloud) rep["cloud"] = {{"points", t.cloud->first}, {"points_near_model", t.cloud->second}};
-  auto planes_json = [](const std::vector<ScanPlane>& planes) {
-    json out = json::array();
-    for (const auto& p : planes)
-      out.push_back({{"normal", {p.plane.n.x(), p.plane.n.y(), p.plane.n.z()}},
-                     {"d", p.plane.d},
-                     {"inliers", p.inliers.size()},
-                     {"rms", p.rms},
-                     {"area", p.hull_area},
-                     {"facade", p.facade},
-                     {"doubled", p.doubled}});
-    return out;
-  };
   if (t.planes) rep["planes"] = planes_json(*t.planes);
   if (t.scan)
     rep["scan"] = {{"doubled_walls", t.scan->doubled_walls},
@@ -129,20 +167,7 @@ json refine_report(const RefineResult& r) {
                    {"relief_share", t.scan->relief_share},
                    {"wall_density", {{"min", t.scan->min_density}, {"max", t.scan->max_density}}}};
   if (t.matching) {
-    json matches = json::array();
-    for (const auto& w : t.matching->walls) {
-      const Match& m = w.match;
-      matches.push_back({{"scan_plane", m.scan_plane},
-                         {"surface", m.surface},
-                         {"s_normal", m.s_normal},
-                         {"d_centroid", m.d_centroid},
-                         {"c_bbox", m.c_bbox},
-                         {"s_match", m.s_match},
-                         {"points", m.owned.size()},
-                         {"deviation", w.deviation},
-                         {"faces", w.faces}});
-    }
-    rep["matches"] = matches;
+    rep["matches"] = matches_json(*t.matching);
     rep["rejected_matches"] = t.matching->rejected;
     rep["q_model"] = t.matching->q_model;
   }
@@ -164,20 +189,7 @@ json refine_report(const RefineResult& r) {
     rep["facades"] = facades;
   }
   if (t.judgement) {
-    auto fit = [](const Judgement::Fit& f) {
-      return json{{"points", f.points},
-                  {"better", f.better},
-                  {"worse", f.worse},
-                  {"rms_before", f.rms_before},
-                  {"rms_after", f.rms_after}};
-    };
-    json walls = json::array();
-    for (const auto& w : t.judgement->walls) walls.push_back(fit(w));
-    rep["judgement"] = {{"ok", t.judgement->ok},
-                        {"check", check_name(t.judgement->check)},
-                        {"detail", t.judgement->detail},
-                        {"building", fit(t.judgement->building)},
-                        {"walls", walls}};
+    rep["judgement"] = judgement_json(*t.judgement);
     if (t.corners_refused) rep["judgement"]["corners_refused"] = *t.corners_refused;
     if (!t.walls_refused.empty()) rep["judgement"]["walls_refused"] = t.walls_refused;
   }
