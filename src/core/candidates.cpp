@@ -324,6 +324,27 @@ std::vector<PlaneVertices> vertices_on_planes(const std::vector<Vec3>& V, const 
   return on;
 }
 
+// Where a vertex of one face lies inside another face's edge (several planes meeting at a point
+// along the line), that edge is split so that adjacency is exact. Such a vertex lies on the
+// face's plane, so only that plane's vertices are tried: trying every vertex for every edge took
+// minutes on a large building (thousands of faces).
+void split_edges_at_vertices(const std::vector<Vec3>& vertices, const std::vector<SupportPlane>& planes,
+                             const std::vector<Piece>& pieces, std::vector<std::vector<int>>& corners) {
+  const auto on_plane = vertices_on_planes(vertices, planes);
+  for (std::size_t f = 0; f < corners.size(); ++f) {
+    auto& v = corners[f];
+    std::vector<int> out;
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      const int a = v[k], b = v[(k + 1) % v.size()];
+      out.push_back(a);
+      const std::vector<int> near = on_plane[pieces[f].plane].near_segment(vertices[a], vertices[b], kVertexWeld);
+      for (int x : vertices_on_segment(vertices, a, b, SegmentRule{kVertexWeld, false, kEdgeEndShare}, &near))
+        out.push_back(x);
+    }
+    v = out;
+  }
+}
+
 }  // namespace
 
 CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Region& region, double min_area) {
@@ -392,23 +413,7 @@ CandidateSet build_candidates(const std::vector<SupportPlane>& planes, const Reg
   }
   cs.vertices = welder.points();
 
-  // Where a vertex of one face lies inside another face's edge (several planes meeting at a
-  // point along the line), split that edge so that adjacency is exact. Such a vertex lies on the
-  // face's plane, so only that plane's vertices are tried: trying every vertex for every edge
-  // took minutes on a large building (thousands of faces).
-  const auto on_plane = vertices_on_planes(cs.vertices, planes);
-  for (std::size_t f = 0; f < corners.size(); ++f) {
-    auto& v = corners[f];
-    std::vector<int> out;
-    for (std::size_t k = 0; k < v.size(); ++k) {
-      const int a = v[k], b = v[(k + 1) % v.size()];
-      out.push_back(a);
-      const std::vector<int> near = on_plane[kept[f].plane].near_segment(cs.vertices[a], cs.vertices[b], kVertexWeld);
-      for (int x : vertices_on_segment(cs.vertices, a, b, SegmentRule{kVertexWeld, false, kEdgeEndShare}, &near))
-        out.push_back(x);
-    }
-    v = out;
-  }
+  split_edges_at_vertices(cs.vertices, planes, kept, corners);
   build_fans(cs, build_mesh(cs, kept, corners));
   return cs;
 }
