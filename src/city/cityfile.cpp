@@ -369,6 +369,35 @@ json parse_feature(const std::string& line, const std::string& where) {
   return feature;
 }
 
+// Pass 1 of a CityJSONSeq: each feature's buildings read for their crop boxes, counted in `sum`.
+struct SequenceTargets {
+  std::vector<CropTarget> targets;
+  std::vector<std::size_t> target_of;
+  std::vector<std::size_t> feature_buildings;  // per feature line
+  Eigen::AlignedBox3d city_box;
+};
+SequenceTargets sequence_targets(const json& header, const std::string& model_path, const CityRefineOptions& options,
+                                 CityRefineSummary& sum) {
+  SequenceTargets seq;
+  std::ifstream in(model_path, std::ios::binary);
+  std::string line;
+  std::getline(in, line);
+  std::unordered_set<std::string> ids;
+  for (int n = 2; std::getline(in, line); ++n) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const std::string where = model_path + ": line " + std::to_string(n);
+    json feature = parse_feature(line, where);
+    add_feature_ids(feature, ids, where);
+    const CityJsonFile f = read_cityjson_document(feature_document(header, std::move(feature)), where, options.lod);
+    sum.buildings += int(f.buildings.size());
+    seq.feature_buildings.push_back(f.buildings.size());
+    sum.objects_without_lod += f.objects_without_lod2;
+    seq.city_box.extend(model_box(f.buildings));
+    add_targets(f.buildings, options, seq.targets, seq.target_of);
+  }
+  return seq;
+}
+
 // CityJSONSeq in, CityJSONSeq out, streamed: pass 1 reads each feature's buildings for the
 // crop boxes (keeping only the boxes), the cloud pass fills them, pass 2 reads each feature
 // again, refines its buildings (features on the pool) and writes the lines out in order.
@@ -384,37 +413,17 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
                          model_path + ": line 1");
   const CityJsonTransform tf = transform_of(header);
   auto t = Clock::now();
-  std::vector<CropTarget> targets;
-  std::vector<std::size_t> target_of;
-  std::vector<std::size_t> feature_buildings;  // per feature line, for pass 2's building indices
+  SequenceTargets seq = sequence_targets(header, model_path, options, sum);
+  std::vector<CropTarget>& targets = seq.targets;
+  const std::vector<std::size_t>& target_of = seq.target_of;
+  const std::vector<std::size_t>& feature_buildings = seq.feature_buildings;  // for pass 2's building indices
   std::size_t features = 0;
-  Eigen::AlignedBox3d city_box;
-  const auto for_each_feature = [&](const std::function<void(int, json&&)>& f) {
-    std::ifstream in(model_path, std::ios::binary);
-    std::string line;
-    std::getline(in, line);
-    for (int n = 2; std::getline(in, line); ++n) {
-      if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-      f(n, parse_feature(line, model_path + ": line " + std::to_string(n)));
-    }
-  };
-  std::unordered_set<std::string> ids;
-  for_each_feature([&](int n, json&& feature) {
-    add_feature_ids(feature, ids, model_path + ": line " + std::to_string(n));
-    const CityJsonFile f = read_cityjson_document(feature_document(header, std::move(feature)),
-                                                  model_path + ": line " + std::to_string(n), options.lod);
-    sum.buildings += int(f.buildings.size());
-    feature_buildings.push_back(f.buildings.size());
-    sum.objects_without_lod += f.objects_without_lod2;
-    city_box.extend(model_box(f.buildings));
-    add_targets(f.buildings, options, targets, target_of);
-  });
   if (sum.buildings == 0) fail_no_lod(model_path, options, sum.objects_without_lod);
-  check_targets(targets, model_path, options);
+  check_targets(seq.targets, model_path, options);
   sum.seconds_read = seconds_since(t);
 
   t = Clock::now();
-  crop_clouds(cloud_paths, targets, city_box, options, sum);
+  crop_clouds(cloud_paths, seq.targets, seq.city_box, options, sum);
   sum.seconds_crop = seconds_since(t);
 
   t = Clock::now();
