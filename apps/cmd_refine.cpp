@@ -1,5 +1,6 @@
 // `lodrefine refine`: one coarse building + its MLS crop -> the refined building.
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -257,9 +258,10 @@ void run(const RefineArgs& a) {
   const PointCloud cloud = read_cloud(clouds, a.cloud_options, &read);
   // A crop the scan did not reach is empty: its building is kept as read, as in a city file. A
   // class filter that leaves none of a cloud's points is a mistake in the command.
-  if (cloud.points.empty() && !a.cloud_options.classes.empty() && cloud_point_count(clouds) > 0)
-    throw InputError(cloud_files_text(clouds) + ": the cloud has no points of classes " +
-                     classes_text(a.cloud_options.classes) + " (of " + std::to_string(cloud_point_count(clouds)) + ")");
+  if (cloud.points.empty() && !a.cloud_options.classes.empty())
+    if (const std::uint64_t all = cloud_point_count(clouds); all > 0)
+      throw InputError(cloud_files_text(clouds) + ": the cloud has no points of classes " +
+                       classes_text(a.cloud_options.classes) + " (of " + std::to_string(all) + ")");
   // Said on stdout and in the report (stderr is for the one error line of a failed run).
   std::vector<std::string> warnings = overlap_problems(read, bounding_box(model.vertices));
   if (cloud.points.empty()) warnings.push_back(cloud_files_text(clouds) + ": the cloud has no points");

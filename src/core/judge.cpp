@@ -144,8 +144,8 @@ long long column_of(const Vec3& p, const Plane& f) {
   return (long long)std::floor(horizontal_along(f).dot(p) / kColumn);
 }
 
-// One model as the judge sees it: distances to it and, when facade lines beyond the cap are
-// judged, its faces' planes and the columns of each face's own points.
+// One model as the judge sees it: distances to it, its faces' planes and, when facade lines
+// beyond the cap are judged, the columns of each face's own points.
 struct Side {
   MeshDistance distance;
   std::vector<Plane> faces;              // per face, its plane
@@ -280,12 +280,12 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
     s0.note(at[k], near0[k], cap);
     s1.note(at[k], near1[k], cap);
   }
+  const double tol = detection.ransac_epsilon;
   std::vector<PointFit> out;
   for (std::size_t k = 0; k < at.size(); ++k) {
     const std::size_t i = judged[k];
     const Vec3& p = at[k];
     const MeshDistance::Nearest &a = near0[k], &b = near1[k];
-    const double tol = detection.ransac_epsilon;
     double c = cap;
     if (facade_lines && facade_of(i) >= 0 && std::min(a.distance, b.distance) > cap) {
       const Plane& scan = planes[std::size_t(on[i])].plane;

@@ -238,36 +238,23 @@ std::string shell_problem(const Mesh& m, const RepairConfig& prm) {
   return "";
 }
 
-// The selection with the start's slivers on the planes they lie on within `sliver_tolerance`
-// (negative: none); nothing when some are and the starting shell then cannot be expressed in the
-// candidates (its pieces cannot be mended to close): select_shell then gives each sliver a plane
-// of its own, as it is.
-// A selection as the refusal of its shell sees it: the candidates selected, the start's, and
-// whether the start was a warm start (enclosing changes are then fixed back alone).
-struct SelectedCandidates {
-  const std::vector<char>& selected;
-  const std::vector<char>& base;
-  bool warm;
-};
-
 // Why the selected shell cannot be written (empty when it can): it does not validate, it moves
 // the model beyond the `evidence`, or a change encloses the supports' points (`scan_points`; those
-// changes in `refused`). A valid shell is snapped onto the start where it still validates.
-std::string shell_refusal(Mesh& shell, const Mesh& start, CandidateSet& cs, const SelectedCandidates& sel,
+// changes in `refused`). `changed`: per candidate, whether the selection differs from the start
+// there; `warm`: whether the start was the warm start (enclosing changes are then fixed back
+// alone). A valid shell is snapped onto the start where it still validates.
+std::string shell_refusal(Mesh& shell, const Mesh& start, CandidateSet& cs, const std::vector<char>& changed, bool warm,
                           const EvidenceReach& evidence, const std::vector<Vec3>& scan_points, const RefineConfig& prm,
                           std::vector<int>& refused) {
   std::string problem = shell_problem(shell, prm.repair);
-  int changes = 0;
-  for (int f = 0; f < cs.size(); ++f) changes += sel.selected[f] != sel.base[f];
+  const bool any = std::find(changed.begin(), changed.end(), 1) != changed.end();
   if (problem.empty()) {
     Mesh snapped = snapped_to_start(shell, start);
     if (shell_problem(snapped, prm.repair).empty()) shell = std::move(snapped);
-    if (changes > 0 && moves_beyond_evidence(shell, start, evidence))
+    if (any && moves_beyond_evidence(shell, start, evidence))
       problem = "it moves the model where the scan shows nothing";
   }
-  if (problem.empty() && changes > 0 && sel.warm) {
-    std::vector<char> changed(cs.size());
-    for (int f = 0; f < cs.size(); ++f) changed[f] = sel.selected[f] != sel.base[f];
+  if (problem.empty() && any && warm) {
     refused = enclosing_changes(cs, changed, start, shell, scan_points, prm.plane);
     if (!refused.empty()) problem = "it encloses scan points (a surface seen through it)";
   }
@@ -330,14 +317,15 @@ Pruned pruned(CandidateSet& all, const FaceProps& all_props, const std::vector<c
   return {std::move(cs), props, std::move(warm)};
 }
 
-// The selection from `start` (sliver_tolerance: add_start_planes'); nullopt when its start cannot
-// be mended while it has slivers (select_shell tries again without). The starting shell (mended
-// where it does not close on the candidates) is GLPK's first incumbent, and what no evidence
-// reaches is fixed to it; without one everything is free. Each plane is cut to where its faces can
-// be (its start faces and scan points, grown by twice the farthest a wall may move: a face reaches
-// a moved neighbour, whose corner with the next moved wall lies that far again; once measured lost
-// a real building's refinement), so a large building's program does not grow with the cube of its
-// planes.
+// The selection with the start's slivers on the planes they lie on within `sliver_tolerance`
+// (negative: none); nothing when some are and the starting shell then cannot be expressed in the
+// candidates (its pieces cannot be mended to close): select_shell then gives each sliver a plane
+// of its own, as it is. The starting shell (mended where it does not close on the candidates) is
+// GLPK's first incumbent, and what no evidence reaches is fixed to it; without one everything is
+// free. Each plane is cut to where its faces can be (its start faces and scan points, grown by
+// twice the farthest a wall may move: a face reaches a moved neighbour, whose corner with the next
+// moved wall lies that far again; once measured lost a real building's refinement), so a large
+// building's program does not grow with the cube of its planes.
 std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointCloud& cloud,
                                               const std::vector<ScanPlane>& planes, const RefineConfig& prm,
                                               double sliver_tolerance) {
@@ -388,17 +376,18 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
     const auto& sel = st.selection;
     if (!sel.ok) return finish("face selection " + sel.status_text());
     const std::vector<char> selected = selected_faces(cs);
-    st.candidates_changed = 0;
-    for (int f = 0; f < cs.size(); ++f) st.candidates_changed += selected[f] != base[f];
+    std::vector<char> changed(selected.size());
+    for (std::size_t f = 0; f < changed.size(); ++f) changed[f] = selected[f] != base[f];
+    st.candidates_changed = int(std::count(changed.begin(), changed.end(), 1));
     out.mesh = traced_shell(cs);
     out.mesh.id = start.id;
     st.faces_from_selection = int(out.mesh.faces.size());
     std::vector<int> refused;  // the changes to fix back (all of them, unless said)
-    problem = shell_refusal(out.mesh, start, cs, {selected, base, !warm.empty()}, evidence, st.evidence, prm, refused);
+    problem = shell_refusal(out.mesh, start, cs, changed, !warm.empty(), evidence, st.evidence, prm, refused);
     if (problem.empty() || st.candidates_changed == 0 || warm.empty() || attempt == kRetries) break;
     if (refused.empty())
       for (int f = 0; f < cs.size(); ++f)
-        if (selected[f] != base[f]) refused.push_back(f);
+        if (changed[f]) refused.push_back(f);
     for (int f : refused) pg.fixed[f] = int(base[f]);
     pg.warm = base;  // agrees with what is fixed back
   }
