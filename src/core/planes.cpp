@@ -20,8 +20,6 @@
 #include <cstdint>
 #include <limits>
 #include <numeric>
-#include <optional>
-#include <set>
 #include <tuple>
 #include <unordered_map>
 

@@ -2,7 +2,6 @@
 // drives is one plane midway; facade planes over only part of a wall's height are relief.
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <optional>
 #include <set>
 #include <utility>
