@@ -3,7 +3,7 @@
 # Usage: scripts/deps.sh [--with-cloudcompare] [--with-browser] [--with-cluster] [--with-lazperf]
 #   --with-cloudcompare  CloudCompare, for the independent C2M cross-check test
 #   --with-lazperf       node and the npm package laz-perf (LASzip as WASM) in /tmp/lazjs, the
-#                        independent decoder tests/io/test_laz.cpp compares ours with
+#                        independent decoder tests/laz/test_laz.cpp compares ours with
 #   --with-browser       Chromium, for the headless test of the HTML report
 #   --with-cluster       Slurm, munge and GNU Parallel, for the cluster dispatch tests
 set -euo pipefail

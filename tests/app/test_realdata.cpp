@@ -5,7 +5,7 @@
 //
 // The real data is GPL-3.0 and lives outside the repository, in ../shared/realdata beside the
 // checkout; the RealData tests skip when it is absent. The CityJSON reader's own tests are in
-// tests/io/test_cityjson.cpp.
+// tests/formats/test_cityjson.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>

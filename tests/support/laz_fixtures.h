@@ -1,6 +1,6 @@
-// LAZ test helpers shared by tests/io/test_laz.cpp and test_laz_write.cpp: the records of a LAS
+// LAZ test helpers shared by tests/laz/test_laz.cpp and test_laz_write.cpp: the records of a LAS
 // or LAZ file, and the independent decoder (the npm package laz-perf under node, run by
-// tests/io/laz_reference_dump.js), which the tests skip without.
+// tests/laz/laz_reference_dump.js), which the tests skip without.
 #pragma once
 #include <cstdlib>
 #include <filesystem>
@@ -37,7 +37,7 @@ inline std::string lazperf_missing() {
 
 // The shell command that has laz-perf decode `laz` into the raw records file `dump`.
 inline std::string lazperf_command(const std::string& laz, const std::string& dump) {
-  const std::string script = std::string(LODREFINE_SOURCE_DIR) + "/tests/io/laz_reference_dump.js";
+  const std::string script = std::string(LODREFINE_SOURCE_DIR) + "/tests/laz/laz_reference_dump.js";
   return "node '" + script + "' '" + lazperf_modules() + "' '" + laz + "' '" + dump + "'";
 }
 

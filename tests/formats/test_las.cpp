@@ -1,5 +1,5 @@
 // LAS reading: every point format 0–10 in the versions that define it, written by the test
-// itself, read back exactly; class filters; lying and truncated headers. LAZ: test_laz.cpp.
+// itself, read back exactly; class filters; lying and truncated headers. LAZ: tests/laz/test_laz.cpp.
 #include <gtest/gtest.h>
 
 #include "support/cli_fixtures.h"
