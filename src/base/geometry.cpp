@@ -236,14 +236,19 @@ std::vector<Vec2> clip_half_plane(const std::vector<Vec2>& poly, const Vec2& a, 
 }
 }  // namespace
 
-double polygon_convex_intersection_area(const std::vector<Vec2>& simple, const std::vector<Vec2>& convex) {
-  if (simple.size() < 3 || convex.size() < 3) return 0.0;
+std::vector<Vec2> polygon_clipped_to_convex(const std::vector<Vec2>& simple, const std::vector<Vec2>& convex) {
+  if (simple.size() < 3 || convex.size() < 3) return {};
   std::vector<Vec2> clip = convex;
   if (signed_area_2d(clip) < 0) std::reverse(clip.begin(), clip.end());
   std::vector<Vec2> poly = simple;
   for (std::size_t i = 0; i < clip.size() && poly.size() >= 3; ++i)
     poly = clip_half_plane(poly, clip[i], clip[(i + 1) % clip.size()]);
-  return poly.size() >= 3 ? std::abs(signed_area_2d(poly)) : 0.0;
+  if (poly.size() < 3) poly.clear();
+  return poly;
+}
+
+double polygon_convex_intersection_area(const std::vector<Vec2>& simple, const std::vector<Vec2>& convex) {
+  return std::abs(signed_area_2d(polygon_clipped_to_convex(simple, convex)));
 }
 
 double convex_intersection_area(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {

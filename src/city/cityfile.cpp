@@ -146,8 +146,12 @@ void apply_job(json& doc, const CityJsonTransform& tf, const CityJsonBuilding& b
     const std::string lod = obj["geometry"][std::size_t(b.geometry_index)]["lod"].is_string()
                                 ? obj["geometry"][std::size_t(b.geometry_index)]["lod"].get<std::string>()
                                 : b.lod;
-    obj["geometry"][std::size_t(b.geometry_index)] =
+    json& geometry = obj["geometry"];
+    geometry[std::size_t(b.geometry_index)] =
         cityjson_solid(job.result.mesh, lod, tf.scale, tf.translate, doc["vertices"]);
+    if (!job.result.fins.faces.empty())
+      geometry.insert(geometry.begin() + b.geometry_index + 1,
+                      cityjson_multisurface(job.result.fins, lod, tf.scale, tf.translate, doc["vertices"]));
     ++(o.outcome == Outcome::Refined ? sum.refined : sum.repaired);
   } else {
     ++(o.outcome == Outcome::Kept ? sum.kept : sum.kept_invalid);
@@ -483,8 +487,12 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
 
 }  // namespace
 
-json cityjson_solid(const Mesh& mesh, const std::string& lod, const Vec3& scale, const Vec3& translate,
-                    json& vertices) {
+namespace {
+
+// `mesh`'s faces as one surface list of a geometry with semantics, its vertices appended to
+// `vertices` quantised by the transform.
+json cityjson_surfaces(const Mesh& mesh, const std::string& type, const std::string& lod, const Vec3& scale,
+                       const Vec3& translate, json& vertices) {
   const long long base = (long long)vertices.size();
   for (const auto& p : mesh.vertices) {
     json q = json::array();
@@ -509,9 +517,23 @@ json cityjson_solid(const Mesh& mesh, const std::string& lod, const Vec3& scale,
     }
     values.push_back(it->second);
   }
-  json g = {{"type", "Solid"}, {"lod", lod}, {"boundaries", json::array({std::move(shell)})}};
-  g["semantics"] = {{"surfaces", std::move(surfaces)}, {"values", json::array({std::move(values)})}};
+  const bool solid = type == "Solid";
+  json g = {{"type", type}, {"lod", lod}, {"boundaries", solid ? json::array({std::move(shell)}) : std::move(shell)}};
+  g["semantics"] = {{"surfaces", std::move(surfaces)},
+                    {"values", solid ? json::array({std::move(values)}) : std::move(values)}};
   return g;
+}
+
+}  // namespace
+
+json cityjson_solid(const Mesh& mesh, const std::string& lod, const Vec3& scale, const Vec3& translate,
+                    json& vertices) {
+  return cityjson_surfaces(mesh, "Solid", lod, scale, translate, vertices);
+}
+
+json cityjson_multisurface(const Mesh& mesh, const std::string& lod, const Vec3& scale, const Vec3& translate,
+                           json& vertices) {
+  return cityjson_surfaces(mesh, "MultiSurface", lod, scale, translate, vertices);
 }
 
 CityRefineSummary refine_city(const std::string& model_path, const std::vector<std::string>& cloud_paths,

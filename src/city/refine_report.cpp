@@ -72,10 +72,13 @@ json rebuild_json(const ShellRebuild& rb, const std::string& why) {
           {"area_dropped", rb.area_dropped},
           {"area_uncovered", rb.area_uncovered},
           {"area_fins", rb.area_fins},
+          {"area_carried", rb.area_carried},
+          {"fins", rb.fins.faces.size()},
           {"sampling", rb.sampling},
           {"candidates_changed", rb.candidates_changed},
           {"hausdorff_input_to_output", rb.input_to_output},
-          {"hausdorff_output_to_input", rb.output_to_input}};
+          {"hausdorff_output_to_input", rb.output_to_input},
+          {"corner_to_input", rb.corner_to_input}};
 }
 
 json planes_json(const std::vector<ScanPlane>& planes) {

@@ -122,7 +122,13 @@ std::string rebuild_summary(const ShellRebuild& rb) {
                 "shell rebuilt on its planes (%.1f m² added, %.1f m² of partitions dropped, %d "
                 "piece(s) changed)",
                 rb.area_added, rb.area_dropped, rb.candidates_changed);
-  return buf;
+  std::string out = buf;
+  if (!rb.fins.faces.empty()) {
+    std::snprintf(buf, sizeof buf, ", %.1f m² of fins beside it (outside on both sides: no solid holds them)",
+                  rb.area_carried);
+    out += buf;
+  }
+  return out;
 }
 
 // One building's run: the result being filled, its local frame and the stage timer.
@@ -154,6 +160,10 @@ class Run {
     trace.seconds.emplace_back("total", seconds_since(t_start_));
     out_.mesh = translated(local_mesh, origin_);
     out_.mesh.id = id_;
+    if (out_.trace.rebuild && out_.trace.rebuild->ok && out_.outcome != Outcome::KeptInvalid) {
+      out_.fins = translated(out_.trace.rebuild->fins, origin_);
+      out_.fins.id = id_;
+    }
     return out_;
   }
 
@@ -205,6 +215,14 @@ std::optional<RefineResult> repair_or_stop(const Mesh& local_model, const Refine
     rb.reason = e.what();
   }
   run.lap(RefineStage::Repair);
+  if (rb.ok && rb.input_to_output <= cfg.repair.weld_tolerance && rb.corner_to_input > cfg.repair.weld_tolerance) {
+    rb.ok = false;
+    char buf[160];
+    std::snprintf(buf, sizeof buf,
+                  "its shell on its planes has a corner %.3f m off its faces (walls added only between its own edges)",
+                  rb.corner_to_input);
+    rb.reason = buf;
+  }
   if (rb.ok && rb.input_to_output > cfg.repair.weld_tolerance) {
     rb.ok = false;
     char buf[160];

@@ -223,6 +223,10 @@ bool warm_start_feasible(const CandidateSet& cs, const Columns& c) {
   if (!every_edge_used_0_or_2(cs, c.pg.warm, c.pg.outside)) return false;
   for (int f = 0; f < cs.size(); ++f)
     if (c.fixed_value(f) >= 0 && c.fixed_value(f) != c.pg.warm[f]) return false;
+  for (const auto& x : c.pg.excluded)
+    if (std::all_of(x.selected.begin(), x.selected.end(), [&](int f) { return c.pg.warm[f] != 0; }) &&
+        std::none_of(x.unselected.begin(), x.unselected.end(), [&](int f) { return c.pg.warm[f] != 0; }))
+      return false;
   return true;
 }
 
@@ -319,6 +323,29 @@ void add_sharp_edge(Program& p, const CandidateSet& cs, const CandidateMap<int>&
       }
       p.add_row(t, GLP_LO, rhs, 0.0);
     }
+}
+
+// No local selection of program.excluded made: sum x(selected) - sum x(unselected) <=
+// |selected| - 1, fixed faces folded in; false when the fixed faces make one.
+bool add_exclusions(Program& p, const Columns& c) {
+  for (const auto& x : c.pg.excluded) {
+    std::vector<std::pair<int, double>> terms;
+    double bound = double(x.selected.size()) - 1.0;
+    bool made_otherwise = false;  // a fixed face already differs from it
+    for (int f : x.selected) {
+      if (c.column(f) > 0) terms.emplace_back(c.column(f), 1.0);
+      else if (c.fixed_value(f) == 1) bound -= 1.0;
+      else made_otherwise = true;
+    }
+    for (int f : x.unselected) {
+      if (c.column(f) > 0) terms.emplace_back(c.column(f), -1.0);
+      else if (c.fixed_value(f) == 1) made_otherwise = true;
+    }
+    if (made_otherwise) continue;
+    if (terms.empty()) return false;
+    p.add_row(terms, GLP_UP, 0.0, bound);
+  }
+  return true;
 }
 
 // Every edge's constraint and complexity term; false when the fixed faces contradict one.
@@ -434,7 +461,7 @@ SelectionResult select_faces(CandidateSet& cs, const SelectionProgram& pg, const
   glp_term_out(GLP_OFF);
   Program p;
   add_coverage_objective(p, cs, c, prm);
-  const bool feasible = add_edges(p, cs, c, prm);
+  const bool feasible = add_edges(p, cs, c, prm) && add_exclusions(p, c);
   res.variables = glp_get_num_cols(p.lp);
   res.constraints = glp_get_num_rows(p.lp);
   res.nonzeros = int(p.ia.size()) - 1;

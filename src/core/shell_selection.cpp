@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <optional>
 #include <unordered_map>
 #include <unordered_set>
@@ -139,8 +140,8 @@ bool moves_beyond_evidence(const Mesh& m, const Mesh& start, const EvidenceReach
 // merged within kSurfaceDistance), which leaves some edges used once or thrice. Those are
 // mended by the nearest selection that closes: a small program over the candidates around each
 // such edge (kMendRings edge-rings, more while it has no solution), the others fixed, each
-// change costing its area; with `whole_last`, at last every candidate free. Empty when it cannot
-// be mended.
+// change costing its area; with `whole_last`, at last every candidate free. None of the local
+// selections `excluded` is made (SelectionProgram::excluded). Empty when it cannot be mended.
 constexpr int kMendRings = 2, kMendTries = 3;
 constexpr int kRetries = 2;
 struct MendScope {
@@ -148,9 +149,12 @@ struct MendScope {
   double keep_weight = 1.0;  // a start candidate dropped costs this times its area, one added its area
 };
 std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_start, const SelectionConfig& prm,
-                               const MendScope& scope = {}) {
-  if (every_edge_used_0_or_2(cs, in_start)) return in_start;
+                               const MendScope& scope = {}, const std::vector<LocalSelection>& excluded = {}) {
+  if (excluded.empty() && every_edge_used_0_or_2(cs, in_start)) return in_start;
   std::vector<char> near(cs.size(), 0);
+  for (const auto& x : excluded)
+    for (const auto* set : {&x.selected, &x.unselected})
+      for (int f : *set) near[f] = 1;
   for (const auto& e : cs.edges) {
     int n = 0;
     for (auto h : e) n += in_start[cs.face(h)];
@@ -176,6 +180,7 @@ std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_sta
       pg.fixed.push_back(near[f] ? -1 : int(in_start[f]));
     }
     pg.sharp_cost.assign(cs.edges.size(), 0.0);
+    pg.excluded = excluded;
     SelectionConfig mend = prm;  // the costs are areas: weight 1
     mend.lambda_coverage = 1.0;
     const SelectionResult r = select_faces(cs, pg, mend);
@@ -424,6 +429,26 @@ constexpr double kMaxRebuildSamples = 250000;
 // uncovered: the rebuild is refused rather than slow (untrusted input).
 constexpr double kMaxWindingTerms = 2e8;
 
+// The selection of the candidates at each point where the traced `shell` is no 2-manifold
+// (pinched_vertices): one the edge constraints allow that no solid is. Each is then excluded and
+// the program solved again (a candidate added there or one dropped), at most kPinchRounds times.
+constexpr int kPinchRounds = 4;
+std::vector<LocalSelection> pinches(const CandidateSet& cs, const std::vector<char>& chosen, const Mesh& shell) {
+  std::vector<LocalSelection> out;
+  for (int v : pinched_vertices(shell)) {
+    const Vec3& p = shell.vertices[std::size_t(v)];
+    LocalSelection at;
+    for (int f = 0; f < cs.size(); ++f) {
+      const std::vector<int> corners = cs.corners(f);
+      if (std::any_of(corners.begin(), corners.end(),
+                      [&](int c) { return (cs.vertices[std::size_t(c)] - p).norm() < 1e-9; }))
+        (chosen[f] ? at.selected : at.unselected).push_back(f);
+    }
+    if (!at.selected.empty()) out.push_back(std::move(at));
+  }
+  return out;
+}
+
 void set_selected(CandidateSet& cs, const std::vector<char>& chosen) {
   auto map = candidate_props::selected.add(cs.mesh);
   for (int f = 0; f < cs.size(); ++f) map[FaceIndex(f)] = chosen[f] != 0;
@@ -448,9 +473,10 @@ std::vector<Vec3> face_samples(const Mesh& m, int f, double spacing) {
 }
 
 // The shell's area on the soup (samples within `tolerance` of it) and beside it (added), and the
-// farthest a sample lies from it.
+// farthest a sample and a vertex lie from it.
 void added_area(const Mesh& shell, const Mesh& soup, double tolerance, ShellRebuild& out) {
   const MeshDistance dist(soup);
+  for (const Vec3& p : shell.vertices) out.corner_to_input = std::max(out.corner_to_input, dist.distance(p, false));
   const double spacing = sample_spacing(shell);
   for (int f = 0; f < int(shell.faces.size()); ++f)
     for (const Vec3& p : sample_faces(shell, {f}, spacing)) {
@@ -494,15 +520,63 @@ class Winding {
 constexpr double kPartitionWinding = 0.75;
 constexpr double kFinWinding = 0.25;
 
-// The farthest a soup sample lies from the rebuilt `shell` (m), over the samples the shell must
-// cover: all but a partition between parts it joins (inside the shell, the soup's volume on both
-// sides). A fin (a face with outside on both sides: a neighbour's wall standing above the roof)
-// is no part of any solid, and an outer wall the shell swallows is no partition: either leaves
-// the soup uncovered. `out` gets the areas (m²) of the samples farther than `tolerance`: the
-// partitions' (dropped), the others (uncovered) and of those a fin's.
-double uncovered(const Mesh& soup, const Mesh& shell, double tolerance, ShellRebuild& out) {
+// The pieces of the soup's faces outside the shell with the soup's outside on both sides (its
+// winding there, without their own face, below kFinWinding): a fin, such as a neighbour's wall
+// standing above the roof. No solid holds one, so it goes beside the shell, as read: each soup
+// face clipped to the candidates of its plane the selection left out, in the face's orientation,
+// semantic and source.
+Mesh fins_beside(const CandidateSet& cs, const Supports& s, const std::vector<char>& chosen, const Mesh& soup,
+                 const Mesh& shell, const Winding& winding, double tolerance) {
+  constexpr double kMinPiece = 1e-4;  // m²: smaller pieces are the clipping's slivers
+  std::vector<std::vector<int>> left_out(cs.planes.size());
+  const auto support = cs.supports();
+  for (int f = 0; f < cs.size(); ++f)
+    if (!chosen[f]) left_out[std::size_t(support[FaceIndex(f)])].push_back(f);
+  const MeshDistance to_shell(shell);
+  Mesh fins;
+  fins.id = soup.id;
+  for (int sf = 0; sf < int(soup.faces.size()); ++sf) {
+    const int k = s.face_plane[std::size_t(sf)];
+    if (k < 0) continue;
+    const Plane& plane = cs.planes[std::size_t(k)].plane;
+    const auto [u, v] = plane.basis();
+    const Vec3 origin = -plane.d * plane.n;
+    auto flat = [&](const std::vector<Vec3>& poly) {
+      std::vector<Vec2> out;
+      for (const Vec3& p : poly) out.emplace_back(u.dot(p - origin), v.dot(p - origin));
+      return out;
+    };
+    const std::vector<Vec2> face = flat(face_points(soup, soup.faces[std::size_t(sf)]));
+    for (int f : left_out[std::size_t(k)]) {
+      const std::vector<Vec2> piece = polygon_clipped_to_convex(face, flat(cs.polygon(f)));
+      if (std::abs(signed_area_2d(piece)) < kMinPiece) continue;
+      std::vector<Vec3> corners;
+      for (const Vec2& q : piece) corners.push_back(origin + q.x() * u + q.y() * v);
+      const Vec3 c = polygon_centroid(corners);
+      if (to_shell.distance(c, true) <= tolerance || std::abs(winding.without(sf, c)) >= kFinWinding) continue;
+      Face out = soup.faces[std::size_t(sf)];
+      out.v.clear();
+      for (const Vec3& p : corners) {
+        out.v.push_back(int(fins.vertices.size()));
+        fins.vertices.push_back(p);
+      }
+      fins.faces.push_back(std::move(out));
+    }
+  }
+  return snapped_to_start(fins, soup);
+}
+
+// The farthest a soup sample lies from the rebuilt `shell` and the `fins` beside it (m), over the
+// samples they must cover: all but a partition between parts the shell joins (inside it, the
+// soup's volume on both sides). An outer wall the shell swallows is no partition, and a fin not
+// carried beside it leaves the soup uncovered too. `out` gets the areas (m²) of the samples
+// farther than `tolerance` from the shell: on the fins (carried), the partitions' (dropped), the
+// others (uncovered) and of those a fin's.
+double uncovered(const Mesh& soup, const Mesh& shell, const Mesh& fins, const Winding& winding, double tolerance,
+                 ShellRebuild& out) {
   const MeshDistance dist(shell);
-  const Winding winding(soup);
+  const std::optional<MeshDistance> to_fins =
+      fins.faces.empty() ? std::nullopt : std::make_optional<MeshDistance>(fins);
   const double spacing = sample_spacing(soup), sample_area = spacing * spacing;
   out.sampling = spacing;
   double terms = 0.0, worst = 0.0;
@@ -512,6 +586,14 @@ double uncovered(const Mesh& soup, const Mesh& shell, double tolerance, ShellReb
       if (std::abs(d) <= tolerance) {
         worst = std::max(worst, std::abs(d));
         continue;
+      }
+      if (to_fins) {
+        const double d_fin = to_fins->distance(p, false);
+        if (d_fin <= tolerance) {
+          worst = std::max(worst, d_fin);
+          out.area_carried += sample_area;
+          continue;
+        }
       }
       terms += double(winding.triangles());
       const double w = terms <= kMaxWindingTerms ? winding.without(f, p) : 0.5;  // past the budget: a wall
@@ -554,22 +636,32 @@ ShellRebuild rebuild_shell(const Mesh& soup, const RefineConfig& prm) {
   }
   const FaceProps props = describe_candidates(cs, soup, s, prm);
   const std::vector<char> cover = face_flags(cs, props.in_start);
-  const std::vector<char> chosen = mended_start(cs, cover, prm.selection, {true, kKeepCover});
-  if (chosen.empty()) {
-    out.reason = "its planes bound no closed shell";
-    return out;
+  std::vector<char> chosen;
+  std::vector<LocalSelection> excluded;
+  for (int round = 0;; ++round) {
+    chosen = mended_start(cs, cover, prm.selection, {true, kKeepCover}, excluded);
+    if (chosen.empty()) {
+      out.reason = "its planes bound no closed shell";
+      return out;
+    }
+    set_selected(cs, chosen);
+    out.mesh = traced_shell(cs);
+    out.mesh.id = soup.id;
+    const std::string problem = shell_problem(out.mesh, prm.repair);
+    if (problem.empty()) break;
+    const std::vector<LocalSelection> more = pinches(cs, chosen, out.mesh);
+    if (more.empty() || round == kPinchRounds) {
+      out.reason = "the shell on its planes is invalid: " + problem;
+      return out;
+    }
+    excluded.insert(excluded.end(), more.begin(), more.end());
   }
   for (int f = 0; f < cs.size(); ++f) out.candidates_changed += chosen[f] != cover[f];
-  set_selected(cs, chosen);
-  out.mesh = traced_shell(cs);
-  out.mesh.id = soup.id;
-  if (const std::string problem = shell_problem(out.mesh, prm.repair); !problem.empty()) {
-    out.reason = "the shell on its planes is invalid: " + problem;
-    return out;
-  }
   Mesh snapped = snapped_to_start(out.mesh, soup);
   if (shell_problem(snapped, prm.repair).empty()) out.mesh = std::move(snapped);
-  out.input_to_output = uncovered(soup, out.mesh, prm.repair.weld_tolerance, out);
+  const Winding winding(soup);
+  out.fins = fins_beside(cs, s, chosen, soup, out.mesh, winding, prm.repair.weld_tolerance);
+  out.input_to_output = uncovered(soup, out.mesh, out.fins, winding, prm.repair.weld_tolerance, out);
   added_area(out.mesh, soup, prm.repair.weld_tolerance, out);
   out.ok = true;
   return out;

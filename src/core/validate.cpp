@@ -88,8 +88,8 @@ void count_edge_defects(const EdgeUses& uses, Validation& v) {
   }
 }
 
-// A vertex is non-manifold when its faces form more than one edge-connected fan.
-int count_nonmanifold_vertices(const Mesh& m, const EdgeUses& uses) {
+// The vertices whose faces form more than one edge-connected fan.
+std::vector<int> fanned_vertices(const Mesh& m, const EdgeUses& uses) {
   std::map<std::pair<int, int>, int> corner;  // (vertex, face) -> id
   for (std::size_t f = 0; f < m.faces.size(); ++f)
     for (int v : m.faces[f].v) {
@@ -102,7 +102,10 @@ int count_nonmanifold_vertices(const Mesh& m, const EdgeUses& uses) {
       for (std::size_t k = 1; k < u.size(); ++k) fans.unite(corner.at({v, u[0].face}), corner.at({v, u[k].face}));
   std::map<int, std::set<int>> fans_of;
   for (const auto& [vf, id] : corner) fans_of[vf.first].insert(fans.find(id));
-  return int(std::count_if(fans_of.begin(), fans_of.end(), [](const auto& e) { return e.second.size() > 1; }));
+  std::vector<int> out;
+  for (const auto& [v, f] : fans_of)
+    if (f.size() > 1) out.push_back(v);
+  return out;
 }
 
 double max_planarity_error(const Mesh& m) {
@@ -282,6 +285,16 @@ std::string size_problem(const Mesh& mesh) {
   return {};
 }
 
+std::vector<int> pinched_vertices(const Mesh& mesh) {
+  const EdgeUses uses = edge_uses(mesh.faces);
+  std::vector<int> out = fanned_vertices(mesh, uses);
+  for (const auto& [e, u] : uses)
+    if (u.size() > 2) out.insert(out.end(), {e.first, e.second});
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 Validation validate_mesh(const Mesh& mesh, double planarity_tolerance, bool check_self_intersections,
                          bool single_component) {
   Validation v;
@@ -290,7 +303,7 @@ Validation validate_mesh(const Mesh& mesh, double planarity_tolerance, bool chec
   if (!v.problem.empty()) return v;
   const EdgeUses uses = edge_uses(mesh.faces);
   count_edge_defects(uses, v);
-  v.nonmanifold_vertices = count_nonmanifold_vertices(mesh, uses);
+  v.nonmanifold_vertices = int(fanned_vertices(mesh, uses).size());
   v.components = count_components(mesh.faces.size(), uses);
   v.volume = signed_volume(mesh.vertices, mesh.faces);
   v.outward = v.volume > 0;

@@ -155,7 +155,14 @@ void check_city_output(const json& in, const std::string& out_path, const CityRe
     }
     if (it != outcome.end() && (it->second == "refined" || it->second == "repaired")) {
       EXPECT_EQ(o.value("attributes", json()), obj.value("attributes", json())) << id;
-      EXPECT_EQ(o.value("geometry", json()).size(), obj.value("geometry", json()).size()) << id;
+      // The same geometries, and a MultiSurface of fins beside the Solid where the input had any.
+      const json og = o.value("geometry", json::array());
+      const std::size_t n_in = obj.value("geometry", json::array()).size();
+      EXPECT_TRUE(og.size() == n_in || og.size() == n_in + 1) << id;
+      for (std::size_t i = 0; og.size() == n_in + 1 && i + 1 < og.size(); ++i)
+        if (og[i + 1]["type"] == "MultiSurface" && og[i]["type"] == "Solid") {
+          EXPECT_EQ(og[i + 1]["lod"], og[i]["lod"]) << id;
+        }
       continue;
     }
     // Kept and untouched: the object and every vertex it uses exactly as read.
@@ -439,6 +446,50 @@ TEST(CityFile, RepairAllMendsTheBuildingsTheCloudDoesNotReach) {
     if (b.mesh.id == "open") {
       EXPECT_NEAR(validate_mesh(b.mesh, 0.01).volume, 480.0, 0.5);
     }
+}
+
+// A house whose wall stands 3 m above its roof (a fin) is repaired: its geometry becomes the
+// Solid and, beside it, a MultiSurface of the same LoD holding the fin as read.
+TEST(CityFile, AFinIsWrittenBesideTheSolidAsAMultiSurface) {
+  const std::string dir = test_dir();
+  SynthOptions so;
+  so.target_points = 4000;
+  so.origin = Vec3(93000.0, 436000.0, 0.0);
+  std::vector<SynthBuilding> bs = {make_building(BuildingType::Gable, 5, so)};
+  SynthBuilding fin = bs[0];
+  fin.id = "fin";
+  fin.coarse = fixtures::as_soup(translated(fixtures::box(Vec3(0, 0, 0), Vec3(10, 8, 6)), Vec3(93200, 436000, 0)));
+  const int n = int(fin.coarse.vertices.size());
+  for (const Vec3& p : {Vec3(0, 0, 6), Vec3(0, 8, 6), Vec3(0, 8, 9), Vec3(0, 0, 9)})
+    fin.coarse.vertices.push_back(p + Vec3(93200, 436000, 0));
+  fin.coarse.faces.push_back({{n, n + 1, n + 2, n + 3}, Semantic::Wall, 6});
+  bs.push_back(fin);
+  const json in = synth_city(bs, Vec3(93000, 436000, 0));
+  write_file_atomic(dir + "/city.json", in.dump());
+  write_ply(dir + "/cloud.ply", bs[0].cloud);
+  CityRefineOptions all;
+  all.repair_all = true;
+  const CityRefineSummary s =
+      refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", RefineConfig{}, all);
+  ASSERT_EQ(s.outcomes.size(), 2u);
+  EXPECT_EQ(s.outcomes[1].outcome, Outcome::Repaired) << s.outcomes[1].reason;
+  check_city_output(in, dir + "/out.city.json", s);
+  const json out = load(dir + "/out.city.json");
+  const json& g = out["CityObjects"]["fin"]["geometry"];
+  ASSERT_EQ(g.size(), 3u) << g.dump();  // LoD 1 as read, the Solid, the fin
+  EXPECT_EQ(g[1]["type"], "Solid");
+  EXPECT_EQ(g[2]["type"], "MultiSurface");
+  EXPECT_EQ(g[2]["lod"], g[1]["lod"]);
+  ASSERT_EQ(g[2]["boundaries"].size(), 1u);
+  const json& ring = g[2]["boundaries"][0][0];
+  ASSERT_EQ(ring.size(), 4u);
+  const json& tf = out["transform"];
+  for (const json& v : ring) {
+    const json& q = out["vertices"][v.get<std::size_t>()];
+    EXPECT_NEAR(q[0].get<double>() * tf["scale"][0].get<double>() + tf["translate"][0].get<double>(), 93200.0, 1e-3);
+    EXPECT_GE(q[2].get<double>() * tf["scale"][2].get<double>() + tf["translate"][2].get<double>(), 6.0 - 1e-3);
+  }
+  EXPECT_EQ(g[2]["semantics"]["surfaces"][0]["type"], "WallSurface");
 }
 
 TEST(CityFile, DenHaagCityGml) {

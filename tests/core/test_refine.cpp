@@ -251,20 +251,28 @@ TEST(Refine, ARepairedHouseIsRefinedOnItsScan) {
   EXPECT_LT(max_abs_y_of_front(r.mesh, 0.0), 0.02);
 }
 
-// A neighbour's wall standing 3 m above the roof (a fin) is part of no solid: the building is
-// kept as read, and the reason says how much of it no shell on its planes covers.
-TEST(Refine, AHouseWithAFinIsKeptInvalidAsRead) {
+// A wall standing 3 m above the roof (a fin) is no part of the solid: the house is repaired, the
+// fin written beside it as read.
+TEST(Refine, AHouseWithAFinIsRepairedWithTheFinBesideIt) {
   Mesh coarse = box_soup(0, 12, 0, 8, 7);
   const int n = int(coarse.vertices.size());
   for (const Vec3& p : {Vec3(0, 0, 7), Vec3(0, 8, 7), Vec3(0, 8, 10), Vec3(0, 0, 10)})
     coarse.vertices.push_back(p + kOrigin);
   coarse.faces.push_back({{n, n + 1, n + 2, n + 3}, Semantic::Wall, 6});
   const RefineResult r = refine_building(coarse, far_cloud(), RefineConfig{});
-  ASSERT_EQ(r.outcome, Outcome::KeptInvalid) << r.reason;
-  const std::size_t at = r.reason.find("uncovered by up to ");
+  ASSERT_EQ(r.outcome, Outcome::Repaired) << r.reason;
+  EXPECT_TRUE(r.valid);
+  const std::size_t at = r.reason.find(" m² of fins beside it");
   ASSERT_NE(at, std::string::npos) << r.reason;
-  EXPECT_NEAR(std::stod(r.reason.substr(at + 19)), 3.0, 0.05) << r.reason;
-  EXPECT_EQ(r.mesh.faces.size(), coarse.faces.size());
+  EXPECT_NEAR(std::stod(r.reason.substr(r.reason.rfind(' ', at - 1))), 24.0, 0.5) << r.reason;
+  EXPECT_NEAR(validate_mesh(r.mesh, 0.01).volume, 12.0 * 8.0 * 7.0, 1e-6);
+  ASSERT_EQ(r.fins.faces.size(), 1u);
+  EXPECT_EQ(r.fins.id, coarse.id);
+  for (const Vec3& p : r.fins.vertices) {
+    double nearest = 1e300;
+    for (const Vec3& q : coarse.vertices) nearest = std::min(nearest, (p - q).norm());
+    EXPECT_LT(nearest, 1e-6);
+  }
 }
 
 TEST(Refine, OutcomeNamesReadBack) {

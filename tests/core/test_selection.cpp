@@ -1,6 +1,7 @@
 // Stage 4b: face selection by GLPK over the candidate arrangement.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -45,6 +46,32 @@ TEST(Selection, RecoversTheClosedBoxFromConfidence) {
     for (auto h : e) n += selected[cs.face(h)];
     EXPECT_TRUE(n == 0 || n == 2);
   }
+}
+
+// An excluded local selection is never made: the box's six faces are not chosen together again
+// (another closed selection is), and with all six fixed in the program has no solution.
+TEST(Selection, AnExcludedLocalSelectionIsNotMade) {
+  const double a = 10, b = 8, c = 6;
+  CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
+  SelectionConfig prm;
+  const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, ConfidenceConfig{});
+  SelectionProgram pg;
+  for (std::size_t f = 0; f < std::size_t(cs.size()); ++f)
+    pg.cost.push_back(coverage_cost(area_of(cs, f), conf[f].value, prm.tau_cov));
+  ASSERT_TRUE(select_faces(cs, pg, prm).ok);
+  LocalSelection box;
+  for (int f = 0; f < cs.size(); ++f)
+    if (selected_faces(cs)[std::size_t(f)]) box.selected.push_back(f);
+  ASSERT_EQ(box.selected.size(), 6u);
+  pg.excluded = {box};
+  const SelectionResult again = select_faces(cs, pg, prm);
+  ASSERT_TRUE(again.ok) << again.status_text();
+  const std::vector<char> now = selected_faces(cs);
+  EXPECT_FALSE(std::all_of(box.selected.begin(), box.selected.end(), [&](int f) { return now[std::size_t(f)] != 0; }));
+  EXPECT_TRUE(every_edge_used_0_or_2(cs, now));
+  pg.fixed.assign(std::size_t(cs.size()), -1);
+  for (int f : box.selected) pg.fixed[std::size_t(f)] = 1;
+  EXPECT_EQ(select_faces(cs, pg, prm).status_text(), "infeasible");
 }
 
 TEST(Selection, InfeasibleBoundaryIsReportedNotCrashed) {

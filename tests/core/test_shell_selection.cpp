@@ -305,8 +305,9 @@ TEST(RebuildShell, AHugeSoupIsSampledWithinBounds) {
 }
 
 // A neighbour's wall standing 3 m above the roof (a fin: outside on both sides) is part of no
-// solid: the rebuilt box leaves it uncovered, and says by how much.
-TEST(RebuildShell, AFinLeavesTheInputUncovered) {
+// solid: the rebuilt box holds the rest, and the fin goes beside it as read (its 24 m², on its
+// plane, oriented like its face).
+TEST(RebuildShell, AFinIsCarriedBesideTheShell) {
   Mesh soup = box_faces({0, 1, 2, 3, 4, 5});
   const int n = int(soup.vertices.size());
   for (const Vec3& p : {Vec3(0, 0, 6), Vec3(0, 8, 6), Vec3(0, 8, 9), Vec3(0, 0, 9)}) soup.vertices.push_back(p);
@@ -314,8 +315,41 @@ TEST(RebuildShell, AFinLeavesTheInputUncovered) {
   const RefineConfig prm;
   const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
   ASSERT_TRUE(rb.ok) << rb.reason;
-  EXPECT_NEAR(rb.input_to_output, 3.0, 0.05);
+  const Validation v = validate_mesh(rb.mesh, prm.repair.planarity_tolerance);
+  EXPECT_TRUE(v.valid()) << v.problem;
+  EXPECT_NEAR(v.volume, 480.0, 1e-6);
+  EXPECT_LE(rb.input_to_output, prm.repair.weld_tolerance);
+  EXPECT_LE(rb.corner_to_input, prm.repair.weld_tolerance);
   EXPECT_EQ(rb.area_dropped, 0.0);
+  EXPECT_NEAR(rb.area_carried, 24.0, 1.0);
+  double area = 0.0;
+  for (const Face& f : rb.fins.faces) {
+    const Vec3 n = newell_normal(face_points(rb.fins, f));
+    area += 0.5 * n.norm();
+    EXPECT_GT(n.normalized().dot(Vec3(1, 0, 0)), 0.999);  // as read: facing +x
+    EXPECT_EQ(f.source, 6);
+    for (int i : f.v) {
+      EXPECT_NEAR(rb.fins.vertices[std::size_t(i)].x(), 0.0, 1e-9);
+      EXPECT_GE(rb.fins.vertices[std::size_t(i)].z(), 6.0 - 1e-9);
+    }
+  }
+  EXPECT_NEAR(area, 24.0, 1e-6);
+}
+
+// The same holds for a fin that its plane's candidates do not fit (it ends mid-wall, where no
+// other plane cuts): only the fin's own outline goes beside the shell.
+TEST(RebuildShell, AFinEndingMidWallIsCarriedToItsOutline) {
+  Mesh soup = box_faces({0, 1, 2, 3, 4, 5});
+  const int n = int(soup.vertices.size());
+  for (const Vec3& p : {Vec3(0, 1, 6), Vec3(0, 5, 6), Vec3(0, 5, 8), Vec3(0, 1, 8)}) soup.vertices.push_back(p);
+  soup.faces.push_back({{n, n + 1, n + 2, n + 3}, Semantic::Wall, 6});
+  const RefineConfig prm;
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
+  ASSERT_TRUE(rb.ok) << rb.reason;
+  EXPECT_LE(rb.input_to_output, prm.repair.weld_tolerance);
+  double area = 0.0;
+  for (const Face& f : rb.fins.faces) area += 0.5 * newell_normal(face_points(rb.fins, f)).norm();
+  EXPECT_NEAR(area, 8.0, 1e-6);
 }
 
 // Two overlapping boxes exported as one soup with their own walls inside each other: the walls

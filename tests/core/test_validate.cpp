@@ -138,6 +138,22 @@ TEST(Validate, CubesSharingAVertexHaveANonManifoldVertexAndTwoComponents) {
   EXPECT_TRUE(mentions(v, "1 non-manifold vertices")) << v.problem;
 }
 
+// The points where a mesh is no 2-manifold: the shared vertex of two cubes touching at a corner,
+// the two ends of the edge two cubes share; none on one cube.
+TEST(Validate, PinchedVerticesAreWhereTheFacesMeetOnlyAtAPointOrFourAtAnEdge) {
+  const Mesh at_vertex = combined(unit_cube(), translated(unit_cube(), {1, 1, 1}));
+  const std::vector<int> v = pinched_vertices(at_vertex);
+  ASSERT_EQ(v.size(), 1u);
+  EXPECT_LT((at_vertex.vertices[std::size_t(v[0])] - Vec3(1, 1, 1)).norm(), 1e-12);
+  const Mesh at_edge = combined(unit_cube(), translated(unit_cube(), {1, 1, 0}));
+  std::vector<Vec3> ends;
+  for (int i : pinched_vertices(at_edge)) ends.push_back(at_edge.vertices[std::size_t(i)]);
+  ASSERT_EQ(ends.size(), 2u);
+  for (const Vec3& p : ends) EXPECT_LT((p - Vec3(1, 1, p.z())).norm(), 1e-12);
+  EXPECT_NE(ends[0].z(), ends[1].z());
+  EXPECT_TRUE(pinched_vertices(unit_cube()).empty());
+}
+
 TEST(Validate, SeparateCubesAreTwoComponents) {
   const Validation v = validate_mesh(combined(unit_cube(), translated(unit_cube(), {3, 0, 0})), kPlanarity);
   EXPECT_TRUE(v.watertight());

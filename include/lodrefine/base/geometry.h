@@ -60,6 +60,10 @@ double segment_distance_2d(const Vec2& p, const Vec2& a, const Vec2& b);
 std::vector<Vec2> convex_hull_2d(std::vector<Vec2> pts);
 // Area of the intersection of two convex CCW polygons.
 double convex_intersection_area(const std::vector<Vec2>& a, const std::vector<Vec2>& b);
+// The part of a simple polygon inside a convex one (Sutherland–Hodgman), in the simple one's
+// orientation; empty when none. A non-convex `simple` may come out with bridging edges that
+// enclose no area.
+std::vector<Vec2> polygon_clipped_to_convex(const std::vector<Vec2>& simple, const std::vector<Vec2>& convex);
 // Intersection area of a simple (possibly non-convex) polygon with a convex one.
 double polygon_convex_intersection_area(const std::vector<Vec2>& simple, const std::vector<Vec2>& convex);
 

@@ -109,5 +109,8 @@ CityRefineSummary refine_city(const std::string& model_path, const std::vector<s
 // appended to `vertices` quantised by the document's transform (`scale`, `translate`).
 nlohmann::ordered_json cityjson_solid(const Mesh& mesh, const std::string& lod, const Vec3& scale,
                                       const Vec3& translate, nlohmann::ordered_json& vertices);
+// The same as a MultiSurface (the fins written beside a rebuilt shell: RefineResult::fins).
+nlohmann::ordered_json cityjson_multisurface(const Mesh& mesh, const std::string& lod, const Vec3& scale,
+                                             const Vec3& translate, nlohmann::ordered_json& vertices);
 
 }  // namespace lodrefine

@@ -113,6 +113,9 @@ struct RefineTrace {
 
 struct RefineResult {
   Mesh mesh;  // in the input (georeferenced) frame
+  // Faces of the input no solid holds (ShellRebuild::fins: outside on both sides, beside a rebuilt
+  // shell), same frame; written beside `mesh` (a city file's MultiSurface of the same LoD).
+  Mesh fins;
   Outcome outcome = Outcome::KeptInvalid;
   std::string reason;  // one line: why this outcome
   bool valid = false;  // `mesh` passed validate_mesh

@@ -62,9 +62,16 @@ struct SelectionResult {
 //   edge;
 // - `warm[f]`: a starting selection (0/1 per candidate); empty: none. It must agree with
 //   `fixed`; if it satisfies every edge constraint it is given to GLPK as the first incumbent
-//   (presolve is then off: the callback works on the original columns).
+//   (presolve is then off: the callback works on the original columns);
+// - `excluded`: local selections never made (a pinch the edge constraints allow: pieces meeting
+//   only at a point, or four at one edge): for each, not all of `selected` chosen while none of
+//   `unselected` is.
 // Faces the edge constraints decide from the fixed ones (an edge with one free face, or two
 // fixed selected faces) are fixed too before GLPK sees the program (SelectionResult::forced).
+// Some candidates' values: those of `selected` chosen, those of `unselected` not.
+struct LocalSelection {
+  std::vector<int> selected, unselected;
+};
 struct SelectionProgram {
   std::vector<double> cost;
   std::vector<double> fit;
@@ -72,6 +79,7 @@ struct SelectionProgram {
   std::vector<int> fixed;
   std::vector<double> sharp_cost;
   std::vector<char> warm;
+  std::vector<LocalSelection> excluded;
 };
 // The search ends at config.mip_work_limit (a count of GLPK's work, so the result does not depend
 // on the machine's load) or, as a last-resort safety ceiling far above it, at `time_limit`

@@ -91,6 +91,12 @@ struct ShellRebuild {
   double sampling = 0.0;         // m: the spacing of the samples these areas and distances come from
   double area_fins = 0.0;        // m²: of that, with outside on both sides (winding below 1/4): a fin
   double output_to_input = 0.0;  // m: the farthest the output lies from the soup (an added wall's middle)
+  double corner_to_input = 0.0;  // m: the farthest an output vertex lies from the soup (an invented corner)
+  // The soup's fins: pieces of its faces with its outside on both sides, outside `mesh` (no
+  // solid holds them), as read and oriented like their faces, to be written beside the shell;
+  // area_carried (m²) is the soup's area on them. The output is `mesh` and `fins` together.
+  Mesh fins;
+  double area_carried = 0.0;
 };
 
 // `soup`: the welded faces (welded_soup, repair.h), local frame; Face::source says which input

@@ -43,6 +43,10 @@ std::string size_problem(const Mesh& mesh);
 Validation validate_mesh(const Mesh& mesh, double planarity_tolerance, bool check_self_intersections = true,
                          bool single_component = true);
 
+// The vertices where `mesh` (shared vertices) is no 2-manifold: its faces there form more than
+// one fan (they meet only at the point), or it ends an edge of more than two faces. Sorted.
+std::vector<int> pinched_vertices(const Mesh& mesh);
+
 // Enclosed volume of `faces` (all indices valid), positive when they point outward; exact for
 // closed meshes of planar faces.
 double signed_volume(const std::vector<Vec3>& vertices, const std::vector<Face>& faces);
