@@ -489,8 +489,8 @@ int nearest_shape(const Vec3& p, const std::vector<int>& shapes, const std::vect
 // back from the neighbouring voxels for every point made supports larger than full
 // detection's, and the selection then kept three topo dev tile buildings from their notch and
 // bay walls (truth facade RMSE 0.084 -> 0.38 m).
-std::vector<std::vector<int>> take_back(const PointCloud& cloud, const Thinning& t,
-                                        const std::vector<std::vector<int>>& shapes, const PlaneConfig& prm) {
+std::vector<std::vector<int>> full_cloud_inliers(const PointCloud& cloud, const Thinning& t,
+                                                 const std::vector<std::vector<int>>& shapes, const PlaneConfig& prm) {
   std::vector<int> rep_shape(t.reps.size(), -1);
   std::vector<Plane> fitted;
   for (int s = 0; s < int(shapes.size()); ++s) {
@@ -537,7 +537,7 @@ std::vector<ScanPlane> detect_planes(const PointCloud& cloud, const PlaneConfig&
   Representatives reps = representatives(cloud, thinning, prm);
   std::vector<std::vector<int>> shapes = prm.ransac ? ransac_shapes(std::move(reps), thinning, distinct, prm)
                                                     : grown_shapes(reps, thinning, distinct, prm);
-  if (thinning.thinned()) shapes = take_back(cloud, thinning, shapes, prm);
+  if (thinning.thinned()) shapes = full_cloud_inliers(cloud, thinning, shapes, prm);
   for (auto& inl : shapes) {
     if (inl.size() < std::max<std::size_t>(3, std::size_t(prm.ransac_min_points))) continue;
     ScanPlane sp = describe_plane(cloud.points, std::move(inl), prm);

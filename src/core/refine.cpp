@@ -131,10 +131,10 @@ std::string rebuild_summary(const ShellRebuild& rb) {
   return out;
 }
 
-// One building's run: the result being filled, its local frame and the stage timer.
-class Run {
+// One building's refinement under way: the result being filled, its local frame and the stage timer.
+class Refinement {
  public:
-  Run(const Mesh& model, double planarity_tolerance) : planarity_tolerance_(planarity_tolerance) {
+  Refinement(const Mesh& model, double planarity_tolerance) : planarity_tolerance_(planarity_tolerance) {
     out_.trace.id = model.id;
     origin_ = local_origin(model);
     out_.trace.origin = origin_;
@@ -180,11 +180,12 @@ class Run {
 // soup that welding and orientation cannot make one valid solid is rebuilt on its planes
 // (rebuild_shell), and written as read (kept-invalid) with the reason when that fails too or
 // the rebuilt shell leaves the input's surfaces by more than weld_tolerance.
-std::optional<RefineResult> repair_or_stop(const Mesh& local_model, const RefineConfig& cfg, Run& run, Mesh& kept) {
-  RefineTrace& trace = run.trace();
+std::optional<RefineResult> repair_or_stop(const Mesh& local_model, const RefineConfig& cfg, Refinement& refinement,
+                                           Mesh& kept) {
+  RefineTrace& trace = refinement.trace();
   if (const std::string too_large = size_problem(local_model); !too_large.empty()) {
-    run.lap(RefineStage::Repair);
-    return run.finish(Outcome::KeptInvalid, too_large, local_model);
+    refinement.lap(RefineStage::Repair);
+    return refinement.finish(Outcome::KeptInvalid, too_large, local_model);
   }
   std::string invalid;
   try {
@@ -195,13 +196,13 @@ std::optional<RefineResult> repair_or_stop(const Mesh& local_model, const Refine
     const Validation v0 = validate_mesh(kept, cfg.repair.planarity_tolerance);
     trace.input_validation = v0;
     if (v0.valid()) {
-      run.lap(RefineStage::Repair);
+      refinement.lap(RefineStage::Repair);
       return std::nullopt;
     }
     if (v0.components > 1 && validate_mesh(kept, cfg.repair.planarity_tolerance, true, false).valid()) {
-      run.lap(RefineStage::Repair);
-      return run.finish(Outcome::Kept, std::to_string(v0.components) + " separate closed shells: kept whole", kept,
-                        false);
+      refinement.lap(RefineStage::Repair);
+      return refinement.finish(Outcome::Kept, std::to_string(v0.components) + " separate closed shells: kept whole",
+                               kept, false);
     }
     invalid = "the input is no valid solid: " + v0.problem;
   } catch (const InputError& e) {
@@ -214,7 +215,7 @@ std::optional<RefineResult> repair_or_stop(const Mesh& local_model, const Refine
   } catch (const InputError& e) {
     rb.reason = e.what();
   }
-  run.lap(RefineStage::Repair);
+  refinement.lap(RefineStage::Repair);
   if (rb.ok && rb.input_to_output <= cfg.repair.weld_tolerance && rb.corner_to_input > cfg.repair.weld_tolerance) {
     rb.ok = false;
     char buf[160];
@@ -239,7 +240,7 @@ std::optional<RefineResult> repair_or_stop(const Mesh& local_model, const Refine
   Mesh rebuilt = std::move(rb.mesh);
   rb.mesh = Mesh();  // the trace keeps the figures; the shell goes on as `kept`
   trace.rebuild = rb;
-  if (!rb.ok) return run.finish(Outcome::KeptInvalid, invalid + "; not rebuilt: " + rb.reason, local_model);
+  if (!rb.ok) return refinement.finish(Outcome::KeptInvalid, invalid + "; not rebuilt: " + rb.reason, local_model);
   kept = std::move(rebuilt);
   kept.id = local_model.id;
   return std::nullopt;
@@ -305,36 +306,36 @@ std::optional<Mesh> starting_shell(const Mesh& current, const std::vector<ModelS
 // own points (judge.h).
 RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::optional<Mesh>& refined, bool any_match,
                               const PointCloud& local, const std::vector<ScanPlane>& planes, const RefineConfig& prm,
-                              Run& run) {
-  RefineTrace& trace = run.trace();
+                              Refinement& refinement) {
+  RefineTrace& trace = refinement.trace();
   const ShellSelection chosen = select_shell(refined ? *refined : current, local, planes, prm);
   trace.selection = chosen.stats;
   trace.selection_reason = chosen.reason;
-  run.lap(RefineStage::Selection);
+  refinement.lap(RefineStage::Selection);
   // A search that ends with no shell falls back to the best shell known: the substitution's.
   if (!chosen.ok && !refined)
-    return run.finish(Outcome::Kept, "the selection found no valid shell: " + chosen.reason, kept);
+    return refinement.finish(Outcome::Kept, "the selection found no valid shell: " + chosen.reason, kept);
   const Mesh& shell = chosen.ok ? chosen.mesh : *refined;
   if (chosen.ok && !refined && chosen.stats.candidates_changed == 0) {
     trace.facades.clear();
-    return run.finish(Outcome::Kept,
-                      !any_match ? "the selection kept the model (no wall matched a scan plane)"
-                                 : "the selection kept the model (the scan agrees with it)",
-                      kept);
+    return refinement.finish(Outcome::Kept,
+                             !any_match ? "the selection kept the model (no wall matched a scan plane)"
+                                        : "the selection kept the model (the scan agrees with it)",
+                             kept);
   }
   std::vector<JudgedWall> moved;
   for (const auto& f : trace.facades) moved.push_back(f.wall);
   const Judgement& verdict = trace.judgement.emplace(
       judge_refinement(kept, shell, moved, local, prm.match, prm.plane, planes, prm.scan_reach()));
-  run.lap(RefineStage::Judge);
-  if (!verdict.ok) return run.finish(Outcome::Kept, "not written: never worse, " + verdict.refusal(), kept);
+  refinement.lap(RefineStage::Judge);
+  if (!verdict.ok) return refinement.finish(Outcome::Kept, "not written: never worse, " + verdict.refusal(), kept);
   const std::string moved_walls = std::to_string(trace.facades.size()) + " wall(s) moved";
   if (!chosen.ok)
-    return run.finish(Outcome::Refined,
-                      moved_walls + " by substitution (the selection found no valid shell: " + chosen.reason + ")",
-                      shell);
-  return run.finish(Outcome::Refined,
-                    std::to_string(chosen.stats.faces_from_selection) + " face(s) selected, " + moved_walls, shell);
+    return refinement.finish(
+        Outcome::Refined, moved_walls + " by substitution (the selection found no valid shell: " + chosen.reason + ")",
+        shell);
+  return refinement.finish(
+      Outcome::Refined, std::to_string(chosen.stats.faces_from_selection) + " face(s) selected, " + moved_walls, shell);
 }
 
 }  // namespace
@@ -397,23 +398,23 @@ RefineTrace::Scan scan_summary(const std::vector<ScanPlane>& walls, const std::v
 
 RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const RefineConfig& prm) {
   prm.validate();
-  Run run(model, prm.repair.planarity_tolerance);
-  RefineTrace& trace = run.trace();
-  const Mesh local_model = translated(model, -run.origin());
+  Refinement refinement(model, prm.repair.planarity_tolerance);
+  RefineTrace& trace = refinement.trace();
+  const Mesh local_model = translated(model, -refinement.origin());
   Mesh kept;
-  if (auto stopped = repair_or_stop(local_model, prm, run, kept)) return *stopped;
+  if (auto stopped = repair_or_stop(local_model, prm, refinement, kept)) return *stopped;
   Mesh current = merge_coplanar_faces(kept);
   current.id = model.id;
 
   // Planes of the scan near the model: a wall seen twice is one, relief is no wall.
-  PointCloud local = cloud_near(current, cloud, run.origin(), prm);
+  PointCloud local = cloud_near(current, cloud, refinement.origin(), prm);
   trace.cloud = {cloud.points.size(), local.points.size()};
   std::vector<ScanPlane> relief;
   const auto planes = scan_walls(current, local, prm, relief);
   trace.scan = scan_summary(planes, relief, local.points.size());
-  run.lap(RefineStage::Planes);
+  refinement.lap(RefineStage::Planes);
   trace.planes = planes;
-  if (planes.empty()) return run.finish(Outcome::Kept, "no planes found in the cloud near the model", kept);
+  if (planes.empty()) return refinement.finish(Outcome::Kept, "no planes found in the cloud near the model", kept);
 
   // Matching on the input: which walls the scan sees, where, and by which points; the outdated
   // ones move onto their planes, and unscanned walls at a scanned facade's end to where the
@@ -424,7 +425,7 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const R
   std::vector<ScannedWall> scanned;
   outdated_walls(current, surfaces, mr, planes, local, prm.match, trace, moves, scanned);
   const auto corners = corner_moves(current, surfaces, scanned, local, planes, prm.match, prm.plane);
-  run.lap(RefineStage::Matching);
+  refinement.lap(RefineStage::Matching);
 
   // The corners are the least certain evidence: a refinement the judge refuses with them is
   // tried once more on the walls' own points alone.
@@ -434,8 +435,8 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const R
     trace.substitution_without_corners.reset();
     const std::optional<Mesh> refined =
         starting_shell(current, surfaces, moves, with_corners, local, planes, prm, trace);
-    run.lap(RefineStage::Substitution);
-    return select_and_judge(kept, current, refined, !mr.matches.empty(), local, planes, prm, run);
+    refinement.lap(RefineStage::Substitution);
+    return select_and_judge(kept, current, refined, !mr.matches.empty(), local, planes, prm, refinement);
   };
   RefineResult result = attempt(corners);
   auto refused = [&] { return trace.judgement && !trace.judgement->ok; };

@@ -87,7 +87,7 @@ Mesh snapped_to_start(const Mesh& m, const Mesh& start) {
 // used, in plan, is a change the scan did not ask for (a roof re-cut far from every scanned
 // facade): such candidates keep their starting-shell value. In plan, as the
 // roof above a moved facade must follow it however high it is. A step's facade also reaches the
-// volume between it and the start wall it replaces, however deep (detail::swept_evidence).
+// volume between it and the start wall it replaces, however deep (detail::step_volume_samples).
 constexpr double kEvidenceReach = 2.0;
 
 // The scan points the selection used, in plan: built once per building, asked whether a point
@@ -148,8 +148,9 @@ struct MendScope {
   bool whole_last = false;   // at last, every candidate free
   double keep_weight = 1.0;  // a start candidate dropped costs this times its area, one added its area
 };
-std::vector<char> mended_start(CandidateSet& cs, const std::vector<char>& in_start, const SelectionConfig& prm,
-                               const MendScope& scope = {}, const std::vector<LocalSelection>& excluded = {}) {
+std::vector<char> nearest_closed_selection(CandidateSet& cs, const std::vector<char>& in_start,
+                                           const SelectionConfig& prm, const MendScope& scope = {},
+                                           const std::vector<LocalSelection>& excluded = {}) {
   if (excluded.empty() && every_edge_used_0_or_2(cs, in_start)) return in_start;
   std::vector<char> near(cs.size(), 0);
   for (const auto& x : excluded)
@@ -331,9 +332,9 @@ Pruned pruned(CandidateSet& all, const FaceProps& all_props, const std::vector<c
 // twice the farthest a wall may move: a face reaches a moved neighbour, whose corner with the next
 // moved wall lies that far again; once measured lost a real building's refinement), so a large
 // building's program does not grow with the cube of its planes.
-std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointCloud& cloud,
-                                              const std::vector<ScanPlane>& planes, const RefineConfig& prm,
-                                              double sliver_tolerance) {
+std::optional<ShellSelection> select_shell_joining_slivers(const Mesh& start, const PointCloud& cloud,
+                                                           const std::vector<ScanPlane>& planes,
+                                                           const RefineConfig& prm, double sliver_tolerance) {
   const auto t0 = Clock::now();
   ShellSelection out;
   auto& st = out.stats;
@@ -351,7 +352,7 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
     return out;
   }
   const FaceProps all_props = describe_candidates(all, start, s, prm);
-  const std::vector<char> all_warm = mended_start(all, face_flags(all, all_props.in_start), prm.selection);
+  const std::vector<char> all_warm = nearest_closed_selection(all, face_flags(all, all_props.in_start), prm.selection);
   if (all_warm.empty() && s.slivers > 0) return std::nullopt;
   auto [cs, props, warm] = pruned(all, all_props, all_warm, st);
 
@@ -368,7 +369,7 @@ std::optional<ShellSelection> select_shell_on(const Mesh& start, const PointClou
   // again (at most kRetries times).
   const std::vector<char> base = warm.empty() ? face_flags(cs, props.in_start) : warm;
   std::vector<Vec3> reach_of = st.evidence;
-  const std::vector<Vec3> swept = detail::swept_evidence(start, s, prm, kEvidenceReach);
+  const std::vector<Vec3> swept = detail::step_volume_samples(start, s, prm, kEvidenceReach);
   reach_of.insert(reach_of.end(), swept.begin(), swept.end());
   const EvidenceReach evidence(reach_of);
   if (!warm.empty()) {
@@ -639,7 +640,7 @@ ShellRebuild rebuild_shell(const Mesh& soup, const RefineConfig& prm) {
   std::vector<char> chosen;
   std::vector<LocalSelection> excluded;
   for (int round = 0;; ++round) {
-    chosen = mended_start(cs, cover, prm.selection, {true, kKeepCover}, excluded);
+    chosen = nearest_closed_selection(cs, cover, prm.selection, {true, kKeepCover}, excluded);
     if (chosen.empty()) {
       out.reason = "its planes bound no closed shell";
       return out;
@@ -669,8 +670,9 @@ ShellRebuild rebuild_shell(const Mesh& soup, const RefineConfig& prm) {
 
 ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
                             const RefineConfig& prm) {
-  if (auto joined = select_shell_on(start, cloud, planes, prm, prm.repair.planarity_tolerance)) return *joined;
-  return *select_shell_on(start, cloud, planes, prm, -1.0);  // no slivers: always a selection
+  if (auto joined = select_shell_joining_slivers(start, cloud, planes, prm, prm.repair.planarity_tolerance))
+    return *joined;
+  return *select_shell_joining_slivers(start, cloud, planes, prm, -1.0);  // no slivers: always a selection
 }
 
 }  // namespace lodrefine

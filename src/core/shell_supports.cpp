@@ -20,15 +20,15 @@ constexpr double kRegionMargin = 1.0;
 
 // Where a scanned facade's points run along its horizontal direction `u` (positions along u;
 // gaps shorter than kRunGap are bridged: a window column still has wall above and below).
-struct Run {
+struct Interval {
   double a, b;
 };
 constexpr double kRunGap = 2 * kCell;  // m
-std::vector<Run> runs_along(const std::vector<Vec3>& pts, const Vec3& u) {
+std::vector<Interval> intervals_along(const std::vector<Vec3>& pts, const Vec3& u) {
   std::vector<double> t;
   for (const auto& p : pts) t.push_back(u.dot(p));
   std::sort(t.begin(), t.end());
-  std::vector<Run> out;
+  std::vector<Interval> out;
   for (double x : t) {
     if (out.empty() || x - out.back().b > kRunGap) out.push_back({x, x});
     else out.back().b = x;
@@ -42,8 +42,8 @@ std::vector<Run> runs_along(const std::vector<Vec3>& pts, const Vec3& u) {
 constexpr double kSideClear = 0.3, kStepReach = 1.0, kSameStep = 0.1;
 
 // The start's span along the horizontal direction u.
-Run span_along(const Mesh& start, const Vec3& u) {
-  Run r{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+Interval span_along(const Mesh& start, const Vec3& u) {
+  Interval r{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
   for (const auto& p : start.vertices) r.a = std::min(r.a, u.dot(p)), r.b = std::max(r.b, u.dot(p));
   return r;
 }
@@ -52,8 +52,9 @@ Run span_along(const Mesh& start, const Vec3& u) {
 // facade `facade` across a step (`span`: the start's span along u): a run of each ends within
 // kStepReach of the other's, inside the footprint, and their runs overlap along u by no more
 // than that (a facade across the street runs alongside, not on from it).
-bool steps_from(const std::vector<Run>& a, const Run& span, const std::vector<Vec3>& facade, const Vec3& u) {
-  const auto b = runs_along(facade, u);
+bool continues_across_step(const std::vector<Interval>& a, const Interval& span, const std::vector<Vec3>& facade,
+                           const Vec3& u) {
+  const auto b = intervals_along(facade, u);
   double overlap = 0.0;
   for (const auto& ra : a)
     for (const auto& rb : b) overlap += std::max(0.0, std::min(ra.b, rb.b) - std::max(ra.a, rb.a));
@@ -70,14 +71,14 @@ bool steps_from(const std::vector<Run>& a, const Run& span, const std::vector<Ve
 // Whether the points `pts` on a facade plane with normal `n` continue another parallel scanned
 // facade of `s` (other than plane `self`) across a step. Their runs and the start's span are
 // found once, not per facade tried.
-bool steps_from_any(const Mesh& start, const Supports& s, const std::vector<Vec3>& pts, const Vec3& n, double angle_deg,
-                    int self = -1) {
+bool continues_another_across_step(const Mesh& start, const Supports& s, const std::vector<Vec3>& pts, const Vec3& n,
+                                   double angle_deg, int self = -1) {
   const Vec3 u = Vec3(-n.y(), n.x(), 0.0).normalized();
-  const std::vector<Run> runs = runs_along(pts, u);
-  const Run span = span_along(start, u);
+  const std::vector<Interval> runs = intervals_along(pts, u);
+  const Interval span = span_along(start, u);
   for (int k = 0; k < int(s.planes.size()); ++k)
     if (k != self && !s.points[k].empty() && unoriented_angle_deg(s.planes[k].plane.n, n) <= angle_deg &&
-        steps_from(runs, span, s.points[k], u))
+        continues_across_step(runs, span, s.points[k], u))
       return true;
   return false;
 }
@@ -89,9 +90,9 @@ bool steps_from_any(const Mesh& start, const Supports& s, const std::vector<Vec3
 // scan, so the model's end stands. A run from the end (within kRunGap of it: a bay's return
 // starts at the model's front) counts as crossing it; runs that begin farther past an end (across
 // a gap) are another building's.
-Run own_extent(const std::vector<Run>& runs, const Run& span, double reach) {
-  Run own = span;
-  for (const Run& r : runs) {
+Interval own_extent(const std::vector<Interval>& runs, const Interval& span, double reach) {
+  Interval own = span;
+  for (const Interval& r : runs) {
     if (r.a <= span.b + kRunGap && r.b > span.b && r.b <= span.b + reach) own.b = std::max(own.b, r.b);
     if (r.b >= span.a - kRunGap && r.a < span.a && r.a >= span.a - reach) own.a = std::min(own.a, r.a);
   }
@@ -139,7 +140,7 @@ void add_start_planes(const Mesh& start, double planarity_tolerance, Supports& s
 // building's own extent (own_extent), when at least ransac_min_points, go to the supporting plane
 // of the start that they lie on, else to a new one.
 // A facade farther before or behind the box (up to the building's depth) counts too where it
-// continues a scanned facade of the building across a step (steps_from): a facade line stepping
+// continues a scanned facade of the building across a step (continues_across_step): a facade line stepping
 // back or forward farther than the reach.
 void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& scan,
                      const RefineConfig& prm, Supports& s) {
@@ -180,7 +181,7 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
     for (const auto& p : start.vertices) box.extend(Vec3(u.dot(p), n.dot(p), p.z()));
     std::vector<Vec3> inliers;
     for (int idx : sp.inliers) inliers.push_back(cloud.points[idx]);
-    const Run own = own_extent(runs_along(inliers, u), {box.min().x(), box.max().x()}, reach);
+    const Interval own = own_extent(intervals_along(inliers, u), {box.min().x(), box.max().x()}, reach);
     std::vector<Vec3> near, beyond;
     for (const Vec3& p : inliers) {
       const Vec3 q(u.dot(p), n.dot(p), p.z());
@@ -194,7 +195,7 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
     else if (int(beyond.size()) >= prm.plane.ransac_min_points) deep.emplace_back(i, std::move(beyond));
   }
   for (const auto& [i, pts] : deep)
-    if (steps_from_any(start, s, pts, scan[i].plane.n, prm.selection.merge_angle_deg)) attach(i, pts);
+    if (continues_another_across_step(start, s, pts, scan[i].plane.n, prm.selection.merge_angle_deg)) attach(i, pts);
 }
 
 // A facade line that steps, a recess or a bay needs the wall across the step, which the scan
@@ -212,7 +213,7 @@ void add_step_walls(const Mesh& start, const RefineConfig& prm, Supports& s) {
     const Vec3 u = Vec3(-pj.n.y(), pj.n.x(), 0.0).normalized();
     const auto [lo, hi] = span_along(start, u);
     std::vector<double> ends;
-    for (const auto& r : runs_along(s.points[j], u)) ends.insert(ends.end(), {r.a, r.b});
+    for (const auto& r : intervals_along(s.points[j], u)) ends.insert(ends.end(), {r.a, r.b});
     std::vector<double> positions;
     for (double e : ends) {
       if (e < lo + kSideClear || e > hi - kSideClear) continue;
@@ -221,7 +222,7 @@ void add_step_walls(const Mesh& start, const RefineConfig& prm, Supports& s) {
         if (k == j || s.points[k].empty() ||
             unoriented_angle_deg(s.planes[k].plane.n, pj.n) > prm.selection.merge_angle_deg)
           continue;
-        for (const auto& r : runs_along(s.points[k], u))
+        for (const auto& r : intervals_along(s.points[k], u))
           for (double f : {r.a, r.b})
             if (std::abs(f - e) <= kStepReach && f > lo + kSideClear && f < hi - kSideClear) positions.push_back(f);
       }
@@ -248,9 +249,9 @@ void add_step_walls(const Mesh& start, const RefineConfig& prm, Supports& s) {
 // replaces that wall's part by the facade is asked for by the scan however deep the step is.
 // Each point of such a facade, swept along the wall's normal onto the nearest parallel start
 // face it stands before, sampled every `step` m (its endpoint included). Only a facade that
-// continues another scanned facade across a step (steps_from): a lone parallel facade before a
+// continues another scanned facade across a step (continues_across_step): a lone parallel facade before a
 // wall may be a neighbour's across an alley.
-std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const RefineConfig& prm, double step) {
+std::vector<Vec3> step_volume_samples(const Mesh& start, const Supports& s, const RefineConfig& prm, double step) {
   const double tilt = prm.plane.facade_max_tilt_deg;
   struct Wall {
     Plane plane;
@@ -269,7 +270,7 @@ std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const Ref
   std::vector<Vec3> out;
   for (int k = s.start_planes; k < int(s.planes.size()); ++k) {
     if (s.points[k].empty() || !near_vertical(s.planes[k].plane, tilt) ||
-        !steps_from_any(start, s, s.points[k], s.planes[k].plane.n, prm.selection.merge_angle_deg, k))
+        !continues_another_across_step(start, s, s.points[k], s.planes[k].plane.n, prm.selection.merge_angle_deg, k))
       continue;
     std::vector<const Wall*> parallel;
     for (const auto& w : walls)

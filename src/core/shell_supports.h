@@ -54,7 +54,7 @@ void add_step_walls(const Mesh& start, const RefineConfig& prm, Supports& s);
 // Where the scan-only facades that step from another scanned facade ask for a change: each point
 // swept along the normal of the nearest parallel start wall it stands before onto that wall (the
 // step, bay or recess between them), sampled every `step` m.
-std::vector<Vec3> swept_evidence(const Mesh& start, const Supports& s, const RefineConfig& prm, double step);
+std::vector<Vec3> step_volume_samples(const Mesh& start, const Supports& s, const RefineConfig& prm, double step);
 // The region: the start and the scan evidence, in the axes of the start's largest wall (near_vertical
 // within `max_tilt_deg`), grown by a margin.
 Region building_region(const Mesh& start, const Supports& s, double max_tilt_deg);
