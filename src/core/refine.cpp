@@ -10,6 +10,7 @@
 
 #include "lodrefine/core/corners.h"
 #include "lodrefine/core/distance.h"
+#include "lodrefine/core/shell_rebuild.h"
 #include "lodrefine/core/shell_selection.h"
 #include "lodrefine/core/substitute.h"
 

@@ -24,21 +24,20 @@ namespace {
 
 using detail::describe_candidates;
 using detail::enclosing_changes;
+using detail::face_flags;
 using detail::FaceIndex;
 using detail::FaceProps;
 using detail::kCell;
+using detail::kSnapBack;
+using detail::MendScope;
 using detail::near_vertical;
+using detail::nearest_closed_selection;
+using detail::shell_problem;
+using detail::snapped_to_start;
 using detail::Supports;
 // A sharp edge costs lambda_complexity * its length * this width (m): the complexity term in the
 // coverage term's units (m²), independent of how large the region is.
 constexpr double kSharpEdgeWidth = 0.25;
-
-// A boolean face map of `cs` as 0/1 per candidate (a selection).
-std::vector<char> face_flags(const CandidateSet& cs, const CandidateMap<bool>& map) {
-  std::vector<char> out;
-  for (auto f : cs.mesh.faces()) out.push_back(char(map[f]));
-  return out;
-}
 
 std::vector<char> kept(const std::vector<char>& v, const std::vector<char>& keep) {
   std::vector<char> out;
@@ -47,47 +46,6 @@ std::vector<char> kept(const std::vector<char>& v, const std::vector<char>& keep
   return out;
 }
 
-// Output vertices within this (m) of a starting-shell vertex are put back on it: the plane meets
-// of the arrangement only approximate a model that is planar within tolerance, and where the
-// selection changed nothing a roof must not move by that. Used only when the shell still
-// validates after it.
-constexpr double kSnapBack = 0.03;
-
-Mesh snapped_to_start(const Mesh& m, const Mesh& start) {
-  PointGrid grid(kSnapBack);
-  for (int i = 0; i < int(start.vertices.size()); ++i) grid.insert(start.vertices[i], i);
-  Mesh out = m;
-  out.vertices.clear();
-  std::vector<int> index(m.vertices.size()), of_start(start.vertices.size(), -1);
-  for (std::size_t k = 0; k < m.vertices.size(); ++k) {
-    int best = -1;
-    double best_d = kSnapBack;
-    grid.visit_near(m.vertices[k], [&](int i) {
-      const double d = (start.vertices[i] - m.vertices[k]).norm();
-      if (d < best_d) best_d = d, best = i;
-      return false;
-    });
-    int& slot = best >= 0 ? of_start[best] : index[k];  // vertices snapped to one start vertex become one
-    if (best < 0 || slot < 0) {
-      slot = int(out.vertices.size());
-      out.vertices.push_back(best >= 0 ? start.vertices[best] : m.vertices[k]);
-    }
-    index[k] = slot;
-  }
-  out.faces.clear();
-  for (Face f : m.faces) {
-    for (int& v : f.v) v = index[v];
-    drop_repeats(f.v);
-    if (f.v.size() >= 3) out.faces.push_back(std::move(f));
-  }
-  return out;
-}
-
-// m: a changed candidate with a corner farther than this from every scan point the selection
-// used, in plan, is a change the scan did not ask for (a roof re-cut far from every scanned
-// facade): such candidates keep their starting-shell value. In plan, as the
-// roof above a moved facade must follow it however high it is. A step's facade also reaches the
-// volume between it and the start wall it replaces, however deep (detail::step_volume_samples).
 constexpr double kEvidenceReach = 2.0;
 
 // The scan points the selection used, in plan: built once per building, asked whether a point
@@ -135,60 +93,7 @@ bool moves_beyond_evidence(const Mesh& m, const Mesh& start, const EvidenceReach
   return false;
 }
 
-// The starting shell as a selection of candidates: its faces are unions of candidates up to
-// where its vertices sit off the planes' meets (a model within tolerance of its planes, planes
-// merged within kSurfaceDistance), which leaves some edges used once or thrice. Those are
-// mended by the nearest selection that closes: a small program over the candidates around each
-// such edge (kMendRings edge-rings, more while it has no solution), the others fixed, each
-// change costing its area; with `whole_last`, at last every candidate free. None of the local
-// selections `excluded` is made (SelectionProgram::excluded). Empty when it cannot be mended.
-constexpr int kMendRings = 2, kMendTries = 3;
 constexpr int kRetries = 2;
-struct MendScope {
-  bool whole_last = false;   // at last, every candidate free
-  double keep_weight = 1.0;  // a start candidate dropped costs this times its area, one added its area
-};
-std::vector<char> nearest_closed_selection(CandidateSet& cs, const std::vector<char>& in_start,
-                                           const SelectionConfig& prm, const MendScope& scope = {},
-                                           const std::vector<LocalSelection>& excluded = {}) {
-  if (excluded.empty() && every_edge_used_0_or_2(cs, in_start)) return in_start;
-  std::vector<char> near(cs.size(), 0);
-  for (const auto& x : excluded)
-    for (const auto* set : {&x.selected, &x.unselected})
-      for (int f : *set) near[f] = 1;
-  for (const auto& e : cs.edges) {
-    int n = 0;
-    for (auto h : e) n += in_start[cs.face(h)];
-    if (n != 0 && n != 2)
-      for (auto h : e) near[cs.face(h)] = 1;
-  }
-  for (int attempt = 0; attempt < kMendTries + int(scope.whole_last); ++attempt) {
-    if (attempt == kMendTries) near.assign(near.size(), 1);
-    for (int ring = 0; ring < kMendRings; ++ring) {
-      std::vector<char> grown = near;
-      for (const auto& e : cs.edges) {
-        bool touches = false;
-        for (auto h : e) touches = touches || near[cs.face(h)];
-        if (touches)
-          for (auto h : e) grown[cs.face(h)] = 1;
-      }
-      near.swap(grown);
-    }
-    SelectionProgram pg;
-    const auto area = cs.areas();
-    for (int f = 0; f < cs.size(); ++f) {
-      pg.cost.push_back(in_start[f] ? -scope.keep_weight * area[FaceIndex(f)] : area[FaceIndex(f)]);
-      pg.fixed.push_back(near[f] ? -1 : int(in_start[f]));
-    }
-    pg.sharp_cost.assign(cs.edges.size(), 0.0);
-    pg.excluded = excluded;
-    SelectionConfig mend = prm;  // the costs are areas: weight 1
-    mend.lambda_coverage = 1.0;
-    const SelectionResult r = select_faces(cs, pg, mend);
-    if (r.ok) return selected_faces(cs);
-  }
-  return {};
-}
 
 // A real building's program (thousands of columns) spends its work budget at the root: GLPK ends
 // with its warm start though a selection far better exists (found with 300 times the budget). So
@@ -230,19 +135,6 @@ std::vector<char> improved_by_neighbourhoods(CandidateSet& cs, const SelectionPr
 // at most 31); local sections, which bound the large ones, changed a small real building's
 // program enough to lose its refinement (RealData.ThreeDBagSeqMovedWall).
 constexpr int kLocalSectionsFrom = 32;
-
-// Why the assembled shell cannot be written, or empty: validate_mesh's problem, or a face that
-// passes through one vertex twice (two pieces pinched together by the output weld or merge).
-std::string shell_problem(const Mesh& m, const RepairConfig& prm) {
-  const Validation v = validate_mesh(m, prm.planarity_tolerance);
-  if (!v.valid()) return v.problem.empty() ? "invalid" : v.problem;
-  for (const auto& f : m.faces) {
-    std::vector<int> ids = f.v;
-    std::sort(ids.begin(), ids.end());
-    if (std::adjacent_find(ids.begin(), ids.end()) != ids.end()) return "a face repeats a vertex";
-  }
-  return "";
-}
 
 // Why the selected shell cannot be written (empty when it can): it does not validate, it moves
 // the model beyond the `evidence`, or a change encloses the supports' points (`scan_points`; those
@@ -411,262 +303,7 @@ std::optional<ShellSelection> select_shell_joining_slivers(const Mesh& start, co
   return finish("");
 }
 
-// A soup's planes are cut over the whole region up to this many candidates (a local section
-// can end a plane short of where a part closes); beyond, within kRebuildReach (m) of their own
-// faces and open or overused edges, up to as many again: a larger program is refused (GLPK's
-// root LP of 60,000 columns took seconds its work budget does not count: time, not work, ended
-// it).
-constexpr int kRebuildWholeRegion = 10000;
-constexpr double kRebuildReach = 1.0;
-// A covered candidate dropped costs this times what an uncovered one added costs (per m²): a
-// missing wall is added whatever its size, and only what crosses another face is dropped.
-constexpr double kKeepCover = 10.0;
-// Spacing (m) of the samples the rebuild's distances are measured on, both ways; wider for a
-// soup so large that it would take more than kMaxRebuildSamples (each face's grid spans its box).
-constexpr double kRebuildSampling = 0.25;
-constexpr double kMaxRebuildSamples = 250000;
-// The most triangle-sample terms the winding numbers may take per building (each sample farther
-// than the tolerance from the shell costs the soup's triangles); past it, a sample counts as
-// uncovered: the rebuild is refused rather than slow (untrusted input).
-constexpr double kMaxWindingTerms = 2e8;
-
-// The selection of the candidates at each point where the traced `shell` is no 2-manifold
-// (pinched_vertices): one the edge constraints allow that no solid is. Each is then excluded and
-// the program solved again (a candidate added there or one dropped), at most kPinchRounds times.
-constexpr int kPinchRounds = 4;
-std::vector<LocalSelection> pinches(const CandidateSet& cs, const std::vector<char>& chosen, const Mesh& shell) {
-  std::vector<LocalSelection> out;
-  for (int v : pinched_vertices(shell)) {
-    const Vec3& p = shell.vertices[std::size_t(v)];
-    LocalSelection at;
-    for (int f = 0; f < cs.size(); ++f) {
-      const std::vector<int> corners = cs.corners(f);
-      if (std::any_of(corners.begin(), corners.end(),
-                      [&](int c) { return (cs.vertices[std::size_t(c)] - p).norm() < 1e-9; }))
-        (chosen[f] ? at.selected : at.unselected).push_back(f);
-    }
-    if (!at.selected.empty()) out.push_back(std::move(at));
-  }
-  return out;
-}
-
-void set_selected(CandidateSet& cs, const std::vector<char>& chosen) {
-  auto map = candidate_props::selected.add(cs.mesh);
-  for (int f = 0; f < cs.size(); ++f) map[FaceIndex(f)] = chosen[f] != 0;
-}
-
-// The spacing of `m`'s samples: kRebuildSampling, or wider where its faces' boxes (bounded by
-// their diagonals) would hold more than kMaxRebuildSamples.
-double sample_spacing(const Mesh& m) {
-  double box_area = 0.0;
-  for (const Face& f : m.faces) box_area += bounding_box(face_points(m, f)).sizes().squaredNorm();
-  return std::max(kRebuildSampling, std::sqrt(box_area / kMaxRebuildSamples));
-}
-
-// The samples of a face: a grid every `spacing`, and its vertices moved a hundredth of the way to
-// its centroid (inside the face, off its neighbours).
-std::vector<Vec3> face_samples(const Mesh& m, int f, double spacing) {
-  std::vector<Vec3> pts = sample_faces(m, {f}, spacing);
-  const std::vector<Vec3> corners = face_points(m, m.faces[std::size_t(f)]);
-  const Vec3 c = polygon_centroid(corners);
-  for (const Vec3& p : corners) pts.push_back(p + 0.01 * (c - p));
-  return pts;
-}
-
-// The shell's area on the soup (samples within `tolerance` of it) and beside it (added), and the
-// farthest a sample and a vertex lie from it.
-void added_area(const Mesh& shell, const Mesh& soup, double tolerance, ShellRebuild& out) {
-  const MeshDistance dist(soup);
-  for (const Vec3& p : shell.vertices) out.corner_to_input = std::max(out.corner_to_input, dist.distance(p, false));
-  const double spacing = sample_spacing(shell);
-  for (int f = 0; f < int(shell.faces.size()); ++f)
-    for (const Vec3& p : sample_faces(shell, {f}, spacing)) {
-      const double d = dist.distance(p, false);
-      out.output_to_input = std::max(out.output_to_input, d);
-      (d <= tolerance ? out.area_kept : out.area_added) += spacing * spacing;
-    }
-}
-
-// The generalized winding number (Jacobson, Kavan and Sorkine-Hornung 2013) of a soup's faces, as
-// read (outward): about 1 inside what they enclose, 0 outside, fractional near a hole.
-class Winding {
- public:
-  explicit Winding(const Mesh& soup) {
-    for_each_triangle(soup, [&](const Vec3& a, const Vec3& b, const Vec3& c, int f) { tris_.push_back({a, b, c, f}); });
-  }
-  std::size_t triangles() const { return tris_.size(); }
-  // At `p`, of the faces other than `skip`.
-  double without(int skip, const Vec3& p) const {
-    double sum = 0.0;
-    for (const Tri& t : tris_) {
-      if (t.face == skip) continue;
-      const Vec3 a = t.a - p, b = t.b - p, c = t.c - p;
-      const double la = a.norm(), lb = b.norm(), lc = c.norm();
-      sum += 2.0 * std::atan2(a.dot(b.cross(c)), la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb);
-    }
-    return sum / (4.0 * kPi);
-  }
-
- private:
-  struct Tri {
-    Vec3 a, b, c;
-    int face;
-  };
-  std::vector<Tri> tris_;
-};
-
-// A soup face's point where the rest of the soup winds more than this has the soup's volume on
-// both sides: a partition between two parts. An outer wall has it on one side only (about 1/2),
-// a fin on neither (less than kFinWinding).
-constexpr double kPartitionWinding = 0.75;
-constexpr double kFinWinding = 0.25;
-
-// The pieces of the soup's faces outside the shell with the soup's outside on both sides (its
-// winding there, without their own face, below kFinWinding): a fin, such as a neighbour's wall
-// standing above the roof. No solid holds one, so it goes beside the shell, as read: each soup
-// face clipped to the candidates of its plane the selection left out, in the face's orientation,
-// semantic and source.
-Mesh fins_beside(const CandidateSet& cs, const Supports& s, const std::vector<char>& chosen, const Mesh& soup,
-                 const Mesh& shell, const Winding& winding, double tolerance) {
-  constexpr double kMinPiece = 1e-4;  // m²: smaller pieces are the clipping's slivers
-  std::vector<std::vector<int>> left_out(cs.planes.size());
-  const auto support = cs.supports();
-  for (int f = 0; f < cs.size(); ++f)
-    if (!chosen[f]) left_out[std::size_t(support[FaceIndex(f)])].push_back(f);
-  const MeshDistance to_shell(shell);
-  Mesh fins;
-  fins.id = soup.id;
-  for (int sf = 0; sf < int(soup.faces.size()); ++sf) {
-    const int k = s.face_plane[std::size_t(sf)];
-    if (k < 0) continue;
-    const Plane& plane = cs.planes[std::size_t(k)].plane;
-    const auto [u, v] = plane.basis();
-    const Vec3 origin = -plane.d * plane.n;
-    auto flat = [&](const std::vector<Vec3>& poly) {
-      std::vector<Vec2> out;
-      for (const Vec3& p : poly) out.emplace_back(u.dot(p - origin), v.dot(p - origin));
-      return out;
-    };
-    const std::vector<Vec2> face = flat(face_points(soup, soup.faces[std::size_t(sf)]));
-    for (int f : left_out[std::size_t(k)]) {
-      const std::vector<Vec2> piece = polygon_clipped_to_convex(face, flat(cs.polygon(f)));
-      if (std::abs(signed_area_2d(piece)) < kMinPiece) continue;
-      std::vector<Vec3> corners;
-      for (const Vec2& q : piece) corners.push_back(origin + q.x() * u + q.y() * v);
-      const Vec3 c = polygon_centroid(corners);
-      if (to_shell.distance(c, true) <= tolerance || std::abs(winding.without(sf, c)) >= kFinWinding) continue;
-      Face out = soup.faces[std::size_t(sf)];
-      out.v.clear();
-      for (const Vec3& p : corners) {
-        out.v.push_back(int(fins.vertices.size()));
-        fins.vertices.push_back(p);
-      }
-      fins.faces.push_back(std::move(out));
-    }
-  }
-  return snapped_to_start(fins, soup);
-}
-
-// The farthest a soup sample lies from the rebuilt `shell` and the `fins` beside it (m), over the
-// samples they must cover: all but a partition between parts the shell joins (inside it, the
-// soup's volume on both sides). An outer wall the shell swallows is no partition, and a fin not
-// carried beside it leaves the soup uncovered too. `out` gets the areas (m²) of the samples
-// farther than `tolerance` from the shell: on the fins (carried), the partitions' (dropped), the
-// others (uncovered) and of those a fin's.
-double uncovered(const Mesh& soup, const Mesh& shell, const Mesh& fins, const Winding& winding, double tolerance,
-                 ShellRebuild& out) {
-  const MeshDistance dist(shell);
-  const std::optional<MeshDistance> to_fins =
-      fins.faces.empty() ? std::nullopt : std::make_optional<MeshDistance>(fins);
-  const double spacing = sample_spacing(soup), sample_area = spacing * spacing;
-  out.sampling = spacing;
-  double terms = 0.0, worst = 0.0;
-  for (int f = 0; f < int(soup.faces.size()); ++f)
-    for (const Vec3& p : face_samples(soup, f, spacing)) {
-      const double d = dist.distance(p, true);
-      if (std::abs(d) <= tolerance) {
-        worst = std::max(worst, std::abs(d));
-        continue;
-      }
-      if (to_fins) {
-        const double d_fin = to_fins->distance(p, false);
-        if (d_fin <= tolerance) {
-          worst = std::max(worst, d_fin);
-          out.area_carried += sample_area;
-          continue;
-        }
-      }
-      terms += double(winding.triangles());
-      const double w = terms <= kMaxWindingTerms ? winding.without(f, p) : 0.5;  // past the budget: a wall
-      if (d < 0.0 && w > kPartitionWinding) {
-        out.area_dropped += sample_area;
-        continue;
-      }
-      worst = std::max(worst, std::abs(d));
-      out.area_uncovered += sample_area;
-      if (std::abs(w) < kFinWinding) out.area_fins += sample_area;
-    }
-  return worst;
-}
-
 }  // namespace
-
-ShellRebuild rebuild_shell(const Mesh& soup, const RefineConfig& prm) {
-  ShellRebuild out;
-  Supports s;
-  detail::add_start_planes(soup, prm.repair.planarity_tolerance, s);
-  if (!detail::carries_ground(soup, s)) {
-    out.reason = "it has no ground face: the foot of its walls would be invented";
-    return out;
-  }
-  detail::add_hole_planes(soup, s);
-  out.planes_added = s.hole_planes;
-  const Region region = detail::building_region(soup, s, prm.plane.facade_max_tilt_deg);
-  CandidateSet cs = build_candidates(s.planes, region, {}, kRebuildWholeRegion);
-  if (cs.capped) {
-    std::vector<Vec3> open_ends;
-    for (const auto& [key, uses] : edge_uses(soup.faces))
-      if (uses.size() != 2) open_ends.insert(open_ends.end(), {soup.vertices[key.first], soup.vertices[key.second]});
-    cs = build_candidates(s.planes, region, detail::plane_reach(soup, s, region, kRebuildReach, open_ends),
-                          kRebuildWholeRegion);
-  }
-  if (cs.capped) {
-    out.reason = "too many candidate faces (over " + std::to_string(kRebuildWholeRegion) + " from " +
-                 std::to_string(s.planes.size()) + " planes)";
-    return out;
-  }
-  const FaceProps props = describe_candidates(cs, soup, s, prm);
-  const std::vector<char> cover = face_flags(cs, props.in_start);
-  std::vector<char> chosen;
-  std::vector<LocalSelection> excluded;
-  for (int round = 0;; ++round) {
-    chosen = nearest_closed_selection(cs, cover, prm.selection, {true, kKeepCover}, excluded);
-    if (chosen.empty()) {
-      out.reason = "its planes bound no closed shell";
-      return out;
-    }
-    set_selected(cs, chosen);
-    out.mesh = traced_shell(cs);
-    out.mesh.id = soup.id;
-    const std::string problem = shell_problem(out.mesh, prm.repair);
-    if (problem.empty()) break;
-    const std::vector<LocalSelection> more = pinches(cs, chosen, out.mesh);
-    if (more.empty() || round == kPinchRounds) {
-      out.reason = "the shell on its planes is invalid: " + problem;
-      return out;
-    }
-    excluded.insert(excluded.end(), more.begin(), more.end());
-  }
-  for (int f = 0; f < cs.size(); ++f) out.candidates_changed += chosen[f] != cover[f];
-  Mesh snapped = snapped_to_start(out.mesh, soup);
-  if (shell_problem(snapped, prm.repair).empty()) out.mesh = std::move(snapped);
-  const Winding winding(soup);
-  out.fins = fins_beside(cs, s, chosen, soup, out.mesh, winding, prm.repair.weld_tolerance);
-  out.input_to_output = uncovered(soup, out.mesh, out.fins, winding, prm.repair.weld_tolerance, out);
-  added_area(out.mesh, soup, prm.repair.weld_tolerance, out);
-  out.ok = true;
-  return out;
-}
 
 ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
                             const RefineConfig& prm) {

@@ -10,6 +10,8 @@
 #include "lodrefine/base/topology.h"
 #include "lodrefine/core/distance.h"
 #include "lodrefine/core/matching.h"
+#include "lodrefine/core/selection.h"
+#include "lodrefine/core/validate.h"
 
 namespace lodrefine::detail {
 namespace {
@@ -463,6 +465,114 @@ std::vector<int> enclosing_changes(const CandidateSet& cs, const std::vector<cha
   for (int k = 0; k < int(pieces.size()); ++k)
     if (count[k] >= prm.ransac_min_points) out.insert(out.end(), pieces[k].begin(), pieces[k].end());
   return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Shared by the selection and the rebuild.
+
+// A boolean face map of `cs` as 0/1 per candidate (a selection).
+std::vector<char> face_flags(const CandidateSet& cs, const CandidateMap<bool>& map) {
+  std::vector<char> out;
+  for (auto f : cs.mesh.faces()) out.push_back(char(map[f]));
+  return out;
+}
+
+Mesh snapped_to_start(const Mesh& m, const Mesh& start) {
+  PointGrid grid(kSnapBack);
+  for (int i = 0; i < int(start.vertices.size()); ++i) grid.insert(start.vertices[i], i);
+  Mesh out = m;
+  out.vertices.clear();
+  std::vector<int> index(m.vertices.size()), of_start(start.vertices.size(), -1);
+  for (std::size_t k = 0; k < m.vertices.size(); ++k) {
+    int best = -1;
+    double best_d = kSnapBack;
+    grid.visit_near(m.vertices[k], [&](int i) {
+      const double d = (start.vertices[i] - m.vertices[k]).norm();
+      if (d < best_d) best_d = d, best = i;
+      return false;
+    });
+    int& slot = best >= 0 ? of_start[best] : index[k];  // vertices snapped to one start vertex become one
+    if (best < 0 || slot < 0) {
+      slot = int(out.vertices.size());
+      out.vertices.push_back(best >= 0 ? start.vertices[best] : m.vertices[k]);
+    }
+    index[k] = slot;
+  }
+  out.faces.clear();
+  for (Face f : m.faces) {
+    for (int& v : f.v) v = index[v];
+    drop_repeats(f.v);
+    if (f.v.size() >= 3) out.faces.push_back(std::move(f));
+  }
+  return out;
+}
+
+// m: a changed candidate with a corner farther than this from every scan point the selection
+// used, in plan, is a change the scan did not ask for (a roof re-cut far from every scanned
+// facade): such candidates keep their starting-shell value. In plan, as the
+// roof above a moved facade must follow it however high it is. A step's facade also reaches the
+// volume between it and the start wall it replaces, however deep (detail::step_volume_samples).
+// The starting shell as a selection of candidates: its faces are unions of candidates up to
+// where its vertices sit off the planes' meets (a model within tolerance of its planes, planes
+// merged within kSurfaceDistance), which leaves some edges used once or thrice. Those are
+// mended by the nearest selection that closes: a small program over the candidates around each
+// such edge (kMendRings edge-rings, more while it has no solution), the others fixed, each
+// change costing its area; with `whole_last`, at last every candidate free. None of the local
+// selections `excluded` is made (SelectionProgram::excluded). Empty when it cannot be mended.
+constexpr int kMendRings = 2, kMendTries = 3;
+std::vector<char> nearest_closed_selection(CandidateSet& cs, const std::vector<char>& in_start,
+                                           const SelectionConfig& prm, const MendScope& scope,
+                                           const std::vector<LocalSelection>& excluded) {
+  if (excluded.empty() && every_edge_used_0_or_2(cs, in_start)) return in_start;
+  std::vector<char> near(cs.size(), 0);
+  for (const auto& x : excluded)
+    for (const auto* set : {&x.selected, &x.unselected})
+      for (int f : *set) near[f] = 1;
+  for (const auto& e : cs.edges) {
+    int n = 0;
+    for (auto h : e) n += in_start[cs.face(h)];
+    if (n != 0 && n != 2)
+      for (auto h : e) near[cs.face(h)] = 1;
+  }
+  for (int attempt = 0; attempt < kMendTries + int(scope.whole_last); ++attempt) {
+    if (attempt == kMendTries) near.assign(near.size(), 1);
+    for (int ring = 0; ring < kMendRings; ++ring) {
+      std::vector<char> grown = near;
+      for (const auto& e : cs.edges) {
+        bool touches = false;
+        for (auto h : e) touches = touches || near[cs.face(h)];
+        if (touches)
+          for (auto h : e) grown[cs.face(h)] = 1;
+      }
+      near.swap(grown);
+    }
+    SelectionProgram pg;
+    const auto area = cs.areas();
+    for (int f = 0; f < cs.size(); ++f) {
+      pg.cost.push_back(in_start[f] ? -scope.keep_weight * area[FaceIndex(f)] : area[FaceIndex(f)]);
+      pg.fixed.push_back(near[f] ? -1 : int(in_start[f]));
+    }
+    pg.sharp_cost.assign(cs.edges.size(), 0.0);
+    pg.excluded = excluded;
+    SelectionConfig mend = prm;  // the costs are areas: weight 1
+    mend.lambda_coverage = 1.0;
+    const SelectionResult r = select_faces(cs, pg, mend);
+    if (r.ok) return selected_faces(cs);
+  }
+  return {};
+}
+
+// Why the assembled shell cannot be written, or empty: validate_mesh's problem, or a face that
+// passes through one vertex twice (two pieces pinched together by the output weld or merge).
+std::string shell_problem(const Mesh& m, const RepairConfig& prm) {
+  const Validation v = validate_mesh(m, prm.planarity_tolerance);
+  if (!v.valid()) return v.problem.empty() ? "invalid" : v.problem;
+  for (const auto& f : m.faces) {
+    std::vector<int> ids = f.v;
+    std::sort(ids.begin(), ids.end());
+    if (std::adjacent_find(ids.begin(), ids.end()) != ids.end()) return "a face repeats a vertex";
+  }
+  return "";
 }
 
 }  // namespace lodrefine::detail

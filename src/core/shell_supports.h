@@ -2,6 +2,7 @@
 // shell's planes, the scan's facades none of them carries, and the hypothesised walls across the
 // steps of a facade line; and the region the arrangement covers. Internal to shell_selection.
 #pragma once
+#include <string>
 #include <vector>
 
 #include "lodrefine/base/geometry.h"
@@ -9,6 +10,7 @@
 #include "lodrefine/core/candidates.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/planes.h"
+#include "lodrefine/core/selection.h"
 
 namespace lodrefine::detail {
 
@@ -116,5 +118,29 @@ FaceProps describe_candidates(CandidateSet& cs, const Mesh& start, const Support
 // planes' points) more than 0.5 m inside `shell` though not inside `start`, nearest the piece.
 std::vector<int> enclosing_changes(const CandidateSet& cs, const std::vector<char>& changed, const Mesh& start,
                                    const Mesh& shell, const std::vector<Vec3>& evidence, const PlaneEvidence& prm);
+
+// A boolean face map of `cs` as 0/1 per candidate (a selection).
+std::vector<char> face_flags(const CandidateSet& cs, const CandidateMap<bool>& map);
+// Output vertices within this (m) of a starting-shell vertex are put back on it: the plane meets
+// of the arrangement only approximate a model that is planar within tolerance, and where the
+// selection changed nothing a roof must not move by that. Used only when the shell still
+// validates after it.
+inline constexpr double kSnapBack = 0.03;
+// `m` with its vertices within kSnapBack of a vertex of `start` put on it (those snapped to one start
+// vertex become one; faces left with fewer than 3 vertices dropped).
+Mesh snapped_to_start(const Mesh& m, const Mesh& start);
+// What nearest_closed_selection may change and at which cost.
+struct MendScope {
+  bool whole_last = false;   // at last, every candidate free
+  double keep_weight = 1.0;  // a start candidate dropped costs this times its area, one added its area
+};
+// The nearest selection to `in_start` that closes (every edge used 0 or 2 times) and makes none
+// of `excluded`; empty when none is found (shell_supports.cpp says how it searches).
+std::vector<char> nearest_closed_selection(CandidateSet& cs, const std::vector<char>& in_start,
+                                           const SelectionConfig& prm, const MendScope& scope = {},
+                                           const std::vector<LocalSelection>& excluded = {});
+// Why an assembled shell cannot be written, or empty: validate_mesh's problem, or a face that
+// passes through one vertex twice.
+std::string shell_problem(const Mesh& m, const RepairConfig& prm);
 
 }  // namespace lodrefine::detail

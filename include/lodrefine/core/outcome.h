@@ -11,7 +11,7 @@ namespace lodrefine {
 // each moved wall's own points fit better than before (judge.h);
 // "kept": the repaired input (nothing to change, or the judge refused the refinement);
 // "repaired": as kept, but the input was no valid solid and its shell was rebuilt on its own
-// planes (rebuild_shell, shell_selection.h): faces added, split or dropped, nothing moved;
+// planes (rebuild_shell, shell_rebuild.h): faces added, split or dropped, nothing moved;
 // "kept-invalid": the input cannot be made a valid solid and the output is it as read.
 // Never from refine_building: "untouched", a building of a city file that the cloud does not
 // reach, written exactly as read (cityfile.h); "failed", a building of an evaluated run whose

@@ -17,6 +17,7 @@
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/planes.h"
 #include "lodrefine/core/repair.h"
+#include "lodrefine/core/shell_rebuild.h"
 #include "lodrefine/core/shell_selection.h"
 #include "lodrefine/core/validate.h"
 

@@ -34,7 +34,7 @@ Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report 
 
 // The soup welded as repair_model welds it at `weld_tolerance`, its degenerate and duplicate faces
 // dropped and its T-junctions split; nothing closed, filled or oriented. What a rebuild
-// (shell_selection.h) reads when the soup cannot be made a valid solid. Throws InputError for a
+// (shell_rebuild.h) reads when the soup cannot be made a valid solid. Throws InputError for a
 // vertex that is not finite or a face with a missing vertex.
 Mesh welded_soup(const Mesh& soup, double weld_tolerance, RepairReport* report = nullptr);
 
