@@ -136,14 +136,36 @@ class Winding {
 constexpr double kPartitionWinding = 0.75;
 constexpr double kFinWinding = 0.25;
 
+// Per soup face, whether a sample of it lies farther than `tolerance` from `shell`.
+std::vector<char> faces_off(const Mesh& soup, const Mesh& shell, double tolerance) {
+  const MeshDistance dist(shell);
+  const double spacing = sample_spacing(soup);
+  std::vector<char> off(soup.faces.size(), 0);
+  for (int f = 0; f < int(soup.faces.size()); ++f)
+    for (const Vec3& p : face_samples(soup, f, spacing))
+      if (dist.distance(p, false) > tolerance) {
+        off[std::size_t(f)] = 1;
+        break;
+      }
+  return off;
+}
+
+Eigen::AlignedBox2d box_of(const std::vector<Vec2>& poly) {
+  Eigen::AlignedBox2d box;
+  for (const Vec2& p : poly) box.extend(p);
+  return box;
+}
+
 // The pieces of the soup's faces outside the shell with the soup's outside on both sides (its
 // winding there, without their own face, below kFinWinding): a fin, such as a neighbour's wall
 // standing above the roof. No solid holds one, so it goes beside the shell, as read: each soup
-// face clipped to the candidates of its plane the selection left out, in the face's orientation,
-// semantic and source.
+// face with samples off the shell clipped to the candidates of its plane the selection left out,
+// in the face's orientation, semantic and source. Each piece's winding number counts against
+// `terms` (kMaxWindingTerms): past it, no piece is carried (the rebuild is then refused).
 Mesh fins_beside(const CandidateSet& cs, const Supports& s, const std::vector<char>& chosen, const Mesh& soup,
-                 const Mesh& shell, const Winding& winding, double tolerance) {
+                 const Mesh& shell, const Winding& winding, double tolerance, double& terms) {
   constexpr double kMinPiece = 1e-4;  // m²: smaller pieces are the clipping's slivers
+  const std::vector<char> off = faces_off(soup, shell, tolerance);
   std::vector<std::vector<int>> left_out(cs.planes.size());
   const auto support = cs.supports();
   for (int f = 0; f < cs.size(); ++f)
@@ -153,7 +175,7 @@ Mesh fins_beside(const CandidateSet& cs, const Supports& s, const std::vector<ch
   fins.id = soup.id;
   for (int sf = 0; sf < int(soup.faces.size()); ++sf) {
     const int k = s.face_plane[std::size_t(sf)];
-    if (k < 0) continue;
+    if (!off[std::size_t(sf)] || k < 0) continue;
     const Plane& plane = cs.planes[std::size_t(k)].plane;
     const auto [u, v] = plane.basis();
     const Vec3 origin = -plane.d * plane.n;
@@ -163,13 +185,18 @@ Mesh fins_beside(const CandidateSet& cs, const Supports& s, const std::vector<ch
       return out;
     };
     const std::vector<Vec2> face = flat(face_points(soup, soup.faces[std::size_t(sf)]));
+    const Eigen::AlignedBox2d face_box = box_of(face);
     for (int f : left_out[std::size_t(k)]) {
-      const std::vector<Vec2> piece = polygon_clipped_to_convex(face, flat(cs.polygon(f)));
+      const std::vector<Vec2> candidate = flat(cs.polygon(f));
+      if (!face_box.intersects(box_of(candidate))) continue;
+      const std::vector<Vec2> piece = polygon_clipped_to_convex(face, candidate);
       if (std::abs(signed_area_2d(piece)) < kMinPiece) continue;
       std::vector<Vec3> corners;
       for (const Vec2& q : piece) corners.push_back(origin + q.x() * u + q.y() * v);
       const Vec3 c = polygon_centroid(corners);
-      if (to_shell.distance(c, true) <= tolerance || std::abs(winding.without(sf, c)) >= kFinWinding) continue;
+      if (to_shell.distance(c, true) <= tolerance) continue;
+      terms += double(winding.triangles());
+      if (terms > kMaxWindingTerms || std::abs(winding.without(sf, c)) >= kFinWinding) continue;
       Face out = soup.faces[std::size_t(sf)];
       out.v.clear();
       for (const Vec3& p : corners) {
@@ -189,13 +216,13 @@ Mesh fins_beside(const CandidateSet& cs, const Supports& s, const std::vector<ch
 // farther than `tolerance` from the shell: on the fins (carried), the partitions' (dropped), the
 // others (uncovered) and of those a fin's.
 double uncovered(const Mesh& soup, const Mesh& shell, const Mesh& fins, const Winding& winding, double tolerance,
-                 ShellRebuild& out) {
+                 double terms, ShellRebuild& out) {
   const MeshDistance dist(shell);
   const std::optional<MeshDistance> to_fins =
       fins.faces.empty() ? std::nullopt : std::make_optional<MeshDistance>(fins);
   const double spacing = sample_spacing(soup), sample_area = spacing * spacing;
   out.sampling = spacing;
-  double terms = 0.0, worst = 0.0;
+  double worst = 0.0;
   for (int f = 0; f < int(soup.faces.size()); ++f)
     for (const Vec3& p : face_samples(soup, f, spacing)) {
       const double d = dist.distance(p, true);
@@ -276,8 +303,9 @@ ShellRebuild rebuild_shell(const Mesh& soup, const RefineConfig& prm) {
   Mesh snapped = snapped_to_start(out.mesh, soup);
   if (shell_problem(snapped, prm.repair).empty()) out.mesh = std::move(snapped);
   const Winding winding(soup);
-  out.fins = fins_beside(cs, s, chosen, soup, out.mesh, winding, prm.repair.weld_tolerance);
-  out.input_to_output = uncovered(soup, out.mesh, out.fins, winding, prm.repair.weld_tolerance, out);
+  double terms = 0.0;  // the winding numbers' work, both passes (kMaxWindingTerms)
+  out.fins = fins_beside(cs, s, chosen, soup, out.mesh, winding, prm.repair.weld_tolerance, terms);
+  out.input_to_output = uncovered(soup, out.mesh, out.fins, winding, prm.repair.weld_tolerance, terms, out);
   added_area(out.mesh, soup, prm.repair.weld_tolerance, out);
   out.ok = true;
   return out;

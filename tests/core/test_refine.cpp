@@ -275,6 +275,46 @@ TEST(Refine, AHouseWithAFinIsRepairedWithTheFinBesideIt) {
   }
 }
 
+// The defect classes of municipal exports the rebuild must leave where they are (issue #38): a
+// roof crossing its wall by 5 mm, a wall face exported twice 5 mm apart, a 1 cm sliver between
+// roof and wall. Each house comes out a valid solid of the box's volume (kept or repaired),
+// no vertex of it off the input's by more than the weld tolerance.
+TEST(Refine, MunicipalDefectsLeaveTheHouseWhereItIs) {
+  const RefineConfig cfg;
+  std::vector<std::pair<std::string, Mesh>> cases;
+  {
+    Mesh m = box_soup(0, 12, 0, 8, 7);  // roof (face 1) 5 mm past the wall y = 0
+    for (int v : m.faces[1].v)
+      if (m.vertices[std::size_t(v)].y() < kOrigin.y() + 1e-9) m.vertices[std::size_t(v)].y() -= 0.005;
+    cases.emplace_back("roof crossing its wall by 5 mm", m);
+  }
+  {
+    Mesh m = box_soup(0, 12, 0, 8, 7);  // wall y = 0 (face 2) again, 5 mm out
+    Face twin = m.faces[2];
+    for (int& v : twin.v) {
+      m.vertices.push_back(m.vertices[std::size_t(v)] - Vec3(0, 0.005, 0));
+      v = int(m.vertices.size()) - 1;
+    }
+    m.faces.push_back(twin);
+    cases.emplace_back("a wall exported twice 5 mm apart", m);
+  }
+  {
+    Mesh m = box_soup(0, 12, 0, 8, 7);  // the roof lowered 1 cm along y = 0, a sliver closing it
+    const int n = int(m.vertices.size());
+    for (const Vec3& p : {Vec3(0, 0, 6.99), Vec3(12, 0, 6.99), Vec3(12, 0, 7), Vec3(0, 0, 7)})
+      m.vertices.push_back(kOrigin + p);
+    m.faces.push_back({{n, n + 1, n + 2, n + 3}, Semantic::Wall, 6});
+    cases.emplace_back("a 1 cm sliver on the wall's top", m);
+  }
+  for (const auto& [what, coarse] : cases) {
+    const RefineResult r = refine_building(coarse, far_cloud(), cfg);
+    EXPECT_TRUE(r.outcome == Outcome::Kept || r.outcome == Outcome::Repaired) << what << ": " << r.reason;
+    EXPECT_TRUE(r.valid) << what << ": " << r.trace.output_validation.problem;
+    EXPECT_NEAR(validate_mesh(r.mesh, kPlanarity).volume, 12 * 8 * 7, 12 * 8 * 0.02) << what;
+    EXPECT_LE(largest_vertex_move(r.mesh, coarse), cfg.repair.weld_tolerance) << what;
+  }
+}
+
 TEST(Refine, OutcomeNamesReadBack) {
   for (Outcome o :
        {Outcome::Refined, Outcome::Kept, Outcome::Repaired, Outcome::KeptInvalid, Outcome::Untouched, Outcome::Failed})
