@@ -301,15 +301,28 @@ std::optional<Mesh> starting_shell(const Mesh& current, const std::vector<ModelS
   return refined;
 }
 
+// The reason of a building the selection kept as it was.
+std::string kept_by_selection(const ShellSelectionStats& stats, bool any_match) {
+  if (!any_match) return "the selection kept the model (no wall matched a scan plane)";
+  // A search stopped by its budget on its first incumbent says nothing of the scan.
+  if (stats.selection.status == SolveStatus::FeasibleBudget)
+    return "the selection kept the model (the work budget ended on the starting shell)";
+  if (stats.selection.status == SolveStatus::FeasibleTimeLimit)
+    return "the selection kept the model (the time limit ended on the starting shell)";
+  return "the selection kept the model (the scan agrees with it)";
+}
+
 // The selection decides every face: the candidate arrangement over the starting shell's planes
-// and the scan's facades, the starting shell as GLPK's first incumbent. The result is written
-// only when it is never worse, on every scan point near the building and on each moved wall's
-// own points (judge.h).
+// and the scan's facades, the starting shell as GLPK's first incumbent (without a substitution,
+// with the outdated walls `moves` on their scan planes: select_shell's `outdated`). The result is
+// written only when it is never worse, on every scan point near the building and on each moved
+// wall's own points (judge.h).
 RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::optional<Mesh>& refined, bool any_match,
-                              const PointCloud& local, const std::vector<ScanPlane>& planes, const RefineConfig& prm,
-                              Refinement& refinement) {
+                              const std::vector<WallMove>& moves, const PointCloud& local,
+                              const std::vector<ScanPlane>& planes, const RefineConfig& prm, Refinement& refinement) {
   RefineTrace& trace = refinement.trace();
-  const ShellSelection chosen = select_shell(refined ? *refined : current, local, planes, prm);
+  const ShellSelection chosen =
+      refined ? select_shell(*refined, local, planes, prm) : select_shell(current, local, planes, prm, moves);
   trace.selection = chosen.stats;
   trace.selection_reason = chosen.reason;
   refinement.lap(RefineStage::Selection);
@@ -319,10 +332,7 @@ RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::
   const Mesh& shell = chosen.ok ? chosen.mesh : *refined;
   if (chosen.ok && !refined && chosen.stats.candidates_changed == 0) {
     trace.facades.clear();
-    return refinement.finish(Outcome::Kept,
-                             !any_match ? "the selection kept the model (no wall matched a scan plane)"
-                                        : "the selection kept the model (the scan agrees with it)",
-                             kept);
+    return refinement.finish(Outcome::Kept, kept_by_selection(chosen.stats, any_match), kept);
   }
   std::vector<JudgedWall> moved;
   for (const auto& f : trace.facades) moved.push_back(f.wall);
@@ -437,7 +447,7 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const R
     const std::optional<Mesh> refined =
         starting_shell(current, surfaces, moves, with_corners, local, planes, prm, trace);
     refinement.lap(RefineStage::Substitution);
-    return select_and_judge(kept, current, refined, !mr.matches.empty(), local, planes, prm, refinement);
+    return select_and_judge(kept, current, refined, !mr.matches.empty(), moves, local, planes, prm, refinement);
   };
   RefineResult result = attempt(corners);
   auto refused = [&] { return trace.judgement && !trace.judgement->ok; };

@@ -102,6 +102,7 @@ constexpr int kRetries = 2;
 // is solved alone, every other candidate fixed at the incumbent, in turn; each such program is
 // small, and its answer is at least as good as the incumbent it started from (which GLPK holds).
 // Together they spend one work budget, shared evenly: the selection then costs at most twice it.
+// A neighbourhood holding every free candidate is skipped: it is the whole program, solved next.
 // Returns the improved incumbent and counts the neighbourhoods that changed it.
 std::vector<char> improved_by_neighbourhoods(CandidateSet& cs, const SelectionProgram& pg, const Supports& s,
                                              const SelectionConfig& prm, int& improved) {
@@ -109,6 +110,7 @@ std::vector<char> improved_by_neighbourhoods(CandidateSet& cs, const SelectionPr
   const auto scanned = std::count_if(s.points.begin(), s.points.end(), [](const auto& p) { return !p.empty(); });
   SelectionConfig share = prm;
   share.mip_work_limit = prm.mip_work_limit / double(std::max<std::ptrdiff_t>(1, scanned));
+  const auto free_all = int(std::count(pg.fixed.begin(), pg.fixed.end(), -1));
   for (const auto& pts : s.points) {
     if (pts.empty()) continue;
     const EvidenceReach near(pts);
@@ -122,13 +124,87 @@ std::vector<char> improved_by_neighbourhoods(CandidateSet& cs, const SelectionPr
       if (!reached) local.fixed[f] = int(current[f]);
       free += reached;
     }
-    if (free == 0) continue;
+    if (free == 0 || free == free_all) continue;  // none, or the whole program: solved next anyway
     if (!select_faces(cs, local, share).ok) continue;
     const std::vector<char> selected = selected_faces(cs);
     if (selected != current) ++improved;
     current = selected;
   }
   return current;
+}
+
+// A vertical wall's outline seen along its horizontal normal: (along the wall, height). A plane
+// parallel to the wall (its scan plane) reads the same outline in it.
+struct WallView {
+  Vec3 u;
+  explicit WallView(const Vec3& n) : u(Vec3(-n.y(), n.x(), 0.0).normalized()) {}
+  Vec2 operator()(const Vec3& p) const { return {u.dot(p), p.z()}; }
+};
+
+// The supporting plane (other than `self`) carrying a wall's scan plane `plane` at the wall's
+// centroid `at`: the nearest parallel one within merge_distance there (add_scan_planes gave the
+// scan plane's points to it, or made it); -1 when none does.
+int carrying_plane(const Supports& s, const Plane& plane, const Vec3& at, int self, const SelectionConfig& prm) {
+  int best = -1;
+  double best_d = prm.merge_distance;
+  const Vec3 on = plane.project(at);
+  for (int j = 0; j < int(s.planes.size()); ++j) {
+    if (j == self || unoriented_angle_deg(s.planes[j].plane.n, plane.n) > prm.merge_angle_deg) continue;
+    const double d = std::abs(s.planes[j].plane.distance(on));
+    if (d <= best_d) best_d = d, best = j;
+  }
+  return best;
+}
+
+// `sel` with each outdated wall's candidates moved onto its scan plane: on the wall's supporting
+// plane those within its outline off, on the plane carrying its scan plane those within the same
+// outline on (by centroid). Not closed: the strips between the two planes are left to
+// nearest_closed_selection. False when a wall's scan plane carries no supporting plane.
+bool swap_onto_scan_planes(const CandidateSet& cs, const Mesh& start, const Supports& s,
+                           const std::vector<WallMove>& outdated, const SelectionConfig& prm, std::vector<char>& sel) {
+  const auto surfaces = model_surfaces(start);
+  const auto support = cs.supports();
+  const auto centroid = cs.centroids();
+  for (const WallMove& mv : outdated) {
+    if (mv.surface < 0 || mv.surface >= int(surfaces.size())) return false;
+    const ModelSurface& wall = surfaces[std::size_t(mv.surface)];
+    const int from = s.face_plane[std::size_t(wall.faces.front())];
+    const int to = carrying_plane(s, mv.plane, wall.centroid, from, prm);
+    if (from < 0 || to < 0) return false;
+    const WallView view(wall.plane.n);
+    std::vector<std::vector<Vec2>> outline;
+    for (int f : wall.faces) {
+      outline.emplace_back();
+      for (int v : start.faces[std::size_t(f)].v) outline.back().push_back(view(start.vertices[std::size_t(v)]));
+    }
+    for (int f = 0; f < cs.size(); ++f) {
+      const int k = support[FaceIndex(f)];
+      if (k != from && k != to) continue;
+      const Vec2 c = view(centroid[FaceIndex(f)]);
+      if (std::any_of(outline.begin(), outline.end(), [&](const auto& poly) { return point_in_polygon_2d(c, poly); }))
+        sel[std::size_t(f)] = char(k == to);
+    }
+  }
+  return true;
+}
+
+// Without a substitution the starting shell has its outdated walls where the model put them, and
+// a real building's program spends its work budget at the root: GLPK ends on its warm start
+// (City3D 08835: an upper storey set back over a ledge, whose move onto its scan folds the ledge's
+// roof, so the substitution is refused; the selection kept the model, which 40 budgets refine).
+// So the warm start is built in the arrangement: `base` (the starting shell) with the walls on
+// their scan planes, closed by the nearest closed selection; `base` itself when that fails or
+// changes a candidate `pg` fixes.
+std::vector<char> warm_with_walls_moved(CandidateSet& cs, const SelectionProgram& pg, const std::vector<char>& base,
+                                        const Mesh& start, const Supports& s, const std::vector<WallMove>& outdated,
+                                        const SelectionConfig& prm) {
+  std::vector<char> swapped = base;
+  if (!swap_onto_scan_planes(cs, start, s, outdated, prm, swapped)) return base;
+  const std::vector<char> closed = nearest_closed_selection(cs, swapped, prm);
+  if (closed.empty()) return base;
+  for (int f = 0; f < cs.size(); ++f)
+    if (pg.fixed[std::size_t(f)] >= 0 && pg.fixed[std::size_t(f)] != int(closed[std::size_t(f)])) return base;
+  return closed;
 }
 
 // Buildings with fewer supporting planes are cut over the whole region (every dev tile building:
@@ -219,14 +295,16 @@ Pruned pruned(CandidateSet& all, const FaceProps& all_props, const std::vector<c
 // (negative: none); nothing when some are and the starting shell then cannot be expressed in the
 // candidates (its pieces cannot be mended to close): select_shell then gives each sliver a plane
 // of its own, as it is. The starting shell (mended where it does not close on the candidates) is
-// GLPK's first incumbent, and what no evidence reaches is fixed to it; without one everything is
-// free. Each plane is cut to where its faces can be (its start faces and scan points, grown by
-// twice the farthest a wall may move: a face reaches a moved neighbour, whose corner with the next
-// moved wall lies that far again; once measured lost a real building's refinement), so a large
-// building's program does not grow with the cube of its planes.
+// GLPK's first incumbent (with the `outdated` walls on their scan planes: warm_with_walls_moved),
+// and what no evidence reaches is fixed to it; without one everything is free. Each plane is cut
+// to where its faces can be (its start faces and scan points, grown by twice the farthest a wall
+// may move: a face reaches a moved neighbour, whose corner with the next moved wall lies that far
+// again; once measured lost a real building's refinement), so a large building's program does not
+// grow with the cube of its planes.
 std::optional<ShellSelection> select_shell_joining_slivers(const Mesh& start, const PointCloud& cloud,
                                                            const std::vector<ScanPlane>& planes,
-                                                           const RefineConfig& prm, double sliver_tolerance) {
+                                                           const RefineConfig& prm, double sliver_tolerance,
+                                                           const std::vector<WallMove>& outdated) {
   const auto t0 = Clock::now();
   ShellSelection out;
   auto& st = out.stats;
@@ -266,6 +344,7 @@ std::optional<ShellSelection> select_shell_joining_slivers(const Mesh& start, co
   const EvidenceReach evidence(reach_of);
   if (!warm.empty()) {
     for (int f : beyond_evidence(cs, evidence)) pg.fixed[f] = int(base[f]);
+    if (!outdated.empty()) pg.warm = warm_with_walls_moved(cs, pg, base, start, s, outdated, prm.selection);
     pg.warm = improved_by_neighbourhoods(cs, pg, s, prm.selection, st.neighbourhoods_improved);
   }
   std::string problem;
@@ -306,10 +385,10 @@ std::optional<ShellSelection> select_shell_joining_slivers(const Mesh& start, co
 }  // namespace
 
 ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
-                            const RefineConfig& prm) {
-  if (auto joined = select_shell_joining_slivers(start, cloud, planes, prm, prm.repair.planarity_tolerance))
+                            const RefineConfig& prm, const std::vector<WallMove>& outdated) {
+  if (auto joined = select_shell_joining_slivers(start, cloud, planes, prm, prm.repair.planarity_tolerance, outdated))
     return *joined;
-  return *select_shell_joining_slivers(start, cloud, planes, prm, -1.0);  // no slivers: always a selection
+  return *select_shell_joining_slivers(start, cloud, planes, prm, -1.0, outdated);  // no slivers: always one
 }
 
 }  // namespace lodrefine

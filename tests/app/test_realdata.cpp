@@ -59,13 +59,6 @@ constexpr double kMaxRms = 0.03;   // allowed RMS of the scan to the refined wal
 constexpr double kRoofFar = 2.0;   // roof vertices farther than this from the wall stay (m)
 constexpr double kRoofTolerance = 0.01;
 
-// Buildings known to fail, with the diagnosed reason (still run and printed, not asserted).
-const std::map<std::string, std::string> kKnownFailures = {
-    {"08835",
-     "kept: 'the selection kept the model (the scan agrees with it)', the scan 0.30 m out (scan RMS 28.9 cm; "
-     "measured 2026-12-04, not diagnosed)"},
-};
-
 // Buildings too slow for the default run (LODREFINE_REALDATA_FULL=1 runs them too). None today:
 // 08835 took GLPK to mip_time_limit (30 s) on each of its 3 replacements; its refine takes 0.7 s now.
 const std::map<std::string, std::string> kSlow = {};
@@ -219,13 +212,15 @@ Row run_building(const Mesh& soup) {
     return row;
   }
   // Without a scan the pipeline returns the repaired input ("kept"): the reference for
-  // "unchanged". Its coplanar faces merged give whole walls to scan.
+  // "unchanged" (a kept building comes out as it, unmerged; a refined one merged, whose vertices
+  // are some of its). Its coplanar faces merged give whole walls to scan.
   const RefineResult base = refine_building(soup, PointCloud{}, prm);
   if (!base.valid) {
     row.outcome = "repaired model invalid: " + base.trace.output_validation.problem;
     return row;
   }
-  const Mesh before = merge_coplanar_faces(translated(base.mesh, -origin));
+  const Mesh repaired = translated(base.mesh, -origin);
+  const Mesh before = merge_coplanar_faces(repaired);
   for (const auto& v : before.vertices) row.snap = std::max(row.snap, nearest_vertex_distance(v, local));
   const int wall = longest_wall(before);
   if (wall < 0) {
@@ -284,7 +279,7 @@ Row run_building(const Mesh& soup) {
   }
   row.rms = facade > 0 ? std::sqrt(sum2 / facade) : NAN;
   if (!(row.rms <= kMaxRms)) row.failures.push_back("scan RMS to the refined wall " + std::to_string(row.rms) + " m");
-  row.roof_moved = moved_far_roof_vertices(refined, before, wall_plane);
+  row.roof_moved = moved_far_roof_vertices(refined, repaired, wall_plane);
   if (row.roof_moved > 0)
     row.failures.push_back(std::to_string(row.roof_moved) + " roof vertices > 2 m from the wall moved");
   return row;
@@ -333,16 +328,9 @@ void run_set(const std::string& title, const std::vector<Mesh>& buildings, int m
   EXPECT_GE(tried, min_tried) << title << ": only " << tried << " of " << rows.size()
                               << " buildings tried (closed by repair, with a wall long enough to scan)";
   for (const auto& r : rows) {
-    const auto known = kKnownFailures.find(r.id);
-    if (known != kKnownFailures.end() && r.eligible && r.failures.empty())
-      std::printf("known failure %s passes now: take it off kKnownFailures\n", r.id.c_str());
     if (!r.eligible || r.failures.empty()) continue;
     std::string all;
     for (const auto& f : r.failures) all += "\n  " + f;
-    if (known != kKnownFailures.end()) {
-      std::printf("known failure %s (%s):%s\n", r.id.c_str(), known->second.c_str(), all.c_str());
-      continue;
-    }
     ADD_FAILURE() << title << " building " << r.id << ":" << all;
   }
 }

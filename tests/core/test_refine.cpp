@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "lodrefine/base/geometry.h"
 #include "lodrefine/core/candidates.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/refine.h"
@@ -313,6 +314,104 @@ TEST(Refine, MunicipalDefectsLeaveTheHouseWhereItIs) {
     EXPECT_NEAR(validate_mesh(r.mesh, kPlanarity).volume, 12 * 8 * 7, 12 * 8 * 0.02) << what;
     EXPECT_LE(largest_vertex_move(r.mesh, coarse), cfg.repair.weld_tolerance) << what;
   }
+}
+
+namespace {
+
+// Two storeys, their fronts facing -y, as an exported soup: the lower one [0,12] x [0,8] x [0,6],
+// its front y = 0 for x in [0,8] and y = `step` beyond x = 8; the upper one [0,12] x [0.37,8] x
+// [6,9], set back 0.37 m over a ledge (City3D 08835's upper storey).
+constexpr double kSetback = 0.37;
+Mesh setback_storey_soup(double step) {
+  Mesh m;
+  m.id = "setback storey";
+  auto add = [&](std::vector<Vec3> pts, Semantic sem) {
+    Face face{{}, sem};
+    for (const auto& p : pts) {
+      face.v.push_back(int(m.vertices.size()));
+      m.vertices.push_back(p + kOrigin);
+    }
+    m.faces.push_back(face);
+  };
+  const double s = kSetback;
+  add({{0, 0, 0}, {0, 8, 0}, {12, 8, 0}, {12, step, 0}, {8, step, 0}, {8, 0, 0}}, Semantic::Ground);
+  add({{0, 0, 0}, {8, 0, 0}, {8, 0, 6}, {0, 0, 6}}, Semantic::Wall);
+  add({{8, 0, 0}, {8, step, 0}, {8, step, 6}, {8, 0, 6}}, Semantic::Wall);
+  add({{8, step, 0}, {12, step, 0}, {12, step, 6}, {8, step, 6}}, Semantic::Wall);
+  add({{0, 0, 6}, {8, 0, 6}, {8, step, 6}, {12, step, 6}, {12, s, 6}, {0, s, 6}}, Semantic::Roof);  // the ledge
+  add({{0, s, 6}, {12, s, 6}, {12, s, 9}, {0, s, 9}}, Semantic::Wall);
+  add({{0, s, 9}, {12, s, 9}, {12, 8, 9}, {0, 8, 9}}, Semantic::Roof);
+  add({{12, 8, 0}, {0, 8, 0}, {0, 8, 9}, {12, 8, 9}}, Semantic::Wall);
+  add({{12, step, 0}, {12, 8, 0}, {12, 8, 9}, {12, s, 9}, {12, s, 6}, {12, step, 6}}, Semantic::Wall);
+  add({{0, 8, 0}, {0, 0, 0}, {0, 0, 6}, {0, s, 6}, {0, s, 9}, {0, 8, 9}}, Semantic::Wall);
+  return m;
+}
+
+// The upper storey's front scanned `out` in front of the model's (the lower 70 % of its height,
+// 5 cm apart, 1 cm range noise), and the street in front of the building.
+PointCloud upper_front_scan(double out) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  PointCloud pc;
+  for (double x = 0.025; x < 12.0; x += 0.05)
+    for (double z = 6.025; z < 6.0 + 0.7 * 3.0; z += 0.05)
+      pc.points.push_back(kOrigin + Vec3(x, kSetback - out + noise(rng), z));
+  for (double x = 0.0; x < 12.0; x += 0.1)
+    for (double y = -0.5; y > -4.0; y -= 0.1) pc.points.push_back(kOrigin + Vec3(x, y, noise(rng)));
+  return pc;
+}
+
+// The faces of `m` facing -y (its fronts), in the local frame.
+std::vector<std::vector<Vec3>> front_faces(const Mesh& m) {
+  std::vector<std::vector<Vec3>> out;
+  for (const auto& f : m.faces) {
+    std::vector<Vec3> poly;
+    for (int v : f.v) poly.push_back(m.vertices[std::size_t(v)] - kOrigin);
+    if (newell_normal(poly).normalized().y() < -0.99) out.push_back(std::move(poly));
+  }
+  return out;
+}
+
+}  // namespace
+
+// The upper storey's front, set back 0.37 m over a ledge, is 0.30 m out: on its scan it stands
+// 0.07 m behind the lower front's left part but 0.14 m before its right part (y = 0.21), so
+// moving it folds the ledge's roof there and the substitution is refused (City3D 08835). The
+// selection's budget, scaled down as this program is (its search finds the refinement after
+// about 0.08 units of work; 08835's after 2,000-3,000 of its 60), ends where it starts: the
+// start is the model with that wall on its scan plane, the arrangement closing the rest (the
+// ledge narrows on the left and becomes a soffit on the right). The lower storey stays.
+TEST(Refine, AnUpperStoreyOverALedgeIsMovedWhereItsSubstitutionFolds) {
+  constexpr double kStep = 0.21, kOut = 0.30;
+  RefineConfig prm;
+  prm.selection.mip_work_limit = 0.04;
+  const auto t0 = std::chrono::steady_clock::now();
+  const RefineResult r = refine_building(setback_storey_soup(kStep), upper_front_scan(kOut), prm);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_TRUE(r.trace.substitution.has_value());
+  EXPECT_FALSE(r.trace.substitution->ok) << "the case is one whose substitution folds";
+  ASSERT_EQ(r.outcome, Outcome::Refined) << r.reason;
+  const Validation v = validate_mesh(r.mesh, kPlanarity);
+  EXPECT_TRUE(v.valid()) << v.problem;
+  int upper = 0, lower = 0;
+  for (const auto& poly : front_faces(r.mesh)) {
+    double top = -1e300;
+    for (const auto& p : poly) top = std::max(top, p.z());
+    if (top > 6.0 + 1e-6) {
+      ++upper;
+      for (const auto& p : poly) EXPECT_LT(std::abs(p.y() - (kSetback - kOut)), 0.01) << "upper front off its scan";
+      continue;
+    }
+    ++lower;
+    for (const auto& p : poly) {  // unmoved: y = 0 left of x = 8, y = kStep right of it
+      if (std::abs(p.x() - 8.0) < 1e-6) continue;
+      EXPECT_NEAR(p.y(), p.x() < 8.0 ? 0.0 : kStep, 1e-3) << "the lower front moved at x = " << p.x();
+    }
+  }
+  EXPECT_EQ(upper, 1);
+  EXPECT_EQ(lower, 2);
+  EXPECT_NEAR(v.volume, 12 * 8 * 9 - 4 * kStep * 6 - 12 * (kSetback - kOut) * 3, 0.05);
+  EXPECT_LT(seconds, 5.0);
 }
 
 TEST(Refine, OutcomeNamesReadBack) {

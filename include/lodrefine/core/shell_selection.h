@@ -16,7 +16,8 @@
 //   saw the facade elsewhere there).
 // Complexity: a cost per length of sharp edge. Constraint: every candidate edge is used by 0 or
 // 2 selected faces. Candidates that no scan evidence reaches are fixed to the starting shell.
-// The starting shell, as a selection of candidates, is GLPK's first incumbent (warm start).
+// The starting shell, as a selection of candidates, is GLPK's first incumbent (warm start), or
+// the starting shell with its outdated walls on their scan planes (`outdated` below).
 #pragma once
 #include <string>
 #include <vector>
@@ -25,6 +26,7 @@
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/planes.h"
 #include "lodrefine/core/selection.h"
+#include "lodrefine/core/substitute.h"
 
 namespace lodrefine {
 
@@ -60,7 +62,16 @@ struct ShellSelection {
 // planarity_tolerance of a larger face's plane, though its own normal is off (a sliver), is a
 // piece of that plane, unless the start then cannot be expressed in the candidates. Never throws
 // for geometry; !ok with the reason when the program has no solution or no valid shell.
+// `outdated`: walls of `start` the scan puts on another plane that `start` still has where the
+// model put them (no substitution moved them; WallMove::surface indexes model_surfaces(start) at
+// its default tolerances, WallMove::plane is the wall's scan plane). GLPK's first incumbent then
+// has each such wall on the supporting plane carrying its scan plane (the wall's outline, seen
+// along its normal), the rest closed by the nearest closed selection; `start` stays what no
+// evidence reaches is fixed to, what changes are counted from and what a refused change goes
+// back to. A wall whose scan plane carries no supporting plane, or a warm start that cannot be
+// closed or changes a fixed candidate, leaves the incumbent `start`. Empty (the default): `start`
+// is the incumbent.
 ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
-                            const RefineConfig& params);
+                            const RefineConfig& params, const std::vector<WallMove>& outdated = {});
 
 }  // namespace lodrefine
