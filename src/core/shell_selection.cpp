@@ -191,7 +191,8 @@ bool swap_onto_scan_planes(const CandidateSet& cs, const Mesh& start, const Supp
 // Without a substitution the starting shell has its outdated walls where the model put them, and
 // a real building's program spends its work budget at the root: GLPK ends on its warm start
 // (City3D 08835: an upper storey set back over a ledge, whose move onto its scan folds the ledge's
-// roof, so the substitution is refused; the selection kept the model, which 40 budgets refine).
+// roof, so the substitution is refused; the selection kept the model, and refined it with 40
+// times the work budget).
 // So the warm start is built in the arrangement: `base` (the starting shell) with the walls on
 // their scan planes, closed by the nearest closed selection; `base` itself when that fails or
 // changes a candidate `pg` fixes.
