@@ -272,7 +272,9 @@ void run(const RefineArgs& a) {
   report["cloud"].update(cloud_json(read));
   report["params"] = params_json(a.params);
   report["written"] = a.out;
-  write_obj(a.out, r.mesh);  // the model first: a report never names a model that is not there
+  // The model first: a report never names a model that is not there. Its fins (faces no solid
+  // holds, beside a rebuilt shell) follow the solid's faces: an OBJ is a polygon soup.
+  write_obj(a.out, r.fins.faces.empty() ? r.mesh : with_fins(r));
   if (!a.report.empty())
     write_file_atomic(a.report, report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   // One line whatever the model's name holds (batch logs keep it): a CR let `o ok\rFAKE: …` print

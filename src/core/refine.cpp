@@ -301,6 +301,17 @@ std::optional<Mesh> starting_shell(const Mesh& current, const std::vector<ModelS
   return refined;
 }
 
+// Whether the fins stand on `shell` where they stood on `rebuilt`: every fin vertex within
+// `tolerance` of the rebuilt shell is within it of `shell` (a refinement that moves the wall a fin
+// stood on would leave it floating).
+bool fins_stay_on(const Mesh& fins, const Mesh& rebuilt, const Mesh& shell, double tolerance) {
+  if (fins.faces.empty()) return true;
+  const MeshDistance before(rebuilt), after(shell);
+  return std::all_of(fins.vertices.begin(), fins.vertices.end(), [&](const Vec3& p) {
+    return before.distance(p, false) > tolerance || after.distance(p, false) <= tolerance;
+  });
+}
+
 // The reason of a building the selection kept as it was.
 std::string kept_by_selection(const ShellSelectionStats& stats, bool any_match) {
   if (!any_match) return "the selection kept the model (no wall matched a scan plane)";
@@ -340,6 +351,8 @@ RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::
       judge_refinement(kept, shell, moved, local, prm.match, prm.plane, planes, prm.scan_reach()));
   refinement.lap(RefineStage::Judge);
   if (!verdict.ok) return refinement.finish(Outcome::Kept, "not written: never worse, " + verdict.refusal(), kept);
+  if (trace.rebuild && !fins_stay_on(trace.rebuild->fins, kept, shell, prm.repair.weld_tolerance))
+    return refinement.finish(Outcome::Kept, "not written: a fin beside the shell would stand apart from it", kept);
   const std::string moved_walls = std::to_string(trace.facades.size()) + " wall(s) moved";
   if (!chosen.ok)
     return refinement.finish(
@@ -406,6 +419,17 @@ RefineTrace::Scan scan_summary(const std::vector<ScanPlane>& walls, const std::v
 }
 
 }  // namespace
+
+Mesh with_fins(const RefineResult& result) {
+  Mesh out = result.mesh;
+  const int base = int(out.vertices.size());
+  out.vertices.insert(out.vertices.end(), result.fins.vertices.begin(), result.fins.vertices.end());
+  for (Face f : result.fins.faces) {
+    for (int& v : f.v) v += base;
+    out.faces.push_back(std::move(f));
+  }
+  return out;
+}
 
 RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const RefineConfig& prm) {
   prm.validate();

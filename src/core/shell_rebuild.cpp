@@ -2,6 +2,7 @@
 #include "lodrefine/core/shell_rebuild.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 #include <vector>
@@ -150,6 +151,43 @@ std::vector<char> faces_off(const Mesh& soup, const Mesh& shell, double toleranc
   return off;
 }
 
+bool convex_2d(const std::vector<Vec2>& poly) {
+  int sign = 0;
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const Vec2 a = poly[(i + 1) % poly.size()] - poly[i];
+    const Vec2 b = poly[(i + 2) % poly.size()] - poly[(i + 1) % poly.size()];
+    const double z = a.x() * b.y() - a.y() * b.x();
+    if (std::abs(z) < 1e-12) continue;
+    if (sign != 0 && (z > 0) != (sign > 0)) return false;
+    sign = z > 0 ? 1 : -1;
+  }
+  return true;
+}
+
+// The parts of a face (`points`, flat: `face`) inside the convex `candidate`, each convex: a
+// convex face clipped whole, another triangle by triangle (clipped whole it could come out
+// touching itself). Without those narrower than `tolerance` (twice the area over the perimeter):
+// a sliver where two planes cross within it.
+std::vector<std::vector<Vec2>> convex_pieces(const std::vector<Vec3>& points, const std::vector<Vec2>& face,
+                                             const std::vector<Vec2>& candidate, double tolerance) {
+  std::vector<std::vector<Vec2>> parts;
+  if (convex_2d(face)) {
+    parts.push_back(face);
+  } else {
+    for (const auto& t : triangulate_polygon(points))
+      parts.push_back({face[std::size_t(t[0])], face[std::size_t(t[1])], face[std::size_t(t[2])]});
+  }
+  std::vector<std::vector<Vec2>> out;
+  for (const auto& part : parts) {
+    std::vector<Vec2> piece = polygon_clipped_to_convex(part, candidate);
+    double perimeter = 0.0;
+    for (std::size_t i = 0; i < piece.size(); ++i) perimeter += (piece[(i + 1) % piece.size()] - piece[i]).norm();
+    if (piece.size() >= 3 && 2.0 * std::abs(signed_area_2d(piece)) > tolerance * perimeter)
+      out.push_back(std::move(piece));
+  }
+  return out;
+}
+
 Eigen::AlignedBox2d box_of(const std::vector<Vec2>& poly) {
   Eigen::AlignedBox2d box;
   for (const Vec2& p : poly) box.extend(p);
@@ -164,7 +202,6 @@ Eigen::AlignedBox2d box_of(const std::vector<Vec2>& poly) {
 // `terms` (kMaxWindingTerms): past it, no piece is carried (the rebuild is then refused).
 Mesh fins_beside(const CandidateSet& cs, const Supports& s, const std::vector<char>& chosen, const Mesh& soup,
                  const Mesh& shell, const Winding& winding, double tolerance, double& terms) {
-  constexpr double kMinPiece = 1e-4;  // m²: smaller pieces are the clipping's slivers
   const std::vector<char> off = faces_off(soup, shell, tolerance);
   std::vector<std::vector<int>> left_out(cs.planes.size());
   const auto support = cs.supports();
@@ -184,26 +221,26 @@ Mesh fins_beside(const CandidateSet& cs, const Supports& s, const std::vector<ch
       for (const Vec3& p : poly) out.emplace_back(u.dot(p - origin), v.dot(p - origin));
       return out;
     };
-    const std::vector<Vec2> face = flat(face_points(soup, soup.faces[std::size_t(sf)]));
-    const Eigen::AlignedBox2d face_box = box_of(face);
+    const std::vector<Vec3> points = face_points(soup, soup.faces[std::size_t(sf)]);
+    const Eigen::AlignedBox2d face_box = box_of(flat(points));
     for (int f : left_out[std::size_t(k)]) {
       const std::vector<Vec2> candidate = flat(cs.polygon(f));
       if (!face_box.intersects(box_of(candidate))) continue;
-      const std::vector<Vec2> piece = polygon_clipped_to_convex(face, candidate);
-      if (std::abs(signed_area_2d(piece)) < kMinPiece) continue;
-      std::vector<Vec3> corners;
-      for (const Vec2& q : piece) corners.push_back(origin + q.x() * u + q.y() * v);
-      const Vec3 c = polygon_centroid(corners);
-      if (to_shell.distance(c, true) <= tolerance) continue;
-      terms += double(winding.triangles());
-      if (terms > kMaxWindingTerms || std::abs(winding.without(sf, c)) >= kFinWinding) continue;
-      Face out = soup.faces[std::size_t(sf)];
-      out.v.clear();
-      for (const Vec3& p : corners) {
-        out.v.push_back(int(fins.vertices.size()));
-        fins.vertices.push_back(p);
+      for (const std::vector<Vec2>& piece : convex_pieces(points, flat(points), candidate, tolerance)) {
+        std::vector<Vec3> corners;
+        for (const Vec2& q : piece) corners.push_back(origin + q.x() * u + q.y() * v);
+        const Vec3 c = polygon_centroid(corners);
+        if (to_shell.distance(c, true) <= tolerance) continue;
+        terms += double(winding.triangles());
+        if (terms > kMaxWindingTerms || std::abs(winding.without(sf, c)) >= kFinWinding) continue;
+        Face out = soup.faces[std::size_t(sf)];
+        out.v.clear();
+        for (const Vec3& p : corners) {
+          out.v.push_back(int(fins.vertices.size()));
+          fins.vertices.push_back(p);
+        }
+        fins.faces.push_back(std::move(out));
       }
-      fins.faces.push_back(std::move(out));
     }
   }
   return snapped_to_start(fins, soup);

@@ -276,6 +276,25 @@ TEST(Refine, AHouseWithAFinIsRepairedWithTheFinBesideIt) {
   }
 }
 
+// The same fin on a front wall that stands 0.5 m too far out: moving the wall onto its scan would
+// leave the fin standing in the air, so the refinement is not written; the repaired house and its
+// fin are. An OBJ gets the fin after the solid's faces.
+TEST(Refine, ARefinementThatWouldLeaveAFinFloatingIsNotWritten) {
+  Mesh coarse = box_soup(0, 12, -0.5, 8, 7);
+  const int n = int(coarse.vertices.size());
+  for (const Vec3& p : {Vec3(0, -0.5, 7), Vec3(12, -0.5, 7), Vec3(12, -0.5, 10), Vec3(0, -0.5, 10)})
+    coarse.vertices.push_back(p + kOrigin);
+  coarse.faces.push_back({{n, n + 1, n + 2, n + 3}, Semantic::Wall, 6});
+  const RefineResult r = refine_building(coarse, scan_front(0.0, 0.5, 11.5, 5.0, 7), RefineConfig{});
+  ASSERT_EQ(r.outcome, Outcome::Repaired) << r.reason;
+  EXPECT_NE(r.reason.find("a fin beside the shell would stand apart from it"), std::string::npos) << r.reason;
+  EXPECT_LT(largest_vertex_move(r.mesh, coarse), 0.01);
+  ASSERT_FALSE(r.fins.faces.empty());
+  const Mesh obj = with_fins(r);
+  EXPECT_EQ(obj.faces.size(), r.mesh.faces.size() + r.fins.faces.size());
+  EXPECT_EQ(obj.vertices.size(), r.mesh.vertices.size() + r.fins.vertices.size());
+}
+
 // The defect classes of municipal exports the rebuild must leave where they are (issue #38): a
 // roof crossing its wall by 5 mm, a wall face exported twice 5 mm apart, a 1 cm sliver between
 // roof and wall. Each house comes out a valid solid of the box's volume (kept or repaired),

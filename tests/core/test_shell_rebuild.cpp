@@ -102,6 +102,38 @@ TEST(RebuildShell, AFinEndingMidWallIsCarriedToItsOutline) {
   EXPECT_NEAR(area, 8.0, 1e-6);
 }
 
+// A U-shaped fin (its arms 2 m wide, the gap between them 2 m deep) is carried in convex pieces:
+// clipped whole, a non-convex face can come out touching itself. Its whole area is carried and
+// no piece is a sliver narrower than the weld tolerance.
+TEST(RebuildShell, ANonConvexFinIsCarriedInConvexPieces) {
+  Mesh soup = box_faces({0, 1, 2, 3, 4, 5});
+  const int n = int(soup.vertices.size());
+  for (const Vec3& p : {Vec3(0, 1, 6), Vec3(0, 7, 6), Vec3(0, 7, 10), Vec3(0, 5, 10), Vec3(0, 5, 8), Vec3(0, 3, 8),
+                        Vec3(0, 3, 10), Vec3(0, 1, 10)})
+    soup.vertices.push_back(p);
+  soup.faces.push_back({{n, n + 1, n + 2, n + 3, n + 4, n + 5, n + 6, n + 7}, Semantic::Wall, 6});
+  const RefineConfig prm;
+  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
+  ASSERT_TRUE(rb.ok) << rb.reason;
+  EXPECT_LE(rb.input_to_output, prm.repair.weld_tolerance);
+  double area = 0.0;
+  for (const Face& f : rb.fins.faces) {
+    std::vector<Vec2> flat;
+    for (int i : f.v) flat.emplace_back(rb.fins.vertices[std::size_t(i)].y(), rb.fins.vertices[std::size_t(i)].z());
+    const double a = std::abs(signed_area_2d(flat));
+    area += a;
+    double perimeter = 0.0;
+    for (std::size_t i = 0; i < flat.size(); ++i) perimeter += (flat[(i + 1) % flat.size()] - flat[i]).norm();
+    EXPECT_GT(2.0 * a, prm.repair.weld_tolerance * perimeter);
+    for (std::size_t i = 0; i < flat.size(); ++i) {  // convex: every turn the same way
+      const Vec2 e = flat[(i + 1) % flat.size()] - flat[i],
+                 g = flat[(i + 2) % flat.size()] - flat[(i + 1) % flat.size()];
+      EXPECT_GE((e.x() * g.y() - e.y() * g.x()) * signed_area_2d(flat), -1e-9);
+    }
+  }
+  EXPECT_NEAR(area, 6.0 * 4.0 - 2.0 * 2.0, 1e-6);
+}
+
 // Two overlapping boxes exported as one soup with their own walls inside each other: the walls
 // inside the union (the other box's volume on both sides) are partitions, dropped; the union
 // covers everything else.

@@ -124,6 +124,9 @@ struct RefineResult {
   bool refined() const { return outcome == Outcome::Refined; }
 };
 
+// `result.mesh` and, after its faces, `result.fins` as one polygon soup (an OBJ's output).
+Mesh with_fins(const RefineResult& result);
+
 // Every model gets an output: the refined building, the repaired input, or the input as read,
 // with the outcome and its reason. A refinement the judge refuses with corner moves is made again
 // without them; one it refuses on a scan move's own wall, again without that move (in turn, while
