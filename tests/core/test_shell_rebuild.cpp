@@ -18,6 +18,24 @@ namespace {
 // walls 2 y = 0, 3 x = 10, 4 y = 8, 5 x = 0).
 Mesh box_faces(std::initializer_list<int> keep) { return only_faces(box(Vec3(0, 0, 0), Vec3(10, 8, 6)), keep); }
 
+// The whole box with one more wall face (source 6), `corners` in order: a fin above the roof.
+Mesh box_with_fin(std::initializer_list<Vec3> corners) {
+  Mesh soup = box_faces({0, 1, 2, 3, 4, 5});
+  Face fin{{}, Semantic::Wall, 6};
+  for (const Vec3& p : corners) {
+    fin.v.push_back(int(soup.vertices.size()));
+    soup.vertices.push_back(p);
+  }
+  soup.faces.push_back(fin);
+  return soup;
+}
+
+// The soup rebuilt with the default configuration.
+ShellRebuild rebuilt(const Mesh& soup) {
+  const RefineConfig prm;
+  return rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
+}
+
 }  // namespace
 
 // A terraced house exported as roof, ground and one end wall (its facades and party wall
@@ -58,12 +76,8 @@ TEST(RebuildShell, AHugeSoupIsSampledWithinBounds) {
 // solid: the rebuilt box holds the rest, and the fin goes beside it as read (its 24 m², on its
 // plane, oriented like its face).
 TEST(RebuildShell, AFinIsCarriedBesideTheShell) {
-  Mesh soup = box_faces({0, 1, 2, 3, 4, 5});
-  const int n = int(soup.vertices.size());
-  for (const Vec3& p : {Vec3(0, 0, 6), Vec3(0, 8, 6), Vec3(0, 8, 9), Vec3(0, 0, 9)}) soup.vertices.push_back(p);
-  soup.faces.push_back({{n, n + 1, n + 2, n + 3}, Semantic::Wall, 6});
   const RefineConfig prm;
-  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
+  const ShellRebuild rb = rebuilt(box_with_fin({Vec3(0, 0, 6), Vec3(0, 8, 6), Vec3(0, 8, 9), Vec3(0, 0, 9)}));
   ASSERT_TRUE(rb.ok) << rb.reason;
   const Validation v = validate_mesh(rb.mesh, prm.repair.planarity_tolerance);
   EXPECT_TRUE(v.valid()) << v.problem;
@@ -89,12 +103,8 @@ TEST(RebuildShell, AFinIsCarriedBesideTheShell) {
 // The same holds for a fin that its plane's candidates do not fit (it ends mid-wall, where no
 // other plane cuts): only the fin's own outline goes beside the shell.
 TEST(RebuildShell, AFinEndingMidWallIsCarriedToItsOutline) {
-  Mesh soup = box_faces({0, 1, 2, 3, 4, 5});
-  const int n = int(soup.vertices.size());
-  for (const Vec3& p : {Vec3(0, 1, 6), Vec3(0, 5, 6), Vec3(0, 5, 8), Vec3(0, 1, 8)}) soup.vertices.push_back(p);
-  soup.faces.push_back({{n, n + 1, n + 2, n + 3}, Semantic::Wall, 6});
   const RefineConfig prm;
-  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
+  const ShellRebuild rb = rebuilt(box_with_fin({Vec3(0, 1, 6), Vec3(0, 5, 6), Vec3(0, 5, 8), Vec3(0, 1, 8)}));
   ASSERT_TRUE(rb.ok) << rb.reason;
   EXPECT_LE(rb.input_to_output, prm.repair.weld_tolerance);
   double area = 0.0;
@@ -106,14 +116,9 @@ TEST(RebuildShell, AFinEndingMidWallIsCarriedToItsOutline) {
 // clipped whole, a non-convex face can come out touching itself. Its whole area is carried and
 // no piece is a sliver narrower than the weld tolerance.
 TEST(RebuildShell, ANonConvexFinIsCarriedInConvexPieces) {
-  Mesh soup = box_faces({0, 1, 2, 3, 4, 5});
-  const int n = int(soup.vertices.size());
-  for (const Vec3& p : {Vec3(0, 1, 6), Vec3(0, 7, 6), Vec3(0, 7, 10), Vec3(0, 5, 10), Vec3(0, 5, 8), Vec3(0, 3, 8),
-                        Vec3(0, 3, 10), Vec3(0, 1, 10)})
-    soup.vertices.push_back(p);
-  soup.faces.push_back({{n, n + 1, n + 2, n + 3, n + 4, n + 5, n + 6, n + 7}, Semantic::Wall, 6});
   const RefineConfig prm;
-  const ShellRebuild rb = rebuild_shell(welded_soup(soup, prm.repair.weld_tolerance), prm);
+  const ShellRebuild rb = rebuilt(box_with_fin({Vec3(0, 1, 6), Vec3(0, 7, 6), Vec3(0, 7, 10), Vec3(0, 5, 10),
+                                                Vec3(0, 5, 8), Vec3(0, 3, 8), Vec3(0, 3, 10), Vec3(0, 1, 10)}));
   ASSERT_TRUE(rb.ok) << rb.reason;
   EXPECT_LE(rb.input_to_output, prm.repair.weld_tolerance);
   double area = 0.0;
