@@ -489,10 +489,10 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
 
 namespace {
 
-// `mesh`'s faces as one surface list of a geometry with semantics, its vertices appended to
-// `vertices` quantised by the transform.
-json cityjson_surfaces(const Mesh& mesh, const std::string& type, const std::string& lod, const Vec3& scale,
-                       const Vec3& translate, json& vertices) {
+// `mesh`'s faces as a geometry with semantics (a Solid of one shell when `solid`, else a
+// MultiSurface), its vertices appended to `vertices` quantised by the transform.
+json cityjson_surfaces(const Mesh& mesh, bool solid, const std::string& lod, const Vec3& scale, const Vec3& translate,
+                       json& vertices) {
   const long long base = (long long)vertices.size();
   for (const auto& p : mesh.vertices) {
     json q = json::array();
@@ -517,8 +517,9 @@ json cityjson_surfaces(const Mesh& mesh, const std::string& type, const std::str
     }
     values.push_back(it->second);
   }
-  const bool solid = type == "Solid";
-  json g = {{"type", type}, {"lod", lod}, {"boundaries", solid ? json::array({std::move(shell)}) : std::move(shell)}};
+  json g = {{"type", solid ? "Solid" : "MultiSurface"},
+            {"lod", lod},
+            {"boundaries", solid ? json::array({std::move(shell)}) : std::move(shell)}};
   g["semantics"] = {{"surfaces", std::move(surfaces)},
                     {"values", solid ? json::array({std::move(values)}) : std::move(values)}};
   return g;
@@ -528,12 +529,12 @@ json cityjson_surfaces(const Mesh& mesh, const std::string& type, const std::str
 
 json cityjson_solid(const Mesh& mesh, const std::string& lod, const Vec3& scale, const Vec3& translate,
                     json& vertices) {
-  return cityjson_surfaces(mesh, "Solid", lod, scale, translate, vertices);
+  return cityjson_surfaces(mesh, true, lod, scale, translate, vertices);
 }
 
 json cityjson_multisurface(const Mesh& mesh, const std::string& lod, const Vec3& scale, const Vec3& translate,
                            json& vertices) {
-  return cityjson_surfaces(mesh, "MultiSurface", lod, scale, translate, vertices);
+  return cityjson_surfaces(mesh, false, lod, scale, translate, vertices);
 }
 
 CityRefineSummary refine_city(const std::string& model_path, const std::vector<std::string>& cloud_paths,

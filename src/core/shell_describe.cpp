@@ -19,16 +19,6 @@ constexpr double kSeeThrough = 3.0;
 // Planes of the starting shell within kSurfaceAngleDeg and kSurfaceDistance are one supporting
 // plane (matching.h: the tolerance of a model surface).
 
-struct Frame2 {  // a plane's 2D frame
-  Vec3 o, u, v;
-  Vec2 operator()(const Vec3& p) const { return {(p - o).dot(u), (p - o).dot(v)}; }
-};
-
-Frame2 frame_of(const Plane& pl, const Vec3& centre) {
-  const auto [u, v] = pl.basis();
-  return {pl.project(centre), u, v};
-}
-
 using CellSet = std::unordered_set<std::int64_t>;
 // In unsigned arithmetic: shifting a negative index is undefined before C++20.
 std::int64_t cell_key(long long i, long long j) {

@@ -22,6 +22,8 @@ namespace {
 using detail::face_flags;
 using detail::FaceIndex;
 using detail::FaceProps;
+using detail::Frame2;
+using detail::frame_of;
 using detail::nearest_closed_selection;
 using detail::shell_problem;
 using detail::snapped_to_start;
@@ -137,18 +139,27 @@ class Winding {
 constexpr double kPartitionWinding = 0.75;
 constexpr double kFinWinding = 0.25;
 
-// Per soup face, whether a sample of it lies farther than `tolerance` from `shell`.
-std::vector<char> faces_off(const Mesh& soup, const Mesh& shell, double tolerance) {
-  const MeshDistance dist(shell);
-  const double spacing = sample_spacing(soup);
-  std::vector<char> off(soup.faces.size(), 0);
-  for (int f = 0; f < int(soup.faces.size()); ++f)
-    for (const Vec3& p : face_samples(soup, f, spacing))
-      if (dist.distance(p, false) > tolerance) {
-        off[std::size_t(f)] = 1;
-        break;
-      }
-  return off;
+// The soup's samples (face_samples, every `spacing`), per face, with their signed distances to
+// the rebuilt shell: the fins and the coverage are measured on the same ones.
+struct SoupSamples {
+  double spacing = 0.0;
+  std::vector<std::vector<Vec3>> at;
+  std::vector<std::vector<double>> to_shell;
+  // Whether a sample of face `f` lies farther than `tolerance` from the shell.
+  bool off(int f, double tolerance) const {
+    const auto& d = to_shell[std::size_t(f)];
+    return std::any_of(d.begin(), d.end(), [&](double x) { return std::abs(x) > tolerance; });
+  }
+};
+SoupSamples samples_of(const Mesh& soup, const MeshDistance& to_shell) {
+  SoupSamples out;
+  out.spacing = sample_spacing(soup);
+  for (int f = 0; f < int(soup.faces.size()); ++f) {
+    out.at.push_back(face_samples(soup, f, out.spacing));
+    out.to_shell.emplace_back();
+    for (const Vec3& p : out.at.back()) out.to_shell.back().push_back(to_shell.distance(p, true));
+  }
+  return out;
 }
 
 bool convex_2d(const std::vector<Vec2>& poly) {
@@ -188,12 +199,6 @@ std::vector<std::vector<Vec2>> convex_pieces(const std::vector<Vec3>& points, co
   return out;
 }
 
-Eigen::AlignedBox2d box_of(const std::vector<Vec2>& poly) {
-  Eigen::AlignedBox2d box;
-  for (const Vec2& p : poly) box.extend(p);
-  return box;
-}
-
 // The pieces of the soup's faces outside the shell with the soup's outside on both sides (its
 // winding there, without their own face, below kFinWinding): a fin, such as a neighbour's wall
 // standing above the roof. No solid holds one, so it goes beside the shell, as read: each soup
@@ -201,34 +206,34 @@ Eigen::AlignedBox2d box_of(const std::vector<Vec2>& poly) {
 // in the face's orientation, semantic and source. Each piece's winding number counts against
 // `terms` (kMaxWindingTerms): past it, no piece is carried (the rebuild is then refused).
 Mesh fins_beside(const CandidateSet& cs, const Supports& s, const std::vector<char>& chosen, const Mesh& soup,
-                 const Mesh& shell, const Winding& winding, double tolerance, double& terms) {
-  const std::vector<char> off = faces_off(soup, shell, tolerance);
+                 const SoupSamples& samples, const MeshDistance& to_shell, const Winding& winding, double tolerance,
+                 double& terms) {
   std::vector<std::vector<int>> left_out(cs.planes.size());
   const auto support = cs.supports();
   for (int f = 0; f < cs.size(); ++f)
     if (!chosen[f]) left_out[std::size_t(support[FaceIndex(f)])].push_back(f);
-  const MeshDistance to_shell(shell);
   Mesh fins;
   fins.id = soup.id;
   for (int sf = 0; sf < int(soup.faces.size()); ++sf) {
     const int k = s.face_plane[std::size_t(sf)];
-    if (!off[std::size_t(sf)] || k < 0) continue;
-    const Plane& plane = cs.planes[std::size_t(k)].plane;
-    const auto [u, v] = plane.basis();
-    const Vec3 origin = -plane.d * plane.n;
+    if (k < 0 || !samples.off(sf, tolerance)) continue;
+    // At the plane's point nearest the local origin: the clip rounds as it was measured (an origin
+    // at the region's centre changed one Delfshaven building's figures).
+    const Frame2 frame = frame_of(cs.planes[std::size_t(k)].plane, Vec3::Zero());
     auto flat = [&](const std::vector<Vec3>& poly) {
       std::vector<Vec2> out;
-      for (const Vec3& p : poly) out.emplace_back(u.dot(p - origin), v.dot(p - origin));
+      for (const Vec3& p : poly) out.push_back(frame(p));
       return out;
     };
     const std::vector<Vec3> points = face_points(soup, soup.faces[std::size_t(sf)]);
-    const Eigen::AlignedBox2d face_box = box_of(flat(points));
+    const std::vector<Vec2> face = flat(points);
+    const Eigen::AlignedBox2d face_box = bounding_box(face);
     for (int f : left_out[std::size_t(k)]) {
       const std::vector<Vec2> candidate = flat(cs.polygon(f));
-      if (!face_box.intersects(box_of(candidate))) continue;
-      for (const std::vector<Vec2>& piece : convex_pieces(points, flat(points), candidate, tolerance)) {
+      if (!face_box.intersects(bounding_box(candidate))) continue;
+      for (const std::vector<Vec2>& piece : convex_pieces(points, face, candidate, tolerance)) {
         std::vector<Vec3> corners;
-        for (const Vec2& q : piece) corners.push_back(origin + q.x() * u + q.y() * v);
+        for (const Vec2& q : piece) corners.push_back(frame.lifted(q));
         const Vec3 c = polygon_centroid(corners);
         if (to_shell.distance(c, true) <= tolerance) continue;
         terms += double(winding.triangles());
@@ -246,23 +251,23 @@ Mesh fins_beside(const CandidateSet& cs, const Supports& s, const std::vector<ch
   return snapped_to_start(fins, soup);
 }
 
-// The farthest a soup sample lies from the rebuilt `shell` and the `fins` beside it (m), over the
-// samples they must cover: all but a partition between parts the shell joins (inside it, the
-// soup's volume on both sides). An outer wall the shell swallows is no partition, and a fin not
-// carried beside it leaves the soup uncovered too. `out` gets the areas (m²) of the samples
-// farther than `tolerance` from the shell: on the fins (carried), the partitions' (dropped), the
-// others (uncovered) and of those a fin's.
-double uncovered(const Mesh& soup, const Mesh& shell, const Mesh& fins, const Winding& winding, double tolerance,
-                 double terms, ShellRebuild& out) {
-  const MeshDistance dist(shell);
+// The farthest a soup sample lies from the rebuilt shell (`samples`: their distances to it) and
+// the `fins` beside it (m), over the samples they must cover: all but a partition between parts
+// the shell joins (inside it, the soup's volume on both sides). An outer wall the shell swallows
+// is no partition, and a fin not carried beside it leaves the soup uncovered too. `out` gets the
+// areas (m²) of the samples farther than `tolerance` from the shell: on the fins (carried), the
+// partitions' (dropped), the others (uncovered) and of those a fin's.
+double uncovered(const SoupSamples& samples, const Mesh& fins, const Winding& winding, double tolerance, double terms,
+                 ShellRebuild& out) {
   const std::optional<MeshDistance> to_fins =
       fins.faces.empty() ? std::nullopt : std::make_optional<MeshDistance>(fins);
-  const double spacing = sample_spacing(soup), sample_area = spacing * spacing;
-  out.sampling = spacing;
+  const double sample_area = samples.spacing * samples.spacing;
+  out.sampling = samples.spacing;
   double worst = 0.0;
-  for (int f = 0; f < int(soup.faces.size()); ++f)
-    for (const Vec3& p : face_samples(soup, f, spacing)) {
-      const double d = dist.distance(p, true);
+  for (int f = 0; f < int(samples.at.size()); ++f)
+    for (std::size_t i = 0; i < samples.at[std::size_t(f)].size(); ++i) {
+      const Vec3& p = samples.at[std::size_t(f)][i];
+      const double d = samples.to_shell[std::size_t(f)][i];
       if (std::abs(d) <= tolerance) {
         worst = std::max(worst, std::abs(d));
         continue;
@@ -340,9 +345,12 @@ ShellRebuild rebuild_shell(const Mesh& soup, const RefineConfig& prm) {
   Mesh snapped = snapped_to_start(out.mesh, soup);
   if (shell_problem(snapped, prm.repair).empty()) out.mesh = std::move(snapped);
   const Winding winding(soup);
+  const MeshDistance to_shell(out.mesh);
+  const SoupSamples samples = samples_of(soup, to_shell);
   double terms = 0.0;  // the winding numbers' work, both passes (kMaxWindingTerms)
-  out.fins = fins_beside(cs, s, chosen, soup, out.mesh, winding, prm.repair.weld_tolerance, terms);
-  out.input_to_output = uncovered(soup, out.mesh, out.fins, winding, prm.repair.weld_tolerance, terms, out);
+  const double tolerance = prm.repair.weld_tolerance;
+  out.fins = fins_beside(cs, s, chosen, soup, samples, to_shell, winding, tolerance, terms);
+  out.input_to_output = uncovered(samples, out.fins, winding, tolerance, terms, out);
   added_area(out.mesh, soup, prm.repair.weld_tolerance, out);
   out.ok = true;
   return out;

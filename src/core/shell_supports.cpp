@@ -470,6 +470,11 @@ std::vector<int> enclosing_changes(const CandidateSet& cs, const std::vector<cha
 // ---------------------------------------------------------------------------------------------
 // Shared by the selection and the rebuild.
 
+Frame2 frame_of(const Plane& pl, const Vec3& centre) {
+  const auto [u, v] = pl.basis();
+  return {pl.project(centre), u, v};
+}
+
 // A boolean face map of `cs` as 0/1 per candidate (a selection).
 std::vector<char> face_flags(const CandidateSet& cs, const CandidateMap<bool>& map) {
   std::vector<char> out;

@@ -119,6 +119,15 @@ FaceProps describe_candidates(CandidateSet& cs, const Mesh& start, const Support
 std::vector<int> enclosing_changes(const CandidateSet& cs, const std::vector<char>& changed, const Mesh& start,
                                    const Mesh& shell, const std::vector<Vec3>& evidence, const PlaneEvidence& prm);
 
+// A plane's 2D frame: its basis (Plane::basis) at an origin on it.
+struct Frame2 {
+  Vec3 o, u, v;
+  Vec2 operator()(const Vec3& p) const { return {(p - o).dot(u), (p - o).dot(v)}; }
+  Vec3 lifted(const Vec2& q) const { return o + q.x() * u + q.y() * v; }  // back onto the plane
+};
+// `pl`'s frame with its origin where `centre` projects onto it.
+Frame2 frame_of(const Plane& pl, const Vec3& centre);
+
 // A boolean face map of `cs` as 0/1 per candidate (a selection).
 std::vector<char> face_flags(const CandidateSet& cs, const CandidateMap<bool>& map);
 // Output vertices within this (m) of a starting-shell vertex are put back on it: the plane meets
