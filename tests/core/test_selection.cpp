@@ -14,17 +14,26 @@
 using namespace lodrefine;
 using namespace lodrefine::fixtures;
 
+namespace {
+
+// Each candidate's coverage cost from its confidence (the paper's sigmoid).
+template <class Confidences>
+std::vector<double> coverage_costs(const CandidateSet& cs, const Confidences& conf, const SelectionConfig& prm) {
+  std::vector<double> cost;
+  for (std::size_t f = 0; f < std::size_t(cs.size()); ++f)
+    cost.push_back(coverage_cost(area_of(cs, f), conf[f].value, prm.tau_cov));
+  return cost;
+}
+
+}  // namespace
+
 TEST(Selection, RecoversTheClosedBoxFromConfidence) {
   const double a = 10, b = 8, c = 6;
   CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
   SelectionConfig prm;
   const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, ConfidenceConfig{});
-  std::vector<double> cost;
-  int full = 0;
-  for (std::size_t f = 0; f < std::size_t(cs.size()); ++f) {
-    cost.push_back(coverage_cost(area_of(cs, f), conf[f].value, prm.tau_cov));
-    full += conf[f].value > 0.99;
-  }
+  const std::vector<double> cost = coverage_costs(cs, conf, prm);
+  const auto full = std::count_if(conf.begin(), conf.end(), [](const auto& x) { return x.value > 0.99; });
   EXPECT_EQ(full, 6);
   const SelectionResult sel = select_faces(cs, cost, std::vector<int>(cs.edges.size(), 0), prm);
   ASSERT_TRUE(sel.ok) << sel.status_text();
@@ -56,8 +65,7 @@ TEST(Selection, AnExcludedLocalSelectionIsNotMade) {
   SelectionConfig prm;
   const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, ConfidenceConfig{});
   SelectionProgram pg;
-  for (std::size_t f = 0; f < std::size_t(cs.size()); ++f)
-    pg.cost.push_back(coverage_cost(area_of(cs, f), conf[f].value, prm.tau_cov));
+  pg.cost = coverage_costs(cs, conf, prm);
   ASSERT_TRUE(select_faces(cs, pg, prm).ok);
   LocalSelection box;
   for (int f = 0; f < cs.size(); ++f)
