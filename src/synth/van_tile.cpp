@@ -130,17 +130,18 @@ double footprint_overlap(const Eigen::AlignedBox3d& a, const Eigen::AlignedBox3d
 }
 
 // The city buildings that are the building itself (its copy must not stand in its own street):
-// the one meta's cityjson_id names and its parts; without one, those standing where the truth
+// the one meta's cityjson_id names and its parts; without one (or ""), those standing where the truth
 // stands: footprint boxes overlapping by half or more (a copy, a coarse model off by a metre),
 // or a box within the truth's grown by 1 m (a part).
 std::vector<std::size_t> city_self(const City& city, const Mesh& truth, const nlohmann::json& b,
                                    const std::string& where) {
   std::vector<std::size_t> out;
   const auto it = b.find("cityjson_id");
-  const bool named = it != b.end() && !it->is_null();
+  bool named = it != b.end() && !it->is_null();
   if (named && !it->is_string()) throw InputError(where + ": cityjson_id is no string");
   if (city.path.empty()) return out;
   const std::string id = named ? it->get<std::string>() : std::string();
+  named = !id.empty();  // "" would be every building's parent
   const Eigen::AlignedBox3d box = bounding_box(truth.vertices);
   const Eigen::AlignedBox3d grown(box.min() - Vec3(1, 1, 1e9), box.max() + Vec3(1, 1, 1e9));
   for (std::size_t i = 0; i < city.buildings.size(); ++i) {

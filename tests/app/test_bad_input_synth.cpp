@@ -77,13 +77,15 @@ TEST(BadInputSynth, SynthRefusesALinkedBuildingFolderAndReplacesLinkedFiles) {
   EXPECT_TRUE(files_in(dir + "/elsewhere").empty());
   write_text(dir + "/victim.txt", "victim\n");
   fs::create_symlink(dir + "/victim.txt", dir + "/tile.ply");
-  const CliRun tile = run_cli("synth --quiet --count 2 --points 500 --out " + dir + "/out --tile " + dir + "/tile.ply", dir);
+  const CliRun tile =
+      run_cli("synth --quiet --count 2 --points 500 --out " + dir + "/out --tile " + dir + "/tile.ply", dir);
   expect_one_error_line(tile, "is a symbolic link");
   EXPECT_TRUE(is_link(dir + "/tile.ply")) << "the tile untouched";
   fs::remove(dir + "/out/synth_flat_0001");
   fs::create_directories(dir + "/out/synth_flat_0001");
   fs::create_symlink(dir + "/victim.txt", dir + "/out/synth_flat_0001/truth.obj");
-  const CliRun ok = run_cli("synth --quiet --count 2 --points 500 --out " + dir + "/out --tile " + dir + "/tile.ply", dir);
+  const CliRun ok =
+      run_cli("synth --quiet --count 2 --points 500 --out " + dir + "/out --tile " + dir + "/tile.ply", dir);
   ASSERT_EQ(ok.exit, 0) << ok.err;
   EXPECT_EQ(read_text(dir + "/victim.txt"), "victim\n");
   EXPECT_FALSE(is_link(dir + "/out/synth_flat_0001/truth.obj"));
@@ -117,8 +119,8 @@ TEST(BadInputSynth, RescanOfAHostileTileIsBoundedAndLeavesNothing) {
   const CliRun once = run_cli(rescan_args(dir, "once"), dir);
   ASSERT_EQ(once.exit, 0) << once.err;
   const CliRun again = run_cli(
-      rescan_args(dir, "again", {{"id", "B"}, {"cityjson_id", "B"}, {"scanned_walls", std::vector<int>(200000, 0)}}), dir,
-      60);
+      rescan_args(dir, "again", {{"id", "B"}, {"cityjson_id", "B"}, {"scanned_walls", std::vector<int>(200000, 0)}}),
+      dir, 60);
   ASSERT_EQ(again.exit, 0) << again.err;
   EXPECT_LT(again.seconds, 10.0);
   EXPECT_TRUE(read_text(dir + "/again/tile.ply") == read_text(dir + "/once/tile.ply")) << "a wall again adds nothing";
@@ -135,7 +137,8 @@ TEST(BadInputSynth, RescanOfAHostileTileIsBoundedAndLeavesNothing) {
   };
   const std::string stray = "v " + std::to_string(rescan_fixtures::kTileOrigin.x() + 50000) + " 447000 0\nf 1 5 9\n";
   const std::vector<Case> cases = {
-      {"a stray vertex 50 km away", "truth/B.obj: spans 50 km, more than a building can (5 km)",
+      {"a stray vertex 50 km away",
+       "truth/B.obj: spans 50 km, more than a building can (5 km)",
        {{"id", "B"}, {"scanned_walls", {0}}},
        rescan_fixtures::box_obj_text(0, 0, stray)},
       {"cityjson_id 5", "building \"B\": cityjson_id is no string", {{"id", "B"}, {"cityjson_id", 5}}},

@@ -59,7 +59,8 @@ inline std::string terrace_city(double b_front = 0.0) {
               {"transform", {{"scale", {0.001, 0.001, 0.001}}, {"translate", {kTileOrigin.x(), kTileOrigin.y(), 0.0}}}},
               {"CityObjects", json::object()},
               {"vertices", json::array()}};
-  const std::pair<const char*, Vec3> boxes[] = {{"A", Vec3(-12, 0, 0)}, {"B", Vec3(0, b_front, 0)}, {"C", Vec3(12, 0, 0)}};
+  const std::pair<const char*, Vec3> boxes[] = {
+      {"A", Vec3(-12, 0, 0)}, {"B", Vec3(0, b_front, 0)}, {"C", Vec3(12, 0, 0)}};
   for (const auto& [id, at] : boxes) {
     const int first = int(doc["vertices"].size());
     for (const Vec3& p : box_corners(at.x(), at.y()))
@@ -76,14 +77,15 @@ inline std::string terrace_city(double b_front = 0.0) {
         {"values", {values}}};
     doc["CityObjects"][id] = {
         {"type", "Building"},
-        {"geometry",
-         {{{"type", "Solid"}, {"lod", "2.2"}, {"boundaries", {shell}}, {"semantics", semantics}}}}};
+        {"geometry", {{{"type", "Solid"}, {"lod", "2.2"}, {"boundaries", {shell}}, {"semantics", semantics}}}}};
   }
   return doc.dump();
 }
 
 // Files through the library's own helpers (the tests write small fixtures, read outputs whole).
-inline void write_text(const fs::path& path, const std::string& text) { lodrefine::write_file_atomic(path.string(), text); }
+inline void write_text(const fs::path& path, const std::string& text) {
+  lodrefine::write_file_atomic(path.string(), text);
+}
 inline std::string read_bytes(const fs::path& path) { return lodrefine::read_file(path.string()); }
 
 // Writes <root>/tile/{meta.json, truth/B.obj, models/B.obj} (the model's front 0.4 m out) and

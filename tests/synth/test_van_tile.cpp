@@ -25,11 +25,13 @@ SynthOptions van() {
 
 fs::path test_root() {
   const char* tmp = std::getenv("TEST_TMPDIR");
-  return fs::path(tmp ? tmp : "/tmp") / ("van_tile_" + std::string(testing::UnitTest::GetInstance()->current_test_info()->name()));
+  return fs::path(tmp ? tmp : "/tmp") /
+         ("van_tile_" + std::string(testing::UnitTest::GetInstance()->current_test_info()->name()));
 }
 
 void set_building(const fs::path& tile, const json& building) {
-  write_text(tile / "meta.json", json{{"origin", {kTileOrigin.x(), kTileOrigin.y(), 0.0}}, {"buildings", {building}}}.dump());
+  write_text(tile / "meta.json",
+             json{{"origin", {kTileOrigin.x(), kTileOrigin.y(), 0.0}}, {"buildings", {building}}}.dump());
 }
 
 // The InputError rescan_tile throws ("" when it writes the tile).
@@ -60,6 +62,8 @@ TEST(VanTile, TheBuildingsOwnCityCopyStaysOutOfItsStreetWithoutCityjsonId) {
   ASSERT_EQ(refusal(tile, city, root / "named"), "");
   set_building(tile, {{"id", "B"}, {"scanned_walls", {0}}});
   ASSERT_EQ(refusal(tile, city, root / "matched"), "");
+  set_building(tile, {{"id", "B"}, {"cityjson_id", ""}, {"scanned_walls", {0}}});  // "" is no id (nor every parent)
+  ASSERT_EQ(refusal(tile, city, root / "empty_id"), "");
   write_text(root / "coarse_city.json", terrace_city(-0.6));
   ASSERT_EQ(refusal(tile, (root / "coarse_city.json").string(), root / "coarse"), "");
   const std::string named = read_bytes(root / "named" / "tile.ply");
@@ -68,6 +72,7 @@ TEST(VanTile, TheBuildingsOwnCityCopyStaysOutOfItsStreetWithoutCityjsonId) {
   EXPECT_EQ(facade_points(root / "coarse"), facade_points(root / "named"));
   EXPECT_TRUE(read_bytes(root / "matched" / "tile.ply") == named) << "the same cloud as with cityjson_id";
   EXPECT_TRUE(read_bytes(root / "coarse" / "tile.ply") == named) << "the same cloud as with cityjson_id";
+  EXPECT_TRUE(read_bytes(root / "empty_id" / "tile.ply") == named) << "the same cloud as with cityjson_id";
   // A cityjson_id the city file lacks is a wrong city file (or id): refused, not guessed.
   set_building(tile, {{"id", "B"}, {"cityjson_id", "Z"}, {"scanned_walls", {0}}});
   EXPECT_NE(refusal(tile, city, root / "unknown").find("building \"B\": cityjson_id \"Z\" is no building of"),
@@ -108,8 +113,7 @@ TEST(VanTile, AModelOfKilometresIsRefusedAtOnce) {
     const auto t0 = std::chrono::steady_clock::now();
     const std::string why = refusal(tile, "", root / "out");
     EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
-    EXPECT_NE(why.find(std::string(which) + "/B.obj: spans 50 km, more than a building can (5 km)"),
-              std::string::npos)
+    EXPECT_NE(why.find(std::string(which) + "/B.obj: spans 50 km, more than a building can (5 km)"), std::string::npos)
         << why;
     EXPECT_FALSE(fs::exists(root / "out")) << which;
   }
@@ -172,8 +176,7 @@ TEST(VanTile, AScanOfTooManyRaysIsRefusedNamingTheBuilding) {
   o.van.angle_step_deg = 0.05, o.van.speed = 2.0, o.van.profile_rate = 50.0;  // 2 x 2,602 rays every 4 cm
   ASSERT_NO_THROW(check_synth_options(o));
   const std::string why = refusal(tile, "", root / "out", o);
-  EXPECT_NE(why.find("building \"B\": the van would cast 10.9 M rays, more than the 10 M"), std::string::npos)
-      << why;
+  EXPECT_NE(why.find("building \"B\": the van would cast 10.9 M rays, more than the 10 M"), std::string::npos) << why;
   EXPECT_FALSE(fs::exists(root / "out"));
   fs::remove_all(root);
 }
