@@ -95,28 +95,6 @@ void place_model(const Model& m, const fs::path& dir) {
   write_file_atomic(target.string(), "# id: " + m.id + "\n" + text.str());
 }
 
-// What a failed crop removes again: the folders and files it created (not those it replaced).
-struct Created {
-  std::vector<fs::path> paths;  // in creation order
-  void dir(const fs::path& d) {
-    if (fs::create_directories(d)) paths.push_back(d);
-  }
-  // A building's folder inside --out: a symbolic link there (a run folder from elsewhere, used as
-  // --models and --out) would take the building's files wherever it points.
-  void building_dir(const fs::path& d) {
-    if (fs::is_symlink(fs::symlink_status(d)))
-      throw InputError(d.string() + ": is a symbolic link; crop writes only inside --out");
-    dir(d);
-  }
-  void file(const fs::path& f) {
-    if (!fs::exists(fs::symlink_status(f))) paths.push_back(f);
-  }
-  void undo() {
-    std::error_code ec;
-    for (auto it = paths.rbegin(); it != paths.rend(); ++it) fs::remove(*it, ec);
-  }
-};
-
 // The box of every model kept (their crop boxes): a tile that misses it is of another area or CRS.
 Eigen::AlignedBox3d models_box(const std::vector<CropTarget>& targets) {
   Eigen::AlignedBox3d box;
@@ -146,35 +124,32 @@ void run(const CropArgs& a) {
     }
   }
   check_outputs(models, kept, tiles, a);
-  Created created;
+  OutputTree tree(a.out);  // a failed crop removes the folders and files it created (not those it replaced)
   std::vector<std::size_t> counts;
   std::size_t n = 0;
   std::vector<CloudFileRead> read;
-  try {
-    created.dir(a.out);
-    std::vector<std::string> clouds;
-    for (const auto& m : kept) {
-      created.building_dir(fs::path(a.out) / m.folder);
-      clouds.push_back((fs::path(a.out) / m.folder / "cloud.ply").string());
-      created.file(clouds.back());
-      created.file(fs::path(a.out) / m.folder / "coarse.obj");
-    }
-    std::unique_ptr<Progress> progress;  // made once the tiles read (their header counts are the total)
-    n = crop_tile_to_files(
-        tiles, targets, clouds, a.buffer_points, counts, a.cloud_options,
-        [&](std::uint64_t points) {
-          if (!progress)
-            progress = std::make_unique<Progress>("crop", "points", cloud_point_count(tiles),
-                                                  Progress::mode_for_stderr(a.quiet));
-          progress->update(points);
-        },
-        &read);
-    if (progress) progress->update(n), progress->finish();
-    for (const auto& m : kept) place_model(m, fs::path(a.out) / m.folder);
-  } catch (...) {
-    created.undo();
-    throw;
+  tree.folder();
+  std::vector<std::string> clouds;
+  for (const auto& m : kept) {
+    // A building's folder that is a symbolic link (a run folder from elsewhere, used as --models
+    // and --out) would take the building's files wherever it points: refused.
+    tree.folder(m.folder);
+    clouds.push_back(tree.file(m.folder + "/cloud.ply"));
+    tree.file(m.folder + "/coarse.obj");
   }
+  std::unique_ptr<Progress> progress;  // made once the tiles read (their header counts are the total)
+  n = crop_tile_to_files(
+      tiles, targets, clouds, a.buffer_points, counts, a.cloud_options,
+      [&](std::uint64_t points) {
+        if (!progress)
+          progress = std::make_unique<Progress>("crop", "points", cloud_point_count(tiles),
+                                                Progress::mode_for_stderr(a.quiet));
+        progress->update(points);
+      },
+      &read);
+  if (progress) progress->update(n), progress->finish();
+  for (const auto& m : kept) place_model(m, fs::path(a.out) / m.folder);
+  tree.keep();
   for (std::size_t i = 0; i < kept.size(); ++i) {
     const std::string& id = kept[i].own_id.empty() ? kept[i].id : kept[i].own_id;
     if (kept[i].folder == id) std::printf("%s: %zu points\n", kept[i].folder.c_str(), counts[i]);

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "commands.h"
+#include "lodrefine/base/files.h"
 #include "lodrefine/city/progress.h"
 #include "lodrefine/synth/synth.h"
 #include "options.h"
@@ -43,23 +44,27 @@ void run(SynthArgs& a) {
   a.opt.defects = !a.no_defects;
   a.opt.nuisances = !a.no_nuisances;
   a.opt.scanner = a.scanner == "van" ? Scanner::Van : Scanner::Even;
+  check_synth_options(a.opt);  // before anything is made: a van that would cast too many rays, say
   if (!a.rescan.empty()) {
     if (a.opt.scanner != Scanner::Van) throw InputError("synth --rescan: give --scanner van");
     rescan_tile(a.rescan, a.city, a.out, a.opt, a.seed, [&](const std::string& id, std::size_t points) {
-      if (!a.quiet) std::printf("%s  crop=%zu points\n", id.c_str(), points);
+      if (!a.quiet) std::printf("%s  crop=%zu points\n", id.c_str(), points);  // ids are safe names
     });
-    std::printf("%s rescanned by the van -> %s/{meta.json,tile.ply,clouds,models,truth}\n", a.rescan.c_str(),
-                a.out.c_str());
+    std::printf("%s rescanned by the van -> %s/{meta.json,tile.ply,clouds,models,truth}\n",
+                escaped_line(a.rescan).c_str(), escaped_line(a.out).c_str());
     return;
   }
+  OutputTree out(a.out);  // what a run refused or failed half-way made is removed again
+  out.folder();
   if (!a.tile.empty()) {
     std::uint64_t done = 0;
     Progress progress("synth", "buildings", std::uint64_t(a.count), Progress::mode_for_stderr(a.quiet));
-    const std::uint64_t points = write_synth_tile(a.out, a.tile, a.count, a.seed, a.grid, a.opt,
+    const std::uint64_t points = write_synth_tile(out, a.tile, a.count, a.seed, a.grid, a.opt,
                                                   [&](const SynthBuilding&) { progress.update(++done); });
     progress.finish();
-    std::printf("%d buildings -> %s/<id>/{coarse,truth}.obj, %llu points -> %s\n", a.count, a.out.c_str(),
-                static_cast<unsigned long long>(points), a.tile.c_str());
+    out.keep();
+    std::printf("%d buildings -> %s/<id>/{coarse,truth}.obj, %llu points -> %s\n", a.count, escaped_line(a.out).c_str(),
+                static_cast<unsigned long long>(points), escaped_line(a.tile).c_str());
     return;
   }
   const auto types =
@@ -67,11 +72,12 @@ void run(SynthArgs& a) {
   for (auto t : types)
     for (int i = 0; i < a.count; ++i) {
       const auto b = make_building(t, a.seed + std::uint64_t(i), a.opt);
-      write_synth_building(a.out, b);
+      write_synth_building(out, b);
       std::printf("%s  faces=%zu points=%zu scanned=[%s] moved=[%s] -> %s/%s\n", b.id.c_str(), b.truth.faces.size(),
-                  b.cloud.points.size(), scanned_summary(b).c_str(), moved_summary(b).c_str(), a.out.c_str(),
-                  b.id.c_str());
+                  b.cloud.points.size(), scanned_summary(b).c_str(), moved_summary(b).c_str(),
+                  escaped_line(a.out).c_str(), b.id.c_str());
     }
+  out.keep();
 }
 
 }  // namespace

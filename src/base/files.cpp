@@ -59,6 +59,16 @@ void AtomicFile::write(const char* data, std::size_t n) {
   }
 }
 
+void AtomicFile::write_at(std::size_t offset, const std::string& s) {
+  std::size_t done = 0;
+  while (done < s.size()) {
+    const ssize_t k = ::pwrite(fd_, s.data() + done, s.size() - done, off_t(offset + done));
+    if (k < 0 && errno == EINTR) continue;
+    if (k <= 0) fail(std::strerror(errno));
+    done += std::size_t(k);
+  }
+}
+
 void AtomicFile::commit() {
   if (::fsync(fd_) != 0) fail(std::strerror(errno));
   const int fd = fd_;
@@ -121,6 +131,66 @@ void copy_file_atomic(const std::string& from, const std::string& to) {
   while (in.read(buffer, sizeof buffer) || in.gcount() > 0) file.write(buffer, std::size_t(in.gcount()));
   if (in.bad()) file.fail("read error in " + from);
   file.commit();
+}
+
+namespace {
+
+// The folders from the root down to <root>/<rel>, the root first.
+std::vector<fs::path> folders_down(const std::string& root, const std::string& rel) {
+  fs::path base(root);
+  while (!base.has_filename() && base.has_relative_path()) base = base.parent_path();  // "out/"
+  std::vector<fs::path> out{base};
+  const fs::path r(rel);
+  if (r.is_absolute()) throw std::logic_error("OutputTree: an absolute path " + rel);
+  for (const fs::path& part : r) {
+    if (part == "..") throw std::logic_error("OutputTree: a path leaving the root " + rel);
+    if (part.empty() || part == ".") continue;
+    out.push_back(out.back() / part);
+  }
+  return out;
+}
+
+}  // namespace
+
+OutputTree::~OutputTree() {
+  if (kept_) return;
+  std::error_code ec;  // a folder something else was put in stays
+  for (auto it = created_.rbegin(); it != created_.rend(); ++it) fs::remove(*it, ec);
+}
+
+std::string OutputTree::check_folder(const std::string& rel) const {
+  const std::vector<fs::path> down = folders_down(root_, rel);
+  for (std::size_t i = 0; i < down.size(); ++i) {
+    std::error_code ec;
+    const fs::file_status st = i == 0 ? fs::status(down[i], ec) : fs::symlink_status(down[i], ec);
+    if (!fs::exists(st)) break;
+    if (fs::is_symlink(st))
+      throw InputError(down[i].string() + ": is a symbolic link; outputs are written only inside " + root_);
+    if (!fs::is_directory(st)) throw InputError(down[i].string() + ": not a folder");
+  }
+  return down.back().string();
+}
+
+std::string OutputTree::folder(const std::string& rel) {
+  check_folder(rel);
+  std::vector<fs::path> down = folders_down(root_, rel);
+  std::vector<fs::path> above;  // the root's missing parents
+  for (fs::path p = down.front().parent_path(); !p.empty() && !fs::exists(p); p = p.parent_path())
+    above.insert(above.begin(), p);
+  down.insert(down.begin(), above.begin(), above.end());
+  for (const fs::path& d : down) {
+    std::error_code ec;
+    if (fs::create_directory(d, ec)) created_.push_back(d.string());
+    else if (ec) throw InputError("cannot create the folder " + d.string() + ": " + ec.message());
+  }
+  return down.back().string();
+}
+
+std::string OutputTree::file(const std::string& rel) {
+  const fs::path path = fs::path(check_folder(fs::path(rel).parent_path().string())) / fs::path(rel).filename();
+  std::error_code ec;
+  if (!fs::exists(fs::symlink_status(path, ec))) created_.push_back(path.string());
+  return path.string();
 }
 
 void require_regular_file(const std::string& path) {

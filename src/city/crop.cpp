@@ -21,6 +21,14 @@
 
 namespace lodrefine {
 
+std::string building_extent_problem(const Mesh& model) {
+  const Eigen::AlignedBox3d box = bounding_box(model.vertices);
+  const double size = box.isEmpty() ? 0.0 : box.sizes().head<2>().maxCoeff();
+  if (size <= kMaxBuildingExtent) return "";
+  return "spans " + std::to_string(long(size / 1000.0)) + " km, more than a building can (" +
+         std::to_string(int(kMaxBuildingExtent / 1000.0)) + " km): a stray vertex?";
+}
+
 CropTarget crop_target(const Mesh& model, double relative, double absolute) {
   CropTarget t;
   t.id = model.id;
@@ -28,10 +36,8 @@ CropTarget crop_target(const Mesh& model, double relative, double absolute) {
   t.lo = box.min();
   t.hi = box.max();
   const Vec3 size = t.hi - t.lo;
-  if (!box.isEmpty() && size.head<2>().maxCoeff() > kMaxBuildingExtent)
-    throw InputError(model.id + ": spans " + std::to_string(long(size.head<2>().maxCoeff() / 1000.0)) +
-                     " km, more than a building can (" + std::to_string(int(kMaxBuildingExtent / 1000.0)) +
-                     " km): a stray vertex? not cropped");
+  if (const std::string problem = building_extent_problem(model); !problem.empty())
+    throw InputError(model.id + ": " + problem + " not cropped");
   const Vec3 grow(relative * size.x() + absolute, relative * size.y() + absolute, absolute);
   t.lo -= grow;
   t.hi += grow;

@@ -38,7 +38,9 @@ Mesh to_world(Mesh m, const Frame& f, const Vec3& shift) {
   return m;
 }
 
-void check_options(const SynthOptions& o) {
+}  // namespace
+
+void check_synth_options(const SynthOptions& o) {
   if (o.min_shift < 0 || o.max_shift < o.min_shift) throw InputError("synth: need 0 <= min_shift <= max_shift");
   if (o.max_shift > 3.0) throw InputError("synth: max_shift above 3 m would break the building's shape");
   if (o.max_rotation_deg < 0 || o.max_rotation_deg > 15) throw InputError("synth: max_rotation_deg must be in 0..15");
@@ -54,7 +56,11 @@ void check_options(const SynthOptions& o) {
     throw InputError("synth: the van needs max_range in 1..1000 m and height in 0..10 m");
   if (v.drives < 1 || v.drives > 8 || !(v.offset >= 0 && v.offset <= 5) || !(std::abs(v.heading_deg) <= 5))
     throw InputError("synth: the van needs 1..8 drives, offset in 0..5 m and heading_deg in -5..5");
+  if (o.scanner == Scanner::Van)
+    require_van_rays(v.drives * van_drive_rays(v, 2 * kVanRunOn), "synth: on even the smallest building");
 }
+
+namespace {
 
 // Every building type with its name, in the order `--type all` generates them.
 constexpr std::pair<BuildingType, const char*> kBuildingTypes[] = {
@@ -93,7 +99,7 @@ bool street_facade_type(BuildingType t) {
 }
 
 SynthBuilding make_building(BuildingType type, std::uint64_t seed, const SynthOptions& opt) {
-  check_options(opt);
+  check_synth_options(opt);
   // One stream per stage, so --no-defects / --no-nuisances leave the other outputs unchanged.
   const std::uint64_t key = splitmix64(seed * 16 + std::uint64_t(type));
   Rng r(key), r_defects(splitmix64(key ^ 1)), r_scan(splitmix64(key ^ 2));

@@ -1,14 +1,10 @@
 // Writing generated buildings (see synth.h): one folder per building, or a city tile whose
 // clouds stream into one PLY.
-#include <unistd.h>
-
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <map>
-#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "lodrefine/base/files.h"
@@ -92,16 +88,15 @@ Json meta_json(const SynthBuilding& b) {
 
 }  // namespace
 
-void write_synth_building(const std::string& dir, const SynthBuilding& b, bool with_cloud) {
-  const std::filesystem::path out = std::filesystem::path(dir) / b.id;
-  std::filesystem::create_directories(out);
-  write_obj((out / "truth.obj").string(), b.truth);
-  write_obj((out / "coarse.obj").string(), b.coarse);
+void write_synth_building(OutputTree& out, const SynthBuilding& b, bool with_cloud) {
+  out.folder(b.id);
+  write_obj(out.file(b.id + "/truth.obj"), b.truth);
+  write_obj(out.file(b.id + "/coarse.obj"), b.coarse);
   if (with_cloud) {
     const std::vector<float> labels(b.point_label.begin(), b.point_label.end());
-    write_ply((out / "cloud.ply").string(), b.cloud, Vec3::Zero(), &labels, "label");
+    write_ply(out.file(b.id + "/cloud.ply"), b.cloud, Vec3::Zero(), &labels, "label");
   }
-  write_file_atomic((out / "meta.json").string(),
+  write_file_atomic(out.file(b.id + "/meta.json"),
                     meta_json(b).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
@@ -109,16 +104,10 @@ void write_synth_building(const std::string& dir, const SynthBuilding& b, bool w
 #error "write_synth_tile writes the host's doubles as binary_little_endian"
 #endif
 
-std::uint64_t write_synth_tile(const std::string& dir, const std::string& tile_ply, int count, std::uint64_t first_seed,
+std::uint64_t write_synth_tile(OutputTree& out, const std::string& tile_ply, int count, std::uint64_t first_seed,
                                double spacing, const SynthOptions& opt,
                                const std::function<void(const SynthBuilding&)>& progress) {
-  std::string tmp;  // created exclusively beside the tile (a planted link is never followed)
-  const int fd = create_temp_file(std::filesystem::path(tile_ply).parent_path().string(), tile_ply, tmp);
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(::fdopen(fd, "wb"), std::fclose);
-  if (!f) {
-    ::close(fd), std::remove(tmp.c_str());
-    throw InputError("cannot write " + tile_ply + ": " + std::strerror(errno));
-  }
+  AtomicFile tile(tile_ply);  // a temporary beside the tile, removed unless complete
   // The count is only known at the end: a fixed-width field, rewritten in place.
   constexpr int kCountWidth = 15;
   const std::string head = "ply\nformat binary_little_endian 1.0\ncomment lodrefine synth tile\nelement vertex ";
@@ -128,16 +117,7 @@ std::uint64_t write_synth_tile(const std::string& dir, const std::string& tile_p
     std::snprintf(num, sizeof num, "%0*llu", kCountWidth, static_cast<unsigned long long>(n));
     return head + num + tail;
   };
-  auto fail = [&] {
-    const std::string reason = std::strerror(errno);
-    f.reset();
-    std::remove(tmp.c_str());
-    throw InputError("cannot write " + tmp + ": " + reason);
-  };
-  auto put = [&](const void* data, std::size_t bytes) {
-    if (std::fwrite(data, 1, bytes, f.get()) != bytes) fail();
-  };
-  put(header(0).data(), header(0).size());
+  tile.write(header(0));
   const auto types = all_building_types();
   const int columns = std::max(1, int(std::ceil(std::sqrt(double(count)))));
   std::uint64_t points = 0;
@@ -150,19 +130,16 @@ std::uint64_t write_synth_tile(const std::string& dir, const std::string& tile_p
     b.coarse = translated(std::move(b.coarse), shift);
     for (auto& p : b.cloud.points) p += shift;
     b.frame_origin += shift;
-    write_synth_building(dir, b, false);
+    write_synth_building(out, b, false);
     std::vector<double> xyz;
     xyz.reserve(3 * b.cloud.points.size());
     for (const auto& p : b.cloud.points) xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
-    put(xyz.data(), xyz.size() * sizeof(double));
+    tile.write(reinterpret_cast<const char*>(xyz.data()), xyz.size() * sizeof(double));
     points += b.cloud.points.size();
     if (progress) progress(b);
   }
-  if (std::fseek(f.get(), 0, SEEK_SET) != 0) fail();
-  put(header(points).data(), header(points).size());
-  if (std::fflush(f.get()) != 0 || ::fsync(::fileno(f.get())) != 0) fail();
-  f.reset();
-  std::filesystem::rename(tmp, tile_ply);
+  tile.write_at(0, header(points));
+  tile.commit();
   return points;
 }
 

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "lodrefine/base/geometry.h"
 
@@ -320,8 +321,9 @@ namespace {
 
 // m: the first lane's distance from the facade, and the far lane's beyond it.
 constexpr double kLaneMin = 4.5, kLaneMax = 7.0, kFarLaneMin = 2.5, kFarLaneMax = 3.5;
-// m: the drive runs this far past the building's ends; the street is clear from this far in front of the facade.
-constexpr double kRunOn = 15.0, kPavement = 2.0;
+// m: the street is clear from this far in front of the facade.
+constexpr double kPavement = 2.0;
+constexpr double kRunOn = kVanRunOn;
 const double kNewStreetCos = std::cos(radians(30.0));
 
 struct FacadeGroup {
@@ -373,10 +375,44 @@ void add_neighbour_boxes(StreetScene& scene, const FacadeGroup& g, double s0, do
   }
 }
 
+// The extent [s0, s1] of the building along the street of group g.
+std::pair<double, double> along_street(const Mesh& truth, const FacadeGroup& g) {
+  const Vec3 u(-g.n.y(), g.n.x(), 0);
+  double s0 = 1e300, s1 = -1e300;
+  for (const auto& p : truth.vertices) s0 = std::min(s0, u.dot(p)), s1 = std::max(s1, u.dot(p));
+  return {s0, s1};
+}
+
 }  // namespace
+
+double van_drive_rays(const VanOptions& o, double length) {
+  const double profiles = std::floor(length / (o.speed / o.profile_rate)) + 2;               // + the sum's rounding
+  const double per_profile = std::floor((kHighestDeg - kLowestDeg) / o.angle_step_deg) + 2;  // + the last's rounding
+  return profiles * 2 * per_profile;
+}
+
+double van_scan_rays(const Mesh& truth, const std::vector<int>& street_faces, const VanOptions& o) {
+  double rays = 0;
+  for (const FacadeGroup& g : facade_groups(truth, street_faces)) {
+    const auto [s0, s1] = along_street(truth, g);
+    rays += o.drives * van_drive_rays(o, s1 - s0 + 2 * kRunOn);
+  }
+  return rays;
+}
+
+void require_van_rays(double rays, const std::string& what) {
+  if (rays <= kMaxVanRays) return;
+  char buf[320];
+  std::snprintf(buf, sizeof buf,
+                ": the van would cast %.1f M rays, more than the %.0f M a building's scan may (memory and time "
+                "grow with them): lower the profile rate or the drives, raise the speed or the angle step",
+                rays / 1e6, kMaxVanRays / 1e6);
+  throw InputError(what + buf);
+}
 
 VanScan van_scan(const Mesh& truth, const std::vector<int>& street_faces, double z0,
                  const std::vector<Mesh>& neighbours, const SynthOptions& o, Rng& r) {
+  require_van_rays(van_scan_rays(truth, street_faces, o.van), "synth");
   StreetScene scene;
   std::vector<int> face_walls(truth.faces.size(), -1);
   for (int f : street_faces)
@@ -394,8 +430,7 @@ VanScan van_scan(const Mesh& truth, const std::vector<int>& street_faces, double
   for (std::size_t gi = 0; gi < groups.size(); ++gi) {
     const FacadeGroup& g = groups[gi];
     const Vec3 u(-g.n.y(), g.n.x(), 0);
-    double s0 = 1e300, s1 = -1e300;
-    for (const auto& p : truth.vertices) s0 = std::min(s0, u.dot(p)), s1 = std::max(s1, u.dot(p));
+    const auto [s0, s1] = along_street(truth, g);
     bool seen = false;
     for (const auto& lane : lanes) seen |= lane.first.side.dot(-g.n) > kNewStreetCos;
     if (seen) continue;

@@ -114,6 +114,21 @@ struct Misregistration {
 };
 Misregistration draw_misregistration(const VanOptions& o, const Vec3& pivot, Rng& r);
 
+// m: each drive runs this far past the building's ends (so even a building of no width needs
+// drives of 2 x kVanRunOn).
+constexpr double kVanRunOn = 15.0;
+
+// Rays one drive of `length` m casts at most: a profile every speed / profile_rate m along it,
+// two profilers, a ray every angle_step_deg over each profile's 130 degrees.
+double van_drive_rays(const VanOptions& o, double length);
+// Rays van_scan casts at most for `truth` and its `street_faces`: o.drives drives along the
+// building (plus the run-on) for each group of street faces facing one way (van_scan may skip
+// some). Cheap: no scene is made.
+double van_scan_rays(const Mesh& truth, const std::vector<int>& street_faces, const VanOptions& o);
+// Throws InputError "<what>: the van would cast N rays ..., more than kMaxVanRays ..." when
+// `rays` (van_scan_rays) pass kMaxVanRays.
+void require_van_rays(double rays, const std::string& what);
+
 // One building's van scan: the points (local frame), their labels and drives, the drives and each
 // drive's misregistration (the first one's is the identity).
 struct VanScan {
@@ -130,7 +145,8 @@ struct VanScan {
 // largest group of them facing one way and past each other group turned more than 30 degrees
 // whose street is clear (no building between the facade and the far lane), o.van.drives times
 // each. `neighbours` stand in the scene as kNeighbour; with none, boxes stand in for them past
-// the street's ends. Noise o.noise along each ray.
+// the street's ends. Noise o.noise along each ray. Throws InputError (require_van_rays) before
+// any work when the scan would pass kMaxVanRays.
 VanScan van_scan(const Mesh& truth, const std::vector<int>& street_faces, double z0,
                  const std::vector<Mesh>& neighbours, const SynthOptions& o, Rng& r);
 

@@ -1,8 +1,10 @@
 // A dev tile scanned again by the van (see synth.h, rescan_tile): the same truths and models, the
 // clouds replaced by a van's scan of each building's street in its own neighbourhood.
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "lodrefine/base/files.h"
 #include "lodrefine/base/geometry.h"
@@ -69,49 +71,107 @@ std::pair<int, int> devtile_label(int label, int b) {
   }
 }
 
-// The indices of the truth's faces that meta's scanned_walls names (positions among its walls).
-std::vector<int> street_faces(const Mesh& truth, const nlohmann::json& scanned_walls) {
-  std::vector<int> walls, out;
-  for (int f = 0; f < int(truth.faces.size()); ++f)
-    if (truth.faces[std::size_t(f)].sem == Semantic::Wall) walls.push_back(f);
-  for (const auto& w : scanned_walls)
-    if (w.is_number_integer() && w.get<long long>() >= 0 && w.get<long long>() < (long long)walls.size())
-      out.push_back(walls[std::size_t(w.get<long long>())]);
-  return out;
-}
+// One building of the tile, read and checked (with every other) before anything is written.
+struct TileBuilding {
+  std::string id;
+  Mesh truth, model;              // as read, georeferenced
+  std::vector<int> street;        // truth face indices of the walls scanned_walls names
+  std::vector<std::size_t> self;  // the city buildings that are this one: kept out of its street
+};
 
 struct City {
-  std::vector<Mesh> meshes;
+  std::string path;
+  std::vector<CityJsonBuilding> buildings;
   std::vector<Eigen::AlignedBox3d> boxes;
 };
 
 City read_city(const std::string& path) {
-  City c;
+  City c{path, {}, {}};
   if (path.empty()) return c;
-  for (auto& b : read_cityjson(path).buildings) {
-    c.boxes.push_back(bounding_box(b.mesh.vertices));
-    c.meshes.push_back(std::move(b.mesh));
-  }
+  c.buildings = read_cityjson(path).buildings;
+  for (const auto& b : c.buildings) c.boxes.push_back(bounding_box(b.mesh.vertices));
   return c;
 }
 
+// "<tile>/meta.json: building "<id>"": where a fault in one building's entry lies.
+std::string where_in(const std::string& tile, const std::string& id) {
+  return tile + "/meta.json: building " + shown_id(id);
+}
+
+// The truth's faces that `scanned_walls` names (positions among its walls), each once: a wall
+// listed again adds nothing (its relief would be drawn again, and the scan's time with it). An
+// entry that is no wall of the truth is refused.
+std::vector<int> street_faces(const Mesh& truth, const nlohmann::json& b, const std::string& where) {
+  std::vector<int> walls, out;
+  for (int f = 0; f < int(truth.faces.size()); ++f)
+    if (truth.faces[std::size_t(f)].sem == Semantic::Wall) walls.push_back(f);
+  const auto it = b.find("scanned_walls");
+  if (it == b.end()) return out;
+  if (!it->is_array()) throw InputError(where + ": scanned_walls is no list of wall indices");
+  std::vector<bool> listed(walls.size(), false);
+  for (const auto& w : *it) {
+    const bool index = w.is_number_integer() && w.get<long long>() >= 0 && w.get<long long>() < (long long)walls.size();
+    if (!index)
+      throw InputError(where + ": scanned_walls holds " + escaped_line(w.dump().substr(0, 40)) + ", no index of its " +
+                       std::to_string(walls.size()) + " walls");
+    if (!listed[std::size_t(w.get<long long>())]) out.push_back(walls[std::size_t(w.get<long long>())]);
+    listed[std::size_t(w.get<long long>())] = true;
+  }
+  return out;
+}
+
+// Area of the overlap of two boxes' footprints over that of their union.
+double footprint_overlap(const Eigen::AlignedBox3d& a, const Eigen::AlignedBox3d& b) {
+  const Eigen::Vector2d lo = a.min().head<2>().cwiseMax(b.min().head<2>());
+  const Eigen::Vector2d hi = a.max().head<2>().cwiseMin(b.max().head<2>());
+  const double both = (hi - lo).cwiseMax(0.0).prod();
+  const double area_a = a.sizes().head<2>().prod(), area_b = b.sizes().head<2>().prod();
+  return both > 0 ? both / (area_a + area_b - both) : 0.0;
+}
+
+// The city buildings that are the building itself (its copy must not stand in its own street):
+// the one meta's cityjson_id names and its parts; without one (or ""), those standing where the truth
+// stands: footprint boxes overlapping by half or more (a copy, a coarse model off by a metre),
+// or a box within the truth's grown by 1 m (a part).
+std::vector<std::size_t> city_self(const City& city, const Mesh& truth, const nlohmann::json& b,
+                                   const std::string& where) {
+  std::vector<std::size_t> out;
+  const auto it = b.find("cityjson_id");
+  bool named = it != b.end() && !it->is_null();
+  if (named && !it->is_string()) throw InputError(where + ": cityjson_id is no string");
+  if (city.path.empty()) return out;
+  const std::string id = named ? it->get<std::string>() : std::string();
+  named = !id.empty();  // "" would be every building's parent
+  const Eigen::AlignedBox3d box = bounding_box(truth.vertices);
+  const Eigen::AlignedBox3d grown(box.min() - Vec3(1, 1, 1e9), box.max() + Vec3(1, 1, 1e9));
+  for (std::size_t i = 0; i < city.buildings.size(); ++i) {
+    const CityJsonBuilding& c = city.buildings[i];
+    const bool same = named ? c.mesh.id == id || c.parent == id
+                            : footprint_overlap(box, city.boxes[i]) >= 0.5 || grown.contains(city.boxes[i]);
+    if (same) out.push_back(i);
+  }
+  if (named && out.empty())
+    throw InputError(where + ": cityjson_id " + shown_id(id) + " is no building of " + city.path);
+  return out;
+}
+
 // The city's buildings near `box` (world frame), but `self`, moved by -origin.
-std::vector<Mesh> neighbours(const City& city, const Eigen::AlignedBox3d& box, const std::string& self,
+std::vector<Mesh> neighbours(const City& city, const Eigen::AlignedBox3d& box, const std::vector<std::size_t>& self,
                              const Vec3& origin) {
   std::vector<Mesh> out;
-  for (std::size_t i = 0; i < city.meshes.size(); ++i) {
-    if (city.meshes[i].id == self) continue;
+  for (std::size_t i = 0; i < city.buildings.size(); ++i) {
+    if (std::find(self.begin(), self.end(), i) != self.end()) continue;
     const auto& b = city.boxes[i];
     if (b.min().x() > box.max().x() + kNeighbourhood || b.max().x() < box.min().x() - kNeighbourhood ||
         b.min().y() > box.max().y() + kNeighbourhood || b.max().y() < box.min().y() - kNeighbourhood)
       continue;
-    out.push_back(translated(city.meshes[i], -origin));
+    out.push_back(translated(city.buildings[i].mesh, -origin));
   }
   return out;
 }
 
 // The tile's origin, once meta.json is known to be a dev tile's: an origin of three numbers, and
-// buildings each with an id that names a file in the tile's folders (no path, nothing hidden).
+// a list of buildings.
 Vec3 tile_origin(const nlohmann::json& meta, const std::string& tile) {
   const std::string where = tile + "/meta.json: ";
   const auto& o = meta.contains("origin") ? meta["origin"] : nlohmann::json();
@@ -119,51 +179,91 @@ Vec3 tile_origin(const nlohmann::json& meta, const std::string& tile) {
     throw InputError(where + "no origin of three numbers: not a dev tile");
   if (!meta.contains("buildings") || !meta["buildings"].is_array())
     throw InputError(where + "no buildings: not a dev tile");
+  const Vec3 origin(o[0].get<double>(), o[1].get<double>(), o[2].get<double>());
+  if (!(origin.array().abs() <= kMaxCoordinate).all()) throw InputError(where + "an origin beyond 1e9 m");
+  return origin;
+}
+
+// A building's id: a safe name (it names the tile's files, and ours), given once.
+std::string building_id(const nlohmann::json& b, const std::string& tile, std::set<std::string>& seen) {
+  const bool named = b.is_object() && b.contains("id") && b["id"].is_string();
+  const std::string id = named ? b["id"].get<std::string>() : std::string();
+  if (!is_safe_name(id))
+    throw InputError(tile + "/meta.json: a building without a safe id (" +
+                     escaped_line(named ? id.substr(0, 60) : b.dump().substr(0, 60)) +
+                     "): ids name the tile's files: [A-Za-z0-9._-], at most " + std::to_string(kMaxSafeName) +
+                     " bytes, no leading '.' or '-'");
+  if (!seen.insert(id).second) throw InputError(where_in(tile, id) + ": listed twice");
+  return id;
+}
+
+// A model of the tile: read, and no wider than a building can be (a stray vertex would have the
+// van drive for kilometres).
+Mesh read_model(const fs::path& path) {
+  Mesh m = read_obj(path.string());
+  const std::string problem = building_extent_problem(m);
+  if (!problem.empty()) throw InputError(path.string() + ": " + problem);
+  return m;
+}
+
+// Every building of meta.json, read and checked: ids, files, sizes, walls, the city's copy and
+// the van's rays. Nothing is written before this returns.
+std::vector<TileBuilding> read_tile(const nlohmann::json& meta, const std::string& tile, const Vec3& origin,
+                                    const City& city, const SynthOptions& opt) {
+  const fs::path in(tile);
+  std::vector<TileBuilding> out;
+  std::set<std::string> seen;
   for (const auto& b : meta["buildings"]) {
-    const bool named = b.is_object() && b.contains("id") && b["id"].is_string();
-    const std::string id = named ? b["id"].get<std::string>() : std::string();
-    if (id.empty() || id.find('/') != std::string::npos || id.find('\0') != std::string::npos || id[0] == '.')
-      throw InputError(where + "a building without a safe id (" + (named ? id : b.dump().substr(0, 60)) + ")");
+    TileBuilding t;
+    t.id = building_id(b, tile, seen);
+    const std::string where = where_in(tile, t.id);
+    t.truth = read_model(in / "truth" / (t.id + ".obj"));
+    t.model = read_model(in / "models" / (t.id + ".obj"));
+    t.street = street_faces(t.truth, b, where);
+    t.self = city_self(city, t.truth, b, where);
+    require_van_rays(van_scan_rays(translated(t.truth, -origin), t.street, opt.van), where);
+    out.push_back(std::move(t));
   }
-  return {o[0].get<double>(), o[1].get<double>(), o[2].get<double>()};
+  return out;
 }
 
 }  // namespace
 
 void rescan_tile(const std::string& tile, const std::string& city_path, const std::string& out, const SynthOptions& opt,
                  std::uint64_t seed, const std::function<void(const std::string&, std::size_t)>& progress) {
-  const fs::path in(tile), to(out);
-  if (fs::exists(to / "meta.json")) throw InputError(out + ": already holds a tile; give an empty folder");
+  check_synth_options(opt);
+  OutputTree tree(out);
+  const fs::path in(tile);
+  if (fs::exists(fs::path(out) / "meta.json")) throw InputError(out + ": already holds a tile; give an empty folder");
+  for (const char* sub : {"clouds", "models", "truth"}) tree.check_folder(sub);  // a planted link refused
   nlohmann::json meta = parse_json(read_file((in / "meta.json").string()), (in / "meta.json").string());
-  const Vec3 origin = tile_origin(meta, tile);  // meta.json checked whole before anything is written
+  const Vec3 origin = tile_origin(meta, tile);
   const City city = read_city(city_path);
-  for (const char* sub : {"clouds", "models", "truth"}) fs::create_directories(to / sub);
+  const std::vector<TileBuilding> buildings = read_tile(meta, tile, origin, city, opt);
+  for (const char* sub : {"clouds", "models", "truth"}) tree.folder(sub);
   DevtileCloud whole;
-  int index = 0;
-  for (auto& b : meta["buildings"]) {
-    const std::string id = b["id"].get<std::string>();
-    const Mesh truth = read_obj((in / "truth" / (id + ".obj")).string());
-    const Mesh model = read_obj((in / "models" / (id + ".obj")).string());
-    const Mesh local = translated(truth, -origin);
+  for (std::size_t index = 0; index < buildings.size(); ++index) {
+    const TileBuilding& t = buildings[index];
+    nlohmann::json& b = meta["buildings"][index];
+    const Mesh local = translated(t.truth, -origin);
     double z0 = 1e300;
     for (const auto& v : local.vertices) z0 = std::min(z0, v.z());
     Rng r(splitmix64(seed * 1000003 + std::uint64_t(index)));
-    const std::string self = b.value("cityjson_id", std::string());
-    const VanScan scan = van_scan(local, street_faces(local, b.value("scanned_walls", nlohmann::json::array())), z0,
-                                  neighbours(city, bounding_box(truth.vertices), self, origin), opt, r);
-    const CropTarget crop = crop_target(model, kCropRelative, kCropAbsolute);
+    const VanScan scan =
+        van_scan(local, t.street, z0, neighbours(city, bounding_box(t.truth.vertices), t.self, origin), opt, r);
+    const CropTarget crop = crop_target(t.model, kCropRelative, kCropAbsolute);
     DevtileCloud cloud;
     for (std::size_t i = 0; i < scan.pts.size(); ++i) {
       const Vec3 p = scan.pts[i] + origin;
       if ((p.array() < crop.lo.array()).any() || (p.array() > crop.hi.array()).any()) continue;
-      const auto [label, owner] = devtile_label(scan.labels[i], index);
+      const auto [label, owner] = devtile_label(scan.labels[i], int(index));
       cloud.pts.push_back(p), cloud.label.push_back(label), cloud.building.push_back(owner);
     }
-    write_file_atomic((to / "clouds" / (id + ".ply")).string(), cloud.ply());
-    fs::copy_file(in / "truth" / (id + ".obj"), to / "truth" / (id + ".obj"), fs::copy_options::overwrite_existing);
-    fs::copy_file(in / "models" / (id + ".obj"), to / "models" / (id + ".obj"), fs::copy_options::overwrite_existing);
+    write_file_atomic(tree.file("clouds/" + t.id + ".ply"), cloud.ply());
+    copy_file_atomic((in / "truth" / (t.id + ".obj")).string(), tree.file("truth/" + t.id + ".obj"));
+    copy_file_atomic((in / "models" / (t.id + ".obj")).string(), tree.file("models/" + t.id + ".obj"));
     int facade = 0;
-    for (std::size_t i = 0; i < cloud.pts.size(); ++i) facade += cloud.building[i] == index && cloud.label[i] <= 1;
+    for (std::size_t i = 0; i < cloud.pts.size(); ++i) facade += cloud.building[i] == int(index) && cloud.label[i] <= 1;
     b["points"] = facade;
     b["crop_points"] = cloud.pts.size();
     b["drives"] = scan.drives.size();
@@ -172,8 +272,7 @@ void rescan_tile(const std::string& tile, const std::string& city_path, const st
       b["misregistration"] = {{"shift", {s.x(), s.y(), s.z()}}, {"heading_deg", scan.misregistration[1].heading_deg}};
     }
     whole.append(cloud);
-    if (progress) progress(id, cloud.pts.size());
-    ++index;
+    if (progress) progress(t.id, cloud.pts.size());
   }
   const VanOptions& v = opt.van;
   meta["scanner"] = {{"kind", "van"},
@@ -191,8 +290,9 @@ void rescan_tile(const std::string& tile, const std::string& city_path, const st
                      {"heading_deg", v.heading_deg},
                      {"noise", opt.noise},
                      {"relief", opt.nuisances}};
-  write_file_atomic((to / "tile.ply").string(), whole.ply());
-  write_file_atomic((to / "meta.json").string(), meta.dump(1) + "\n");
+  write_file_atomic(tree.file("tile.ply"), whole.ply());
+  write_file_atomic(tree.file("meta.json"), meta.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  tree.keep();
 }
 
 }  // namespace lodrefine

@@ -229,3 +229,54 @@ TEST(EscapedLine, ControlCharactersEscapedTextKept) {
   EXPECT_EQ(escaped_line("Größe 東京 \xc2\xa0nbsp"), "Größe 東京 \xc2\xa0nbsp");
   EXPECT_EQ(escaped_line(std::string("nul\0end", 7)), "nul\\x00end");
 }
+
+// The outputs of one run (issue 47): a folder below the root that is a symbolic link is refused
+// (a planted `truth -> /elsewhere` took synth's files there), and a run that does not finish
+// removes the files and folders it created, never one that was there before.
+TEST(OutputTree, RefusesLinkedFoldersAndRemovesOnlyWhatItCreated) {
+  const std::string root = temp_path("output_tree");
+  fs::remove_all(root);
+  fs::create_directories(root + "/old");
+  write_file_atomic(root + "/old/keep.txt", "keep");
+  fs::create_directories(root + "/elsewhere");
+  fs::create_directory_symlink(root + "/elsewhere", root + "/old/linked");
+  {
+    OutputTree tree(root + "/");
+    tree.folder("new/deeper");
+    write_file_atomic(tree.file("new/deeper/x.txt"), "x");
+    write_file_atomic(tree.file("old/keep.txt"), "replaced");
+    write_file_atomic(tree.file("old/y.txt"), "y");
+    EXPECT_TRUE(fs::exists(root + "/new/deeper/x.txt"));
+    for (const std::string rel : {"old/linked", "old/linked/sub"}) {
+      EXPECT_THROW(tree.folder(rel), InputError) << rel;
+      EXPECT_THROW(tree.file(rel + "/z.txt"), InputError) << rel;
+    }
+    try {
+      tree.check_folder("old/linked");
+      ADD_FAILURE() << "a linked folder was taken";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()),
+                root + "/old/linked: is a symbolic link; outputs are written only inside " + root + "/");
+    }
+    EXPECT_THROW(tree.folder("old/keep.txt"), InputError);
+    EXPECT_THROW(tree.file("../x.txt"), std::logic_error);
+  }  // not kept
+  EXPECT_FALSE(fs::exists(root + "/new"));
+  EXPECT_FALSE(fs::exists(root + "/old/y.txt"));
+  EXPECT_EQ(read_file(root + "/old/keep.txt"), "replaced") << "replaced, not removed: it was there before";
+  EXPECT_TRUE(fs::is_empty(root + "/elsewhere"));
+  {
+    OutputTree tree(root + "/made/here");
+    tree.folder("a");
+    write_file_atomic(tree.file("a/x.txt"), "x");
+  }
+  EXPECT_FALSE(fs::exists(root + "/made")) << "the root's missing parents too";
+  {
+    OutputTree tree(root + "/made");
+    tree.folder("a");
+    write_file_atomic(tree.file("a/x.txt"), "x");
+    tree.keep();
+  }
+  EXPECT_TRUE(fs::exists(root + "/made/a/x.txt"));
+  fs::remove_all(root);
+}

@@ -440,7 +440,9 @@ TEST(SynthWrite, WritesFourFilesAndMeta) {
   SynthOptions o;
   o.target_points = 3000;
   const auto b = make_building(BuildingType::TShape, 3, o);
-  write_synth_building(dir.string(), b);
+  OutputTree out(dir.string());
+  write_synth_building(out, b);
+  out.keep();
   const auto d = dir / b.id;
   for (const char* f : {"truth.obj", "coarse.obj", "cloud.ply", "meta.json"})
     EXPECT_TRUE(std::filesystem::exists(d / f)) << f;

@@ -51,6 +51,8 @@ class AtomicFile {
   ~AtomicFile();
   void write(const char* data, std::size_t n);
   void write(const std::string& s) { write(s.data(), s.size()); }
+  // Overwrites bytes already written at `offset` (a count only known at the end, in a header).
+  void write_at(std::size_t offset, const std::string& s);
   void commit();
   [[noreturn]] void fail(const std::string& reason);  // discards, throws std::runtime_error
 
@@ -99,6 +101,39 @@ auto read_naming_memory(const std::string& path, Read&& read) -> decltype(read()
 void write_file_atomic(const std::string& path, const std::string& content);
 // Copies the regular file `from` to `to` atomically (same guarantees as write_file_atomic).
 void copy_file_atomic(const std::string& from, const std::string& to);
+
+// The files and folders one run writes below the output folder it was given. A folder below the
+// root that is a symbolic link is refused (a planted `truth -> /elsewhere` would take the files
+// where it points; the root itself is the user's and may be one), and what the run created is
+// removed again unless keep() is reached: a run refused or failed half-way leaves no partial
+// output, and nothing that was there before is ever removed. Write each file with AtomicFile (a
+// link at a file is replaced, never followed). Paths `rel` are relative to the root, with no
+// `..` (a programming error: std::logic_error).
+class OutputTree {
+ public:
+  explicit OutputTree(std::string root) : root_(std::move(root)) {}
+  OutputTree(const OutputTree&) = delete;
+  OutputTree& operator=(const OutputTree&) = delete;
+  ~OutputTree();  // removes what was created, newest first, unless kept
+
+  // <root>/<rel> checked, nothing created: throws InputError "<path>: is a symbolic link; ..."
+  // when it or a folder between it and the root is a link, "<path>: not a folder" when it is
+  // anything else but a folder (or missing: fine). Returns the path.
+  std::string check_folder(const std::string& rel = "") const;
+  // Creates the root and the folders down to <root>/<rel> that are missing (each recorded),
+  // after check_folder. Returns the path.
+  std::string folder(const std::string& rel = "");
+  // <root>/<rel>, a file this run is about to write in a folder made by folder(): recorded when
+  // nothing is there yet. Returns the path.
+  std::string file(const std::string& rel);
+  const std::string& root() const { return root_; }
+  void keep() { kept_ = true; }
+
+ private:
+  std::string root_;
+  std::vector<std::string> created_;  // in creation order
+  bool kept_ = false;
+};
 
 // Throws InputError "<path>: not a regular file ..." for devices, FIFOs, sockets and
 // directories: reading /dev/zero or a pipe would not end (or not before gigabytes), and their

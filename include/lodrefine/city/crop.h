@@ -19,6 +19,11 @@ struct CropTarget {
 // crop would hold a whole tile.
 constexpr double kMaxBuildingExtent = 5000.0;
 
+// "spans N km, more than a building can (5 km): a stray vertex?" for a model wider than
+// kMaxBuildingExtent in x or y, else empty: crop, a city refine and synth --rescan refuse such a
+// model, each naming it.
+std::string building_extent_problem(const Mesh& model);
+
 // The model's bounding box grown by `relative` of its size and `absolute` metres on each side
 // (vertically by `absolute` only). Throws InputError "<model id>: spans N km ..." for a model
 // wider than kMaxBuildingExtent.

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "lodrefine/base/files.h"
 #include "lodrefine/base/types.h"
 
 namespace lodrefine {
@@ -36,6 +37,11 @@ struct VanOptions {
   double offset = 0.08;       // m: the second drive's misregistration, drawn in [offset / 4, offset]
   double heading_deg = 0.03;  // deg: and its heading error, drawn in [-heading_deg, heading_deg]
 };
+
+// The most rays one building's van scan may cast over all its drives (each return holds ~80
+// bytes until the building is cropped: ~0.8 GB at most). The defaults cast ~0.5 M rays past a
+// 20 m facade; --points bounds the even scanner the same way.
+inline constexpr double kMaxVanRays = 10e6;
 
 enum class Scanner {
   Even,  // the facades sampled evenly (a jittered grid), nuisances cut from it
@@ -86,19 +92,27 @@ struct SynthBuilding {
                                  // -3 ground, -4 neighbour, -5 relief (balcony, cornice), -6 room behind glass
 };
 
+// Throws InputError, one line naming the rule, for options out of their ranges, and with
+// Scanner::Van for a van that would pass kMaxVanRays on even the smallest building (one street,
+// its drives each of the 2 x 15 m they run on past the building's ends). make_building and
+// rescan_tile call it; a command calls it first, before anything is written.
+void check_synth_options(const SynthOptions& opt);
+
 // Deterministic for (type, seed, options).
 SynthBuilding make_building(BuildingType type, std::uint64_t seed, const SynthOptions& opt = {});
 
-// Writes DIR/<id>/{truth.obj, coarse.obj, cloud.ply, meta.json} (without cloud.ply when
-// `with_cloud` is false).
-void write_synth_building(const std::string& dir, const SynthBuilding& b, bool with_cloud = true);
+// Writes <out>/<id>/{truth.obj, coarse.obj, cloud.ply, meta.json} (without cloud.ply when
+// `with_cloud` is false), recorded in `out` (a folder <id> that is a symbolic link is refused,
+// InputError; a link at a file is replaced, never followed).
+void write_synth_building(OutputTree& out, const SynthBuilding& b, bool with_cloud = true);
 
 // A city tile for the city-scale bench: `count` buildings (types cycling, seeds first_seed...)
-// on a square grid of `spacing` metres from opt.origin, each written as DIR/<id>/{truth.obj,
+// on a square grid of `spacing` metres from opt.origin, each written as <out>/<id>/{truth.obj,
 // coarse.obj, meta.json}, and all their clouds streamed into one binary PLY `tile_ply` (one
-// building in memory at a time; written under a temporary name, renamed when complete).
-// `progress` (may be empty) gets each building after it is written. Returns the tile's points.
-std::uint64_t write_synth_tile(const std::string& dir, const std::string& tile_ply, int count, std::uint64_t first_seed,
+// building in memory at a time; written under a temporary name, renamed when complete, so a
+// failure leaves the tile as it was). `progress` (may be empty) gets each building after it is
+// written. Returns the tile's points.
+std::uint64_t write_synth_tile(OutputTree& out, const std::string& tile_ply, int count, std::uint64_t first_seed,
                                double spacing, const SynthOptions& opt,
                                const std::function<void(const SynthBuilding&)>& progress);
 
