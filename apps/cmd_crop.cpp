@@ -104,7 +104,8 @@ Eigen::AlignedBox3d models_box(const std::vector<CropTarget>& targets) {
 }
 
 void run(const CropArgs& a) {
-  const std::vector<std::string> tiles = cloud_files(a.tiles, "--tile");
+  std::vector<SkippedEntry> not_tiles;  // the folders' entries that are no cloud files
+  const std::vector<std::string> tiles = cloud_files(a.tiles, "--tile", &not_tiles);
   if (!fs::is_directory(a.models)) throw InputError(a.models + ": not a directory");
   const auto models = find_models(a.models);
   if (models.empty()) throw InputError(a.models + ": no *.obj or */coarse.obj models");
@@ -150,6 +151,7 @@ void run(const CropArgs& a) {
   if (progress) progress->update(n), progress->finish();
   for (const auto& m : kept) place_model(m, fs::path(a.out) / m.folder);
   tree.keep();
+  if (!not_tiles.empty()) std::printf("%s\n", skipped_entries_text(not_tiles).c_str());
   for (std::size_t i = 0; i < kept.size(); ++i) {
     const std::string& id = kept[i].own_id.empty() ? kept[i].id : kept[i].own_id;
     if (kept[i].folder == id) std::printf("%s: %zu points\n", kept[i].folder.c_str(), counts[i]);

@@ -7,6 +7,8 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <utility>
+#include <vector>
 
 #include "commands.h"
 #include "lodrefine/base/files.h"
@@ -33,7 +35,18 @@ struct RefineArgs {
   bool quiet = false;
   bool repair_all = false;                                // city files only
   std::uint64_t max_crop_points = kDefaultMaxCropPoints;  // city files only
+  // The options above marked "city files only", each with what it does: given with an OBJ
+  // model, one is refused by name (refuse_city_options), never ignored.
+  std::vector<std::pair<const CLI::Option*, std::string>> city_only;
 };
+
+// The first option of a city file's refine given with an OBJ model, refused in one line.
+void refuse_city_options(const RefineArgs& a) {
+  for (const auto& [option, what] : a.city_only)
+    if (option->count() > 0)
+      throw InputError(a.model + ": " + option->get_name() + " (" + what +
+                       ") applies to a city file as --model (CityJSON, CityJSONSeq, CityGML), not to an OBJ");
+}
 
 // Scan points per refined building on the review page: enough to see each facade, and what
 // bounds the collector's memory (only refined buildings keep meshes and points).
@@ -133,7 +146,8 @@ void check_outputs_are_new(const RefineArgs& a, const std::vector<std::string>& 
 
 // The report's "cloud" files: each file's path, the points read from it and their bounds (null
 // when none), in reading order; "path" too when the cloud is one file, as before several were read.
-nlohmann::json cloud_json(const std::vector<CloudFileRead>& files) {
+// Then the entries of the cloud folders skipped as no cloud files, each with its path and why.
+nlohmann::json cloud_json(const std::vector<CloudFileRead>& files, const std::vector<SkippedEntry>& skipped) {
   nlohmann::json cloud = nlohmann::json::object(), list = nlohmann::json::array();
   if (files.size() == 1) cloud["path"] = files.front().path;
   const auto xyz = [](const Vec3& p) { return nlohmann::json::array({p.x(), p.y(), p.z()}); };
@@ -143,8 +157,14 @@ nlohmann::json cloud_json(const std::vector<CloudFileRead>& files) {
          {"points", f.points},
          {"bounds", f.bounds.isEmpty() ? nlohmann::json()
                                        : nlohmann::json{{"min", xyz(f.bounds.min())}, {"max", xyz(f.bounds.max())}}}});
+  for (const SkippedEntry& e : skipped) list.push_back({{"path", e.path}, {"skipped", e.reason}});
   cloud["files"] = std::move(list);
   return cloud;
+}
+
+// The cloud folders' skipped entries, one line on stdout before the outcome (none when none).
+void print_skipped(const std::vector<SkippedEntry>& skipped) {
+  if (!skipped.empty()) std::printf("%s\n", skipped_entries_text(skipped).c_str());
 }
 
 // "12 refined, 2 repaired, 3 kept, 1 kept-invalid": the progress line's tally.
@@ -155,7 +175,7 @@ std::string tally_text(const CityRefineSummary& s) {
 
 // A city file (CityJSON, CityJSONSeq, CityGML) in: every building the cloud covers, one
 // CityJSON 2.0 file out.
-void run_city(const RefineArgs& a, const std::vector<std::string>& clouds) {
+void run_city(const RefineArgs& a, const std::vector<std::string>& clouds, const std::vector<SkippedEntry>& skipped) {
   CityRefineOptions o;
   o.building = a.building;
   o.lod = a.lod;
@@ -182,7 +202,7 @@ void run_city(const RefineArgs& a, const std::vector<std::string>& clouds) {
   if (!a.html.empty()) write_review(a, clouds, s, review);
   if (!a.report.empty()) {
     nlohmann::json j = {{"model", a.model},
-                        {"cloud", cloud_json(s.clouds)},
+                        {"cloud", cloud_json(s.clouds, skipped)},
                         {"written", a.out},
                         {"input", s.input_format},
                         {"buildings", s.buildings},
@@ -219,6 +239,7 @@ void run_city(const RefineArgs& a, const std::vector<std::string>& clouds) {
     refused += (refused.empty() ? "" : ", ") + check + " " + std::to_string(n);
     n_refused += n;
   }
+  print_skipped(skipped);
   for (const std::string& w : s.warnings) std::printf("warning: %s\n", escaped_line(w).c_str());
   std::printf(
       "%s: %d building(s), %llu cloud points (%llu in building crops): %d refined, %d repaired, %d kept (never "
@@ -237,7 +258,8 @@ bool is_city_file(const std::string& path) {
 
 void run(const RefineArgs& a) {
   a.params.validate();
-  const std::vector<std::string> clouds = cloud_files(a.clouds);
+  std::vector<SkippedEntry> skipped;
+  const std::vector<std::string> clouds = cloud_files(a.clouds, "--cloud", &skipped);
   check_outputs_are_new(a, clouds);
   check_output_dir(a.out);
   check_output_dir(a.report);
@@ -246,13 +268,9 @@ void run(const RefineArgs& a) {
     const std::string ext = std::filesystem::path(a.out).extension().string();
     if (ext == ".obj" || ext == ".OBJ")
       throw InputError(a.out + ": a city file in gives a CityJSON city file out; name it e.g. refined.city.json");
-    return run_city(a, clouds);
+    return run_city(a, clouds, skipped);
   }
-  if (!a.html.empty())
-    throw InputError(a.html + ": --html is the review page of a city refine (a city file as --model)");
-  if (!a.building.empty() || !a.lod.empty())
-    throw InputError(a.model +
-                     ": --building and --lod pick buildings of a city file (CityJSON, CityGML), not of an OBJ");
+  refuse_city_options(a);
   const Mesh model = read_obj(a.model);
   std::vector<CloudFileRead> read;
   const PointCloud cloud = read_cloud(clouds, a.cloud_options, &read);
@@ -269,7 +287,7 @@ void run(const RefineArgs& a) {
   nlohmann::json report = refine_report(r);
   for (const std::string& w : warnings) report["warnings"].push_back(w);
   report["model"] = a.model;
-  report["cloud"].update(cloud_json(read));
+  report["cloud"].update(cloud_json(read, skipped));
   report["params"] = params_json(a.params);
   report["written"] = a.out;
   // The model first: a report never names a model that is not there. Its fins (faces no solid
@@ -279,6 +297,7 @@ void run(const RefineArgs& a) {
     write_file_atomic(a.report, report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   // One line whatever the model's name holds (batch logs keep it): a CR let `o ok\rFAKE: …` print
   // over the outcome.
+  print_skipped(skipped);
   std::string warned;
   for (const std::string& w : warnings) warned += "; warning: " + escaped_line(w);
   std::printf("%s: %s (%s) -> %s (%.2f s)%s\n", escaped_line(model.id).c_str(), outcome_name(r.outcome),
@@ -303,27 +322,37 @@ void add_refine_command(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingPath);
   cmd->add_option("--out", args.out, "Refined model (OBJ; CityJSON for a city file), written atomically")->required();
-  cmd->add_option("--building", args.building, "City file: refine only this CityObject id");
-  cmd->add_option("--lod", args.lod, "City file: the LoD geometry to refine, e.g. 2.2 (default: the highest 2.x)")
-      ->check(lod_validator());
-  cmd->add_option("--html", args.html,
-                  "City file: write a review page (self-contained HTML, three.js embedded): "
-                  "summary, the buildings the cloud reached, a district map, each refined "
-                  "building in 3D over its scan");
-  add_ranged_option(cmd, "--jobs", args.jobs,
-                    "City file: buildings refined at once, one thread each (default: "
-                    "all cores; the output is the same whatever the number)",
-                    1, 1024);
-  cmd->add_flag("--quiet", args.quiet, "City file: no progress line on stderr");
-  cmd->add_flag("--repair-all", args.repair_all,
-                "City file: also the buildings the cloud does not reach go through repair: each one that is no "
-                "valid solid is rebuilt on its own planes (outcome repaired) or says why not (kept-invalid); the "
-                "valid ones are kept as read. Every building then gets lodrefine_outcome");
+  // What only a city file's refine does: one help group, and refused with an OBJ model.
+  const auto city_only = [&](CLI::Option* option, const char* what) {
+    option->group("City files (a city file as --model; refused with an OBJ)");
+    args.city_only.emplace_back(option, what);
+  };
+  city_only(cmd->add_option("--building", args.building, "Refine only this CityObject id"), "one building of the city");
+  city_only(cmd->add_option("--lod", args.lod, "The LoD geometry to refine, e.g. 2.2 (default: the highest 2.x)")
+                ->check(lod_validator()),
+            "the city's LoD to refine");
+  city_only(cmd->add_option("--html", args.html,
+                            "Write a review page (self-contained HTML, three.js embedded): summary, the buildings "
+                            "the cloud reached, a district map, each refined building in 3D over its scan"),
+            "the review page of a city refine");
+  city_only(add_ranged_option(cmd, "--jobs", args.jobs,
+                              "Buildings refined at once, one thread each (default: all cores; the output is the "
+                              "same whatever the number)",
+                              1, 1024),
+            "buildings refined at once");
+  city_only(cmd->add_flag("--repair-all", args.repair_all,
+                          "Also the buildings the cloud does not reach go through repair: each one that is no "
+                          "valid solid is rebuilt on its own planes (outcome repaired) or says why not "
+                          "(kept-invalid); the valid ones are kept as read. Every building then gets "
+                          "lodrefine_outcome"),
+            "repair of the buildings the cloud does not reach");
+  city_only(cmd->add_option("--max-crop-points", args.max_crop_points,
+                            "Refuse the run when the buildings' crop boxes hold more points together (each is "
+                            "held in memory, 24 bytes); refine the district in parts")
+                ->capture_default_str(),
+            "the bound on the buildings' crops");
+  cmd->add_flag("--quiet", args.quiet, "No progress line on stderr (a city file's; an OBJ refine prints none)");
   cmd->add_option("--report", args.report, "JSON report: matches, planes, candidates, MIP, timings, validation");
-  cmd->add_option("--max-crop-points", args.max_crop_points,
-                  "City file: refuse the run when the buildings' crop boxes hold more points together (each "
-                  "is held in memory, 24 bytes); refine the district in parts")
-      ->capture_default_str();
   add_cloud_options(cmd, args.cloud_options);
   add_param_options(cmd, args.params);
   cmd->callback([] { run(args); });

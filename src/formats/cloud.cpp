@@ -1,10 +1,15 @@
 // Format dispatch for point clouds: PLY (io) or LAS (las), by content; a cloud of several files.
 #include "lodrefine/formats/cloud.h"
 
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <utility>
@@ -47,36 +52,94 @@ Declared declared(const std::string& path) {
   return {n, n};
 }
 
-// A folder's cloud files (see cloud_files), sorted by name.
-std::vector<std::string> folder_clouds(const std::string& folder, const std::string& option) {
+// What a folder entry is, as far as its cloud goes (see cloud_files): a cloud file, one of
+// lodrefine's temporaries (skipped whatever its name), or anything else (said in the fault).
+enum class EntryKind { Cloud, Temporary, NoCloud };
+
+struct Entry {
+  EntryKind kind;
+  std::string fault;  // what it is when not a cloud, for a refusal or a skip
+};
+
+// Whether an entry's name says it is a cloud file: it ends in .ply, .las or .laz, in any case
+// (".laz" alone too).
+bool cloud_name(const fs::path& path) {
+  std::string name = path.filename().string();
+  if (name.size() < 4) return false;
+  name = name.substr(name.size() - 4);
+  for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return name == ".ply" || name == ".las" || name == ".laz";
+}
+
+// Looks at one entry without reading more than its first bytes; a FIFO or device is never opened.
+Entry inspect(const fs::path& path) {
+  if (path.filename().string().rfind(kTempPrefix, 0) == 0)
+    return {EntryKind::Temporary, "a lodrefine temporary (a file being written)"};
+  std::error_code ec, link_ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (!fs::exists(status)) {
+    if (!fs::is_symlink(fs::symlink_status(path, link_ec)))
+      return {EntryKind::NoCloud, "cannot be read (" + ec.message() + ")"};
+    return {EntryKind::NoCloud, status.type() == fs::file_type::not_found
+                                    ? std::string("a link to nothing (its target does not exist)")
+                                    : "a link that cannot be followed (" + ec.message() + ")"};
+  }
+  if (fs::is_directory(status)) return {EntryKind::NoCloud, "a folder (a folder's subfolders are not read)"};
+  if (!fs::is_regular_file(status)) return {EntryKind::NoCloud, "not a regular file (a FIFO, device or socket)"};
+  if (fs::file_size(path, ec) == 0 && !ec) return {EntryKind::NoCloud, "empty (0 bytes)"};
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) return {EntryKind::NoCloud, std::string("cannot be read (") + std::strerror(errno) + ")"};
+  ::close(fd);
+  const FileKind kind = sniff_file(path.string());
+  if (kind == FileKind::Ply || kind == FileKind::Las) return {EntryKind::Cloud, ""};
+  return {EntryKind::NoCloud, kind == FileKind::Other
+                                  ? std::string("not a PLY, LAS or LAZ cloud (its first bytes are "
+                                                "neither 'ply' nor 'LASF')")
+                                  : "not a PLY or LAS point cloud: the file is " + file_kind_text(kind)};
+}
+
+// A folder's cloud files (see cloud_files), sorted by name; its other entries go to `skipped`.
+std::vector<std::string> folder_clouds(const std::string& folder, const std::string& option,
+                                       std::vector<SkippedEntry>& skipped) {
   std::vector<std::string> found;
-  std::size_t skipped = 0;
+  std::vector<SkippedEntry> others, refused;  // refused: cloud-named entries that are no cloud
   std::error_code ec;
   for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string path = it->path().string(), name = it->path().filename().string();
-    const FileKind kind = name.rfind(kTempPrefix, 0) == 0 ? FileKind::Other : sniff_file(path);
-    if (kind == FileKind::Ply || kind == FileKind::Las) found.push_back(path);
-    else ++skipped;
+    const Entry entry = inspect(it->path());
+    const std::string path = it->path().string();
+    if (entry.kind == EntryKind::Cloud) found.push_back(path);
+    else if (entry.kind == EntryKind::NoCloud && cloud_name(it->path())) refused.push_back({path, entry.fault});
+    else others.push_back({path, entry.fault});
+  }
+  if (!refused.empty()) {  // the first by name, whatever order the folder lists them in
+    const SkippedEntry& first =
+        *std::min_element(refused.begin(), refused.end(), [](const auto& a, const auto& b) { return a.path < b.path; });
+    throw InputError(first.path + ": " + first.reason + "; a cloud file of the " + option +
+                     " folder is part of the survey: remove or replace it");
   }
   if (ec) throw InputError(folder + ": cannot list the folder (" + ec.message() + ")");
   if (found.empty())
     throw InputError(folder + ": no PLY, LAS or LAZ cloud in the " + option + " folder" +
-                     (skipped == 0   ? std::string(" (empty)")
-                      : skipped == 1 ? std::string(" (1 other entry)")
-                                     : " (" + std::to_string(skipped) + " other entries)"));
+                     (others.empty()       ? std::string(" (empty)")
+                      : others.size() == 1 ? std::string(" (1 other entry)")
+                                           : " (" + std::to_string(others.size()) + " other entries)"));
   std::sort(found.begin(), found.end());
+  std::sort(others.begin(), others.end(), [](const auto& a, const auto& b) { return a.path < b.path; });
+  skipped.insert(skipped.end(), others.begin(), others.end());
   return found;
 }
 
 }  // namespace
 
-std::vector<std::string> cloud_files(const std::vector<std::string>& values, const std::string& option) {
+std::vector<std::string> cloud_files(const std::vector<std::string>& values, const std::string& option,
+                                     std::vector<SkippedEntry>* skipped) {
   std::vector<std::string> files;
+  std::vector<SkippedEntry> others;
   for (const std::string& value : values) {
     std::error_code ec;
     const fs::file_status status = fs::status(value, ec);
     if (fs::is_directory(status)) {
-      const std::vector<std::string> found = folder_clouds(value, option);
+      const std::vector<std::string> found = folder_clouds(value, option, others);
       files.insert(files.end(), found.begin(), found.end());
     } else if (fs::exists(status)) {
       files.push_back(value);
@@ -87,6 +150,7 @@ std::vector<std::string> cloud_files(const std::vector<std::string>& values, con
     }
   }
   if (files.empty()) throw InputError(option + ": no cloud given");
+  if (skipped) *skipped = std::move(others);
   std::map<std::pair<dev_t, ino_t>, std::size_t> seen;  // each file's first place in the list
   for (std::size_t i = 0; i < files.size(); ++i) {
     struct stat st {};
@@ -97,6 +161,17 @@ std::vector<std::string> cloud_files(const std::vector<std::string>& values, con
                        " may name each cloud file once");
   }
   return files;
+}
+
+std::string skipped_entries_text(const std::vector<SkippedEntry>& skipped) {
+  constexpr std::size_t kNamed = 5;
+  if (skipped.empty()) return {};
+  std::string line = "skipped " + std::to_string(skipped.size()) + (skipped.size() == 1 ? " entry" : " entries") +
+                     " of the cloud folders, no cloud files: ";
+  for (std::size_t i = 0; i < skipped.size() && i < kNamed; ++i)
+    line += (i ? ", " : "") + escaped_line(skipped[i].path) + " (" + escaped_line(skipped[i].reason) + ")";
+  if (skipped.size() > kNamed) line += " and " + std::to_string(skipped.size() - kNamed) + " more";
+  return line;
 }
 
 std::string cloud_files_text(const std::vector<std::string>& paths) {

@@ -9,15 +9,10 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
-#include <mutex>
-
-#include <tbb/blocked_range.h>
-#include <tbb/global_control.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include "lodrefine/base/files.h"
 #include "lodrefine/base/geometry.h"
+#include "lodrefine/city/in_order_pool.h"
 #include "lodrefine/city/refine_report.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/core/validate.h"
@@ -248,49 +243,38 @@ std::vector<RunRow> evaluate_run(const std::string& dir, const RefineConfig& par
                                  const CloudOptions& cloud_options) {
   const auto buildings = discover_run(dir);
   std::vector<RunRow> rows(buildings.size());
-  std::size_t finished = 0, failed = 0;
-  // Each building's series goes into `series` in the run's order, whatever finished first: the
-  // pooled sums (floating point) are then the same bytes for any --jobs. Only those waiting for
-  // an earlier one are held.
-  std::vector<std::unique_ptr<PooledSeries>> waiting(buildings.size());
-  std::size_t merged = 0;
-  std::mutex mutex;  // guards series, waiting, the counts and the progress line
+  std::size_t next = 0, finished = 0, failed = 0;
   Progress progress("eval", "buildings", buildings.size(), progress_mode);
-  auto evaluate = [&](std::size_t k) {
-    const BuildingFiles& f = buildings[k];
-    RunRow& row = rows[k];
-    try {
-      row = evaluate_building_files(f, params, svg_dir, cloud_options);
-    } catch (const InputError& e) {
-      row = failure_row(f.id, e.what());
-    }
-    row.files = f;
-    // Only what the table needs is kept: a city's reports in full would weigh hundreds of MB.
-    add_refine_record(row, read_json_or_null(f.report), f.failed.empty() ? "" : first_line(f.failed), f.report);
-    auto own = std::make_unique<PooledSeries>();
-    own->add(row.eval);
-    drop_series(row.eval);
-    const std::lock_guard<std::mutex> lock(mutex);
-    waiting[k] = std::move(own);
-    for (; merged < waiting.size() && waiting[merged]; ++merged) {
-      series.merge(*waiting[merged]);
-      waiting[merged].reset();
-    }
-    failed += !row.eval.ok();
-    progress.update(++finished, std::to_string(failed) + " failed");
-  };
-  // TBB caps its threads at the cores: --jobs asks for exactly `jobs` (as io/cityfile does).
-  jobs = std::max(1, jobs);
-  const tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(jobs));
-  tbb::task_arena arena(jobs);
-  arena.execute([&] {
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, buildings.size(), 1),
-        [&](const tbb::blocked_range<std::size_t>& range) {
-          for (std::size_t k = range.begin(); k != range.end(); ++k) evaluate(k);
-        },
-        tbb::simple_partitioner());  // one building per task: their costs differ widely
-  });
+  // Each building's series go into `series` in the run's order, whatever finished first: the
+  // pooled sums (floating point) are then the same bytes for any --jobs. The pool hands them
+  // back in that order and holds only its items in flight (in_order_pool), so the per-point
+  // series waiting for an earlier building are bounded by --jobs, not by the run.
+  in_order_pool<std::size_t>(
+      jobs,
+      [&]() -> std::shared_ptr<std::size_t> {
+        return next == buildings.size() ? nullptr : std::make_shared<std::size_t>(next++);
+      },
+      [&](std::size_t& k) {
+        const BuildingFiles& f = buildings[k];
+        RunRow& row = rows[k];
+        try {
+          row = evaluate_building_files(f, params, svg_dir, cloud_options);
+        } catch (const InputError& e) {
+          row = failure_row(f.id, e.what());
+        }
+        row.files = f;
+        // Only what the table needs is kept: a city's reports in full would weigh hundreds of MB.
+        add_refine_record(row, read_json_or_null(f.report), f.failed.empty() ? "" : first_line(f.failed), f.report);
+      },
+      [&](std::size_t& k) {
+        RunRow& row = rows[k];
+        PooledSeries own;  // pooled as one part, then merged: the same sums as before the pool
+        own.add(row.eval);
+        series.merge(own);
+        drop_series(row.eval);
+        failed += !row.eval.ok();
+        progress.update(++finished, std::to_string(failed) + " failed");
+      });
   progress.finish();
   return rows;
 }

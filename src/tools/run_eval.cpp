@@ -146,7 +146,9 @@ RunRow evaluate_single(const EvalOptions& a, const std::vector<std::string>& clo
 }  // namespace
 
 int run_eval(const EvalOptions& a, std::FILE* out) {
-  const std::vector<std::string> clouds = a.clouds.empty() ? std::vector<std::string>() : cloud_files(a.clouds);
+  std::vector<SkippedEntry> skipped;
+  const std::vector<std::string> clouds =
+      a.clouds.empty() ? std::vector<std::string>() : cloud_files(a.clouds, "--cloud", &skipped);
   check_options(a, clouds);
   const GateInputs gate_inputs = read_gate_inputs(a);
   const bool batch = !a.dir.empty();
@@ -160,6 +162,7 @@ int run_eval(const EvalOptions& a, std::FILE* out) {
   std::vector<BuildingEval> evals;
   for (const RunRow& r : rows) evals.push_back(r.eval);
   const PooledEval pooled = pool_evaluations(evals, series);
+  if (!skipped.empty()) std::fprintf(out, "%s\n", skipped_entries_text(skipped).c_str());
   std::fputs(table1_text(pooled, batch).c_str(), out);
   if (batch) std::fputs(totals_text(run_totals(rows)).c_str(), out);
   write_outputs(a, rows, pooled, series);

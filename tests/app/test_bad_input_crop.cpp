@@ -146,3 +146,17 @@ TEST(BadInputFiles, CropNeverWritesOverAnotherModel) {
   EXPECT_FALSE(fs::exists(run + "/" + folder + "/cloud.ply"));
   add_row("crop --models R --out R where a hashed folder is another model's", "refused, nothing written", r.exit);
 }
+
+// Fourth pass (issue 47).
+
+// Issue 47: crop cut the tiles of a folder but for those it could not read, without a word.
+TEST(BadInputAttack, CropRefusesATileFolderWithATileItCannotRead) {
+  const std::string dir = temp_dir("attack_tiles_crop");
+  fs::create_directories(dir + "/models");
+  write_text(dir + "/models/b.obj", valid_model());
+  const CliRun r = expect_bad_tiles_refused("crop --quiet --models " + dir + "/models --out " + dir + "/run --tile ",
+                                            dir, {dir + "/run"});
+  EXPECT_NE(r.out.find(std::to_string(wall_scan().size()) + " tile points, 1 buildings cropped"), std::string::npos)
+      << r.out;
+  add_row("crop --tile tiles/ with a 0-byte, dangling, folder or truncated c.laz", "refused naming it", 2);
+}

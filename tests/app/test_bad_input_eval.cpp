@@ -225,3 +225,16 @@ TEST(BadInputAttack, RunReportsOfTheWrongKindStayOurWords) {
   add_row("run folder report.json with \"reason\": 5 / a 3,000-character report_version", "our words, one short line",
           v.exit);
 }
+
+// Fourth pass (issue 47).
+
+// Issue 47: eval measured a building on the tiles of a folder but for those it could not read.
+TEST(BadInputAttack, EvalRefusesACloudFolderWithATileItCannotRead) {
+  const std::string dir = temp_dir("attack_tiles_eval");
+  write_text(dir + "/model.obj", valid_model());
+  const CliRun r = expect_bad_tiles_refused(
+      "eval --original " + dir + "/model.obj --refined " + dir + "/model.obj --json " + dir + "/e.json --cloud ", dir,
+      {dir + "/e.json"});
+  EXPECT_NE(r.out.find("C2M"), std::string::npos) << r.out;  // Table 1 after the line
+  add_row("eval --cloud tiles/ with a 0-byte, dangling, folder or truncated c.laz", "refused naming it", 2);
+}

@@ -234,3 +234,60 @@ TEST(BadInputAttack, OutcomeLineEscapesCarriageReturns) {
   EXPECT_EQ(r.out.rfind("ok\\rFAKE: refined (all good): ", 0), 0u) << r.out;
   add_row("OBJ name with a CR (`o ok\\rFAKE: refined`)", "escaped in the outcome line", r.exit);
 }
+
+// Fourth pass (issue 47).
+
+// The options of a city file's refine were refused with an OBJ model for --html, --building and
+// --lod, but --repair-all, --jobs and --max-crop-points were taken and ignored without a word:
+// each is refused by name now, nothing written, and --help groups them under city files.
+TEST(BadInputAttack, CityOnlyOptionsAreRefusedWithAnObjModel) {
+  const std::string dir = temp_dir("attack_city_only");
+  write_text(dir + "/model.obj", valid_model());
+  write_text(dir + "/cloud.ply", valid_cloud());
+  const std::string refine = "refine --model " + dir + "/model.obj --cloud " + dir + "/cloud.ply --out " + dir +
+                             "/out.obj --report " + dir + "/out.json";
+  for (const std::string& option : std::vector<std::string>{"--repair-all", "--jobs 2", "--max-crop-points 10",
+                                                            "--html " + dir + "/p.html", "--building a", "--lod 2.2"}) {
+    const CliRun r = run_cli(refine + " " + option, dir);
+    expect_one_error_line(r, dir + "/model.obj: " + option.substr(0, option.find(' ')) + " (");
+    EXPECT_NE(r.err.find(") applies to a city file as --model (CityJSON, CityJSONSeq, CityGML), not to an OBJ"),
+              std::string::npos)
+        << r.err;
+    for (const char* out : {"/out.obj", "/out.json", "/p.html"}) EXPECT_FALSE(fs::exists(dir + out)) << option;
+  }
+  const CliRun help = run_cli("refine --help", dir);
+  const std::size_t group = help.out.find("City files (a city file as --model; refused with an OBJ)");
+  ASSERT_NE(group, std::string::npos) << help.out;
+  for (const char* option : {"--repair-all", "--jobs", "--max-crop-points", "--html", "--building", "--lod"})
+    EXPECT_GT(help.out.find(std::string("  ") + option, group), group) << option << "\n" << help.out;
+  EXPECT_EQ(run_cli(refine, dir).exit, 0);
+  add_row("refine an OBJ with --repair-all, --jobs or --max-crop-points", "refused by name, as --html", 2);
+}
+
+// A cloud folder left out the tiles it could not read without a word (issue 47): the run went
+// on with a.ply and b.ply only, exit 0. Each such entry refuses the run in one line naming it,
+// nothing written, for a city file and an OBJ alike; a file that is no cloud by name or content
+// is skipped, on stdout and in the report's cloud.files with why.
+TEST(BadInputAttack, RefineRefusesACloudFolderWithATileItCannotRead) {
+  const std::string dir = temp_dir("attack_tiles_refine");
+  write_text(dir + "/model.obj", valid_model());
+  write_text(dir + "/city.json", box_city({"B"}));
+  expect_bad_tiles_refused("refine --quiet --model " + dir + "/city.json --out " + dir + "/out.city.json --cloud ", dir,
+                           {dir + "/out.city.json"});
+  const CliRun r = expect_bad_tiles_refused(
+      "refine --model " + dir + "/model.obj --out " + dir + "/out.obj --report " + dir + "/out.json --cloud ", dir,
+      {dir + "/out.obj", dir + "/out.json"});
+  const std::string tiles = dir + "/tiles";
+  const std::string no_cloud = "not a PLY, LAS or LAZ cloud (its first bytes are neither 'ply' nor 'LASF')";
+  EXPECT_EQ(
+      r.out.rfind("skipped 1 entry of the cloud folders, no cloud files: " + tiles + "/notes.txt (" + no_cloud + ")\n",
+                  0),
+      0u)
+      << r.out;
+  const json files = json::parse(read_text(dir + "/out.json"))["cloud"]["files"];
+  ASSERT_EQ(files.size(), 3u) << files.dump();
+  EXPECT_EQ(files[0]["path"], tiles + "/a.ply");
+  EXPECT_EQ(files[1]["path"], tiles + "/b.ply");
+  EXPECT_EQ(files[2], json({{"path", tiles + "/notes.txt"}, {"skipped", no_cloud}}));
+  add_row("refine --cloud tiles/ with a 0-byte, dangling, folder or truncated c.laz", "refused naming it", 2);
+}

@@ -105,11 +105,16 @@ TEST(Clouds, RefineOfACloudInSeveralFilesWritesTheMergedFilesModel) {
   ASSERT_EQ(r.exit, 0) << r.err;
   EXPECT_TRUE(slurp(dir + "/tiles.obj") == slurp(dir + "/tiles_merged.obj"));
   const json report = json::parse(slurp(dir + "/tiles.json"));
-  ASSERT_EQ(report["cloud"]["files"].size(), 3u);
+  ASSERT_EQ(report["cloud"]["files"].size(), 4u);  // the three tiles read, then the file skipped
   for (std::size_t k = 0; k < 3; ++k) {
     EXPECT_EQ(report["cloud"]["files"][k]["path"], tiles[k]);
     EXPECT_EQ(report["cloud"]["files"][k]["points"], parts[k].points.size());
   }
+  EXPECT_EQ(report["cloud"]["files"][3]["path"], dir + "/tiles/index.txt");
+  EXPECT_NE(report["cloud"]["files"][3]["skipped"].get<std::string>().find("not a PLY, LAS or LAZ cloud"),
+            std::string::npos);
+  EXPECT_EQ(r.out.rfind("skipped 1 entry of the cloud folders, no cloud files: " + dir + "/tiles/index.txt (", 0), 0u)
+      << r.out;
 }
 
 // A file of another area among the clouds: named on the outcome line and in the report's

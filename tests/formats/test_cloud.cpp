@@ -5,8 +5,12 @@
 
 #include "support/io_fixtures.h"
 
+#include <sys/stat.h>
+
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <utility>
 
 #include "lodrefine/formats/cloud.h"
 #include "lodrefine/formats/las.h"
@@ -69,6 +73,64 @@ TEST(CloudFiles, FolderGivesItsCloudsByNameAndSkipsTheRest) {
   // A link to a cloud elsewhere is a cloud of the folder.
   fs::create_symlink(lone, dir + "/c.ply");
   EXPECT_EQ(cloud_files({dir}).back(), dir + "/c.ply");
+  // What was skipped, and why, by path: a file neither named nor holding a cloud, a subfolder, a
+  // link to nothing whose name says no cloud (an editor's lock), a temporary.
+  fs::create_symlink(dir + "/gone", dir + "/.#lock");
+  std::vector<SkippedEntry> skipped;
+  cloud_files({dir}, "--cloud", &skipped);
+  const std::string no_cloud = "not a PLY, LAS or LAZ cloud (its first bytes are neither 'ply' nor 'LASF')";
+  const std::vector<std::pair<std::string, std::string>> expected_skips = {
+      {dir + "/.#lock", "a link to nothing (its target does not exist)"},
+      {dir + "/.lodrefine-tmp-x1", "a lodrefine temporary (a file being written)"},
+      {dir + "/city.json", "not a PLY or LAS point cloud: the file is JSON (a CityJSON model?)"},
+      {dir + "/model.obj", no_cloud},
+      {dir + "/notes.txt", no_cloud},
+      {dir + "/sub", "a folder (a folder's subfolders are not read)"}};
+  ASSERT_EQ(skipped.size(), expected_skips.size());
+  for (std::size_t i = 0; i < skipped.size(); ++i)
+    EXPECT_EQ(std::make_pair(skipped[i].path, skipped[i].reason), expected_skips[i]);
+  EXPECT_EQ(skipped_entries_text(skipped), "skipped 6 entries of the cloud folders, no cloud files: " + dir +
+                                               "/.#lock (a link to nothing (its target does not exist)), " + dir +
+                                               "/.lodrefine-tmp-x1 (a lodrefine temporary (a file being written)), " +
+                                               dir + "/city.json (" + expected_skips[2].second + "), " + dir +
+                                               "/model.obj (" + no_cloud + "), " + dir + "/notes.txt (" + no_cloud +
+                                               ") and 1 more");
+  EXPECT_EQ(skipped_entries_text({}), "");
+}
+
+// Issue 47: a folder is a survey. An entry named as a cloud file that is none (empty, a link to
+// nothing, a folder, a truncated header, a FIFO) was left out without a word and the run went on
+// with the other tiles: each refuses the list now, naming the entry and what it is.
+TEST(CloudFiles, AFoldersCloudNamedEntryThatIsNoCloudIsRefused) {
+  struct Fault {
+    std::string name, is;
+    std::function<void(const std::string&)> make;
+  };
+  const std::vector<Fault> faults = {
+      {"c.laz", "empty (0 bytes)", [](const std::string& p) { write_text(p, ""); }},
+      {".LAS", "empty (0 bytes)", [](const std::string& p) { write_text(p, ""); }},  // a name that is all suffix
+      {"d.laz", "a link to nothing (its target does not exist)",
+       [](const std::string& p) { fs::create_symlink(p + ".gone", p); }},
+      {"x.LAZ", "a folder (a folder's subfolders are not read)", [](const std::string& p) { fs::create_directory(p); }},
+      {"e.las", "not a PLY, LAS or LAZ cloud (its first bytes are neither 'ply' nor 'LASF')",
+       [](const std::string& p) { write_text(p, "LAS"); }},
+      {"f.Ply", "not a PLY or LAS point cloud: the file is JSON (a CityJSON model?)",
+       [](const std::string& p) { write_text(p, "{\"type\": \"CityJSON\"}"); }},
+      {"g.laz", "a link that cannot be followed (Too many levels of symbolic links)",
+       [](const std::string& p) { fs::create_symlink(p, p); }},
+      {"h.las", "not a regular file (a FIFO, device or socket)",
+       [](const std::string& p) { ASSERT_EQ(::mkfifo(p.c_str(), 0644), 0); }},
+      {"z.laz", "not a regular file (a FIFO, device or socket)",
+       [](const std::string& p) { fs::create_symlink("/dev/zero", p); }}};
+  for (const Fault& f : faults) {
+    const std::string dir = folder("survey_" + f.name);
+    write_ply(dir + "/a.ply", points_from(85000.0, 3));
+    write_ply(dir + "/b.ply", points_from(85010.0, 3));
+    f.make(dir + "/" + f.name);
+    EXPECT_EQ(refusal([&] { cloud_files({dir}, "--tile"); }),
+              dir + "/" + f.name + ": " + f.is +
+                  "; a cloud file of the --tile folder is part of the survey: remove or replace it");
+  }
 }
 
 TEST(CloudFiles, EmptyFoldersMissingPathsAndOneFileTwiceAreRefused) {

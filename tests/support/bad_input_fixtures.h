@@ -257,6 +257,41 @@ inline std::string box_city(const std::vector<std::string>& ids, const std::vect
   return doc.dump();
 }
 
+// ---------------------------------------------------------------------------------------------
+// Cloud folders (issue 47)
+
+// A survey folder `<dir>/<name>`, made anew: a.ply and b.ply, the wall scan in two halves.
+inline std::string survey_folder(const std::string& dir, const std::string& name) {
+  const std::string tiles = dir + "/" + name;
+  fs::remove_all(tiles);
+  fs::create_directories(tiles);
+  const std::vector<Vec3> scan = wall_scan();
+  const auto half = scan.begin() + std::ptrdiff_t(scan.size() / 2);
+  write_text(tiles + "/a.ply", ply_binary(std::vector<Vec3>(scan.begin(), half)));
+  write_text(tiles + "/b.ply", ply_binary(std::vector<Vec3>(half, scan.end())));
+  return tiles;
+}
+
+// An entry named as a cloud file among the tiles that is none, and what a refusal says of it.
+struct BadTile {
+  std::string name, says;
+  void (*make)(const std::string& path);
+};
+inline std::vector<BadTile> bad_tiles() {
+  return {{"c.laz", "c.laz: empty (0 bytes); a cloud file of the", [](const std::string& p) { write_text(p, ""); }},
+          {"d.laz", "d.laz: a link to nothing", [](const std::string& p) { fs::create_symlink(p + ".gone", p); }},
+          {"x.laz", "x.laz: a folder", [](const std::string& p) { fs::create_directory(p); }},
+          // A LAS header cut after its signature: the reader's line, before any point is read.
+          {"t.las", "t.las: ", [](const std::string& p) { write_text(p, "LASF" + std::string(40, '\0')); }}};
+}
+
+// A survey folder holding one bad tile beside a.ply and b.ply.
+inline std::string survey_folder_with(const std::string& dir, const BadTile& bad) {
+  const std::string tiles = survey_folder(dir, "tiles_" + bad.name);
+  bad.make(tiles + "/" + bad.name);
+  return tiles;
+}
+
 inline std::vector<std::string> files_in(const std::string& dir) {
   std::vector<std::string> out;
   for (const auto& e : fs::directory_iterator(dir)) out.push_back(e.path().filename().string());
@@ -269,6 +304,26 @@ inline void expect_one_error_line(const CliRun& r, const std::string& says) {
   EXPECT_EQ(lines(r.err).size(), 1u) << r.err;
   EXPECT_EQ(r.err.rfind("lodrefine: error: ", 0), 0u) << r.err;
   EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+}
+
+// Runs `command` + a survey folder holding each bad tile: refused in one line naming the tile,
+// nothing at any of `written`. Then + a survey folder with a note beside the tiles: the run goes
+// on and says on stdout it skipped the note. Returns that run (the folder: `<dir>/tiles`).
+inline CliRun expect_bad_tiles_refused(const std::string& command, const std::string& dir,
+                                       const std::vector<std::string>& written) {
+  for (const BadTile& bad : bad_tiles()) {
+    const std::string tiles = survey_folder_with(dir, bad);
+    expect_one_error_line(run_cli(command + tiles, dir), tiles + "/" + bad.says);
+    for (const std::string& path : written) EXPECT_FALSE(fs::exists(path)) << bad.name << ": " << path;
+  }
+  const std::string tiles = survey_folder(dir, "tiles");
+  write_text(tiles + "/notes.txt", "drive 1, 2026-11-30\n");
+  const CliRun r = run_cli(command + tiles, dir);
+  EXPECT_EQ(r.exit, 0) << r.err;
+  EXPECT_NE(r.out.find("skipped 1 entry of the cloud folders, no cloud files: " + tiles + "/notes.txt (not a PLY"),
+            std::string::npos)
+      << r.out;
+  return r;
 }
 
 // `lodrefine ARGS` with its address space limited to `kb` KB (stdout dropped).

@@ -35,17 +35,32 @@ CloudFormat cloud_format(const std::string& path);
 // (the same points, in the same order, so the same results). Every function below that takes
 // such a list bounds memory as for one file: max_points and max_held apply to the total.
 
+// An entry of a folder given as a cloud that is no cloud file, and what it is instead.
+struct SkippedEntry {
+  std::string path;    // the folder's path as given, then the entry's name
+  std::string reason;  // "a folder (a folder's subfolders are not read)", "not a PLY, LAS or LAZ cloud (…)", …
+};
+
 // The cloud files of a command's --cloud (or --tile) values, in reading order. Each value is a
 // file or a folder, expanded in the order given:
 // - a file is taken as named; one that is no cloud is refused when read (cloud_format says what
 //   it is, the PLY reader refuses anything else);
-// - a folder gives its regular files (links to them too; not its subfolders) whose content is a
-//   cloud (sniff_file: PLY or LAS/LAZ), sorted by name (byte order); its other files, and
-//   lodrefine's temporaries (.lodrefine-tmp-*), are skipped.
+// - a folder gives its regular files (links to them too) whose content is a cloud (sniff_file:
+//   PLY or LAS/LAZ), sorted by name (byte order). A folder is a survey: an entry named as a
+//   cloud file (.ply, .las, .laz, any case) that is not one (empty, unreadable, a link to
+//   nothing, a folder, a FIFO or device, or other content) is refused, never left out. Its
+//   other entries (files neither named nor holding a cloud, subfolders, lodrefine's temporaries
+//   .lodrefine-tmp-*) are skipped: each with what it is in `skipped` (when given), by path.
 // Throws InputError (one line) for a value that is no file or folder, a folder holding no
-// cloud, and one file given twice (the same device and inode: links and other spellings count),
-// naming `option`.
-std::vector<std::string> cloud_files(const std::vector<std::string>& values, const std::string& option = "--cloud");
+// cloud, a folder's cloud-named entry that is no cloud file, and one file given twice (the same
+// device and inode: links and other spellings count), naming `option`.
+std::vector<std::string> cloud_files(const std::vector<std::string>& values, const std::string& option = "--cloud",
+                                     std::vector<SkippedEntry>* skipped = nullptr);
+
+// One line for stdout saying what the folders' skipped entries were ("skipped 2 entries of the
+// cloud folders, no cloud files: t/notes.txt (…), t/old (…)"; at most five named, then "and N
+// more"); empty when none. Paths and reasons escaped (escaped_line).
+std::string skipped_entries_text(const std::vector<SkippedEntry>& skipped);
 
 // "a.las", or "a.las and 2 other cloud files": a list of files in a message.
 std::string cloud_files_text(const std::vector<std::string>& paths);

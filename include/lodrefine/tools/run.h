@@ -100,9 +100,11 @@ Mesh read_eval_model(const std::string& path);
 
 // Evaluates every building of `dir` (discover_run), `jobs` at once, rows in id order, each with
 // its refine record. A building with unreadable inputs is a failed row; any other error stops
-// the run and is rethrown. Each building's per-point series go into `series` as it finishes and
-// are then dropped (memory: the bins, not the run's points); a progress line counts the
-// buildings (`progress_mode`). Each building's cloud is read with `cloud_options` (max_points).
+// the run and is rethrown. Each building's per-point series go into `series` in the run's order
+// (the same bytes whatever `jobs`) and are then dropped: memory holds the bins and at most
+// kInOrderItemsPerJob x jobs buildings' series (in_order_pool.h), not the run's. A progress line
+// counts the buildings (`progress_mode`). Each building's cloud is read with `cloud_options`
+// (max_points).
 std::vector<RunRow> evaluate_run(const std::string& dir, const RefineConfig& params, const std::string& svg_dir,
                                  int jobs, PooledSeries& series, Progress::Mode progress_mode,
                                  const CloudOptions& cloud_options = {});
