@@ -140,8 +140,8 @@ TEST(CityFilePasses, CityGmlRingsAreWrittenWithoutTheirClosingVertex) {
     ASSERT_EQ(ring.size(), box.faces[k].v.size()) << ring.dump();
     EXPECT_NE(ring.front(), ring.back()) << ring.dump();
     for (std::size_t i = 0; i < ring.size(); ++i)
-      EXPECT_LT((written.vertices[std::size_t(written.faces[k].v[i])] -
-                 box.vertices[std::size_t(box.faces[k].v[i])]).norm(),
-                1e-6);
+      EXPECT_LT(
+          (written.vertices[std::size_t(written.faces[k].v[i])] - box.vertices[std::size_t(box.faces[k].v[i])]).norm(),
+          1e-6);
   }
 }

@@ -7,8 +7,8 @@
 #include <cmath>
 #include <functional>
 #include <map>
-#include <vector>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "lodrefine/base/geometry.h"
 #include "lodrefine/core/distance.h"
@@ -68,9 +68,9 @@ inline double fins_apart(const Mesh& fins, const Mesh& solid) {
 }
 
 struct FinsInFile {
-  int buildings = 0;        // with fins beside their Solid
-  double apart = 0.0;      // m: the fins farthest apart from their Solid (fins_apart), over the file
-  std::string worst_id;     // the building it is in
+  int buildings = 0;     // with fins beside their Solid
+  double apart = 0.0;    // m: the fins farthest apart from their Solid (fins_apart), over the file
+  std::string worst_id;  // the building it is in
 };
 
 // Every building of `doc` lodrefine wrote with fins beside its Solid.
