@@ -1,12 +1,14 @@
 // `lodrefine convert`: a CityJSON / CityJSONSeq or CityGML file -> one OBJ per LoD2 building, as an FME
 // fan-out export writes them (polygon soup, `o <id>`, WallSurface/RoofSurface/GroundSurface
-// groups, georeferenced coordinates), ready for `lodrefine refine` / `crop`.
+// groups, georeferenced coordinates), ready for `lodrefine refine` / `crop`; fins lodrefine
+// wrote beside a Solid follow in the fins group, as refine writes them.
 #include <cstdio>
 #include <filesystem>
 #include <set>
 
 #include "commands.h"
 #include "lodrefine/base/files.h"
+#include "lodrefine/base/submesh.h"
 #include "lodrefine/formats/citygml.h"
 #include "lodrefine/formats/obj.h"
 #include "options.h"
@@ -39,13 +41,23 @@ std::vector<fs::path> output_paths(const std::vector<const CityJsonBuilding*>& c
   return out;
 }
 
+// A building's faces and, apart, the fins read beside its Solid (its OBJ's fins group).
+ObjModel split_fins(const CityJsonBuilding& b) {
+  const auto split = b.mesh.faces.end() - b.fin_faces;
+  return {compacted(b.mesh.vertices, {b.mesh.faces.begin(), split}, b.mesh.id),
+          compacted(b.mesh.vertices, {split, b.mesh.faces.end()}, b.mesh.id)};
+}
+
 // Writes every model or none: on a failure (a full disk) what was written is removed again.
 void write_all(const std::vector<const CityJsonBuilding*>& chosen, const std::vector<fs::path>& paths,
                const ConvertArgs& a) {
   const bool made_dir = fs::create_directories(a.out_dir);
   std::size_t written = 0;
   try {
-    for (; written < chosen.size(); ++written) write_obj(paths[written].string(), chosen[written]->mesh);
+    for (; written < chosen.size(); ++written) {
+      const ObjModel m = split_fins(*chosen[written]);
+      write_obj(paths[written].string(), m.solid, m.fins);
+    }
   } catch (...) {
     for (std::size_t i = 0; i < written; ++i) fs::remove(paths[i]);
     if (made_dir) fs::remove(a.out_dir);

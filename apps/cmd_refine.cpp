@@ -291,8 +291,8 @@ void run(const RefineArgs& a) {
   report["params"] = params_json(a.params);
   report["written"] = a.out;
   // The model first: a report never names a model that is not there. Its fins (faces no solid
-  // holds, beside a rebuilt shell) follow the solid's faces: an OBJ is a polygon soup.
-  write_obj(a.out, r.fins.faces.empty() ? r.mesh : with_fins(r));
+  // holds, beside a rebuilt shell) follow the solid's faces in their own group.
+  write_obj(a.out, r.mesh, r.fins);
   if (!a.report.empty())
     write_file_atomic(a.report, report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   // One line whatever the model's name holds (batch logs keep it): a CR let `o ok\rFAKE: …` print

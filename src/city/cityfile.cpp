@@ -144,6 +144,8 @@ void apply_job(json& doc, const CityJsonTransform& tf, const CityJsonBuilding& b
     json& geometry = obj["geometry"];
     geometry[std::size_t(b.geometry_index)] =
         cityjson_solid(job.result.mesh, lod, tf.scale, tf.translate, doc["vertices"]);
+    // The fins read with the Solid were part of its soup: the result's fins take their place.
+    if (b.fins_index >= 0) geometry.erase(std::size_t(b.fins_index));
     if (!job.result.fins.faces.empty())
       geometry.insert(geometry.begin() + b.geometry_index + 1,
                       cityjson_multisurface(job.result.fins, lod, tf.scale, tf.translate, doc["vertices"]));

@@ -420,17 +420,6 @@ RefineTrace::Scan scan_summary(const std::vector<ScanPlane>& walls, const std::v
 
 }  // namespace
 
-Mesh with_fins(const RefineResult& result) {
-  Mesh out = result.mesh;
-  const int base = int(out.vertices.size());
-  out.vertices.insert(out.vertices.end(), result.fins.vertices.begin(), result.fins.vertices.end());
-  for (Face f : result.fins.faces) {
-    for (int& v : f.v) v += base;
-    out.faces.push_back(std::move(f));
-  }
-  return out;
-}
-
 RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const RefineConfig& prm) {
   prm.validate();
   Refinement refinement(model, prm.repair.planarity_tolerance);

@@ -11,6 +11,7 @@
 #include <set>
 
 #include "lodrefine/base/geometry.h"
+#include "lodrefine/base/submesh.h"
 #include "lodrefine/base/topology.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/validate.h"
@@ -315,19 +316,6 @@ Semantic fill_semantic(const std::vector<Vec3>& V, const std::vector<Face>& face
   return best;
 }
 
-Mesh compact(const std::vector<Vec3>& V, std::vector<Face> faces, const std::string& id) {
-  Mesh out;
-  out.id = id;
-  std::vector<int> map(V.size(), -1);
-  for (Face& f : faces)
-    for (int& i : f.v) {
-      if (map[i] < 0) map[i] = int(out.vertices.size()), out.vertices.push_back(V[i]);
-      i = map[i];
-    }
-  out.faces = std::move(faces);
-  return out;
-}
-
 // ---------------------------------------------------------------------------------------------
 // Coplanar merging
 
@@ -467,7 +455,7 @@ Mesh welded_soup(const Mesh& soup, double weld_tolerance, RepairReport* report) 
   std::vector<Vec3> V;
   std::vector<Face> faces = welded_faces(soup, weld_tolerance, weld_tolerance, V, r);
   if (report) *report = r;
-  return compact(V, std::move(faces), soup.id);
+  return compacted(V, std::move(faces), soup.id);
 }
 
 Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report, double gap_tolerance) {
@@ -486,7 +474,7 @@ Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report,
     faces[f].sem = fill_semantic(V, faces, int(f), uses, first_new);
   r.flipped_faces = int(std::count(flipped.begin(), flipped.begin() + long(first_new), 1));
 
-  Mesh out = compact(V, std::move(faces), soup.id);
+  Mesh out = compacted(V, std::move(faces), soup.id);
   const Validation val = validate_mesh(out, std::numeric_limits<double>::infinity(), false);
   r.closed = out.faces.size() >= kMinClosedFaces && val.watertight() && val.inconsistent_edges == 0 && val.volume > 0;
   if (report) *report = r;
@@ -557,7 +545,7 @@ Mesh merge_coplanar_faces(const Mesh& mesh, double angle_deg, double distance) {
     else if (members[region[f]].front() == int(f)) faces.push_back(it->second);
   }
   drop_straight_vertices(mesh.vertices, faces, distance);
-  return compact(mesh.vertices, std::move(faces), mesh.id);
+  return compacted(mesh.vertices, std::move(faces), mesh.id);
 }
 
 Mesh repair_input(const Mesh& local_model, const RepairConfig& prm, RepairReport& rr) {

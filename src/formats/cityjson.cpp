@@ -200,7 +200,8 @@ class Reader {
       b.lod = lod.is_string() ? lod.get<std::string>() : lod.dump();
       b.geometry_type = (*geom)["type"].get<std::string>();
       b.geometry_index = int(geom - &obj["geometry"][0]);
-      read_geometry(*geom, vertices, b);
+      const int sources = read_geometry(*geom, vertices, b);
+      read_fins(obj, *geom, vertices, sources, b);
       if (b.skipped_holes > 0)
         out.notes.push_back(one_line(id, 60) + ": " + std::to_string(b.skipped_holes) +
                             " inner ring(s) dropped (surfaces keep their outer ring)");
@@ -256,7 +257,28 @@ class Reader {
     return best;
   }
 
-  void read_geometry(const json& g, const std::vector<Vec3>& vertices, CityJsonBuilding& b) {
+  // The fins lodrefine wrote beside a building's Solid (a MultiSurface of its LoD right after
+  // it, in an object with a `lodrefine_outcome` attribute), appended to the building's soup,
+  // their sources after the Solid's `sources` surfaces. A foreign file's second geometry of one
+  // LoD is no fin: it is left alone.
+  void read_fins(const json& obj, const json& solid, const std::vector<Vec3>& vertices, int sources,
+                 CityJsonBuilding& b) {
+    const json& geoms = obj["geometry"];
+    const std::size_t next = std::size_t(b.geometry_index) + 1;
+    if (b.geometry_type != "Solid" || next >= geoms.size() ||
+        !member(member(obj, "attributes"), "lodrefine_outcome").is_string())
+      return;
+    const json& fins = geoms[next];
+    if (member(fins, "type") != "MultiSurface" || member(fins, "lod") != member(solid, "lod")) return;
+    const std::size_t before = b.mesh.faces.size();
+    read_geometry(fins, vertices, b, sources);
+    b.fins_index = int(next);
+    b.fin_faces = int(b.mesh.faces.size() - before);
+  }
+
+  // Reads geometry `g`'s surfaces into b.mesh, their sources numbered from `first_source`;
+  // returns the number after the last.
+  int read_geometry(const json& g, const std::vector<Vec3>& vertices, CityJsonBuilding& b, int first_source = 0) {
     const std::string type = g["type"].get<std::string>();
     int depth = 0;  // array levels above a surface: 1 MultiSurface, 2 Solid, 3 MultiSolid
     if (type == "MultiSurface" || type == "CompositeSurface") depth = 1;
@@ -281,7 +303,7 @@ class Reader {
       if (sem.contains("values") && !sem["values"].is_null()) values = &sem["values"];
     }
 
-    int source = 0;
+    int source = first_source;
     // Walks one shell (array of surfaces) with its semantic values (or null).
     auto read_shell = [&](const json& shell, const json* shell_values) {
       if (!shell.is_array()) fail(type + " boundaries are not nested as the type needs");
@@ -305,7 +327,7 @@ class Reader {
     };
     if (depth == 1) {
       read_shell(boundaries, values);
-      return;
+      return source;
     }
     auto read_solid = [&](const json& solid, const json* solid_values) {
       if (!solid.is_array() || solid.empty()) fail(type + " boundaries are not nested as the type needs");
@@ -316,11 +338,12 @@ class Reader {
     };
     if (depth == 2) {
       read_solid(boundaries, values);
-      return;
+      return source;
     }
     if (values != nullptr && (!values->is_array() || values->size() != boundaries.size()))
       fail("semantics values do not match the " + type + " boundaries");
     for (std::size_t k = 0; k < boundaries.size(); ++k) read_solid(boundaries[k], values ? &(*values)[k] : nullptr);
+    return source;
   }
 
   // One surface: its outer ring becomes a face; inner rings are counted and dropped. An outer

@@ -31,6 +31,7 @@
 #include <stdexcept>
 
 #include "lodrefine/base/files.h"
+#include "lodrefine/base/submesh.h"
 #include "lodrefine/base/text.h"
 
 #ifndef TINYOBJLOADER_USE_DOUBLE
@@ -176,7 +177,8 @@ class ObjBuild {
  public:
   ObjBuild(const std::string& path, CheckedObj checked) : path_(path), checked_(std::move(checked)) {}
 
-  Mesh run(int* skipped_faces) {
+  // `fins` (may be null) gets one flag per face of the result: in a fins group (kFinsGroup).
+  Mesh run(int* skipped_faces, std::vector<char>* fins = nullptr) {
     tinyobj::callback_t cb;
     cb.vertex_cb = [](void* self, tinyobj::real_t, tinyobj::real_t, tinyobj::real_t, tinyobj::real_t) {
       ++static_cast<ObjBuild*>(self)->vertices_seen_;  // the values are the check's (see the top)
@@ -184,8 +186,13 @@ class ObjBuild {
     cb.index_cb = [](void* self, tinyobj::index_t* idx, int n) { static_cast<ObjBuild*>(self)->face(idx, n); };
     cb.group_cb = [](void* self, const char** names, int n) {
       std::string joined;  // `g a b` is one group to us: semantic_from_name looks for substrings
-      for (int i = 0; i < n; ++i) joined += (i ? " " : "") + std::string(names[i]);
+      bool fins = false;   // ... but a fin is in a group named exactly so
+      for (int i = 0; i < n; ++i) {
+        joined += (i ? " " : "") + std::string(names[i]);
+        fins = fins || std::string_view(names[i]) == kFinsGroup;
+      }
       static_cast<ObjBuild*>(self)->group_sem_ = semantic_from_name(joined);
+      static_cast<ObjBuild*>(self)->in_fins_ = fins;
     };
     cb.usemtl_cb = [](void* self, const char* name, int) {
       static_cast<ObjBuild*>(self)->mtl_sem_ = semantic_from_name(std::string(trim(name)));
@@ -197,6 +204,7 @@ class ObjBuild {
       fail(path_, "tinyobjloader: " + std::string(trim(err.substr(0, err.find('\n')))));
     finish();
     if (skipped_faces) *skipped_faces = skipped_;
+    if (fins) *fins = std::move(fins_);
     return std::move(mesh_);
   }
 
@@ -217,6 +225,7 @@ class ObjBuild {
     f.sem = group_sem_ != Semantic::Other ? group_sem_ : mtl_sem_;
     f.source = int(mesh_.faces.size());
     mesh_.faces.push_back(std::move(f));
+    fins_.push_back(in_fins_);
   }
 
   void finish() {
@@ -249,6 +258,8 @@ class ObjBuild {
   std::size_t vertices_seen_ = 0, faces_seen_ = 0;
   int skipped_ = 0;
   Semantic group_sem_ = Semantic::Other, mtl_sem_ = Semantic::Other;
+  bool in_fins_ = false;    // the current group is a fins group
+  std::vector<char> fins_;  // per face of mesh_: in a fins group
 };
 
 void append_fixed(std::string& out, double v) {
@@ -258,7 +269,40 @@ void append_fixed(std::string& out, double v) {
   out.append(buf, r.ptr);
 }
 
-std::string obj_text(const Mesh& mesh, const Vec3& origin, AtomicFile& file) {
+// Appends `mesh`'s faces grouped by semantic (`g <prefix><semantic>`), indices offset by `base`.
+void append_faces(std::string& out, const Mesh& mesh, std::size_t base, const std::string& prefix,
+                  const std::string& what, AtomicFile& file) {
+  for (Semantic sem : {Semantic::Wall, Semantic::Roof, Semantic::Ground, Semantic::Other}) {
+    bool header = false;
+    for (std::size_t k = 0; k < mesh.faces.size(); ++k) {
+      const Face& f = mesh.faces[k];
+      if (f.sem != sem) continue;
+      if (f.v.size() < 3) file.fail(what + std::to_string(k) + " has fewer than 3 vertices");
+      if (!header) out += "g " + prefix + semantic_name(sem) + "\n", header = true;
+      out += 'f';
+      for (int i : f.v) {
+        if (i < 0 || std::size_t(i) >= mesh.vertices.size())
+          file.fail(what + std::to_string(k) + " references missing vertex " + std::to_string(i));
+        out += ' ' + std::to_string(base + std::size_t(i) + 1);
+      }
+      out += '\n';
+    }
+  }
+}
+
+void append_vertices(std::string& out, const Mesh& mesh, const Vec3& origin, const std::string& what,
+                     AtomicFile& file) {
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Vec3 p = mesh.vertices[i] + origin;
+    if (!p.allFinite()) file.fail(what + std::to_string(i) + " is not finite");
+    out += "v ";
+    append_fixed(out, p.x()), out += ' ', append_fixed(out, p.y()), out += ' ', append_fixed(out, p.z());
+    out += '\n';
+  }
+}
+
+// The solid's faces first, then the fins in their own groups (kFinsGroup).
+std::string obj_text(const Mesh& mesh, const Mesh& fins, const Vec3& origin, AtomicFile& file) {
   std::string out = "# lodrefine\n";
   // An id with blanks goes in a `# id:` comment (read back as is; `o` takes one token for other
   // tools), unless line breaks or outer blanks would not survive that either.
@@ -269,46 +313,39 @@ std::string obj_text(const Mesh& mesh, const Vec3& origin, AtomicFile& file) {
   });
   if (token != mesh.id && one_line_id && trim(mesh.id) == mesh.id) out += "# id: " + mesh.id + "\n";
   else if (!mesh.id.empty()) out += "o " + token + "\n";
-  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
-    const Vec3 p = mesh.vertices[i] + origin;
-    if (!p.allFinite()) file.fail("vertex " + std::to_string(i) + " is not finite");
-    out += "v ";
-    append_fixed(out, p.x()), out += ' ', append_fixed(out, p.y()), out += ' ', append_fixed(out, p.z());
-    out += '\n';
-  }
-  for (Semantic sem : {Semantic::Wall, Semantic::Roof, Semantic::Ground, Semantic::Other}) {
-    bool header = false;
-    for (std::size_t k = 0; k < mesh.faces.size(); ++k) {
-      const Face& f = mesh.faces[k];
-      if (f.sem != sem) continue;
-      if (f.v.size() < 3) file.fail("face " + std::to_string(k) + " has fewer than 3 vertices");
-      if (!header) out += std::string("g ") + semantic_name(sem) + "\n", header = true;
-      out += 'f';
-      for (int i : f.v) {
-        if (i < 0 || std::size_t(i) >= mesh.vertices.size())
-          file.fail("face " + std::to_string(k) + " references missing vertex " + std::to_string(i));
-        out += ' ' + std::to_string(i + 1);
-      }
-      out += '\n';
-    }
-  }
+  append_vertices(out, mesh, origin, "vertex ", file);
+  append_vertices(out, fins, origin, "fin vertex ", file);
+  append_faces(out, mesh, 0, "", "face ", file);
+  append_faces(out, fins, mesh.vertices.size(), std::string(kFinsGroup) + " ", "fin face ", file);
   return out;
+}
+
+Mesh read_checked(const std::string& path, int* skipped_faces, std::vector<char>* fins) {
+  const FileKind kind = sniff_file(path);
+  if (kind != FileKind::Other) fail(path, "not an OBJ model: the file is " + file_kind_text(kind));
+  return read_naming_memory(
+      path, [&] { return ObjBuild(path, ObjCheck(path).run(read_whole_file(path))).run(skipped_faces, fins); });
 }
 
 }  // namespace
 
-Mesh read_obj(const std::string& path, int* skipped_faces) {
-  const FileKind kind = sniff_file(path);
-  if (kind != FileKind::Other) fail(path, "not an OBJ model: the file is " + file_kind_text(kind));
-  return read_naming_memory(
-      path, [&] { return ObjBuild(path, ObjCheck(path).run(read_whole_file(path))).run(skipped_faces); });
-}
+Mesh read_obj(const std::string& path, int* skipped_faces) { return read_checked(path, skipped_faces, nullptr); }
 
 Mesh read_obj(const std::string& path) { return read_obj(path, nullptr); }
 
-void write_obj(const std::string& path, const Mesh& mesh, const Vec3& origin) {
+ObjModel read_obj_model(const std::string& path) {
+  std::vector<char> in_fins;
+  const Mesh all = read_checked(path, nullptr, &in_fins);
+  std::vector<Face> solid, fins;
+  for (std::size_t k = 0; k < all.faces.size(); ++k) (in_fins[k] ? fins : solid).push_back(all.faces[k]);
+  return {compacted(all.vertices, std::move(solid), all.id), compacted(all.vertices, std::move(fins), all.id)};
+}
+
+void write_obj(const std::string& path, const Mesh& mesh, const Vec3& origin) { write_obj(path, mesh, Mesh(), origin); }
+
+void write_obj(const std::string& path, const Mesh& mesh, const Mesh& fins, const Vec3& origin) {
   AtomicFile file(path);
-  file.write(obj_text(mesh, origin, file));
+  file.write(obj_text(mesh, fins, origin, file));
   file.commit();
 }
 

@@ -157,8 +157,11 @@ std::string building_footprint_svg(const BuildingEval& e, const LocalBuilding& b
                        e.id + ": original vs refined, facade points (XY)", max_points);
 }
 
+// A model as eval judges it: its solid, without the faces of its fins group (a repaired
+// building's fins stand beside the solid: they are no part of its watertightness or centroid).
 Mesh read_eval_model(const std::string& path) {
-  Mesh m = read_obj(path);
+  Mesh m = read_obj_model(path).solid;
+  if (m.faces.empty()) throw InputError(path + ": every face is in the fins group (no solid to evaluate)");
   if (const std::string too_large = size_problem(m); !too_large.empty()) throw InputError(path + ": " + too_large);
   return m;
 }

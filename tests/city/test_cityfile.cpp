@@ -186,9 +186,11 @@ void check_city_output(const json& in, const std::string& out_path, const CityRe
     const auto it = outcome.find(b.mesh.id);
     if (it == outcome.end() || (it->second != "refined" && it->second != "repaired")) continue;
     EXPECT_EQ(b.geometry_type, "Solid") << b.mesh.id;
-    EXPECT_EQ(geometry_problem(b.mesh), "") << b.mesh.id;
+    Mesh solid = b.mesh;  // its fins, read with it, come last
+    solid.faces.resize(solid.faces.size() - std::size_t(b.fin_faces));
+    EXPECT_EQ(geometry_problem(solid), "") << b.mesh.id;
     int walls = 0, roofs = 0, grounds = 0;
-    for (const Face& f : b.mesh.faces)
+    for (const Face& f : solid.faces)
       walls += f.sem == Semantic::Wall, roofs += f.sem == Semantic::Roof, grounds += f.sem == Semantic::Ground;
     EXPECT_GE(walls, 4) << b.mesh.id;
     EXPECT_GE(roofs, 1) << b.mesh.id;

@@ -195,6 +195,80 @@ TEST(CityJson, ConvertCommandWritesOneObjPerBuilding) {
 }
 
 // ---------------------------------------------------------------------------------------
+// Fins read back (a building lodrefine wrote: its Solid, then a MultiSurface of its LoD).
+
+namespace {
+
+// The cube with a fin on its wall x = 0 standing 1 m above the roof: vertices 8 and 9.
+const char* kFinMultiSurface = R"({"type":"MultiSurface","lod":"2.2","boundaries":[[[4,7,9,8]]],)"
+                               R"("semantics":{"surfaces":[{"type":"WallSurface"}],"values":[0]}})";
+
+std::string fin_document(const std::string& objects) {
+  std::string doc = cube_document("2.0", objects);
+  const std::size_t end = doc.rfind("]]");
+  return doc.substr(0, end) + "],[0,0,2000],[0,1000,2000]]}";
+}
+
+std::string building(const std::string& id, bool ours, const std::vector<std::string>& geometries) {
+  std::string g;
+  for (const auto& x : geometries) g += (g.empty() ? "" : ",") + x;
+  return "\"" + id + "\":{\"type\":\"Building\"," + (ours ? R"("attributes":{"lodrefine_outcome":"repaired"},)" : "") +
+         "\"geometry\":[" + g + "]}";
+}
+
+}  // namespace
+
+// Only a building lodrefine wrote has fins to read back, and only the MultiSurface of its
+// Solid's LoD right after the Solid: crafted and foreign layouts read as before.
+TEST(CityJson, ReadsOurFinsWithTheirSolidOnly) {
+  const std::string solid = cube_solid("\"2.2\""), fins = kFinMultiSurface;
+  const std::string objects =
+      building("ours", true, {solid, fins}) + "," + building("foreign", false, {solid, fins}) + "," +
+      building("other_lod", true, {solid, std::string(fins).replace(fins.find("2.2"), 3, "2")}) + "," +
+      building("fins_alone", true, {fins}) + "," + building("twice", true, {solid, fins, fins}) + "," +
+      building("fins_first", true, {fins, solid});
+  const CityJsonFile f = parse_cityjson(fin_document(objects));
+  std::map<std::string, const CityJsonBuilding*> by_id;
+  for (const auto& b : f.buildings) by_id[b.mesh.id] = &b;
+  ASSERT_EQ(by_id.size(), 6u);
+  const CityJsonBuilding& ours = *by_id.at("ours");
+  ASSERT_EQ(ours.mesh.faces.size(), 7u);
+  EXPECT_EQ(ours.fin_faces, 1);
+  EXPECT_EQ(ours.fins_index, 1);
+  EXPECT_EQ(ours.mesh.faces.back().sem, Semantic::Wall);
+  EXPECT_EQ(ours.mesh.faces.back().source, 6);  // after the Solid's six
+  EXPECT_NEAR(ours.mesh.vertices[std::size_t(ours.mesh.faces.back().v[2])].z(), 4.0, 1e-9);
+  for (const char* id : {"foreign", "other_lod", "fins_alone", "fins_first"}) {
+    SCOPED_TRACE(id);
+    EXPECT_EQ(by_id.at(id)->fin_faces, 0);
+    EXPECT_EQ(by_id.at(id)->fins_index, -1);
+  }
+  EXPECT_EQ(by_id.at("foreign")->mesh.faces.size(), 6u);
+  EXPECT_EQ(by_id.at("other_lod")->mesh.faces.size(), 6u);
+  EXPECT_EQ(by_id.at("fins_alone")->mesh.faces.size(), 1u);  // a MultiSurface alone is the model
+  EXPECT_EQ(by_id.at("fins_first")->geometry_type, "MultiSurface");
+  EXPECT_EQ(by_id.at("twice")->fin_faces, 1);  // the second is another geometry, left alone
+}
+
+// `convert` keeps the fins: after the solid's faces, in the OBJ's fins group (before, it wrote
+// the Solid alone and dropped them without a word).
+TEST(CityJson, ConvertKeepsTheFinsInTheirGroup) {
+  const fs::path dir = fs::temp_directory_path() / ("lodrefine_convert_fins_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  write_file_atomic((dir / "in.city.json").string(),
+                    fin_document(building("ours", true, {cube_solid("\"2.2\""), kFinMultiSurface})));
+  const std::string cmd = std::string(LODREFINE_BINARY) + " convert --cityjson '" + (dir / "in.city.json").string() +
+                          "' --out-dir '" + (dir / "out").string() + "' > /dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  const ObjModel m = read_obj_model((dir / "out" / "ours.obj").string());
+  EXPECT_EQ(m.solid.faces.size(), 6u);
+  ASSERT_EQ(m.fins.faces.size(), 1u);
+  EXPECT_EQ(m.fins.faces[0].sem, Semantic::Wall);
+  EXPECT_EQ(m.fins.vertices.size(), 4u);
+  fs::remove_all(dir);
+}
+
+// ---------------------------------------------------------------------------------------
 // Real files.
 
 TEST(CityJson, ReadsTheRealFiles) {

@@ -220,3 +220,58 @@ TEST(BadInputRegression, ObjWriterRoundTripsHugeCoordinates) {
     EXPECT_NE(std::string(e.what()).find("beyond 1e9 m"), std::string::npos) << e.what();
   }
 }
+
+// A repaired building's fins follow the solid's faces in their own group (`g fins <semantic>`):
+// read_obj_model tells them apart, read_obj reads the building whole (a soup, as refine reads
+// it), with each fin's semantic. Before, the fins were written among the solid's faces.
+TEST(IoObj, FinsAreWrittenAfterTheSolidInTheirOwnGroup) {
+  Mesh solid;
+  solid.id = "house";
+  solid.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  solid.faces = {{{0, 2, 1}, Semantic::Ground, 0},
+                 {{0, 1, 3}, Semantic::Wall, 1},
+                 {{1, 2, 3}, Semantic::Roof, 2},
+                 {{2, 0, 3}, Semantic::Wall, 3}};
+  Mesh fins;
+  fins.vertices = {{0, 0, 1}, {0, 1, 0}, {0, 1, 2}, {0, 0, 2}};
+  fins.faces = {{{0, 1, 2, 3}, Semantic::Wall, 4}};
+  const std::string path = temp_path("fins.obj");
+  write_obj(path, solid, fins);
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), {});
+  const std::size_t group = text.find("g fins WallSurface\nf 5 6 7 8\n");
+  ASSERT_NE(group, std::string::npos) << text;
+  EXPECT_EQ(text.find("\nf ", group + 20), std::string::npos) << "a solid face after the fins:\n" << text;
+  const ObjModel m = read_obj_model(path);
+  EXPECT_EQ(m.solid.id, "house");
+  EXPECT_EQ(m.fins.id, "house");
+  ASSERT_EQ(m.solid.faces.size(), 4u);
+  EXPECT_EQ(m.solid.vertices.size(), 4u);
+  ASSERT_EQ(m.fins.faces.size(), 1u);
+  EXPECT_EQ(m.fins.faces[0].sem, Semantic::Wall);
+  ASSERT_EQ(m.fins.vertices.size(), 4u);
+  EXPECT_EQ(m.fins.vertices[2], Vec3(0, 1, 2));
+  const Mesh all = read_obj(path);
+  ASSERT_EQ(all.faces.size(), 5u);
+  EXPECT_EQ(all.faces.back().sem, Semantic::Wall);
+}
+
+// A foreign OBJ's groups: only a group named exactly `fins` (any name of its `g` line) holds
+// fins; `finsbury` or `Fins` do not.
+TEST(IoObj, OnlyAGroupNamedFinsHoldsFins) {
+  const std::string path = write_bytes("foreign.obj",
+                                       "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                                       "g finsbury\nf 1 2 3\ng Fins\nf 1 2 3\n"
+                                       "g RoofSurface fins\nf 1 2 3\ng fins\nf 1 3 2\ng\nf 1 2 3\n");
+  const ObjModel m = read_obj_model(path);
+  ASSERT_EQ(m.solid.faces.size(), 3u);
+  ASSERT_EQ(m.fins.faces.size(), 2u);
+  EXPECT_EQ(m.fins.faces[0].sem, Semantic::Roof);
+  EXPECT_EQ(m.fins.faces[1].sem, Semantic::Other);
+  EXPECT_EQ(m.fins.faces[1].source, 3);  // the face's index in the file
+  // A file of fins only has no solid; what needs one says so (eval, below).
+  const ObjModel only = read_obj_model(write_bytes("only.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\ng fins\nf 1 2 3\n"));
+  EXPECT_TRUE(only.solid.faces.empty());
+  EXPECT_TRUE(only.solid.vertices.empty());
+  EXPECT_EQ(only.fins.faces.size(), 1u);
+}

@@ -22,6 +22,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (const auto& b : f.buildings) {
       FUZZ_CHECK(!b.mesh.faces.empty(), "building %s without faces", b.mesh.id.c_str());
       FUZZ_CHECK(f.sequence || ids.insert(b.mesh.id).second, "id %s read twice from one document", b.mesh.id.c_str());
+      FUZZ_CHECK(b.fin_faces >= 0 && std::size_t(b.fin_faces) <= b.mesh.faces.size(), "%d fin faces of %zu",
+                 b.fin_faces, b.mesh.faces.size());
+      FUZZ_CHECK(b.fins_index < 0 ? b.fin_faces == 0 : b.fins_index == b.geometry_index + 1,
+                 "fins at %d beside geometry %d", b.fins_index, b.geometry_index);
       for (const auto& face : b.mesh.faces) {
         FUZZ_CHECK(face.v.size() >= 3, "face of %zu vertices", face.v.size());
         for (int v : face.v) {

@@ -1,7 +1,8 @@
 // libFuzzer target: bytes -> temporary .obj -> read_obj. InputError is the only accepted way
 // to refuse input; any other exception, a sanitizer report or a broken invariant is a crash.
 // Accepted meshes must be usable by the pipeline (indices in range, finite coordinates,
-// polygons of 3+ vertices) and survive write_obj -> read_obj unchanged in shape.
+// polygons of 3+ vertices) and survive write_obj -> read_obj unchanged in shape; the split
+// into solid and fins (read_obj_model) covers every face and survives its own round trip.
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -50,6 +51,26 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const double err = (back.vertices[i] - m.vertices[i]).lpNorm<Eigen::Infinity>();
     const double mag = m.vertices[i].lpNorm<Eigen::Infinity>();
     FUZZ_CHECK(err <= 1e-6 + 1e-12 * mag, "round trip moved vertex %zu by %g", i, err);
+  }
+
+  // The fins group: the split covers every face, and survives write_obj -> read_obj_model.
+  ObjModel split;
+  try {
+    split = read_obj_model(path);
+  } catch (const InputError& e) {
+    FUZZ_CHECK(false, "read_obj accepted what read_obj_model refuses: %s", e.what());
+  }
+  FUZZ_CHECK(split.solid.faces.size() + split.fins.faces.size() == m.faces.size(), "split: %zu + %zu faces of %zu",
+             split.solid.faces.size(), split.fins.faces.size(), m.faces.size());
+  try {
+    write_obj(out, split.solid, split.fins);
+    const ObjModel again = read_obj_model(out);
+    FUZZ_CHECK(
+        again.solid.faces.size() == split.solid.faces.size() && again.fins.faces.size() == split.fins.faces.size(),
+        "fins round trip: %zu + %zu faces, was %zu + %zu", again.solid.faces.size(), again.fins.faces.size(),
+        split.solid.faces.size(), split.fins.faces.size());
+  } catch (const std::runtime_error& e) {
+    FUZZ_CHECK(false, "fins round trip failed: %s", e.what());
   }
   return 0;
 }

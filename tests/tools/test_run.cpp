@@ -210,3 +210,30 @@ TEST(RunEvaluate, PooledSeriesAreTheSameBitsForAnyJobs) {
       EXPECT_EQ(std::memcmp(&(a.*field), &(b.*field), sizeof(double)), 0) << i << ": " << a.*field << " " << b.*field;
   }
 }
+
+// A repaired building's refined.obj holds its fins after the solid (the fins group): eval judges
+// the solid, watertight with its volume centroid. Before, the fin's face made the building not
+// watertight and its centroid an area centroid pulled up the fin.
+TEST(RunEvaluate, TheFinsGroupIsNoPartOfTheSolidEvalJudges) {
+  const fs::path run = cli_fixtures::test_dir("lodrefine_eval_fins");
+  write_run_building(run, "a", true, run_report("repaired", "shell rebuilt on its planes"));
+  const Mesh solid = translated(box(Vec3(0, -kRunWallOffset, 0), Vec3(12, 8, 6)), kRunOrigin);
+  Mesh fin;
+  for (const Vec3& p : {Vec3(0, 8, 6), Vec3(12, 8, 6), Vec3(12, 8, 16), Vec3(0, 8, 16)})
+    fin.vertices.push_back(p + kRunOrigin);
+  fin.faces.push_back({{0, 1, 2, 3}, Semantic::Wall, 6});
+  write_obj((run / "a" / "refined.obj").string(), solid, fin);
+  PooledSeries series;
+  const auto rows = evaluate_run(run.string(), RefineConfig{}, "", 1, series, Progress::Mode::Off);
+  ASSERT_EQ(rows.size(), 1u);
+  const BuildingEval& a = rows[0].eval;
+  ASSERT_TRUE(a.ok()) << a.error;
+  EXPECT_TRUE(a.watertight_after);
+  EXPECT_NEAR(a.c_ref.z() + rows[0].origin.z(), 3.0, 1e-6);  // the box's volume centroid
+  EXPECT_NEAR(a.after.rmse, 0.0, 0.02);
+  // A refined model whose every face is a fin has no solid to judge: a failure row that says so.
+  std::ofstream(run / "a" / "refined.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\ng fins\nf 1 2 3\n";
+  const auto again = evaluate_run(run.string(), RefineConfig{}, "", 1, series, Progress::Mode::Off);
+  ASSERT_EQ(again.size(), 1u);
+  EXPECT_NE(again[0].eval.error.find("every face is in the fins group"), std::string::npos) << again[0].eval.error;
+}

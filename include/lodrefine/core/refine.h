@@ -115,7 +115,9 @@ struct RefineTrace {
 struct RefineResult {
   Mesh mesh;  // in the input (georeferenced) frame
   // Faces of the input no solid holds (ShellRebuild::fins: outside on both sides, beside a rebuilt
-  // shell), same frame; written beside `mesh` (a city file's MultiSurface of the same LoD).
+  // shell), same frame; written beside `mesh` (a city file's MultiSurface of the same LoD, an
+  // OBJ's fins group). A model read back with them is a soup again: a second pass rebuilds the
+  // shell, finds them again, and writes no refinement that would leave one floating.
   Mesh fins;
   Outcome outcome = Outcome::KeptInvalid;
   std::string reason;  // one line: why this outcome
@@ -123,9 +125,6 @@ struct RefineResult {
   RefineTrace trace;
   bool refined() const { return outcome == Outcome::Refined; }
 };
-
-// `result.mesh` and, after its faces, `result.fins` as one polygon soup (an OBJ's output).
-Mesh with_fins(const RefineResult& result);
 
 // Every model gets an output: the refined building, the repaired input, or the input as read,
 // with the outcome and its reason. A refinement the judge refuses with corner moves is made again

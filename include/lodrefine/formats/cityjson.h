@@ -3,11 +3,11 @@
 // Every Building and every BuildingPart that has an LoD 2.x geometry becomes one Mesh (id =
 // its CityObject id; parts are NOT merged into their parent). The geometry used is the highest
 // LoD 2.x one: Solid -> its exterior shell, MultiSolid/CompositeSolid -> the exterior shell of
-// each solid, MultiSurface/CompositeSurface -> all surfaces. The output is a polygon soup in
-// the georeferenced frame (the file's `transform` applied), each face with its own vertices,
-// as an OBJ fan-out export of the same building would be; Face::source is the surface's index
-// in the geometry (running over all shells), Face::sem comes from the semantics
-// (WallSurface / RoofSurface / GroundSurface, anything else -> Other).
+// each solid, MultiSurface/CompositeSurface -> all surfaces; a Solid lodrefine wrote with fins
+// beside it (CityJsonBuilding::fins_index) -> its shell and, after it, the fins' surfaces. The output is a polygon soup
+// in the georeferenced frame (the file's `transform` applied), each face with its own vertices, as an OBJ fan-out
+// export of the same building would be; Face::source is the surface's index in the geometry (running over all shells),
+// Face::sem comes from the semantics (WallSurface / RoofSurface / GroundSurface, anything else -> Other).
 #pragma once
 #include <optional>
 #include <string>
@@ -22,12 +22,16 @@
 namespace lodrefine {
 
 struct CityJsonBuilding {
-  Mesh mesh;                  // polygon soup, georeferenced, mesh.id = CityObject id
+  Mesh mesh;                  // polygon soup, georeferenced, mesh.id = CityObject id; its fins last
   std::string type;           // "Building" or "BuildingPart"
   std::string parent;         // first parent id (BuildingPart), empty otherwise
   std::string lod;            // the LoD used, as written in the file ("2", "2.2")
   std::string geometry_type;  // "Solid", "MultiSurface", ...
   int geometry_index = -1;    // position of that geometry in the object's "geometry" array
+  // A building lodrefine wrote (a `lodrefine_outcome` attribute) with a MultiSurface of the
+  // Solid's LoD right after it: its fins (RefineResult::fins), read back as part of the building.
+  int fins_index = -1;        // that MultiSurface's position in "geometry" (geometry_index + 1), or -1
+  int fin_faces = 0;          // the last fin_faces of mesh.faces are the fins' (their sources follow the Solid's)
   int skipped_holes = 0;      // inner rings dropped (the surface keeps its outer ring only)
   int skipped_rings = 0;      // outer rings with < 3 distinct vertices, dropped
   int skipped_shells = 0;     // interior shells of solids, dropped

@@ -19,9 +19,27 @@ Mesh read_obj(const std::string& path);
 // are relative to the vertices so far.
 Mesh read_obj(const std::string& path, int* skipped_faces);
 
+// The group a repaired building's fins are written in, after the solid's faces (`g fins
+// WallSurface`, `g fins RoofSurface`, ...: each fin also in its semantic's group). A face in a
+// group of this name (any name of its `g` line, exactly) is a fin.
+inline constexpr const char* kFinsGroup = "fins";
+
+// A building's OBJ with its fins told apart.
+struct ObjModel {
+  Mesh solid;  // every face outside a fins group (a repaired building's solid), in file order
+  Mesh fins;   // the faces of fins groups, in file order (none in most files)
+};
+// Reads as read_obj does (the same refusals; both meshes carry the id, each only the vertices
+// its faces use). `solid` may be empty when every face is in a fins group: callers that need a
+// solid say so.
+ObjModel read_obj_model(const std::string& path);
+
 // Writes polygons grouped by semantic (`g WallSurface` ...), `o <id>`, vertices offset by
 // `origin` (the local frame's origin) and printed with enough digits for < 0.1 mm at 7-digit
 // magnitudes. Atomic (temp + rename). Throws std::runtime_error if the target is not writable.
 void write_obj(const std::string& path, const Mesh& mesh, const Vec3& origin = Vec3::Zero());
+// The same with `fins` (faces no solid holds, beside a repaired building's solid) after the
+// mesh's faces, in groups `g fins <semantic>` (kFinsGroup), so that readers tell them apart.
+void write_obj(const std::string& path, const Mesh& mesh, const Mesh& fins, const Vec3& origin = Vec3::Zero());
 
 }  // namespace lodrefine

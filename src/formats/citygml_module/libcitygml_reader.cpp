@@ -234,6 +234,8 @@ class Converter {
       if (added) vertices_.push_back(q);
       out.push_back(it->second);
     }
+    // GML closes a ring by repeating its first position; a CityJSON ring does not repeat it.
+    while (out.size() > 1 && out.back() == out.front()) out.erase(out.size() - 1);
     return out;
   }
 
