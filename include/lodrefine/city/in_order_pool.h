@@ -40,18 +40,14 @@ void in_order_pool(int jobs, const std::function<std::shared_ptr<Item>()>& take,
   arena.execute([&] {
     tbb::parallel_pipeline(
         kInOrderItemsPerJob * std::size_t(jobs),
-        tbb::make_filter<void, Ptr>(tbb::filter_mode::serial_in_order,
-                                    [&](tbb::flow_control& fc) {
-                                      Ptr item = take();
-                                      if (!item) fc.stop();
-                                      return item;
-                                    }) &
-            tbb::make_filter<Ptr, Ptr>(tbb::filter_mode::parallel,
-                                       [&](Ptr item) {
-                                         work(*item);
-                                         return item;
-                                       }) &
-            tbb::make_filter<Ptr, void>(tbb::filter_mode::serial_in_order, [&](Ptr item) { give(*item); }));
+        tbb::make_filter<void, Ptr>(tbb::filter_mode::serial_in_order, [&](tbb::flow_control& fc) {
+          Ptr item = take();
+          if (!item) fc.stop();
+          return item;
+        }) & tbb::make_filter<Ptr, Ptr>(tbb::filter_mode::parallel, [&](Ptr item) {
+          work(*item);
+          return item;
+        }) & tbb::make_filter<Ptr, void>(tbb::filter_mode::serial_in_order, [&](Ptr item) { give(*item); }));
   });
 }
 
