@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
@@ -92,7 +93,10 @@ FileKind sniff_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   char head[64] = {};
   if (in) in.read(head, sizeof head);
-  const std::string h(head, std::size_t(in.gcount()));
+  return sniff_head(std::string(head, std::size_t(in.gcount())));
+}
+
+FileKind sniff_head(const std::string& h) {
   if (h.rfind("LASF", 0) == 0) return FileKind::Las;
   if (h.rfind("ply\n", 0) == 0 || h.rfind("ply\r", 0) == 0) return FileKind::Ply;
   std::string_view s = h;
@@ -259,6 +263,9 @@ void refuse_overwritten(const std::vector<RunFile>& inputs, const std::vector<Ru
   std::vector<fs::path> read;
   for (const RunFile& in : inputs) read.push_back(in.path.empty() ? fs::path() : read_at(in.path));
   for (const RunFile& out : outputs) {
+    const fs::path name = fs::path(out.path).lexically_normal().filename();
+    const auto named = [&](const fs::path& in) { return !in.empty() && (name.empty() || in.filename() == name); };
+    if (std::none_of(read.begin(), read.end(), named)) continue;  // no folder resolved for most outputs
     const fs::path at = written_at(out.path);
     for (std::size_t i = 0; i < inputs.size(); ++i)
       if (!inputs[i].path.empty() && at == read[i])

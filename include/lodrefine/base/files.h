@@ -23,6 +23,7 @@ constexpr double kMinScale = 1e-9;
 // file given in the wrong place is, and lets commands that take several formats pick one.
 enum class FileKind { Ply, Las, Xml, Json, Other };
 FileKind sniff_file(const std::string& path);  // Other also for unreadable files (the reader reports)
+FileKind sniff_head(const std::string& head);  // the same from a file's first (up to 64) bytes
 // "a PLY point cloud", "a LAS/LAZ point cloud", "XML (a CityGML model?)", "JSON (a CityJSON
 // model?)"; empty for Other.
 std::string file_kind_text(FileKind kind);
