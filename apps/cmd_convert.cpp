@@ -2,13 +2,13 @@
 // fan-out export writes them (polygon soup, `o <id>`, WallSurface/RoofSurface/GroundSurface
 // groups, georeferenced coordinates), ready for `lodrefine refine` / `crop`; fins lodrefine
 // wrote beside a Solid follow in the fins group, as refine writes them.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <set>
 
 #include "commands.h"
 #include "lodrefine/base/files.h"
-#include "lodrefine/base/submesh.h"
 #include "lodrefine/formats/citygml.h"
 #include "lodrefine/formats/obj.h"
 #include "options.h"
@@ -42,11 +42,15 @@ std::vector<fs::path> output_paths(const std::vector<const CityJsonBuilding*>& c
 }
 
 // A building's faces and, apart, the fins read beside its Solid (its OBJ's fins group).
-ObjModel split_fins(const CityJsonBuilding& b) {
-  const auto split = b.mesh.faces.end() - b.fin_faces;
-  return {compacted(b.mesh.vertices, {b.mesh.faces.begin(), split}, b.mesh.id),
-          compacted(b.mesh.vertices, {split, b.mesh.faces.end()}, b.mesh.id)};
+ObjModel solid_and_fins(const CityJsonBuilding& b) {
+  std::vector<char> in_fins(b.mesh.faces.size(), 0);
+  std::fill(in_fins.end() - b.fin_faces, in_fins.end(), 1);
+  return split_fins(b.mesh, in_fins);
 }
+
+// A building lodrefine wrote whose Solid kept no surface (every ring degenerate) but whose fins
+// did: its fins alone are no model of it.
+bool fins_only(const CityJsonBuilding& b) { return b.fin_faces > 0 && std::size_t(b.fin_faces) == b.mesh.faces.size(); }
 
 // Writes every model or none: on a failure (a full disk) what was written is removed again.
 void write_all(const std::vector<const CityJsonBuilding*>& chosen, const std::vector<fs::path>& paths,
@@ -55,7 +59,7 @@ void write_all(const std::vector<const CityJsonBuilding*>& chosen, const std::ve
   std::size_t written = 0;
   try {
     for (; written < chosen.size(); ++written) {
-      const ObjModel m = split_fins(*chosen[written]);
+      const ObjModel m = solid_and_fins(*chosen[written]);
       write_obj(paths[written].string(), m.solid, m.fins);
     }
   } catch (...) {
@@ -73,12 +77,21 @@ void run(const ConvertArgs& a) {
   const CityJsonFile file = a.citygml.empty() ? read_cityjson(path, a.lod) : read_citygml(path);
   const std::set<std::string> wanted(a.ids.begin(), a.ids.end());
   std::vector<const CityJsonBuilding*> chosen;
+  std::vector<std::string> no_solid;  // fins_only: skipped, each named
   std::set<std::string> found;
-  for (const auto& b : file.buildings)
-    if (wanted.empty() || wanted.count(b.mesh.id)) chosen.push_back(&b), found.insert(b.mesh.id);
+  for (const auto& b : file.buildings) {
+    if (!wanted.empty() && !wanted.count(b.mesh.id)) continue;
+    found.insert(b.mesh.id);
+    if (fins_only(b)) no_solid.push_back(b.mesh.id);
+    else chosen.push_back(&b);
+  }
   for (const auto& id : wanted)
     if (!found.count(id))
       throw InputError(path + ": no Building/BuildingPart " + shown_id(id) + " with an LoD 2.x geometry");
+  if (chosen.empty() && !no_solid.empty())
+    throw InputError(path + ": " + shown_id(no_solid.front()) + "'s Solid has no usable surface, only fins beside it" +
+                     (no_solid.size() > 1 ? " (and " + std::to_string(no_solid.size() - 1) + " more)" : "") +
+                     "; nothing to convert");
   if (chosen.empty())
     throw InputError(path + ": no Building/BuildingPart with " +
                      (a.lod.empty() ? std::string("an LoD 2.x") : "an LoD " + a.lod) + " geometry (" +
@@ -91,13 +104,18 @@ void run(const ConvertArgs& a) {
     std::printf("%s <- %s\n", paths[i].filename().string().c_str(), shown_id(chosen[i]->mesh.id).c_str());
   for (const auto& note : file.notes)
     std::fprintf(stderr, "lodrefine: note: %s: %s\n", escaped_line(path).c_str(), escaped_line(note).c_str());
+  for (const auto& id : no_solid)
+    std::fprintf(stderr, "lodrefine: note: %s: %s's Solid has no usable surface, only fins beside it: skipped\n",
+                 escaped_line(path).c_str(), shown_id(id).c_str());
   for (const auto& id : file.ids_without_lod2)
     std::fprintf(stderr, "lodrefine: note: %s: %s has no LoD %s geometry, skipped\n", escaped_line(path).c_str(),
                  shown_id(id).c_str(), a.lod.empty() ? "2.x" : a.lod.c_str());
-  std::printf("%zu building(s) written to %s (%s %s%s, %s; %d object(s) without LoD %s skipped)\n", chosen.size(),
+  const std::string fins_alone =
+      no_solid.empty() ? "" : ", " + std::to_string(no_solid.size()) + " with fins and no usable Solid skipped";
+  std::printf("%zu building(s) written to %s (%s %s%s, %s; %d object(s) without LoD %s skipped%s)\n", chosen.size(),
               escaped_line(a.out_dir).c_str(), file.format.c_str(), escaped_line(file.version).c_str(),
               file.sequence ? " sequence" : "", file.crs.empty() ? "no CRS" : escaped_line(file.crs).c_str(),
-              file.objects_without_lod2, a.lod.empty() ? "2.x" : a.lod.c_str());
+              file.objects_without_lod2, a.lod.empty() ? "2.x" : a.lod.c_str(), fins_alone.c_str());
 }
 
 }  // namespace

@@ -65,15 +65,17 @@ std::vector<Model> find_models(const fs::path& dir) {
 // `a_b--<hash>/coarse.obj` lies, renamed itself: its model was replaced without a word).
 void check_outputs(const std::vector<Model>& models, const std::vector<Model>& kept,
                    const std::vector<std::string>& tiles, const CropArgs& a) {
+  std::vector<RunFile> tile_files, outputs;
+  for (const std::string& tile : tiles) tile_files.push_back({"tile", tile});
+  for (const auto& m : kept)
+    for (const char* name : {"cloud.ply", "coarse.obj"})
+      outputs.push_back({shown_id(m.id) + "'s " + name, (fs::path(a.out) / m.folder / name).string()});
+  refuse_overwritten(tile_files, outputs);
   std::map<std::string, const Model*> inputs;  // by path with its folders' links resolved
   for (const auto& m : models) inputs[fs::weakly_canonical(m.path).string()] = &m;
   for (const auto& m : kept)
     for (const char* name : {"cloud.ply", "coarse.obj"}) {
       const fs::path out = fs::path(a.out) / m.folder / name;
-      for (const std::string& tile : tiles)
-        if (same_file(out.string(), tile))
-          throw InputError(tile + ": the tile would be overwritten by " + shown_id(m.id) + "'s " + name +
-                           "; give another --out");
       const auto it = inputs.find((fs::weakly_canonical(out.parent_path()) / name).string());
       if (it != inputs.end() && it->second->id != m.id)
         throw InputError(it->second->path.string() + ": the model of " + shown_id(it->second->id) +

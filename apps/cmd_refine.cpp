@@ -271,7 +271,8 @@ void run(const RefineArgs& a) {
     return run_city(a, clouds, skipped);
   }
   refuse_city_options(a);
-  const Mesh model = read_obj(a.model);
+  std::vector<char> in_fins;  // per face: in the model's fins group (a model refine wrote)
+  const Mesh model = read_obj(a.model, in_fins);
   std::vector<CloudFileRead> read;
   const PointCloud cloud = read_cloud(clouds, a.cloud_options, &read);
   // A crop the scan did not reach is empty: its building is kept as read, as in a city file. A
@@ -291,8 +292,12 @@ void run(const RefineArgs& a) {
   report["params"] = params_json(a.params);
   report["written"] = a.out;
   // The model first: a report never names a model that is not there. Its fins (faces no solid
-  // holds, beside a rebuilt shell) follow the solid's faces in their own group.
-  write_obj(a.out, r.mesh, r.fins);
+  // holds, beside a rebuilt shell) follow the solid's faces in their own group; a model kept as
+  // read (kept-invalid: the same faces in the same order) keeps its fins group as read.
+  const bool as_read = r.outcome == Outcome::KeptInvalid && r.mesh.faces.size() == in_fins.size() &&
+                       std::count(in_fins.begin(), in_fins.end(), 1) > 0;
+  const ObjModel written = as_read ? split_fins(r.mesh, in_fins) : ObjModel{r.mesh, r.fins};
+  write_obj(a.out, written.solid, written.fins);
   if (!a.report.empty())
     write_file_atomic(a.report, report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   // One line whatever the model's name holds (batch logs keep it): a CR let `o ok\rFAKE: …` print

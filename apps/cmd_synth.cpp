@@ -69,6 +69,10 @@ void run(SynthArgs& a) {
   }
   const auto types =
       a.type == "all" ? all_building_types() : std::vector<BuildingType>{building_type_from_name(a.type)};
+  std::vector<std::string> ids;  // every building's folder checked before the first is made
+  for (auto t : types)
+    for (int i = 0; i < a.count; ++i) ids.push_back(synth_building_id(t, a.seed + std::uint64_t(i)));
+  check_synth_outputs(out, ids);
   for (auto t : types)
     for (int i = 0; i < a.count; ++i) {
       const auto b = make_building(t, a.seed + std::uint64_t(i), a.opt);

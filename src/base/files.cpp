@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
@@ -50,22 +51,19 @@ AtomicFile::AtomicFile(const std::string& path) : path_(path) {
 
 AtomicFile::~AtomicFile() { discard(); }
 
-void AtomicFile::write(const char* data, std::size_t n) {
+void AtomicFile::write(const char* data, std::size_t n) { write_from(data, n, -1); }
+
+void AtomicFile::write_at(std::size_t offset, const std::string& s) {
+  write_from(s.data(), s.size(), static_cast<long long>(offset));
+}
+
+void AtomicFile::write_from(const char* data, std::size_t n, long long offset) {
   while (n > 0) {
-    const ssize_t k = ::write(fd_, data, n);
+    const ssize_t k = offset < 0 ? ::write(fd_, data, n) : ::pwrite(fd_, data, n, off_t(offset));
     if (k < 0 && errno == EINTR) continue;
     if (k <= 0) fail(std::strerror(errno));
     data += k, n -= std::size_t(k);
-  }
-}
-
-void AtomicFile::write_at(std::size_t offset, const std::string& s) {
-  std::size_t done = 0;
-  while (done < s.size()) {
-    const ssize_t k = ::pwrite(fd_, s.data() + done, s.size() - done, off_t(offset + done));
-    if (k < 0 && errno == EINTR) continue;
-    if (k <= 0) fail(std::strerror(errno));
-    done += std::size_t(k);
+    if (offset >= 0) offset += k;
   }
 }
 
@@ -95,7 +93,10 @@ FileKind sniff_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   char head[64] = {};
   if (in) in.read(head, sizeof head);
-  const std::string h(head, std::size_t(in.gcount()));
+  return sniff_head(std::string(head, std::size_t(in.gcount())));
+}
+
+FileKind sniff_head(const std::string& h) {
   if (h.rfind("LASF", 0) == 0) return FileKind::Las;
   if (h.rfind("ply\n", 0) == 0 || h.rfind("ply\r", 0) == 0) return FileKind::Ply;
   std::string_view s = h;
@@ -158,22 +159,31 @@ OutputTree::~OutputTree() {
   for (auto it = created_.rbegin(); it != created_.rend(); ++it) fs::remove(*it, ec);
 }
 
-std::string OutputTree::check_folder(const std::string& rel) const {
-  const std::vector<fs::path> down = folders_down(root_, rel);
+namespace {
+
+// Throws when a folder of `down` (folders_down) is a link, or anything but a folder.
+void check_down(const std::vector<fs::path>& down, const std::string& root) {
   for (std::size_t i = 0; i < down.size(); ++i) {
     std::error_code ec;
     const fs::file_status st = i == 0 ? fs::status(down[i], ec) : fs::symlink_status(down[i], ec);
     if (!fs::exists(st)) break;
     if (fs::is_symlink(st))
-      throw InputError(down[i].string() + ": is a symbolic link; outputs are written only inside " + root_);
+      throw InputError(down[i].string() + ": is a symbolic link; outputs are written only inside " + root);
     if (!fs::is_directory(st)) throw InputError(down[i].string() + ": not a folder");
   }
+}
+
+}  // namespace
+
+std::string OutputTree::check_folder(const std::string& rel) const {
+  const std::vector<fs::path> down = folders_down(root_, rel);
+  check_down(down, root_);
   return down.back().string();
 }
 
 std::string OutputTree::folder(const std::string& rel) {
-  check_folder(rel);
   std::vector<fs::path> down = folders_down(root_, rel);
+  check_down(down, root_);
   std::vector<fs::path> above;  // the root's missing parents
   for (fs::path p = down.front().parent_path(); !p.empty() && !fs::exists(p); p = p.parent_path())
     above.insert(above.begin(), p);
@@ -230,6 +240,42 @@ void refuse_overwrites(const std::vector<FileOption>& inputs, const std::vector<
 
 namespace {
 
+// Where an output is written: its folder's links resolved, a link at the name itself replaced
+// (AtomicFile), not followed.
+fs::path written_at(const std::string& path) {
+  fs::path p = fs::absolute(path).lexically_normal();
+  if (!p.has_filename()) p = p.parent_path();  // "out/"
+  std::error_code ec;
+  const fs::path folder = fs::weakly_canonical(p.parent_path(), ec);
+  return (ec ? p.parent_path() : folder) / p.filename();
+}
+
+// Where an input is read: every link resolved.
+fs::path read_at(const std::string& path) {
+  std::error_code ec;
+  const fs::path p = fs::weakly_canonical(fs::absolute(path), ec);
+  return ec ? written_at(path) : p;
+}
+
+}  // namespace
+
+void refuse_overwritten(const std::vector<RunFile>& inputs, const std::vector<RunFile>& outputs) {
+  std::vector<fs::path> read;
+  for (const RunFile& in : inputs) read.push_back(in.path.empty() ? fs::path() : read_at(in.path));
+  for (const RunFile& out : outputs) {
+    const fs::path name = fs::path(out.path).lexically_normal().filename();
+    const auto named = [&](const fs::path& in) { return !in.empty() && (name.empty() || in.filename() == name); };
+    if (std::none_of(read.begin(), read.end(), named)) continue;  // no folder resolved for most outputs
+    const fs::path at = written_at(out.path);
+    for (std::size_t i = 0; i < inputs.size(); ++i)
+      if (!inputs[i].path.empty() && at == read[i])
+        throw InputError(inputs[i].path + ": the " + inputs[i].what + " would be overwritten by " + out.what +
+                         "; give another --out");
+  }
+}
+
+namespace {
+
 bool safe_char(char c) {
   return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' || c == '_' || c == '-';
 }
@@ -270,7 +316,13 @@ std::string escaped_line(const std::string& text) {
 }
 
 std::string shown_id(const std::string& id) {
-  return nlohmann::json(id).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  auto quoted = [](const std::string& s) {
+    return nlohmann::json(s).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  };
+  if (id.size() <= kMaxShownId) return quoted(id);
+  std::size_t cut = kMaxShownId;  // at a character's first byte: a cut one would show as U+FFFD
+  while (cut > 0 && (static_cast<unsigned char>(id[cut]) & 0xC0) == 0x80) --cut;
+  return quoted(id.substr(0, cut) + "...") + " (" + std::to_string(id.size()) + " bytes)";
 }
 
 bool is_safe_name(const std::string& name) {

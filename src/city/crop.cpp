@@ -42,7 +42,7 @@ CropTarget crop_target(const Mesh& model, double relative, double absolute) {
   t.hi = box.max();
   const Vec3 size = t.hi - t.lo;
   if (const std::string problem = building_extent_problem(model); !problem.empty())
-    throw InputError(model.id + ": " + problem + " not cropped");
+    throw InputError(shown_id(model.id) + ": " + problem + " not cropped");
   const Vec3 grow(relative * size.x() + absolute, relative * size.y() + absolute, absolute);
   t.lo -= grow;
   t.hi += grow;

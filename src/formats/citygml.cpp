@@ -66,8 +66,8 @@ nlohmann::ordered_json citygml_to_cityjson(const std::string& path, std::string*
   io_citygml::to_cityjson(path, text, srs.empty() ? std::string() : crs_url(srs), doc, renamed);
   if (notes)
     for (const auto& [given, written] : renamed)
-      notes->push_back("gml:id " + io_text::quote(given) + " is given to more than one building: one is written as " +
-                       io_text::quote(written));
+      notes->push_back("gml:id " + shown_id(given) + " is given to more than one building: one is written as " +
+                       shown_id(written));
   return doc;
 }
 

@@ -177,7 +177,7 @@ class Reader {
     if (it == root.end() || !it->is_object()) fail("no \"CityObjects\" object");
     const std::string outer = where_;
     for (const auto& [id, obj] : it->items()) {
-      where_ = (outer.empty() ? "" : outer + ": ") + "object " + one_line(id, 60);
+      where_ = (outer.empty() ? "" : outer + ": ") + "object " + shown_id(id);
       if (!obj.is_object()) fail("is not a JSON object");
       const json& type = member(obj, "type");
       if (!type.is_null() && !type.is_string()) fail("\"type\" is not a string");
@@ -203,16 +203,16 @@ class Reader {
       const int sources = read_geometry(*geom, vertices, b);
       read_fins(obj, *geom, vertices, sources, b);
       if (b.skipped_holes > 0)
-        out.notes.push_back(one_line(id, 60) + ": " + std::to_string(b.skipped_holes) +
+        out.notes.push_back(shown_id(id) + ": " + std::to_string(b.skipped_holes) +
                             " inner ring(s) dropped (surfaces keep their outer ring)");
       if (b.skipped_shells > 0)
-        out.notes.push_back(one_line(id, 60) + ": " + std::to_string(b.skipped_shells) + " interior shell(s) dropped");
+        out.notes.push_back(shown_id(id) + ": " + std::to_string(b.skipped_shells) + " interior shell(s) dropped");
       if (b.skipped_rings > 0) {
         degenerate_rings_ += b.skipped_rings;
         ++degenerate_objects_;
       }
       if (b.mesh.faces.empty()) {
-        out.notes.push_back(one_line(id, 60) + ": LoD " + b.lod + " geometry has no usable surface, skipped");
+        out.notes.push_back(shown_id(id) + ": LoD " + b.lod + " geometry has no usable surface, skipped");
         continue;
       }
       out.buildings.push_back(std::move(b));
@@ -489,7 +489,7 @@ class ParseGuard {
     f.last_key = k;
     if (f.free || f.keys.insert(k).second) return;
     if (f.city_objects)
-      throw InputError(name_ + ": CityObjects id " + one_line(k, 60) +
+      throw InputError(name_ + ": CityObjects id " + shown_id(k) +
                        " appears twice (two objects under one id; one would be lost)");
     throw InputError(name_ + ": key \"" + one_line(k, 60) +
                      "\" appears twice in one object (JSON keeps only one of them; readers differ on which)");

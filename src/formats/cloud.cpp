@@ -89,14 +89,18 @@ Entry inspect(const fs::path& path) {
   if (fs::file_size(path, ec) == 0 && !ec) return {EntryKind::NoCloud, "empty (0 bytes)"};
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) return {EntryKind::NoCloud, std::string("cannot be read (") + std::strerror(errno) + ")"};
+  char head[64];  // its kind from the bytes this open reads (no second open)
+  const ssize_t n = ::read(fd, head, sizeof head);
   ::close(fd);
-  const FileKind kind = sniff_file(path.string());
+  const FileKind kind = sniff_head(std::string(head, n > 0 ? std::size_t(n) : 0));
   if (kind == FileKind::Ply || kind == FileKind::Las) return {EntryKind::Cloud, ""};
   return {EntryKind::NoCloud, kind == FileKind::Other
                                   ? std::string("not a PLY, LAS or LAZ cloud (its first bytes are "
                                                 "neither 'ply' nor 'LASF')")
                                   : "not a PLY or LAS point cloud: the file is " + file_kind_text(kind)};
 }
+
+bool by_path(const SkippedEntry& a, const SkippedEntry& b) { return a.path < b.path; }
 
 // A folder's cloud files (see cloud_files), sorted by name; its other entries go to `skipped`.
 std::vector<std::string> folder_clouds(const std::string& folder, const std::string& option,
@@ -112,8 +116,7 @@ std::vector<std::string> folder_clouds(const std::string& folder, const std::str
     else others.push_back({path, entry.fault});
   }
   if (!refused.empty()) {  // the first by name, whatever order the folder lists them in
-    const SkippedEntry& first =
-        *std::min_element(refused.begin(), refused.end(), [](const auto& a, const auto& b) { return a.path < b.path; });
+    const SkippedEntry& first = *std::min_element(refused.begin(), refused.end(), by_path);
     throw InputError(first.path + ": " + first.reason + "; a cloud file of the " + option +
                      " folder is part of the survey: remove or replace it");
   }
@@ -124,7 +127,7 @@ std::vector<std::string> folder_clouds(const std::string& folder, const std::str
                       : others.size() == 1 ? std::string(" (1 other entry)")
                                            : " (" + std::to_string(others.size()) + " other entries)"));
   std::sort(found.begin(), found.end());
-  std::sort(others.begin(), others.end(), [](const auto& a, const auto& b) { return a.path < b.path; });
+  std::sort(others.begin(), others.end(), by_path);
   skipped.insert(skipped.end(), others.begin(), others.end());
   return found;
 }

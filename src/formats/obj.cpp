@@ -333,12 +333,19 @@ Mesh read_obj(const std::string& path, int* skipped_faces) { return read_checked
 
 Mesh read_obj(const std::string& path) { return read_obj(path, nullptr); }
 
+Mesh read_obj(const std::string& path, std::vector<char>& in_fins) { return read_checked(path, nullptr, &in_fins); }
+
+ObjModel split_fins(const Mesh& mesh, const std::vector<char>& in_fins) {
+  std::vector<Face> solid, fins;
+  for (std::size_t k = 0; k < mesh.faces.size(); ++k)
+    (k < in_fins.size() && in_fins[k] ? fins : solid).push_back(mesh.faces[k]);
+  return {compacted(mesh.vertices, std::move(solid), mesh.id), compacted(mesh.vertices, std::move(fins), mesh.id)};
+}
+
 ObjModel read_obj_model(const std::string& path) {
   std::vector<char> in_fins;
-  const Mesh all = read_checked(path, nullptr, &in_fins);
-  std::vector<Face> solid, fins;
-  for (std::size_t k = 0; k < all.faces.size(); ++k) (in_fins[k] ? fins : solid).push_back(all.faces[k]);
-  return {compacted(all.vertices, std::move(solid), all.id), compacted(all.vertices, std::move(fins), all.id)};
+  const Mesh all = read_obj(path, in_fins);
+  return split_fins(all, in_fins);
 }
 
 void write_obj(const std::string& path, const Mesh& mesh, const Vec3& origin) { write_obj(path, mesh, Mesh(), origin); }

@@ -5,6 +5,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include "lodrefine/base/text.h"
@@ -375,6 +376,28 @@ void write_ply(const std::string& path, const PointCloud& cloud, const Vec3& ori
   }
   file.write(out);
   file.commit();
+}
+
+PlyStream::PlyStream(const std::string& path, const std::string& comment, const std::string& properties)
+    : file_(path), comment_(comment), properties_(properties) {
+  file_.write(header());
+}
+
+std::string PlyStream::header() const {
+  char count[32];  // wide enough for any count: rewritten in place
+  std::snprintf(count, sizeof count, "%015llu", static_cast<unsigned long long>(vertices_));
+  return "ply\nformat binary_little_endian 1.0\ncomment " + comment_ + "\nelement vertex " + count + "\n" +
+         properties_ + "end_header\n";
+}
+
+void PlyStream::write(const char* records, std::size_t bytes, std::uint64_t vertices) {
+  file_.write(records, bytes);
+  vertices_ += vertices;
+}
+
+void PlyStream::commit() {
+  file_.write_at(0, header());
+  file_.commit();
 }
 
 }  // namespace lodrefine

@@ -98,15 +98,19 @@ bool street_facade_type(BuildingType t) {
   return t == BuildingType::Recess || t == BuildingType::Bay || t == BuildingType::Setback;
 }
 
+std::string synth_building_id(BuildingType type, std::uint64_t seed) {
+  char id[64];
+  std::snprintf(id, sizeof id, "synth_%s_%04llu", building_type_name(type), static_cast<unsigned long long>(seed));
+  return id;
+}
+
 SynthBuilding make_building(BuildingType type, std::uint64_t seed, const SynthOptions& opt) {
   check_synth_options(opt);
   // One stream per stage, so --no-defects / --no-nuisances leave the other outputs unchanged.
   const std::uint64_t key = splitmix64(seed * 16 + std::uint64_t(type));
   Rng r(key), r_defects(splitmix64(key ^ 1)), r_scan(splitmix64(key ^ 2));
   SynthBuilding b;
-  char id[64];
-  std::snprintf(id, sizeof id, "synth_%s_%04llu", building_type_name(type), static_cast<unsigned long long>(seed));
-  b.id = id;
+  b.id = synth_building_id(type, seed);
   b.type = type;
   b.seed = seed;
   b.options = opt;

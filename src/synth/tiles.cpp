@@ -100,6 +100,19 @@ void write_synth_building(OutputTree& out, const SynthBuilding& b, bool with_clo
                     meta_json(b).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
+void check_synth_outputs(const OutputTree& out, const std::vector<std::string>& ids, const std::string& tile_ply) {
+  std::vector<RunFile> outputs;
+  for (const std::string& id : ids) {
+    out.check_folder(id);
+    if (tile_ply.empty()) continue;
+    const std::filesystem::path folder = std::filesystem::path(out.root()) / id;
+    outputs.push_back({shown_id(id) + "'s folder", folder.string()});
+    for (const char* name : {"truth.obj", "coarse.obj", "cloud.ply", "meta.json"})
+      outputs.push_back({shown_id(id) + "'s " + name, (folder / name).string()});
+  }
+  refuse_overwritten({{"tile", tile_ply}}, outputs);
+}
+
 #if !defined(__BYTE_ORDER__) || __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
 #error "write_synth_tile writes the host's doubles as binary_little_endian"
 #endif
@@ -107,20 +120,13 @@ void write_synth_building(OutputTree& out, const SynthBuilding& b, bool with_clo
 std::uint64_t write_synth_tile(OutputTree& out, const std::string& tile_ply, int count, std::uint64_t first_seed,
                                double spacing, const SynthOptions& opt,
                                const std::function<void(const SynthBuilding&)>& progress) {
-  AtomicFile tile(tile_ply);  // a temporary beside the tile, removed unless complete
-  // The count is only known at the end: a fixed-width field, rewritten in place.
-  constexpr int kCountWidth = 15;
-  const std::string head = "ply\nformat binary_little_endian 1.0\ncomment lodrefine synth tile\nelement vertex ";
-  const std::string tail = "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
-  auto header = [&](std::uint64_t n) {
-    char num[32];
-    std::snprintf(num, sizeof num, "%0*llu", kCountWidth, static_cast<unsigned long long>(n));
-    return head + num + tail;
-  };
-  tile.write(header(0));
   const auto types = all_building_types();
+  std::vector<std::string> ids;
+  for (int i = 0; i < count; ++i)
+    ids.push_back(synth_building_id(types[std::size_t(i) % types.size()], first_seed + std::uint64_t(i)));
+  check_synth_outputs(out, ids, tile_ply);
+  PlyStream tile(tile_ply, "lodrefine synth tile", "property double x\nproperty double y\nproperty double z\n");
   const int columns = std::max(1, int(std::ceil(std::sqrt(double(count)))));
-  std::uint64_t points = 0;
   for (int i = 0; i < count; ++i) {
     SynthBuilding b = make_building(types[std::size_t(i) % types.size()], first_seed + std::uint64_t(i), opt);
     // Onto its grid cell: a pure translation, so truth, model, scan and meta stay consistent.
@@ -134,13 +140,11 @@ std::uint64_t write_synth_tile(OutputTree& out, const std::string& tile_ply, int
     std::vector<double> xyz;
     xyz.reserve(3 * b.cloud.points.size());
     for (const auto& p : b.cloud.points) xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
-    tile.write(reinterpret_cast<const char*>(xyz.data()), xyz.size() * sizeof(double));
-    points += b.cloud.points.size();
+    tile.write(reinterpret_cast<const char*>(xyz.data()), xyz.size() * sizeof(double), b.cloud.points.size());
     if (progress) progress(b);
   }
-  tile.write_at(0, header(points));
   tile.commit();
-  return points;
+  return tile.vertices();
 }
 
 }  // namespace lodrefine

@@ -4,13 +4,16 @@
 #include <cstring>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 
 #include "lodrefine/base/files.h"
 #include "lodrefine/base/geometry.h"
 #include "lodrefine/city/crop.h"
+#include "lodrefine/core/validate.h"
 #include "lodrefine/formats/cityjson.h"
 #include "lodrefine/formats/obj.h"
+#include "lodrefine/formats/ply.h"
 #include "lodrefine/synth/synth.h"
 #include "van.h"
 
@@ -33,29 +36,25 @@ constexpr double kCropRelative = 0.1, kCropAbsolute = 3.0;
 
 // The dev tiles' cloud layout: x y z (double), label (0 facade, 1 window, 2 clutter, 3 ground)
 // and building (index in meta.json, -1 none), binary little endian.
-struct DevtileCloud {
-  std::vector<Vec3> pts;
-  std::vector<int> label, building;
+constexpr const char* kDevtileProperties =
+    "property double x\nproperty double y\nproperty double z\nproperty int label\nproperty int building\n";
+constexpr const char* kDevtileComment = "lodrefine synth --rescan (van)";
 
-  std::string ply() const {
-    std::string s = "ply\nformat binary_little_endian 1.0\ncomment lodrefine synth --rescan (van)\nelement vertex " +
-                    std::to_string(pts.size()) +
-                    "\nproperty double x\nproperty double y\nproperty double z\nproperty int label\nproperty int "
-                    "building\nend_header\n";
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      char rec[32];
-      std::memcpy(rec, pts[i].data(), 24);
-      std::memcpy(rec + 24, &label[i], 4);
-      std::memcpy(rec + 28, &building[i], 4);
-      s.append(rec, 32);
-    }
-    return s;
+// One building's crop in that layout.
+struct DevtileCloud {
+  std::string records;  // 32 bytes a point
+  std::size_t points = 0, facade = 0;
+
+  void add(const Vec3& p, int label, int building, bool own_facade) {
+    char rec[32];
+    std::memcpy(rec, p.data(), 24);
+    std::memcpy(rec + 24, &label, 4);
+    std::memcpy(rec + 28, &building, 4);
+    records.append(rec, 32);
+    ++points;
+    facade += own_facade;
   }
-  void append(const DevtileCloud& o) {
-    pts.insert(pts.end(), o.pts.begin(), o.pts.end());
-    label.insert(label.end(), o.label.begin(), o.label.end());
-    building.insert(building.end(), o.building.begin(), o.building.end());
-  }
+  void write_to(PlyStream& ply) const { ply.write(records.data(), records.size(), points); }
 };
 
 // A scene label as the dev tiles' (label, building) for building `b`.
@@ -155,19 +154,35 @@ std::vector<std::size_t> city_self(const City& city, const Mesh& truth, const nl
   return out;
 }
 
-// The city's buildings near `box` (world frame), but `self`, moved by -origin.
-std::vector<Mesh> neighbours(const City& city, const Eigen::AlignedBox3d& box, const std::vector<std::size_t>& self,
-                             const Vec3& origin) {
-  std::vector<Mesh> out;
+// The city's buildings near `box` (world frame), but `self`: those that stand in its street.
+std::vector<std::size_t> near_buildings(const City& city, const Eigen::AlignedBox3d& box,
+                                        const std::vector<std::size_t>& self) {
+  std::vector<std::size_t> out;
   for (std::size_t i = 0; i < city.buildings.size(); ++i) {
     if (std::find(self.begin(), self.end(), i) != self.end()) continue;
     const auto& b = city.boxes[i];
     if (b.min().x() > box.max().x() + kNeighbourhood || b.max().x() < box.min().x() - kNeighbourhood ||
         b.min().y() > box.max().y() + kNeighbourhood || b.max().y() < box.min().y() - kNeighbourhood)
       continue;
-    out.push_back(translated(city.buildings[i].mesh, -origin));
+    out.push_back(i);
   }
   return out;
+}
+
+// The city's buildings in the street of a building whose box is `box`, moved by -origin.
+std::vector<Mesh> neighbours(const City& city, const Eigen::AlignedBox3d& box, const std::vector<std::size_t>& self,
+                             const Vec3& origin) {
+  std::vector<Mesh> out;
+  for (std::size_t i : near_buildings(city, box, self)) out.push_back(translated(city.buildings[i].mesh, -origin));
+  return out;
+}
+
+// The neighbours the van will meet, within the bounds refine holds models to (size_problem: a
+// face of 60,000 vertices made every ray slow): refused, naming the city's building.
+void check_neighbours(const City& city, const Eigen::AlignedBox3d& box, const std::vector<std::size_t>& self) {
+  for (std::size_t i : near_buildings(city, box, self))
+    if (const std::string too_large = size_problem(city.buildings[i].mesh); !too_large.empty())
+      throw InputError(city.path + ": building " + shown_id(city.buildings[i].mesh.id) + ": " + too_large);
 }
 
 // The tile's origin, once meta.json is known to be a dev tile's: an origin of three numbers, and
@@ -190,18 +205,20 @@ std::string building_id(const nlohmann::json& b, const std::string& tile, std::s
   const std::string id = named ? b["id"].get<std::string>() : std::string();
   if (!is_safe_name(id))
     throw InputError(tile + "/meta.json: a building without a safe id (" +
-                     escaped_line(named ? id.substr(0, 60) : b.dump().substr(0, 60)) +
+                     (named ? shown_id(id) : escaped_line(b.dump().substr(0, 60))) +
                      "): ids name the tile's files: [A-Za-z0-9._-], at most " + std::to_string(kMaxSafeName) +
                      " bytes, no leading '.' or '-'");
   if (!seen.insert(id).second) throw InputError(where_in(tile, id) + ": listed twice");
   return id;
 }
 
-// A model of the tile: read, and no wider than a building can be (a stray vertex would have the
-// van drive for kilometres).
+// A model of the tile: read, no wider than a building can be (a stray vertex would have the van
+// drive for kilometres), within the bounds refine holds models to (size_problem: the van's rays
+// meet every face).
 Mesh read_model(const fs::path& path) {
   Mesh m = read_obj(path.string());
-  const std::string problem = building_extent_problem(m);
+  std::string problem = building_extent_problem(m);
+  if (problem.empty()) problem = size_problem(m);
   if (!problem.empty()) throw InputError(path.string() + ": " + problem);
   return m;
 }
@@ -221,10 +238,86 @@ std::vector<TileBuilding> read_tile(const nlohmann::json& meta, const std::strin
     t.model = read_model(in / "models" / (t.id + ".obj"));
     t.street = street_faces(t.truth, b, where);
     t.self = city_self(city, t.truth, b, where);
+    check_neighbours(city, bounding_box(t.truth.vertices), t.self);
     require_van_rays(van_scan_rays(translated(t.truth, -origin), t.street, opt.van), where);
     out.push_back(std::move(t));
   }
   return out;
+}
+
+// Refuses a rescan whose output would overwrite one of its inputs (a --city file where a
+// building's truth goes, say): every file named before the first is written.
+void check_rescan_outputs(const std::vector<TileBuilding>& buildings, const std::string& tile,
+                          const std::string& city_path, const std::string& out) {
+  const fs::path in(tile), to(out);
+  std::vector<RunFile> inputs{{"tile's meta.json", (in / "meta.json").string()}, {"--city file", city_path}};
+  std::vector<RunFile> outputs{{"the rescan's meta.json", (to / "meta.json").string()},
+                               {"the rescan's tile.ply", (to / "tile.ply").string()}};
+  for (const TileBuilding& t : buildings) {
+    for (const char* sub : {"truth", "models"}) {
+      const std::string what = std::string(sub) + " of " + shown_id(t.id);
+      inputs.push_back({"tile's " + what, (in / sub / (t.id + ".obj")).string()});
+      outputs.push_back({"the rescan's " + what, (to / sub / (t.id + ".obj")).string()});
+    }
+    outputs.push_back({"the rescan's cloud of " + shown_id(t.id), (to / "clouds" / (t.id + ".ply")).string()});
+  }
+  refuse_overwritten(inputs, outputs);
+}
+
+// Building `index`'s van scan, cropped as the dev tiles' (the model's box grown by 10 % and 3 m),
+// with its drives recorded in its meta entry `b`.
+DevtileCloud scan_building(const TileBuilding& t, std::size_t index, const City& city, const Vec3& origin,
+                           const SynthOptions& opt, std::uint64_t seed, nlohmann::json& b) {
+  const Mesh local = translated(t.truth, -origin);
+  double z0 = 1e300;
+  for (const auto& v : local.vertices) z0 = std::min(z0, v.z());
+  Rng r(splitmix64(seed * 1000003 + std::uint64_t(index)));
+  const VanScan scan =
+      van_scan(local, t.street, z0, neighbours(city, bounding_box(t.truth.vertices), t.self, origin), opt, r);
+  const CropTarget crop = crop_target(t.model, kCropRelative, kCropAbsolute);
+  DevtileCloud cloud;
+  for (std::size_t i = 0; i < scan.pts.size(); ++i) {
+    const Vec3 p = scan.pts[i] + origin;
+    if ((p.array() < crop.lo.array()).any() || (p.array() > crop.hi.array()).any()) continue;
+    const auto [label, owner] = devtile_label(scan.labels[i], int(index));
+    cloud.add(p, label, owner, owner == int(index) && label <= 1);
+  }
+  b["points"] = cloud.facade;
+  b["crop_points"] = cloud.points;
+  b["drives"] = scan.drives.size();
+  if (scan.misregistration.size() > 1) {
+    const Vec3& s = scan.misregistration[1].shift;
+    b["misregistration"] = {{"shift", {s.x(), s.y(), s.z()}}, {"heading_deg", scan.misregistration[1].heading_deg}};
+  }
+  return cloud;
+}
+
+// meta.json's "scanner": how the clouds were made.
+nlohmann::json scanner_json(const std::string& tile, const std::string& city_path, const SynthOptions& opt,
+                            std::uint64_t seed) {
+  const VanOptions& v = opt.van;
+  return {{"kind", "van"},
+          {"source_tile", tile},
+          {"city", city_path},
+          {"seed", seed},
+          {"speed", v.speed},
+          {"profile_rate", v.profile_rate},
+          {"angle_step_deg", v.angle_step_deg},
+          {"height", v.height},
+          {"yaw_deg", v.yaw_deg},
+          {"max_range", v.max_range},
+          {"drives", v.drives},
+          {"offset", v.offset},
+          {"heading_deg", v.heading_deg},
+          {"noise", opt.noise},
+          {"relief", opt.nuisances}};
+}
+
+// <root>/<sub>/<name>, its folder made when the first file goes into it: a run killed while the
+// van scans leaves no empty folders behind.
+std::string file_in(OutputTree& tree, const char* sub, const std::string& name) {
+  tree.folder(sub);
+  return tree.file(std::string(sub) + "/" + name);
 }
 
 }  // namespace
@@ -240,57 +333,28 @@ void rescan_tile(const std::string& tile, const std::string& city_path, const st
   const Vec3 origin = tile_origin(meta, tile);
   const City city = read_city(city_path);
   const std::vector<TileBuilding> buildings = read_tile(meta, tile, origin, city, opt);
-  for (const char* sub : {"clouds", "models", "truth"}) tree.folder(sub);
-  DevtileCloud whole;
+  check_rescan_outputs(buildings, tile, city_path, out);
+  // The tile's cloud streamed, one building's crop in memory at a time; opened with the first
+  // building's files.
+  std::optional<PlyStream> whole;
   for (std::size_t index = 0; index < buildings.size(); ++index) {
     const TileBuilding& t = buildings[index];
-    nlohmann::json& b = meta["buildings"][index];
-    const Mesh local = translated(t.truth, -origin);
-    double z0 = 1e300;
-    for (const auto& v : local.vertices) z0 = std::min(z0, v.z());
-    Rng r(splitmix64(seed * 1000003 + std::uint64_t(index)));
-    const VanScan scan =
-        van_scan(local, t.street, z0, neighbours(city, bounding_box(t.truth.vertices), t.self, origin), opt, r);
-    const CropTarget crop = crop_target(t.model, kCropRelative, kCropAbsolute);
-    DevtileCloud cloud;
-    for (std::size_t i = 0; i < scan.pts.size(); ++i) {
-      const Vec3 p = scan.pts[i] + origin;
-      if ((p.array() < crop.lo.array()).any() || (p.array() > crop.hi.array()).any()) continue;
-      const auto [label, owner] = devtile_label(scan.labels[i], int(index));
-      cloud.pts.push_back(p), cloud.label.push_back(label), cloud.building.push_back(owner);
-    }
-    write_file_atomic(tree.file("clouds/" + t.id + ".ply"), cloud.ply());
-    copy_file_atomic((in / "truth" / (t.id + ".obj")).string(), tree.file("truth/" + t.id + ".obj"));
-    copy_file_atomic((in / "models" / (t.id + ".obj")).string(), tree.file("models/" + t.id + ".obj"));
-    int facade = 0;
-    for (std::size_t i = 0; i < cloud.pts.size(); ++i) facade += cloud.building[i] == int(index) && cloud.label[i] <= 1;
-    b["points"] = facade;
-    b["crop_points"] = cloud.pts.size();
-    b["drives"] = scan.drives.size();
-    if (scan.misregistration.size() > 1) {
-      const Vec3& s = scan.misregistration[1].shift;
-      b["misregistration"] = {{"shift", {s.x(), s.y(), s.z()}}, {"heading_deg", scan.misregistration[1].heading_deg}};
-    }
-    whole.append(cloud);
-    if (progress) progress(t.id, cloud.pts.size());
+    const DevtileCloud cloud = scan_building(t, index, city, origin, opt, seed, meta["buildings"][index]);
+    PlyStream own(file_in(tree, "clouds", t.id + ".ply"), kDevtileComment, kDevtileProperties);
+    cloud.write_to(own);
+    own.commit();
+    copy_file_atomic((in / "truth" / (t.id + ".obj")).string(), file_in(tree, "truth", t.id + ".obj"));
+    copy_file_atomic((in / "models" / (t.id + ".obj")).string(), file_in(tree, "models", t.id + ".obj"));
+    if (!whole) whole.emplace(tree.file("tile.ply"), kDevtileComment, kDevtileProperties);
+    cloud.write_to(*whole);
+    if (progress) progress(t.id, cloud.points);
   }
-  const VanOptions& v = opt.van;
-  meta["scanner"] = {{"kind", "van"},
-                     {"source_tile", tile},
-                     {"city", city_path},
-                     {"seed", seed},
-                     {"speed", v.speed},
-                     {"profile_rate", v.profile_rate},
-                     {"angle_step_deg", v.angle_step_deg},
-                     {"height", v.height},
-                     {"yaw_deg", v.yaw_deg},
-                     {"max_range", v.max_range},
-                     {"drives", v.drives},
-                     {"offset", v.offset},
-                     {"heading_deg", v.heading_deg},
-                     {"noise", opt.noise},
-                     {"relief", opt.nuisances}};
-  write_file_atomic(tree.file("tile.ply"), whole.ply());
+  if (!whole) {  // a tile of no buildings
+    tree.folder();
+    whole.emplace(tree.file("tile.ply"), kDevtileComment, kDevtileProperties);
+  }
+  meta["scanner"] = scanner_json(tile, city_path, opt, seed);
+  whole->commit();
   write_file_atomic(tree.file("meta.json"), meta.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   tree.keep();
 }

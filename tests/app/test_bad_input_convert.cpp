@@ -58,6 +58,35 @@ TEST(BadInputFiles, ConvertAccountsForEveryBuildingAndNeverOverwrites) {
           r.exit);
 }
 
+// A building refine wrote (a Solid, its fins in a MultiSurface after it) whose Solid's rings are
+// all degenerate: convert wrote an OBJ of the fins alone, as if they were the building. It is
+// skipped now, named in a note and in the count; asked for alone, it is an error.
+TEST(BadInputFiles, ConvertSkipsABuildingOfFinsAloneNamingIt) {
+  const std::string dir = temp_dir("convert_fins_alone");
+  json city = json::parse(box_city({"ok"}));
+  json degenerate = json::array();
+  for (int f = 0; f < 6; ++f) degenerate.push_back({{0, 0, 0}});
+  city["CityObjects"]["ours"] = {{"type", "Building"},
+                                 {"attributes", {{"lodrefine_outcome", "repaired"}}},
+                                 {"geometry",
+                                  {{{"type", "Solid"}, {"lod", "2.2"}, {"boundaries", {degenerate}}},
+                                   {{"type", "MultiSurface"}, {"lod", "2.2"}, {"boundaries", {{{4, 5, 6}}}}}}}};
+  write_text(dir + "/city.json", city.dump());
+  const CliRun r = run_cli("convert --cityjson " + dir + "/city.json --out-dir " + dir + "/objs", dir);
+  ASSERT_EQ(r.exit, 0) << r.err;
+  EXPECT_EQ(files_in(dir + "/objs"), std::vector<std::string>{"ok.obj"});
+  EXPECT_NE(r.err.find("lodrefine: note: " + dir +
+                       "/city.json: \"ours\"'s Solid has no usable surface, only fins beside it: skipped"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.out.find("1 building(s) written"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1 with fins and no usable Solid skipped"), std::string::npos) << r.out;
+  const CliRun alone = run_cli("convert --cityjson " + dir + "/city.json --id ours --out-dir " + dir + "/alone", dir);
+  expect_one_error_line(alone, "\"ours\"'s Solid has no usable surface, only fins beside it; nothing to convert");
+  EXPECT_FALSE(fs::exists(dir + "/alone"));
+  add_row("convert: a Solid of degenerate rings with fins beside it", "skipped, named; alone: refused", r.exit);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Memory running out (ulimit -v) while a CityGML file is read: the module's libraries initialise
 // inside dlopen (an exception there ended in std::terminate, exit 134, with GnuTLS's own line),

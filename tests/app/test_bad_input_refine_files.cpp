@@ -291,3 +291,31 @@ TEST(BadInputAttack, RefineRefusesACloudFolderWithATileItCannotRead) {
   EXPECT_EQ(files[2], json({{"path", tiles + "/notes.txt"}, {"skipped", no_cloud}}));
   add_row("refine --cloud tiles/ with a 0-byte, dangling, folder or truncated c.laz", "refused naming it", 2);
 }
+
+// A model refine wrote (its fins group after the solid) that is kept as read (kept-invalid:
+// here a face of 1,001 vertices) lost its fins group: the fins came out among the solid's
+// faces. Written as read, they keep their group.
+TEST(BadInputFiles, AKeptInvalidModelKeepsItsFinsGroup) {
+  const std::string dir = temp_dir("kept_invalid_fins");
+  std::string extra = "g fins WallSurface\nv " + fmt(kOrigin.x()) + " " + fmt(kOrigin.y() - 0.4) + " 7\nv " +
+                      fmt(kOrigin.x()) + " " + fmt(kOrigin.y() - 0.4) + " 8\nv " + fmt(kOrigin.x() + 1) + " " +
+                      fmt(kOrigin.y() - 0.4) + " 8\nf 25 26 27\ng RoofSurface\n";
+  std::string face = "f";
+  for (int k = 0; k < 1001; ++k) {
+    const double a = 2 * M_PI * k / 1001;
+    extra += "v " + fmt(kOrigin.x() + 6 + 3 * std::cos(a)) + " " + fmt(kOrigin.y() + 4 + 3 * std::sin(a)) + " 3\n";
+    face += " " + std::to_string(28 + k);
+  }
+  write_text(dir + "/m.obj", box_obj({0, 1, 2, 3, 4, 5}, extra + face + "\n"));
+  write_text(dir + "/c.ply", valid_cloud());
+  const CliRun r = run_cli("refine --model " + dir + "/m.obj --cloud " + dir + "/c.ply --out " + dir + "/r.obj", dir);
+  ASSERT_EQ(r.exit, 0) << r.err;
+  EXPECT_NE(r.out.find("kept-invalid (face 7 has 1001 vertices"), std::string::npos) << r.out;
+  const ObjModel written = read_obj_model(dir + "/r.obj");
+  const ObjModel read = read_obj_model(dir + "/m.obj");
+  ASSERT_EQ(written.fins.faces.size(), 1u) << "the fins group kept";
+  EXPECT_EQ(written.fins.faces[0].sem, Semantic::Wall);
+  EXPECT_EQ(written.solid.faces.size(), read.solid.faces.size());
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_LT((written.fins.vertices[i] - read.fins.vertices[i]).norm(), 1e-6);
+  add_row("refine: a kept-invalid OBJ with a fins group", "written as read, fins in their group", r.exit);
+}

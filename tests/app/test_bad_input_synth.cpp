@@ -3,7 +3,11 @@
 // cast billions of rays (issue 47). Each refusal is one line, exit 2, with nothing written.
 #include <gtest/gtest.h>
 
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <string>
 #include <vector>
@@ -25,6 +29,31 @@ std::string rescan_args(const std::string& dir, const std::string& out,
 }
 
 bool is_link(const std::string& path) { return fs::is_symlink(fs::symlink_status(path)); }
+
+// The peak resident memory (KB) of `lodrefine ARGS` (its own, by wait4), which must exit 0.
+long peak_kb(const std::string& args) {
+  const std::string cmd = "exec " + shell_quote(LODREFINE_BINARY) + " " + args + " >/dev/null 2>&1";
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  int st = 0;
+  struct rusage ru {};
+  ::wait4(pid, &st, 0, &ru);
+  EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << args;
+  return ru.ru_maxrss;
+}
+
+// Every folder below `dir` (itself included) that is empty.
+std::vector<std::string> empty_folders(const std::string& dir) {
+  std::vector<std::string> out;
+  if (fs::is_directory(dir) && fs::is_empty(dir)) out.push_back(dir);
+  if (!fs::is_directory(dir)) return out;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.is_directory() && fs::is_empty(e.path())) out.push_back(e.path().string());
+  return out;
+}
 
 mode_t mode_of(const std::string& path) {
   struct stat st {};
@@ -75,6 +104,13 @@ TEST(BadInputSynth, SynthRefusesALinkedBuildingFolderAndReplacesLinkedFiles) {
   const CliRun r = run_cli("synth --type flat --out " + dir + "/out --points 500", dir);
   expect_one_error_line(r, "out/synth_flat_0001: is a symbolic link");
   EXPECT_TRUE(files_in(dir + "/elsewhere").empty());
+  // The second building's folder a link: refused before the first was made (and printed).
+  fs::rename(dir + "/out/synth_flat_0001", dir + "/out/synth_gable_0001");
+  const CliRun second = run_cli("synth --type all --out " + dir + "/out --points 500", dir);
+  expect_one_error_line(second, "out/synth_gable_0001: is a symbolic link");
+  EXPECT_EQ(second.out, "") << "nothing said written";
+  EXPECT_EQ(files_in(dir + "/out"), std::vector<std::string>{"synth_gable_0001"});
+  fs::rename(dir + "/out/synth_gable_0001", dir + "/out/synth_flat_0001");
   write_text(dir + "/victim.txt", "victim\n");
   fs::create_symlink(dir + "/victim.txt", dir + "/tile.ply");
   const CliRun tile =
@@ -157,4 +193,104 @@ TEST(BadInputSynth, RescanOfAHostileTileIsBoundedAndLeavesNothing) {
     EXPECT_FALSE(fs::exists(dir + "/out")) << c.what;
     add_row("synth --rescan: " + c.what, "one line, nothing written", r.exit);
   }
+}
+
+// A face of 60,000 vertices in a truth or in a --city neighbour made every van ray slow; refine
+// refuses such models (size_problem: faces of 1,000 vertices, 20,000 corners). So does the
+// rescan now, naming the file (and the city's building), before anything is written.
+TEST(BadInputSynth, RescanRefusesAModelOrNeighbourBeyondRefinesBounds) {
+  const std::string dir = temp_dir("synth_rescan_huge_face");
+  const std::string args = rescan_args(dir, "out");
+  write_text(dir + "/in/tile/truth/B.obj",
+             rescan_fixtures::box_obj_text(0, 0, rescan_fixtures::circle_face_obj(1001, 9)));
+  const CliRun truth = run_cli(args, dir, 60);
+  expect_one_error_line(truth, "truth/B.obj: face 6 has 1001 vertices, more than 1000 (LoD2 faces have tens)");
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+  add_row("synth --rescan: a truth face of 1,001 vertices", "refused as refine does", truth.exit);
+  rescan_args(dir, "out");  // the tile as it was; A, B's neighbour, gets the face
+  json city = json::parse(rescan_fixtures::terrace_city());
+  json& a = city["CityObjects"]["A"]["geometry"][0];
+  json ring = json::array();
+  for (int k = 0; k < 1001; ++k) {
+    const double t = 2 * M_PI * k / 1001;
+    ring.push_back(city["vertices"].size());
+    city["vertices"].push_back(
+        {std::llround((-6 + 3 * std::cos(t)) * 1000), std::llround((4 + 3 * std::sin(t)) * 1000), 3000});
+  }
+  a["boundaries"][0].push_back({ring});
+  a["semantics"]["values"][0].push_back(1);
+  write_text(dir + "/in/city.json", city.dump());
+  const CliRun neighbour = run_cli(args, dir, 60);
+  expect_one_error_line(neighbour, "city.json: building \"A\": face 6 has 1001 vertices, more than 1000");
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+  add_row("synth --rescan --city: a neighbour's face of 1,001 vertices", "refused, naming the building",
+          neighbour.exit);
+}
+
+// `synth --tile X/synth_flat_0001/truth.obj --out X` renamed the tile over the truth it had just
+// written; a rescan's --city file where a truth goes was overwritten by it. Both are refused up
+// front, as crop refuses a tile where a building's cloud goes.
+TEST(BadInputSynth, AnOutputOverAnInputOrAnotherOutputIsRefused) {
+  const std::string dir = temp_dir("synth_overwrites");
+  const std::string synth = "synth --quiet --count 2 --points 500 --out " + dir + "/X --tile ";
+  ASSERT_EQ(run_cli(synth + dir + "/tile.ply", dir).exit, 0);
+  const std::string truth = read_text(dir + "/X/synth_flat_0001/truth.obj");
+  for (const std::string& tile : {dir + "/X/synth_flat_0001/truth.obj", dir + "/X/synth_gable_0002"}) {
+    const CliRun r = run_cli(synth + tile, dir);
+    expect_one_error_line(r, tile + ": the tile would be overwritten by \"synth_");
+  }
+  EXPECT_EQ(read_text(dir + "/X/synth_flat_0001/truth.obj"), truth);
+  add_row("synth --tile X/synth_flat_0001/truth.obj --out X", "refused: the tile is a building's file", 2);
+  const std::string args = rescan_args(dir, "out");
+  fs::create_directories(dir + "/out/truth");
+  fs::rename(dir + "/in/city.json", dir + "/out/truth/B.obj");
+  const std::string city = read_text(dir + "/out/truth/B.obj");
+  const std::string moved =
+      args.substr(0, args.find(" --city ")) + " --city " + dir + "/out/truth/B.obj --out " + dir + "/out";
+  const CliRun r = run_cli(moved, dir);
+  expect_one_error_line(r, "out/truth/B.obj: the --city file would be overwritten by the rescan's truth of \"B\"");
+  EXPECT_EQ(read_text(dir + "/out/truth/B.obj"), city);
+  EXPECT_EQ(files_in(dir + "/out/truth"), std::vector<std::string>{"B.obj"});
+  add_row("synth --rescan --city out/truth/B.obj", "refused: the city is where a truth goes", r.exit);
+}
+
+// A 100 kB cityjson_id gave a 100 kB error line: every id quoted is cut (shown_id).
+TEST(BadInputSynth, AHugeIdIsCutInTheMessage) {
+  const std::string dir = temp_dir("synth_huge_id");
+  const std::string id(100000, 'x');
+  const CliRun r = run_cli(rescan_args(dir, "out", {{"id", "B"}, {"cityjson_id", id}, {"scanned_walls", {0}}}), dir);
+  expect_one_error_line(r, "cityjson_id \"" + std::string(kMaxShownId, 'x') + "...\" (100000 bytes) is no building of");
+  EXPECT_LT(r.err.size(), 500u);
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+  add_row("synth --rescan: cityjson_id of 100 kB", "one line of < 500 bytes, the id cut", r.exit);
+}
+
+#if !defined(__SANITIZE_ADDRESS__)  // ASan's quarantine keeps what is freed: its peak grows with the run
+// --rescan held the whole tile's cloud until the end (223 MB for 40 buildings): the tile is
+// streamed now, one building's crop in memory at a time. 12 buildings need no more than 3.
+TEST(BadInputSynth, RescanMemoryDoesNotGrowWithTheTile) {
+  const std::string dir = temp_dir("synth_rescan_memory");
+  long peak[2] = {0, 0};
+  for (int k : {0, 1}) {
+    const std::string tile = rescan_fixtures::write_row_tile(dir + "/in" + std::to_string(k), k == 0 ? 3 : 12);
+    peak[k] = peak_kb("synth --scanner van --rescan " + tile + " --out " + dir + "/out" + std::to_string(k));
+  }
+  EXPECT_LT(peak[1] - peak[0], 12000) << "3 buildings: " << peak[0] << " KB, 12: " << peak[1] << " KB";
+  add_row("synth --rescan: 3 and 12 buildings",
+          "peak " + std::to_string(peak[0] / 1024) + " and " + std::to_string(peak[1] / 1024) + " MB", 0);
+}
+#endif
+
+// A --rescan killed while the van scanned left out/{clouds,models,truth} empty: a folder is made
+// when its first file is written now.
+TEST(BadInputSynth, AKilledRescanLeavesNoEmptyFolders) {
+  const std::string dir = temp_dir("synth_rescan_killed");
+  const std::string tile = rescan_fixtures::write_row_tile(dir + "/in", 2);
+  const std::string cmd = "timeout -s KILL 1 " + shell_quote(LODREFINE_BINARY) + " synth --scanner van --rescan " +
+                          tile + " --van-drives 8 --van-rate 200 --out " + dir + "/out >/dev/null 2>&1";
+  const int st = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 137) << "killed while the van scans (the first building takes 5 s)";
+  EXPECT_EQ(empty_folders(dir + "/out"), std::vector<std::string>{});
+  EXPECT_FALSE(fs::exists(dir + "/out")) << "nothing written before the first building's scan ends";
+  add_row("synth --rescan killed (SIGKILL) during the first scan", "no folders left", 137);
 }

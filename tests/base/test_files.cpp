@@ -280,3 +280,18 @@ TEST(OutputTree, RefusesLinkedFoldersAndRemovesOnlyWhatItCreated) {
   EXPECT_TRUE(fs::exists(root + "/made/a/x.txt"));
   fs::remove_all(root);
 }
+
+// A 100 kB id quoted whole gave a 100 kB message line: cut at kMaxShownId bytes, at a
+// character's start (a cut UTF-8 character would show as U+FFFD), its size said.
+TEST(ShownId, QuotesShortIdsWholeAndCutsLongOnes) {
+  EXPECT_EQ(shown_id("B 1"), "\"B 1\"");
+  EXPECT_EQ(shown_id("a\nb"), "\"a\\nb\"");
+  EXPECT_EQ(shown_id(std::string(kMaxShownId, 'a')), "\"" + std::string(kMaxShownId, 'a') + "\"");
+  const std::string huge(100000, 'x');
+  EXPECT_EQ(shown_id(huge), "\"" + std::string(kMaxShownId, 'x') + "...\" (100000 bytes)");
+  const std::string accents = std::string(kMaxShownId - 1, 'a') + "\xc3\xa9" + "tail";  // é across the cut
+  EXPECT_EQ(shown_id(accents),
+            "\"" + std::string(kMaxShownId - 1, 'a') + "...\" (" + std::to_string(accents.size()) + " bytes)");
+  const std::string controls(100000, '\x01');  // each shown as \u0001: still bounded
+  EXPECT_LT(shown_id(controls).size(), 6 * kMaxShownId + 40);
+}

@@ -963,7 +963,7 @@ TEST(CityFile, AttributesThatAreNoObjectAreRefusedNotReplaced) {
     refine_city(dir + "/city.json", {dir + "/cloud.ply"}, dir + "/out.city.json", RefineConfig{}, {});
     ADD_FAILURE() << "refined";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("object " + bs[0].id + ": \"attributes\" is not a JSON object"),
+    EXPECT_NE(std::string(e.what()).find("object " + shown_id(bs[0].id) + ": \"attributes\" is not a JSON object"),
               std::string::npos)
         << e.what();
   }

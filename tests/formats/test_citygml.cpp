@@ -361,7 +361,7 @@ TEST(CityGmlSecurity, EveryBuildingKeepsItsOwnId) {
   EXPECT_EQ(ids, (std::vector<std::string>{"dup", "dup~3", "building-1", "building-4", "dup~2"}));
   EXPECT_NEAR(f.buildings[1].mesh.vertices[0].x(), 20.0, 1e-9);  // the second "dup" is the second building
   ASSERT_FALSE(f.notes.empty());
-  EXPECT_EQ(f.notes[0], "gml:id 'dup' is given to more than one building: one is written as 'dup~3'");
+  EXPECT_EQ(f.notes[0], "gml:id \"dup\" is given to more than one building: one is written as \"dup~3\"");
 }
 
 // A building nesting 20,000 BuildingParts overflowed the stack in the CityGML module (libcitygml

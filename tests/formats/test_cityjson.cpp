@@ -148,7 +148,7 @@ TEST(CityJson, RejectsMalformedInputWithOneLineMessages) {
        "line 3: expected a CityJSONFeature"},
       {cube_document(
            "2.0", R"("A":{"type":"Building","geometry":[)" + ok_solid + R"(]},"B":{"type":"Building","geometry":{}})"),
-       "object B: \"geometry\" is not an array"},
+       "object \"B\": \"geometry\" is not an array"},
   };
   for (const auto& [text, expect] : bad) {
     try {
@@ -360,7 +360,7 @@ TEST(CityJsonSecurity, DeepNestingOverflowsAndDuplicatesAreOneLine) {
       {R"({"type":"CityJSON","version":"1.1","CityObjects":{},"vertices":[[2e15,0,0]]})",
        "bad.json: vertex 0 is beyond 1e9 m from the origin"},
       // A duplicate CityObjects key kept one of the two buildings.
-      {cube_document("2.0", ok + "}," + ok + "}"), "bad.json: CityObjects id A appears twice"},
+      {cube_document("2.0", ok + "}," + ok + "}"), "bad.json: CityObjects id \"A\" appears twice"},
   };
   for (const auto& [text, expect] : bad) {
     const std::string msg = refusal_of(text);
@@ -394,11 +394,11 @@ TEST(CityJsonSecurity, KeysGivenTwiceAndNonStringTypesAreOneLine) {
       {cube_document("2.0", R"("A":{"type":"Building","geometry":[)" +
                                 cube_solid("\"2\"").replace(1, 0, R"("boundaries":[],)") + "]}"),
        "bad.json: key \"boundaries\" appears twice in one object"},
-      {cube_document("2.0", ok + R"(,"B":{"type":5})"), "bad.json: object B: \"type\" is not a string"},
+      {cube_document("2.0", ok + R"(,"B":{"type":5})"), "bad.json: object \"B\": \"type\" is not a string"},
       {R"({"type":"CityJSON","version":2,"CityObjects":{},"vertices":[]})", "bad.json: \"version\" is not a string"},
       // 2^63 was shown as -9223372036854775808.
       {cube_document("2.0", ok).replace(doc.find("[[[[0,"), 6, "[[[[9223372036854775808,"),
-       "bad.json: object A: vertex index 9223372036854775808 is out of range"},
+       "bad.json: object \"A\": vertex index 9223372036854775808 is out of range"},
   };
   for (const auto& [text, expect] : bad) {
     const std::string msg = refusal_of(text);

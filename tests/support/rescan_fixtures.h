@@ -4,6 +4,7 @@
 #pragma once
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <sstream>
 #include <string>
@@ -101,6 +102,38 @@ inline std::string write_tile(const fs::path& root,
   write_text(root / "tile" / "models" / "B.obj", box_obj_text(0, -0.4));
   write_text(root / "city.json", terrace_city());
   return (root / "tile").string();
+}
+
+// Writes <root>/tile with `count` boxes 30 m apart along x (ids B00, B01, ...: truth, and a model
+// with its front 0.4 m out), each scanned on its front wall, and no city file. Returns the tile.
+inline std::string write_row_tile(const fs::path& root, int count) {
+  fs::remove_all(root);
+  fs::create_directories(root / "tile" / "truth");
+  fs::create_directories(root / "tile" / "models");
+  json buildings = json::array();
+  for (int i = 0; i < count; ++i) {
+    const std::string id = (i < 10 ? "B0" : "B") + std::to_string(i);
+    write_text(root / "tile" / "truth" / (id + ".obj"), box_obj_text(30.0 * i, 0));
+    write_text(root / "tile" / "models" / (id + ".obj"), box_obj_text(30.0 * i, -0.4));
+    buildings.push_back({{"id", id}, {"scanned_walls", {0}}});
+  }
+  write_text(root / "tile" / "meta.json",
+             json{{"origin", {kTileOrigin.x(), kTileOrigin.y(), 0.0}}, {"buildings", buildings}}.dump());
+  return (root / "tile").string();
+}
+
+// OBJ text of a face of `n` vertices on a circle of 3 m about (6, 4, 3) (local, georeferenced by
+// kTileOrigin), its vertices numbered from `first` (1-based): a huge face to append.
+inline std::string circle_face_obj(int n, int first) {
+  std::ostringstream s;
+  s.precision(12);
+  for (int k = 0; k < n; ++k) {
+    const double a = 2 * M_PI * k / n;
+    s << "v " << kTileOrigin.x() + 6 + 3 * std::cos(a) << " " << kTileOrigin.y() + 4 + 3 * std::sin(a) << " 3\n";
+  }
+  s << "g RoofSurface\nf";
+  for (int k = 0; k < n; ++k) s << " " << first + k;
+  return s.str() + "\n";
 }
 
 }  // namespace rescan_fixtures

@@ -23,6 +23,7 @@ constexpr double kMinScale = 1e-9;
 // file given in the wrong place is, and lets commands that take several formats pick one.
 enum class FileKind { Ply, Las, Xml, Json, Other };
 FileKind sniff_file(const std::string& path);  // Other also for unreadable files (the reader reports)
+FileKind sniff_head(const std::string& head);  // the same from a file's first (up to 64) bytes
 // "a PLY point cloud", "a LAS/LAZ point cloud", "XML (a CityGML model?)", "JSON (a CityJSON
 // model?)"; empty for Other.
 std::string file_kind_text(FileKind kind);
@@ -57,6 +58,7 @@ class AtomicFile {
   [[noreturn]] void fail(const std::string& reason);  // discards, throws std::runtime_error
 
  private:
+  void write_from(const char* data, std::size_t n, long long offset);  // offset < 0: at the end
   void discard();
   std::string path_, tmp_;
   int fd_ = -1;
@@ -155,6 +157,19 @@ struct FileOption {
 // (same_file). Called before anything is read.
 void refuse_overwrites(const std::vector<FileOption>& inputs, const std::vector<FileOption>& outputs);
 
+// A file (or folder) a command reads or is about to write, and what it is to the user: "the
+// tile", "\"A\"'s cloud.ply".
+struct RunFile {
+  std::string what, path;
+};
+// Throws InputError "<input's path>: the <input's what> would be overwritten by <output's what>;
+// give another --out" for the first of `outputs` written where one of `inputs` is read: a tile
+// that lies in the output folder where a building's file goes, say. An input is where its links
+// lead; an output is where it is written (its folders' links resolved; a link at the output
+// itself is replaced, never followed, so the file it names is safe). Called before anything is
+// written; `inputs` may hold an output another writes last (synth's tile).
+void refuse_overwritten(const std::vector<RunFile>& inputs, const std::vector<RunFile>& outputs);
+
 // Names for untrusted ids (CityObject ids, file stems) in file and folder names that make, the
 // shell and every file system take as they are.
 //
@@ -166,7 +181,11 @@ void refuse_overwrites(const std::vector<FileOption>& inputs, const std::vector<
 // one's hashed name: SafeNames resolves both within a set).
 inline constexpr std::size_t kMaxSafeName = 100;
 // An untrusted id for a message line: in double quotes, JSON-escaped (control characters as
-// \u00XX, invalid UTF-8 as U+FFFD), so it can neither break the line nor the terminal.
+// \u00XX, invalid UTF-8 as U+FFFD), so it can neither break the line nor the terminal; an id
+// over kMaxShownId bytes is cut there (at a character's start) and shown as `"<first bytes>..."
+// (<size> bytes)`, so a 100 kB id gives a line of a few hundred bytes. Every id quoted in a
+// message goes through this.
+inline constexpr std::size_t kMaxShownId = 80;
 std::string shown_id(const std::string& id);
 // Untrusted text for a message line as it is, but for its control characters (C0, DEL, C1):
 // \n, \r, \t or \xHH (a C1 character as its UTF-8 bytes), so a newline or an escape code in a

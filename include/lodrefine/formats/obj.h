@@ -2,6 +2,7 @@
 // InputError with a one-line message on malformed input; the writer is atomic.
 #pragma once
 #include <string>
+#include <vector>
 
 #include "lodrefine/base/files.h"
 #include "lodrefine/base/types.h"
@@ -33,6 +34,12 @@ struct ObjModel {
 // its faces use). `solid` may be empty when every face is in a fins group: callers that need a
 // solid say so.
 ObjModel read_obj_model(const std::string& path);
+// read_obj, also telling fins apart: `in_fins` gets one flag per face of the result, set for a
+// face in a fins group (the mesh as one soup, for refine; split_fins parts it as read).
+Mesh read_obj(const std::string& path, std::vector<char>& in_fins);
+// `mesh`'s faces flagged in `in_fins` (one flag per face) apart from the others, in order, each
+// part with only the vertices its faces use and the mesh's id.
+ObjModel split_fins(const Mesh& mesh, const std::vector<char>& in_fins);
 
 // Writes polygons grouped by semantic (`g WallSurface` ...), `o <id>`, vertices offset by
 // `origin` (the local frame's origin) and printed with enough digits for < 0.1 mm at 7-digit

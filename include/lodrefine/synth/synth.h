@@ -98,6 +98,10 @@ struct SynthBuilding {
 // rescan_tile call it; a command calls it first, before anything is written.
 void check_synth_options(const SynthOptions& opt);
 
+// The id make_building gives the building of (type, seed), and its folder's name:
+// "synth_<type>_<seed, at least 4 digits>".
+std::string synth_building_id(BuildingType type, std::uint64_t seed);
+
 // Deterministic for (type, seed, options).
 SynthBuilding make_building(BuildingType type, std::uint64_t seed, const SynthOptions& opt = {});
 
@@ -106,12 +110,19 @@ SynthBuilding make_building(BuildingType type, std::uint64_t seed, const SynthOp
 // InputError; a link at a file is replaced, never followed).
 void write_synth_building(OutputTree& out, const SynthBuilding& b, bool with_cloud = true);
 
+// Checks, before anything is made, that write_synth_building can write the buildings `ids` in
+// `out`: throws InputError when a building's folder is a symbolic link or no folder, or when
+// `tile_ply` (may be empty) is a building's folder or one of its files ("<tile>: the tile would
+// be overwritten by "<id>"'s truth.obj; give another --out"). write_synth_tile calls it; a
+// command writing buildings one by one calls it first.
+void check_synth_outputs(const OutputTree& out, const std::vector<std::string>& ids, const std::string& tile_ply = "");
+
 // A city tile for the city-scale bench: `count` buildings (types cycling, seeds first_seed...)
 // on a square grid of `spacing` metres from opt.origin, each written as <out>/<id>/{truth.obj,
 // coarse.obj, meta.json}, and all their clouds streamed into one binary PLY `tile_ply` (one
 // building in memory at a time; written under a temporary name, renamed when complete, so a
 // failure leaves the tile as it was). `progress` (may be empty) gets each building after it is
-// written. Returns the tile's points.
+// written. Every output is checked first (check_synth_outputs). Returns the tile's points.
 std::uint64_t write_synth_tile(OutputTree& out, const std::string& tile_ply, int count, std::uint64_t first_seed,
                                double spacing, const SynthOptions& opt,
                                const std::function<void(const SynthBuilding&)>& progress);
