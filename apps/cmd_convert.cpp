@@ -88,7 +88,8 @@ void run(const ConvertArgs& a) {
   for (const auto& id : wanted)
     if (!found.count(id))
       throw InputError(path + ": no Building/BuildingPart " + shown_id(id) + " with an LoD 2.x geometry");
-  if (chosen.empty() && !no_solid.empty())
+  // A building asked for by name is converted or the run refused, never skipped with a note.
+  if ((chosen.empty() || !wanted.empty()) && !no_solid.empty())
     throw InputError(path + ": " + shown_id(no_solid.front()) + "'s Solid has no usable surface, only fins beside it" +
                      (no_solid.size() > 1 ? " (and " + std::to_string(no_solid.size() - 1) + " more)" : "") +
                      "; nothing to convert");

@@ -305,7 +305,7 @@ void run(const RefineArgs& a) {
   print_skipped(skipped);
   std::string warned;
   for (const std::string& w : warnings) warned += "; warning: " + escaped_line(w);
-  std::printf("%s: %s (%s) -> %s (%.2f s)%s\n", escaped_line(model.id).c_str(), outcome_name(r.outcome),
+  std::printf("%s: %s (%s) -> %s (%.2f s)%s\n", line_id(model.id).c_str(), outcome_name(r.outcome),
               escaped_line(r.reason).c_str(), escaped_line(a.out).c_str(), r.trace.stage_seconds("total").value_or(0.0),
               warned.c_str());
 }

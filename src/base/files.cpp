@@ -325,6 +325,8 @@ std::string shown_id(const std::string& id) {
   return quoted(id.substr(0, cut) + "...") + " (" + std::to_string(id.size()) + " bytes)";
 }
 
+std::string line_id(const std::string& id) { return is_safe_name(id) ? id : shown_id(id); }
+
 bool is_safe_name(const std::string& name) {
   if (name.empty() || name.size() > kMaxSafeName || name[0] == '-' || name[0] == '.') return false;
   for (char c : name)

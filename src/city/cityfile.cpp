@@ -271,7 +271,8 @@ void add_targets(const std::vector<CityJsonBuilding>& buildings, const CityRefin
 }
 
 void check_targets(const std::vector<CropTarget>& targets, const std::string& model_path, const CityRefineOptions& o) {
-  if (targets.empty()) throw InputError(model_path + ": no building '" + o.building + "' with the LoD asked for");
+  if (targets.empty())
+    throw InputError(model_path + ": no building " + shown_id(o.building) + " with the LoD asked for");
 }
 
 [[noreturn]] void fail_no_lod(const std::string& model_path, const CityRefineOptions& o, int without) {

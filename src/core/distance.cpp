@@ -11,6 +11,7 @@
 #include <deque>
 #include <limits>
 
+#include "lodrefine/base/files.h"
 #include "lodrefine/base/geometry.h"
 
 namespace lodrefine {
@@ -95,7 +96,7 @@ class SurfaceIndex {
       tris_.push_back(t);
       cgal_.emplace_back(to_cgal(t.a), to_cgal(t.b), to_cgal(t.c));
     });
-    if (tris_.empty()) throw InputError("mesh '" + mesh.id + "' has no non-degenerate face");
+    if (tris_.empty()) throw InputError("mesh " + shown_id(mesh.id) + " has no non-degenerate face");
     tree_.insert(cgal_.cbegin(), cgal_.cend());
     tree_.build();
     tree_.accelerate_distance_queries();

@@ -10,6 +10,7 @@
 #include <queue>
 #include <set>
 
+#include "lodrefine/base/files.h"
 #include "lodrefine/base/geometry.h"
 #include "lodrefine/base/submesh.h"
 #include "lodrefine/base/topology.h"
@@ -28,7 +29,7 @@ constexpr double kMinWeldTolerance = 1e-9;
 constexpr std::size_t kMinClosedFaces = 4;
 
 [[noreturn]] void reject(const Mesh& m, const std::string& why) {
-  throw InputError("building " + (m.id.empty() ? std::string("(no id)") : m.id) + ": " + why);
+  throw InputError("building " + (m.id.empty() ? std::string("(no id)") : line_id(m.id)) + ": " + why);
 }
 
 void check_input(const Mesh& soup) {

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lodrefine/base/files.h"
 #include "lodrefine/base/geometry.h"
 #include "lodrefine/core/distance.h"
 #include "lodrefine/core/refine.h"
@@ -91,7 +92,7 @@ std::string caption(const CityReviewBuilding& b) {
 // (reasons carry the figures of the building, e.g. "... better (RMS 0.12 -> 0.15 m)"), without
 // a leading "building <id>: ".
 std::string check_of(const std::string& id, std::string reason) {
-  if (const std::string own = "building " + id + ": "; reason.rfind(own, 0) == 0) reason.erase(0, own.size());
+  if (const std::string own = "building " + line_id(id) + ": "; reason.rfind(own, 0) == 0) reason.erase(0, own.size());
   std::string key = reason.substr(0, std::min(reason.find(':'), reason.find('(')));
   std::string out;
   for (std::size_t i = 0; i < key.size(); ++i) {

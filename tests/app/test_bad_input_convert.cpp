@@ -84,7 +84,12 @@ TEST(BadInputFiles, ConvertSkipsABuildingOfFinsAloneNamingIt) {
   const CliRun alone = run_cli("convert --cityjson " + dir + "/city.json --id ours --out-dir " + dir + "/alone", dir);
   expect_one_error_line(alone, "\"ours\"'s Solid has no usable surface, only fins beside it; nothing to convert");
   EXPECT_FALSE(fs::exists(dir + "/alone"));
-  add_row("convert: a Solid of degenerate rings with fins beside it", "skipped, named; alone: refused", r.exit);
+  const CliRun named =
+      run_cli("convert --cityjson " + dir + "/city.json --id ours --id ok --out-dir " + dir + "/named", dir);
+  expect_one_error_line(named, "\"ours\"'s Solid has no usable surface, only fins beside it; nothing to convert");
+  EXPECT_FALSE(fs::exists(dir + "/named"));
+  add_row("convert: a Solid of degenerate rings with fins beside it", "skipped, named; asked for by --id: refused",
+          r.exit);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lodrefine/formats/ply.h"
@@ -41,6 +42,35 @@ TEST(BadInputSecurity, NonUtf8NamesAreWrittenWithReplacementCharacters) {
   EXPECT_EQ(e.exit, 0) << e.err;
   EXPECT_EQ(e.err.find("json.exception"), std::string::npos) << e.err;
   EXPECT_NE(read_text(dir + "/e.json").find("b\xEF\xBF\xBD"), std::string::npos);
+}
+
+// An OBJ object name of 100,000 bytes, of bytes that are no UTF-8, or on a model of degenerate faces
+// (its reason names the building too): refine's one result line stays short, and no raw byte of
+// the name reaches the terminal. A plain name is shown as it is.
+TEST(BadInputSecurity, AHostileObjectNameIsCutOnTheResultLine) {
+  const std::string dir = temp_dir("hostile_name");
+  write_text(dir + "/c.ply", valid_cloud());
+  const std::string huge(100000, 'A');
+  const std::string degenerate = "v 0 0 0\nv 0 0 0\nv 0 0 0\ng WallSurface\nf 1 2 3\n";
+  for (const auto& [name, body] : {std::pair{huge, valid_model()}, std::pair{huge, degenerate},
+                                   std::pair{std::string(200, '\xff'), valid_model()}}) {
+    write_text(dir + "/m.obj", "o " + name + "\n" + body);
+    fs::remove(dir + "/r.obj");
+    const CliRun r = run_cli("refine --model " + shell_quote(dir + "/m.obj") + " --cloud " +
+                                 shell_quote(dir + "/c.ply") + " --out " + shell_quote(dir + "/r.obj"),
+                             dir);
+    ASSERT_EQ(r.exit, 0) << r.err.substr(0, 300);
+    ASSERT_EQ(lines(r.out).size(), 1u);
+    EXPECT_LT(r.out.size(), 1000u) << r.out.substr(0, 300);  // the id twice, cut, on a degenerate model
+    EXPECT_NE(r.out.find("bytes)"), std::string::npos) << r.out.substr(0, 300);
+    EXPECT_EQ(r.out.find('\xff'), std::string::npos);
+  }
+  write_text(dir + "/m.obj", valid_model());
+  fs::remove(dir + "/r.obj");
+  const CliRun plain = run_cli("refine --model " + shell_quote(dir + "/m.obj") + " --cloud " +
+                                   shell_quote(dir + "/c.ply") + " --out " + shell_quote(dir + "/r.obj"),
+                               dir);
+  EXPECT_EQ(plain.out.rfind("bldg_0001: ", 0), 0u) << plain.out;
 }
 
 // ---------------------------------------------------------------------------------------------

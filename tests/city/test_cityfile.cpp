@@ -345,7 +345,7 @@ TEST(CityFile, ErrorsAndBuildingsThatCannotBeRefined) {
                "does not overlap the city model x 92");
   expect_error("refine --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir +
                    "/x.city.json --building nope",
-               "no building 'nope'");
+               "no building \"nope\"");
   expect_error(
       "refine --model " + dir + "/city.json --cloud " + dir + "/cloud.ply --out " + dir + "/x.city.json --lod 3",
       "no Building/BuildingPart with an LoD 3 geometry");

@@ -187,6 +187,9 @@ inline constexpr std::size_t kMaxSafeName = 100;
 // message goes through this.
 inline constexpr std::size_t kMaxShownId = 80;
 std::string shown_id(const std::string& id);
+// An id at the head of a result line or a reason ("<id>: ...", "building <id>: ..."): as it is when
+// it is a safe name (batch logs and the review page match those), else shown_id's form.
+std::string line_id(const std::string& id);
 // Untrusted text for a message line as it is, but for its control characters (C0, DEL, C1):
 // \n, \r, \t or \xHH (a C1 character as its UTF-8 bytes), so a newline or an escape code in a
 // path, key or file's text can neither break the line nor reach the terminal.
