@@ -7,6 +7,8 @@
 #include <optional>
 #include <set>
 
+#include "lodrefine/base/topology.h"
+
 namespace lodrefine {
 namespace {
 
@@ -150,20 +152,14 @@ Adjacency adjacent_surfaces(const Mesh& mesh, const std::vector<ModelSurface>& s
   std::vector<int> face_surface(mesh.faces.size(), -1);
   for (int s = 0; s < int(surfaces.size()); ++s)
     for (int f : surfaces[s].faces) face_surface[f] = s;
-  std::map<std::pair<int, int>, std::vector<int>> edge_surfaces;
-  for (int f = 0; f < int(mesh.faces.size()); ++f) {
-    const auto& v = mesh.faces[f].v;
-    for (std::size_t k = 0; k < v.size(); ++k) {
-      const int a = v[k], b = v[(k + 1) % v.size()];
-      edge_surfaces[{std::min(a, b), std::max(a, b)}].push_back(face_surface[f]);
-    }
-  }
   Adjacency shared;
-  for (const auto& [e, ss] : edge_surfaces)
-    if (ss.size() == 2 && ss[0] != ss[1]) {
-      shared[{ss[0], ss[1]}].push_back(e);
-      shared[{ss[1], ss[0]}].push_back(e);
-    }
+  for (const auto& [e, us] : edge_uses(mesh.faces)) {
+    if (us.size() != 2) continue;
+    const int s0 = face_surface[us[0].face], s1 = face_surface[us[1].face];
+    if (s0 == s1) continue;
+    shared[{s0, s1}].push_back(e);
+    shared[{s1, s0}].push_back(e);
+  }
   return shared;
 }
 

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <map>
 
+#include "lodrefine/base/topology.h"
+
 namespace lodrefine {
 namespace {
 
@@ -120,14 +122,7 @@ ModelSurface describe_surface(const Mesh& mesh, const std::vector<int>& members)
 
 std::vector<ModelSurface> model_surfaces(const Mesh& mesh, double angle_deg, double distance) {
   const int nf = int(mesh.faces.size());
-  std::map<std::pair<int, int>, std::vector<int>> edge_faces;
-  for (int f = 0; f < nf; ++f) {
-    const auto& v = mesh.faces[f].v;
-    for (std::size_t i = 0; i < v.size(); ++i) {
-      const int a = v[i], b = v[(i + 1) % v.size()];
-      edge_faces[{std::min(a, b), std::max(a, b)}].push_back(f);
-    }
-  }
+  const EdgeUses uses = edge_uses(mesh.faces);
   std::vector<Plane> face_plane(nf);
   for (int f = 0; f < nf; ++f) face_plane[f] = polygon_plane(face_points(mesh, mesh.faces[f]));
 
@@ -144,8 +139,10 @@ std::vector<ModelSurface> model_surfaces(const Mesh& mesh, double angle_deg, dou
       members.push_back(f);
       const auto& v = mesh.faces[f].v;
       for (std::size_t i = 0; i < v.size(); ++i) {
-        const int a = v[i], b = v[(i + 1) % v.size()];
-        for (int g : edge_faces[{std::min(a, b), std::max(a, b)}]) {
+        const auto across = uses.find(edge_key(v[i], v[(i + 1) % v.size()]));
+        if (across == uses.end()) continue;  // a repeated vertex: no edge
+        for (const EdgeUse& u : across->second) {
+          const int g = u.face;
           if (group[g] >= 0) continue;
           if (face_plane[g].n.dot(face_plane[seed].n) < std::cos(radians(angle_deg))) continue;
           bool on_plane = true;

@@ -34,7 +34,6 @@ void RefineConfig::validate() const {
   match.validate();
   if (match.w_normal + match.w_coverage <= 0) throw InputError("match: parameters w_normal + w_coverage must be > 0");
   selection.validate();
-  confidence.validate();
 }
 
 const std::vector<ParamInfo>& param_table() {

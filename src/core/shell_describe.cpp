@@ -6,7 +6,6 @@
 #include <vector>
 
 #include "lodrefine/base/geometry.h"
-#include "lodrefine/core/confidence.h"
 #include "lodrefine/core/matching.h"
 #include "shell_supports.h"
 

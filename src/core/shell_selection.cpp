@@ -12,9 +12,9 @@
 
 #include "lodrefine/base/geometry.h"
 #include "lodrefine/base/topology.h"
-#include "lodrefine/core/confidence.h"
 #include "lodrefine/core/distance.h"
 #include "lodrefine/core/matching.h"
+#include "lodrefine/core/objective.h"
 #include "lodrefine/core/shell_trace.h"
 #include "lodrefine/core/validate.h"
 #include "shell_supports.h"

@@ -10,6 +10,7 @@
 
 #include "lodrefine/base/files.h"
 #include "support/bad_input_fixtures.h"
+#include "support/test_paths.h"
 
 using namespace lodrefine;
 using namespace lodrefine::bad_input;
@@ -87,7 +88,7 @@ TEST(BadInputFiles, FailedWriteLeavesNoHalfRunFolder) {
   // SIGXFSZ ignored: a write beyond 64 KB fails with EFBIG, as on a full disk.
   auto limited = [&](const std::string& args) {
     return std::system(("cd " + shell_quote(dir) + " && sh -c \"trap '' XFSZ; ulimit -f 64; exec " +
-                        shell_quote(LODREFINE_BINARY) + " " + args + "\" > /dev/null 2> err.txt")
+                        shell_quote(test_paths::lodrefine_binary()) + " " + args + "\" > /dev/null 2> err.txt")
                            .c_str());
   };
   EXPECT_NE(limited("crop --tile tile.ply --models models --out run"), 0);

@@ -32,6 +32,7 @@
 #include "lodrefine/base/geometry.h"
 #include "lodrefine/formats/obj.h"
 #include "support/bad_input_fixtures.h"
+#include "support/test_paths.h"
 
 using namespace lodrefine;
 using namespace lodrefine::bad_input;
@@ -173,7 +174,7 @@ std::vector<Case> cases() {
   {
     // A LAZ (the fuzz seed: 6 points, one per chunk) cut inside its chunk table, and with a
     // header count beyond what its chunks hold.
-    const std::string laz = read_text(std::string(LODREFINE_SOURCE_DIR) + "/tests/fuzz/corpus/fuzz_laz/v12_f0.laz");
+    const std::string laz = read_text(test_paths::source_dir() + "/tests/fuzz/corpus/fuzz_laz/v12_f0.laz");
     c.push_back({"cloud: LAZ cut inside its chunk table",
                  [laz](Paths& p) { cloud_is(p, laz.substr(0, laz.size() - 6)); }, Expect::Error, "LAZ chunk"});
     c.push_back({"cloud: LAZ header count beyond its chunks",
@@ -359,7 +360,7 @@ std::vector<Case> cases() {
   // --- every input a fuzz target ever crashed on (tests/fuzz/regressions/<target>/), replayed
   // through the CLI: fuzz_obj inputs as the model, fuzz_ply inputs as the cloud, fuzz_refine
   // inputs split as the target splits them (its "tiny" flag becomes the same parameters).
-  const fs::path reg = fs::path(LODREFINE_SOURCE_DIR) / "tests" / "fuzz" / "regressions";
+  const fs::path reg = fs::path(test_paths::source_dir()) / "tests" / "fuzz" / "regressions";
   std::error_code ec;
   for (const char* target : {"fuzz_obj", "fuzz_ply", "fuzz_refine"}) {
     std::vector<fs::path> files;
@@ -537,8 +538,8 @@ TEST(BadInputAtomic, KillAtAnyTimeLeavesNoPartialModel) {
     if (pid == 0) {
       const int devnull = ::open("/dev/null", O_WRONLY);
       ::dup2(devnull, 1), ::dup2(devnull, 2);
-      ::execl(LODREFINE_BINARY, LODREFINE_BINARY, "refine", "--model", model.c_str(), "--cloud", cloud.c_str(), "--out",
-              out.c_str(), static_cast<char*>(nullptr));
+      ::execl(test_paths::lodrefine_binary().c_str(), test_paths::lodrefine_binary().c_str(), "refine", "--model",
+              model.c_str(), "--cloud", cloud.c_str(), "--out", out.c_str(), static_cast<char*>(nullptr));
       ::_exit(127);
     }
     ::usleep(useconds_t(frac * full.seconds * 1e6));

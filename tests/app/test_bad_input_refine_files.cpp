@@ -15,6 +15,7 @@
 
 #include "lodrefine/formats/ply.h"
 #include "support/bad_input_fixtures.h"
+#include "support/test_paths.h"
 
 using namespace lodrefine;
 using namespace lodrefine::bad_input;
@@ -174,7 +175,7 @@ TEST(BadInputMemory, CloudUnderAnAddressSpaceLimitIsNamed) {
   for (int i = 0; i < 6000000; ++i) big.points.emplace_back(u(rng), u(rng), u(rng));
   write_ply(cloud, big);
   big = PointCloud();
-  const std::string model = std::string(LODREFINE_SOURCE_DIR) + "/data/samples/synth_gable_0001/coarse.obj";
+  const std::string model = test_paths::source_dir() + "/data/samples/synth_gable_0001/coarse.obj";
   std::vector<long> limits;
   for (long kb = 90000; kb <= 200000; kb += 10000) limits.push_back(kb);
   const int failures = expect_named_out_of_memory(limits,

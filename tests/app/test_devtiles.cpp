@@ -20,6 +20,7 @@
 #include "lodrefine/formats/ply.h"
 #include "support/cli_fixtures.h"
 #include "support/fins_fixtures.h"
+#include "support/test_paths.h"
 
 using namespace lodrefine;
 
@@ -30,7 +31,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path tiles_dir() { return fs::path(LODREFINE_SOURCE_DIR) / ".." / "shared" / "devtiles"; }
+fs::path tiles_dir() { return fs::path(test_paths::source_dir()) / ".." / "shared" / "devtiles"; }
 
 struct Sums {
   double before = 0, after = 0;

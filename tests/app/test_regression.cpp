@@ -7,12 +7,13 @@
 #include <fstream>
 
 #include <nlohmann/json.hpp>
+#include "support/test_paths.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 
 TEST(Regression, SampleBatchStaysWithinThresholds) {
-  const fs::path src = LODREFINE_SOURCE_DIR;
+  const fs::path src = test_paths::source_dir();
   const fs::path run = fs::temp_directory_path() / ("lodrefine_regression_" + std::to_string(::getpid()));
   fs::remove_all(run);
   fs::create_directories(run);
@@ -24,7 +25,8 @@ TEST(Regression, SampleBatchStaysWithinThresholds) {
   }
   ASSERT_GE(samples, 3);
   const std::string cmd = "make -s -f '" + (src / "scripts" / "batch.mk").string() + "' RUN='" + run.string() +
-                          "' LODREFINE='" + LODREFINE_BINARY + "' -j2 > '" + (run / "batch.log").string() + "' 2>&1";
+                          "' LODREFINE='" + test_paths::lodrefine_binary() + "' -j2 > '" +
+                          (run / "batch.log").string() + "' 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << "batch failed, see " << run / "batch.log";
 
   std::ifstream tf(src / "tests" / "regression_thresholds.json"), sf(run / "summary.json");

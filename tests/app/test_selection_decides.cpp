@@ -23,6 +23,7 @@
 #include "lodrefine/formats/cloud.h"
 #include "lodrefine/formats/obj.h"
 #include "lodrefine/synth/synth.h"
+#include "support/test_paths.h"
 
 using namespace lodrefine;
 namespace fs = std::filesystem;
@@ -100,7 +101,7 @@ Figures expect_selection_decided(const Mesh& coarse, const Mesh& truth, const Po
 }  // namespace
 
 TEST(SelectionDecides, EverySample) {
-  const fs::path samples = fs::path(LODREFINE_SOURCE_DIR) / "data" / "samples";
+  const fs::path samples = fs::path(test_paths::source_dir()) / "data" / "samples";
   int n = 0;
   for (const auto& dir : fs::directory_iterator(samples)) {
     if (!fs::exists(dir.path() / "truth.obj")) continue;
@@ -119,7 +120,7 @@ TEST(SelectionDecides, EverySample) {
 // refining again on the other's, the selection still moves wall 0 onto its scan (judged on the
 // building's points) and the building comes out on the truth.
 TEST(SelectionDecides, AScanMoveTheJudgeRefusesIsDroppedAndTheBuildingRefinedOnTheOthers) {
-  const fs::path dir = fs::path(LODREFINE_SOURCE_DIR) / "data" / "samples" / "synth_stepped_1402";
+  const fs::path dir = fs::path(test_paths::source_dir()) / "data" / "samples" / "synth_stepped_1402";
   const Mesh coarse = read_obj((dir / "coarse.obj").string());
   const PointCloud cloud = read_cloud((dir / "cloud.ply").string());
   const RefineResult r = refine_building(coarse, cloud, RefineConfig{});

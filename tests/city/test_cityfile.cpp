@@ -31,6 +31,7 @@
 #include "lodrefine/formats/obj.h"
 #include "lodrefine/formats/ply.h"
 #include "lodrefine/synth/synth.h"
+#include "support/test_paths.h"
 
 using namespace lodrefine;
 
@@ -54,14 +55,14 @@ json load(const std::string& path) {
   return json::parse(in);
 }
 
-fs::path shared_dir() { return fs::path(LODREFINE_SOURCE_DIR) / ".." / "shared"; }
+fs::path shared_dir() { return fs::path(test_paths::source_dir()) / ".." / "shared"; }
 
 // "valid", or the validator's complaint; "" when the schemas or python3-jsonschema are absent.
 std::string schema_verdict(const std::string& path) {
   const fs::path schemas = shared_dir() / "schemas" / "cityjson-2.0.2";
   if (!fs::exists(schemas) || !fs::exists("/usr/bin/python3")) return "";
   const std::string out = path + ".verdict";
-  const std::string cmd = "/usr/bin/python3 " + std::string(LODREFINE_SOURCE_DIR) + "/scripts/validate_cityjson.py " +
+  const std::string cmd = "/usr/bin/python3 " + test_paths::source_dir() + "/scripts/validate_cityjson.py " +
                           schemas.string() + " " + path + " >" + out + " 2>&1";
   const int st = std::system(cmd.c_str());
   std::ifstream in(out);
@@ -575,10 +576,9 @@ TEST(CityFile, CityJsonSeqStreamedThrough) {
       }
   const fs::path schemas = shared_dir() / "schemas" / "cityjson-2.0.2";
   if (fs::exists(schemas) && fs::exists("/usr/bin/python3")) {
-    const int st =
-        std::system(("/usr/bin/python3 " + std::string(LODREFINE_SOURCE_DIR) + "/scripts/validate_cityjson.py " +
-                     schemas.string() + " " + dir + "/out.city.jsonl --seq >" + dir + "/v.txt 2>&1")
-                        .c_str());
+    const int st = std::system(("/usr/bin/python3 " + test_paths::source_dir() + "/scripts/validate_cityjson.py " +
+                                schemas.string() + " " + dir + "/out.city.jsonl --seq >" + dir + "/v.txt 2>&1")
+                                   .c_str());
     std::ifstream v(dir + "/v.txt");
     const std::string verdict((std::istreambuf_iterator<char>(v)), {});
     if (!(WIFEXITED(st) && WEXITSTATUS(st) == 2)) {
@@ -808,7 +808,7 @@ TEST(CityFile, ProgressLineOnATerminalOnly) {
   auto on_terminal = [&](const std::string& extra) {
     const std::string log = dir + "/tty.log";
     const int st = std::system(
-        ("script -qec '" + std::string(LODREFINE_BINARY) + " " + args + extra + "' /dev/null > " + log + " 2>&1")
+        ("script -qec '" + test_paths::lodrefine_binary() + " " + args + extra + "' /dev/null > " + log + " 2>&1")
             .c_str());
     EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0);
     std::ifstream in(log, std::ios::binary);

@@ -13,9 +13,6 @@ TEST(Params, DefaultsAreValidAndMatchThePaper) {
   EXPECT_NO_THROW(p.validate());
   EXPECT_DOUBLE_EQ(p.selection.tau_cov, 0.3);
   EXPECT_DOUBLE_EQ(p.selection.merge_angle_deg, 5.0);
-  EXPECT_DOUBLE_EQ(p.confidence.conf_angle_deg, 5.0);
-  EXPECT_DOUBLE_EQ(p.confidence.conf_cloud_distance, 0.2);
-  EXPECT_DOUBLE_EQ(p.confidence.conf_bbox_iou, 0.3);
   EXPECT_DOUBLE_EQ(p.selection.bbox_expand, 0.1);
 }
 
@@ -49,20 +46,20 @@ TEST(Params, ValidateNamesTheStage) {
     EXPECT_EQ(std::string(e.what()).rfind("plane: parameter ransac_epsilon = 5 ", 0), 0u) << e.what();
   }
   c = RefineConfig{};
-  c.confidence.conf_bbox_iou = -1.0;
-  EXPECT_THROW(c.confidence.validate(), InputError);
+  c.selection.tau_cov = -1.0;
+  EXPECT_THROW(c.selection.validate(), InputError);
   EXPECT_NO_THROW(c.plane.validate());  // a stage checks only its own rows
   try {
     c.validate();
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("confidence: ", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind("selection: ", 0), 0u) << e.what();
   }
 }
 
 TEST(Params, EveryRowBelongsToOneStageInPipelineOrder) {
   const auto& stages = stage_table();
-  ASSERT_EQ(stages.size(), 5u);
+  ASSERT_EQ(stages.size(), 4u);
   EXPECT_EQ(stages.front().name, "repair");
   std::set<std::string> names;
   std::size_t stage = 0;
@@ -103,7 +100,6 @@ TEST(Params, EachStageConfigIsTheMemberOfItsName) {
   EXPECT_STREQ(decltype(RefineConfig::plane)::stage, "plane");
   EXPECT_STREQ(decltype(RefineConfig::match)::stage, "match");
   EXPECT_STREQ(decltype(RefineConfig::selection)::stage, "selection");
-  EXPECT_STREQ(decltype(RefineConfig::confidence)::stage, "confidence");
   RefineConfig c;
   c.match.match_distance = 2.0;
   c.selection.bbox_margin = 0.5;

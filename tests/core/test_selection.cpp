@@ -6,7 +6,7 @@
 #include <random>
 
 #include "lodrefine/core/candidates.h"
-#include "lodrefine/core/confidence.h"
+#include "lodrefine/core/objective.h"
 #include "lodrefine/core/selection.h"
 #include "support/candidate_fixtures.h"
 #include "support/cpu_burners.h"
@@ -16,12 +16,20 @@ using namespace lodrefine::fixtures;
 
 namespace {
 
+// The box's confidence: 1 on its six faces (the candidates inside the box), 0 on the pieces
+// beyond it, as a starting shell without contrary scan evidence has it (shell_describe).
+std::vector<double> box_confidence(const CandidateSet& cs, double a, double b, double c) {
+  std::vector<double> conf;
+  for (int f = 0; f < cs.size(); ++f) conf.push_back(inside_box(centroid_of(cs, f), a, b, c) ? 1.0 : 0.0);
+  return conf;
+}
+
 // Each candidate's coverage cost from its confidence (the paper's sigmoid).
-template <class Confidences>
-std::vector<double> coverage_costs(const CandidateSet& cs, const Confidences& conf, const SelectionConfig& prm) {
+std::vector<double> coverage_costs(const CandidateSet& cs, const std::vector<double>& conf,
+                                   const SelectionConfig& prm) {
   std::vector<double> cost;
   for (std::size_t f = 0; f < std::size_t(cs.size()); ++f)
-    cost.push_back(coverage_cost(area_of(cs, f), conf[f].value, prm.tau_cov));
+    cost.push_back(coverage_cost(area_of(cs, f), conf[f], prm.tau_cov));
   return cost;
 }
 
@@ -31,9 +39,9 @@ TEST(Selection, RecoversTheClosedBoxFromConfidence) {
   const double a = 10, b = 8, c = 6;
   CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
   SelectionConfig prm;
-  const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, ConfidenceConfig{});
+  const auto conf = box_confidence(cs, a, b, c);
   const std::vector<double> cost = coverage_costs(cs, conf, prm);
-  const auto full = std::count_if(conf.begin(), conf.end(), [](const auto& x) { return x.value > 0.99; });
+  const auto full = std::count_if(conf.begin(), conf.end(), [](double x) { return x > 0.99; });
   EXPECT_EQ(full, 6);
   const SelectionResult sel = select_faces(cs, cost, std::vector<int>(cs.edges.size(), 0), prm);
   ASSERT_TRUE(sel.ok) << sel.status_text();
@@ -63,7 +71,7 @@ TEST(Selection, AnExcludedLocalSelectionIsNotMade) {
   const double a = 10, b = 8, c = 6;
   CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
   SelectionConfig prm;
-  const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, ConfidenceConfig{});
+  const auto conf = box_confidence(cs, a, b, c);
   SelectionProgram pg;
   pg.cost = coverage_costs(cs, conf, prm);
   ASSERT_TRUE(select_faces(cs, pg, prm).ok);
@@ -100,11 +108,11 @@ TEST(Selection, StartsFromAClosedWarmStartAndRefusesAnOpenOne) {
   const double a = 10, b = 8, c = 6;
   CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
   SelectionConfig prm;
-  const auto conf = candidate_confidence(cs, box_references(a, b, c), {}, ConfidenceConfig{});
+  const auto conf = box_confidence(cs, a, b, c);
   SelectionProgram pg;
   std::vector<char> box(std::size_t(cs.size()), 0);
   for (std::size_t f = 0; f < std::size_t(cs.size()); ++f) {
-    pg.cost.push_back(coverage_cost(area_of(cs, f), conf[f].value, prm.tau_cov));
+    pg.cost.push_back(coverage_cost(area_of(cs, f), conf[f], prm.tau_cov));
     box[f] = inside_box(centroid_of(cs, f), a, b, c);
   }
   EXPECT_TRUE(every_edge_used_0_or_2(cs, box));

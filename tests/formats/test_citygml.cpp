@@ -14,6 +14,7 @@
 
 #include "lodrefine/formats/citygml.h"
 #include "support/hang_guard.h"
+#include "support/test_paths.h"
 
 using namespace lodrefine;
 namespace fs = std::filesystem;
@@ -157,7 +158,7 @@ TEST(CityGml, BadFilesAreOneClearError) {
 }
 
 TEST(CityGml, DenHaagBuildingParts) {
-  const fs::path p = fs::path(LODREFINE_SOURCE_DIR) / ".." / "shared/realdata/val3dity/data/gml/DenHaag_1BwBP.gml";
+  const fs::path p = fs::path(test_paths::source_dir()) / ".." / "shared/realdata/val3dity/data/gml/DenHaag_1BwBP.gml";
   if (!fs::exists(p)) GTEST_SKIP() << p << " absent";
   const CityJsonFile f = read_citygml(p.string());
   EXPECT_EQ(f.version, "1.0");

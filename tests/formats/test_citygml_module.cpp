@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "support/cli_fixtures.h"
+#include "support/test_paths.h"
 
 namespace fs = std::filesystem;
 using cli_fixtures::Cli;
@@ -21,10 +22,10 @@ using cli_fixtures::slurp;
 
 namespace {
 
-const std::string kSource = LODREFINE_SOURCE_DIR;
+const std::string kSource = test_paths::source_dir();
 const std::string kCityGml = kSource + "/tests/fuzz/corpus/fuzz_citygml/thematic.gml";      // building "t"
 const std::string kCityJson = kSource + "/tests/fuzz/corpus/fuzz_cityjson/cube.city.json";  // one building
-const fs::path kBuildDir = fs::path(LODREFINE_BINARY).parent_path();
+const fs::path kBuildDir = fs::path(test_paths::lodrefine_binary()).parent_path();
 
 // The shared libraries `readelf -d` lists as NEEDED by `file` (nullopt without readelf).
 std::optional<std::vector<std::string>> needed_libraries(const std::string& file) {
@@ -56,7 +57,7 @@ Cli run(const std::string& exe, const std::string& args, const std::string& dir,
 std::string lone_executable(const std::string& dir) {
   fs::create_directories(dir + "/bin");
   const std::string exe = dir + "/bin/lodrefine";
-  fs::copy_file(LODREFINE_BINARY, exe, fs::copy_options::overwrite_existing);
+  fs::copy_file(test_paths::lodrefine_binary(), exe, fs::copy_options::overwrite_existing);
   return exe;
 }
 
@@ -67,7 +68,7 @@ bool is_one_error_line(const std::string& err) {
 }  // namespace
 
 TEST(CityGmlModule, ExecutablesNeedNoCityGmlXercesOrGdal) {
-  for (const std::string& file : {std::string(LODREFINE_BINARY), fs::read_symlink("/proc/self/exe").string()}) {
+  for (const std::string& file : {test_paths::lodrefine_binary(), fs::read_symlink("/proc/self/exe").string()}) {
     const auto libs = needed_libraries(file);
     if (!libs) GTEST_SKIP() << "readelf is not installed";
     ASSERT_FALSE(libs->empty()) << file;  // readelf read it: libc at least

@@ -19,6 +19,7 @@
 #include "lodrefine/formats/obj.h"
 #include "support/hang_guard.h"
 #include "support/realdata.h"
+#include "support/test_paths.h"
 
 using namespace lodrefine;
 namespace fs = std::filesystem;
@@ -171,7 +172,7 @@ TEST(CityJson, ConvertCommandWritesOneObjPerBuilding) {
   const std::string objects = std::string(R"("B/1":{"type":"Building","geometry":[)") + cube_solid("\"2\"") +
                               R"(]},"B2":{"type":"Building","geometry":[)" + cube_solid("\"2.2\"") + "]}";
   write_file_atomic((dir / "in.city.json").string(), cube_document("1.1", objects));
-  const std::string cmd = std::string(LODREFINE_BINARY) + " convert --cityjson '" + (dir / "in.city.json").string() +
+  const std::string cmd = test_paths::lodrefine_binary() + " convert --cityjson '" + (dir / "in.city.json").string() +
                           "' --out-dir '" + (dir / "out").string() + "'";
   ASSERT_EQ(std::system((cmd + " > /dev/null").c_str()), 0) << cmd;
   const Mesh m = read_obj((dir / "out" / (safe_name("B/1") + ".obj")).string());  // B_1--<hash>.obj
@@ -257,7 +258,7 @@ TEST(CityJson, ConvertKeepsTheFinsInTheirGroup) {
   fs::create_directories(dir);
   write_file_atomic((dir / "in.city.json").string(),
                     fin_document(building("ours", true, {cube_solid("\"2.2\""), kFinMultiSurface})));
-  const std::string cmd = std::string(LODREFINE_BINARY) + " convert --cityjson '" + (dir / "in.city.json").string() +
+  const std::string cmd = test_paths::lodrefine_binary() + " convert --cityjson '" + (dir / "in.city.json").string() +
                           "' --out-dir '" + (dir / "out").string() + "' > /dev/null";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   const ObjModel m = read_obj_model((dir / "out" / "ours.obj").string());

@@ -25,6 +25,7 @@
 #include "support/io_fixtures.h"
 #include "support/laz_fixtures.h"
 #include "support/realdata.h"
+#include "support/test_paths.h"
 
 using namespace lodrefine;
 namespace fs = std::filesystem;
@@ -207,7 +208,7 @@ TEST(Laz, LyingHeadersAndTruncatedChunksAreOneLine) {
 
 namespace {
 
-std::string corpus_dir() { return std::string(LODREFINE_SOURCE_DIR) + "/tests/fuzz/corpus/fuzz_laz"; }
+std::string corpus_dir() { return test_paths::source_dir() + "/tests/fuzz/corpus/fuzz_laz"; }
 
 }  // namespace
 

@@ -29,6 +29,7 @@
 #include "lodrefine/core/validate.h"
 #include "lodrefine/formats/obj.h"
 #include "support/ply_fixtures.h"
+#include "support/test_paths.h"
 
 namespace lodrefine::bad_input {
 
@@ -148,7 +149,7 @@ inline std::string shell_quote(const std::string& s) {
 inline CliRun run_cli(const std::string& args, const std::string& dir, double timeout_seconds = 300) {
   const std::string out = dir + "/.stdout", err = dir + "/.stderr";
   const std::string cmd = "timeout -k 5 " + std::to_string(int(std::ceil(timeout_seconds))) + " " +
-                          shell_quote(LODREFINE_BINARY) + " " + args + " >" + shell_quote(out) + " 2>" +
+                          shell_quote(test_paths::lodrefine_binary()) + " " + args + " >" + shell_quote(out) + " 2>" +
                           shell_quote(err);
   const auto t0 = std::chrono::steady_clock::now();
   const int st = std::system(cmd.c_str());
@@ -329,10 +330,10 @@ inline CliRun expect_bad_tiles_refused(const std::string& command, const std::st
 // `lodrefine ARGS` with its address space limited to `kb` KB (stdout dropped).
 inline CliRun run_limited(long kb, const std::string& args, const std::string& dir) {
   const std::string err = dir + "/.err";
-  const std::string cmd =
-      "timeout -k 5 120 sh -c " +
-      shell_quote("ulimit -v " + std::to_string(kb) + "; exec " + shell_quote(LODREFINE_BINARY) + " " + args) +
-      " >/dev/null 2>" + shell_quote(err);
+  const std::string cmd = "timeout -k 5 120 sh -c " +
+                          shell_quote("ulimit -v " + std::to_string(kb) + "; exec " +
+                                      shell_quote(test_paths::lodrefine_binary()) + " " + args) +
+                          " >/dev/null 2>" + shell_quote(err);
   const int st = std::system(cmd.c_str());
   CliRun r;
   r.exit = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + (WIFSIGNALED(st) ? WTERMSIG(st) : 0);

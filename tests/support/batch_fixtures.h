@@ -16,14 +16,15 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include "support/test_paths.h"
 
 namespace lodrefine::batch_fixtures {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-inline const fs::path kSource = LODREFINE_SOURCE_DIR;
-inline const std::string kBinary = LODREFINE_BINARY;
+inline const fs::path kSource = test_paths::source_dir();
+inline const std::string kBinary = test_paths::lodrefine_binary();
 
 // One shell word: in single quotes, a quote inside as '\''.
 inline std::string shell_quoted(const fs::path& p) {

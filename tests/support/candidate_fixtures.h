@@ -1,12 +1,10 @@
 // The box [0,a] x [0,b] x [0,c] as the candidate stages see it: its six outward supporting
-// planes, the region around it and its faces as model references (same order as the planes:
-// x = 0, x = a, y = 0, y = b, z = 0, z = c). Shared by the candidate, confidence and selection
-// tests.
+// planes (x = 0, x = a, y = 0, y = b, z = 0, z = c) and the region around it. Shared by the
+// candidate, selection and shell tests.
 #pragma once
 #include <vector>
 
 #include "lodrefine/core/candidates.h"
-#include "lodrefine/core/confidence.h"
 
 namespace lodrefine::fixtures {
 
@@ -24,15 +22,6 @@ inline std::vector<SupportPlane> box_planes(double a, double b, double c) {
 // The pipeline's region around a building's box: 10 % and 1 m beyond it on each side.
 inline Region box_region(double a, double b, double c) {
   return Region::around({Vec3(0, 0, 0), Vec3(a, b, c)}, 0.1, 1.0);
-}
-
-inline std::vector<ModelReference> box_references(double a, double b, double c) {
-  return {{{Vec3(0, 0, 0), Vec3(0, 0, c), Vec3(0, b, c), Vec3(0, b, 0)}},
-          {{Vec3(a, 0, 0), Vec3(a, b, 0), Vec3(a, b, c), Vec3(a, 0, c)}},
-          {{Vec3(0, 0, 0), Vec3(a, 0, 0), Vec3(a, 0, c), Vec3(0, 0, c)}},
-          {{Vec3(0, b, 0), Vec3(0, b, c), Vec3(a, b, c), Vec3(a, b, 0)}},
-          {{Vec3(0, 0, 0), Vec3(0, b, 0), Vec3(a, b, 0), Vec3(a, 0, 0)}},
-          {{Vec3(0, 0, c), Vec3(a, 0, c), Vec3(a, b, c), Vec3(0, b, c)}}};
 }
 
 // Candidate f's face maps (candidates.h).

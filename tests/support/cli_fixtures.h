@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include "support/test_paths.h"
 
 namespace cli_fixtures {
 
@@ -36,7 +37,7 @@ struct Cli {
 inline Cli run_cli(const std::string& args, const std::string& dir) {
   const std::string out = dir + "/.out", err = dir + "/.err";
   const auto t0 = std::chrono::steady_clock::now();
-  const int st = std::system((std::string(LODREFINE_BINARY) + " " + args + " >" + out + " 2>" + err).c_str());
+  const int st = std::system((test_paths::lodrefine_binary() + " " + args + " >" + out + " 2>" + err).c_str());
   Cli r;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.exit = WIFEXITED(st) ? WEXITSTATUS(st) : -1;

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "lodrefine/formats/las.h"
+#include "support/test_paths.h"
 
 namespace lodrefine::fixtures {
 
@@ -37,7 +38,7 @@ inline std::string lazperf_missing() {
 
 // The shell command that has laz-perf decode `laz` into the raw records file `dump`.
 inline std::string lazperf_command(const std::string& laz, const std::string& dump) {
-  const std::string script = std::string(LODREFINE_SOURCE_DIR) + "/tests/laz/laz_reference_dump.js";
+  const std::string script = test_paths::source_dir() + "/tests/laz/laz_reference_dump.js";
   return "node '" + script + "' '" + lazperf_modules() + "' '" + laz + "' '" + dump + "'";
 }
 

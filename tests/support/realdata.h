@@ -4,11 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include "support/test_paths.h"
 
 namespace lodrefine::fixtures {
 
 inline std::filesystem::path realdata_dir() {
-  return std::filesystem::path(LODREFINE_SOURCE_DIR) / ".." / "shared" / "realdata";
+  return std::filesystem::path(test_paths::source_dir()) / ".." / "shared" / "realdata";
 }
 
 }  // namespace lodrefine::fixtures

@@ -73,12 +73,6 @@ namespace lodrefine {
     "it depend on the machine's load")                                                                              \
   X(double, mip_gap, 1e-4, 0.0, 1.0, "GLPK relative MIP gap")
 
-#define LODREFINE_CONFIDENCE_PARAMS(X)                                                                               \
-  X(double, conf_angle_deg, 5.0, 0.0, 90.0, "confidence: angle filter theta_filter (deg)")                           \
-  X(double, conf_model_distance, 0.5, 0.0, 10.0, "confidence: max corner distance to a model reference (m)")         \
-  X(double, conf_cloud_distance, 0.2, 0.0, 10.0, "confidence: max mean/std point distance to a cloud reference (m)") \
-  X(double, conf_bbox_iou, 0.3, 0.0, 1.0, "confidence: min bbox IoU or coverage ratio to a model reference")
-
 // S(Config, stage, what the stage does, rows). `stage` names the stage: its Config::stage, the
 // RefineConfig member that holds its config, its CLI help group.
 #define LODREFINE_STAGES(S)                                                                                     \
@@ -86,14 +80,12 @@ namespace lodrefine {
   S(PlaneConfig, plane, "detect planes in the scan near the model (RANSAC)", LODREFINE_PLANE_PARAMS)            \
   S(MatchConfig, match, "match scan planes to walls; decide which walls are outdated", LODREFINE_MATCH_PARAMS)  \
   S(SelectionConfig, selection, "candidate faces and the GLPK program that selects the shell",                  \
-    LODREFINE_SELECTION_PARAMS)                                                                                 \
-  S(ConfidenceConfig, confidence, "confidence of candidate faces from model and cloud references",              \
-    LODREFINE_CONFIDENCE_PARAMS)
+    LODREFINE_SELECTION_PARAMS)
 
 // Every row of every stage, in pipeline order.
 #define LODREFINE_PARAMS(X)  \
   LODREFINE_REPAIR_PARAMS(X) \
-  LODREFINE_PLANE_PARAMS(X) LODREFINE_MATCH_PARAMS(X) LODREFINE_SELECTION_PARAMS(X) LODREFINE_CONFIDENCE_PARAMS(X)
+  LODREFINE_PLANE_PARAMS(X) LODREFINE_MATCH_PARAMS(X) LODREFINE_SELECTION_PARAMS(X)
 
 // One field of a stage config (roofer's ConfigField pattern): its name, stage, bounds and
 // meaning, and the member it is (`config.*member`).
