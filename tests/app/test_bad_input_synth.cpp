@@ -32,7 +32,7 @@ bool is_link(const std::string& path) { return fs::is_symlink(fs::symlink_status
 
 // The peak resident memory (KB) of `lodrefine ARGS` (its own, by wait4), which must exit 0.
 long peak_kb(const std::string& args) {
-  const std::string cmd = "exec " + shell_quote(LODREFINE_BINARY) + " " + args + " >/dev/null 2>&1";
+  const std::string cmd = "exec " + shell_quote(test_paths::lodrefine_binary()) + " " + args + " >/dev/null 2>&1";
   const pid_t pid = ::fork();
   if (pid == 0) {
     ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
@@ -286,7 +286,7 @@ TEST(BadInputSynth, RescanMemoryDoesNotGrowWithTheTile) {
 TEST(BadInputSynth, AKilledRescanLeavesNoEmptyFolders) {
   const std::string dir = temp_dir("synth_rescan_killed");
   const std::string tile = rescan_fixtures::write_row_tile(dir + "/in", 2);
-  const std::string cmd = "timeout -s KILL 1 " + shell_quote(LODREFINE_BINARY) + " synth --scanner van --rescan " +
+  const std::string cmd = "timeout -s KILL 1 " + shell_quote(test_paths::lodrefine_binary()) + " synth --scanner van --rescan " +
                           tile + " --van-drives 8 --van-rate 200 --out " + dir + "/out >/dev/null 2>&1";
   const int st = std::system(cmd.c_str());
   ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 137) << "killed while the van scans (the first building takes 5 s)";
