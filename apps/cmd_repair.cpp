@@ -79,10 +79,11 @@ void run(const RepairArgs& a) {
     if (b.outcome != Outcome::Untouched)
       std::printf("%s: %s (%s), codes %s\n", shown_id(b.id).c_str(), outcome_name(b.outcome),
                   escaped_line(b.reason).c_str(), codes_text(b.errors_before, b.errors_after).c_str());
-  std::printf("%s: %d building(s): %d valid as read (written as read), %d repaired, %d kept, %d kept-invalid -> %s "
-              "(%.1f s)\n",
-              escaped_line(s.input_format).c_str(), s.buildings, s.untouched, s.repaired, s.kept, s.kept_invalid,
-              escaped_line(a.out).c_str(), s.seconds_read + s.seconds_refine + s.seconds_write);
+  std::printf(
+      "%s: %d building(s): %d valid as read (written as read), %d repaired, %d kept, %d kept-invalid -> %s "
+      "(%.1f s)\n",
+      escaped_line(s.input_format).c_str(), s.buildings, s.untouched, s.repaired, s.kept, s.kept_invalid,
+      escaped_line(a.out).c_str(), s.seconds_read + s.seconds_refine + s.seconds_write);
 }
 
 }  // namespace

@@ -20,7 +20,9 @@ void run(const ValidateArgs& a) {
   refuse_overwrites({{"CITY", a.city}}, {{"--json", a.json}});
   check_output_dir(a.json);
   const CityValidity v = validate_city(a.city, a.lod, a.tolerances);
-  if (!a.json.empty()) write_file_atomic(a.json, validity_report_json(v).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  if (!a.json.empty())
+    write_file_atomic(a.json,
+                      validity_report_json(v).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   std::map<int, int> count;  // buildings per code
   for (const BuildingValidity& b : v.buildings) {
     for (int code : error_codes(b.validation)) ++count[code];
@@ -28,11 +30,13 @@ void run(const ValidateArgs& a) {
                 b.valid() ? "valid" : escaped_line(errors_text(b.validation.errors)).c_str());
   }
   std::string codes;
-  for (const auto& [code, n] : count) codes += (codes.empty() ? "" : ", ") + std::to_string(code) + " x" + std::to_string(n);
+  for (const auto& [code, n] : count)
+    codes += (codes.empty() ? "" : ", ") + std::to_string(code) + " x" + std::to_string(n);
   std::printf("%s: %zu building(s) (LoD %s): %zu valid, %d invalid%s (snap %g m, planarity %g m)\n",
               escaped_line(v.input_format).c_str(), v.buildings.size(), a.lod.empty() ? "2.x" : a.lod.c_str(),
-              v.buildings.size() - std::size_t(v.invalid()), v.invalid(), codes.empty() ? "" : ("; buildings per code: " + codes).c_str(),
-              a.tolerances.snap, a.tolerances.planarity);
+              v.buildings.size() - std::size_t(v.invalid()), v.invalid(),
+              codes.empty() ? "" : ("; buildings per code: " + codes).c_str(), a.tolerances.snap,
+              a.tolerances.planarity);
   exit_code() = v.invalid() > 0 ? 1 : 0;
 }
 
@@ -41,8 +45,9 @@ void run(const ValidateArgs& a) {
 void add_validate_command(CLI::App& app) {
   static ValidateArgs args;
   auto* cmd = app.add_subcommand(
-      "validate", "Check every building of a city file as a solid; report its defects with val3dity's error codes "
-                  "(exit 0: all valid, 1: some invalid, 2: bad input)");
+      "validate",
+      "Check every building of a city file as a solid; report its defects with val3dity's error codes "
+      "(exit 0: all valid, 1: some invalid, 2: bad input)");
   cmd->add_option("city", args.city, "City file (" + formats_text(kCityFormatNames) + ")")
       ->required()
       ->check(CLI::ExistingFile);

@@ -31,14 +31,16 @@ CityValidity validate_city(const std::string& path, const std::string& lod, cons
   if (file.buildings.empty())
     throw InputError(path + ": no Building/BuildingPart with " +
                      (lod.empty() ? std::string("an LoD 2.x") : "an LoD " + lod) + " geometry (" +
-                     std::to_string(file.objects_without_lod2) + " building object(s) without one); nothing to validate");
+                     std::to_string(file.objects_without_lod2) +
+                     " building object(s) without one); nothing to validate");
   for (const CityJsonBuilding& b : file.buildings) {
     BuildingValidity v{b.mesh.id, b.type, b.lod, b.geometry_type, validate_soup(b.mesh, tolerances)};
     if (b.skipped_rings > 0) {  // dropped by the reader: the faces validated are without them
-      v.validation.errors.insert(v.validation.errors.begin(),
-                                 {ValidityCode::TooFewPoints, {},
-                                  std::to_string(b.skipped_rings) +
-                                      " ring(s) with fewer than 3 distinct vertices (left out of the shell)"});
+      v.validation.errors.insert(
+          v.validation.errors.begin(),
+          {ValidityCode::TooFewPoints,
+           {},
+           std::to_string(b.skipped_rings) + " ring(s) with fewer than 3 distinct vertices (left out of the shell)"});
       if (v.validation.problem.empty()) v.validation.problem = v.validation.errors.front().info;
     }
     out.buildings.push_back(std::move(v));
@@ -62,7 +64,8 @@ nlohmann::json validity_report_json(const CityValidity& city) {
   std::map<std::string, std::pair<int, int>> by_feature, by_primitive;
   std::set<int> all;
   for (const BuildingValidity& b : city.buildings) {
-    for (auto* counts : {&by_feature[b.type], &by_primitive[b.geometry_type]}) ++counts->first, counts->second += b.valid();
+    for (auto* counts : {&by_feature[b.type], &by_primitive[b.geometry_type]})
+      ++counts->first, counts->second += b.valid();
     for (int code : error_codes(b.validation)) all.insert(code);
     features.push_back({{"id", b.id},
                         {"type", b.type},
@@ -87,7 +90,8 @@ nlohmann::json validity_report_json(const CityValidity& city) {
 std::string errors_text(const std::vector<ValidityError>& errors) {
   std::string out;
   for (const ValidityError& e : errors)
-    out += (out.empty() ? "" : "; ") + std::to_string(code_number(e.code)) + " " + code_name(e.code) + " (" + e.info + ")";
+    out +=
+        (out.empty() ? "" : "; ") + std::to_string(code_number(e.code)) + " " + code_name(e.code) + " (" + e.info + ")";
   return out;
 }
 

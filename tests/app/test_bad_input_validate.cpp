@@ -36,7 +36,8 @@ TEST(BadInputValidate, NoCityFileExitsTwo) {
 TEST(BadInputValidate, NoBuildingOfTheLodAskedForExitsTwo) {
   const std::string dir = cli_fixtures::test_dir("bad_validate");
   std::ofstream(dir + "/city.json") << validity_fixtures::box_city({{"a", {}, {}, 0}});
-  expect_one_error_line(run_cli("validate " + dir + "/city.json --lod 1.2", dir), "no Building/BuildingPart with an LoD 1.2");
+  expect_one_error_line(run_cli("validate " + dir + "/city.json --lod 1.2", dir),
+                        "no Building/BuildingPart with an LoD 1.2");
   expect_one_error_line(run_cli("repair " + dir + "/city.json --lod 1.2 --out " + dir + "/out.json", dir),
                         "no Building/BuildingPart with an LoD 1.2");
   EXPECT_FALSE(std::filesystem::exists(dir + "/out.json"));

@@ -21,7 +21,7 @@ struct Reads {
 };
 
 const std::vector<Reads> kCommands = {
-    {"refine", true, true, true}, {"crop", true, true, false},     {"eval", true, true, false},
+    {"refine", true, true, true},    {"crop", true, true, false},      {"eval", true, true, false},
     {"convert", false, false, true}, {"validate", false, false, true}, {"repair", false, false, true},
 };
 

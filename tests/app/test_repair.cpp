@@ -24,8 +24,8 @@ std::string schema_verdict(const std::string& path) {
   const std::filesystem::path schemas = lodrefine::fixtures::realdata_dir() / ".." / "schemas" / "cityjson-2.0.2";
   if (!std::filesystem::exists(schemas)) return "";
   const std::string out = path + ".verdict";
-  const int st = std::system(("/usr/bin/python3 " + std::string(LODREFINE_SOURCE_DIR) + "/scripts/validate_cityjson.py " +
-                              schemas.string() + " " + path + " >" + out + " 2>&1")
+  const int st = std::system(("/usr/bin/python3 " + std::string(LODREFINE_SOURCE_DIR) +
+                              "/scripts/validate_cityjson.py " + schemas.string() + " " + path + " >" + out + " 2>&1")
                                  .c_str());
   std::string text = cli_fixtures::slurp(out);
   if (WIFEXITED(st) && WEXITSTATUS(st) == 2) return "";
@@ -40,12 +40,13 @@ std::string schema_verdict(const std::string& path) {
 // stays exactly as read, without attributes; validate then finds every building valid.
 TEST(RepairCommand, RepairsTheInvalidAndKeepsTheValidAsRead) {
   const std::string dir = cli_fixtures::test_dir("repair");
-  const std::string in = validity_fixtures::box_city({{"valid", {}, {}, 0}, {"open", {1}, {}, 20}, {"flipped", {}, {3}, 40}});
+  const std::string in =
+      validity_fixtures::box_city({{"valid", {}, {}, 0}, {"open", {1}, {}, 20}, {"flipped", {}, {3}, 40}});
   std::ofstream(dir + "/city.json") << in;
-  const cli_fixtures::Cli r =
-      run_cli("repair " + dir + "/city.json --out " + dir + "/out.city.json --report " + dir + "/report.json --quiet", dir);
+  const cli_fixtures::Cli r = run_cli(
+      "repair " + dir + "/city.json --out " + dir + "/out.city.json --report " + dir + "/report.json --quiet", dir);
   ASSERT_EQ(r.exit, 0) << r.err;
-  EXPECT_NE(r.out.find("open: repaired ("), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"open\": repaired ("), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("codes 302 -> none"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("codes 307 -> none"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("3 building(s): 1 valid as read (written as read), 2 repaired, 0 kept, 0 kept-invalid"),

@@ -29,8 +29,8 @@ TEST(ValidateCommand, AllValidExitsZero) {
   const std::string city = write_city(dir, {{"a", {}, {}, 0}, {"b", {}, {}, 20}});
   const cli_fixtures::Cli r = run_cli("validate " + city, dir);
   EXPECT_EQ(r.exit, 0) << r.err;
-  EXPECT_NE(r.out.find("a: valid\n"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("b: valid\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"a\": valid\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"b\": valid\n"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("CityJSON 2.0: 2 building(s) (LoD 2.x): 2 valid, 0 invalid (snap 0.001 m, planarity 0.01 m)"),
             std::string::npos)
       << r.out;
@@ -38,15 +38,17 @@ TEST(ValidateCommand, AllValidExitsZero) {
 
 TEST(ValidateCommand, InvalidBuildingsExitOneWithTheirCodes) {
   const std::string dir = cli_fixtures::test_dir("validate");
-  const std::string city =
-      write_city(dir, {{"valid", {}, {}, 0}, {"open", {1}, {}, 20}, {"flipped", {}, {3}, 40}, {"inward", {}, {0, 1, 2, 3, 4, 5}, 60}});
+  const std::string city = write_city(
+      dir,
+      {{"valid", {}, {}, 0}, {"open", {1}, {}, 20}, {"flipped", {}, {3}, 40}, {"inward", {}, {0, 1, 2, 3, 4, 5}, 60}});
   const cli_fixtures::Cli r = run_cli("validate " + city, dir);
   EXPECT_EQ(r.exit, 1) << r.err;
-  EXPECT_NE(r.out.find("open: 302 SHELL_NOT_CLOSED (4 boundary edges (mesh not closed))\n"), std::string::npos)
+  EXPECT_NE(r.out.find("\"open\": 302 SHELL_NOT_CLOSED (4 boundary edges (mesh not closed))\n"), std::string::npos)
       << r.out;
-  EXPECT_NE(r.out.find("flipped: 307 POLYGON_WRONG_ORIENTATION (4 inconsistently oriented edges)\n"), std::string::npos)
+  EXPECT_NE(r.out.find("\"flipped\": 307 POLYGON_WRONG_ORIENTATION (4 inconsistently oriented edges)\n"),
+            std::string::npos)
       << r.out;
-  EXPECT_NE(r.out.find("inward: 405 WRONG_ORIENTATION_SHELL"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"inward\": 405 WRONG_ORIENTATION_SHELL"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("4 building(s) (LoD 2.x): 1 valid, 3 invalid; buildings per code: 302 x1, 307 x1, 405 x1"),
             std::string::npos)
       << r.out;

@@ -25,8 +25,8 @@ TEST(Version, ProgramAndReportsSayCMakesVersion) {
   const json report = json::parse(cli_fixtures::slurp(dir + "/report.json"));
   EXPECT_EQ(report["lodrefine_version"], LODREFINE_VERSION);
   EXPECT_TRUE(report["output_validation"]["errors"].is_array());
-  const cli_fixtures::Cli e = run_cli("eval --original " + sample + "coarse.obj --refined " + dir + "/refined.obj --cloud " +
-                                          sample + "cloud.ply --json " + dir + "/eval.json",
+  const cli_fixtures::Cli e = run_cli("eval --original " + sample + "coarse.obj --refined " + dir +
+                                          "/refined.obj --cloud " + sample + "cloud.ply --json " + dir + "/eval.json",
                                       dir);
   ASSERT_EQ(e.exit, 0) << e.err;
   EXPECT_EQ(json::parse(cli_fixtures::slurp(dir + "/eval.json"))["lodrefine_version"], LODREFINE_VERSION);

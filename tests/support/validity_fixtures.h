@@ -32,7 +32,8 @@ inline std::string box_city(const std::vector<BoxBuilding>& buildings) {
   for (const BoxBuilding& b : buildings) {
     const long long base = (long long)doc["vertices"].size();
     for (const auto& p : box)
-      doc["vertices"].push_back({std::llround((p[0] + b.x) * 1000), std::llround(p[1] * 1000), std::llround(p[2] * 1000)});
+      doc["vertices"].push_back(
+          {std::llround((p[0] + b.x) * 1000), std::llround(p[1] * 1000), std::llround(p[2] * 1000)});
     json shell = json::array(), values = json::array();
     for (int f = 0; f < 6; ++f) {
       if (std::count(b.missing.begin(), b.missing.end(), f)) continue;

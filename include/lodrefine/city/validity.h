@@ -23,8 +23,8 @@ struct CityValidity {
   std::string path;
   std::string input_format;  // "CityJSON 2.0", "CityJSONSeq 2.0", "CityGML 2.0"
   ValidityTolerances tolerances;
-  std::vector<BuildingValidity> buildings;    // in file order
-  std::vector<std::string> ids_without_lod;   // Building/BuildingPart objects without the LoD asked for
+  std::vector<BuildingValidity> buildings;   // in file order
+  std::vector<std::string> ids_without_lod;  // Building/BuildingPart objects without the LoD asked for
   int invalid() const;
 };
 
