@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "city_argument.h"
 #include "commands.h"
 #include "lodrefine/base/files.h"
 #include "lodrefine/city/cityfile.h"
@@ -93,9 +94,7 @@ void add_repair_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("repair",
                                  "Repair every building of a city file that is no valid solid, without a scan "
                                  "(its shell rebuilt on its own planes); the valid ones are written as read");
-  cmd->add_option("city", args.city, "City file (" + formats_text(kCityFormatNames) + ")")
-      ->required()
-      ->check(CLI::ExistingFile);
+  add_city_argument(cmd, args.city);
   cmd->add_option("--out", args.out,
                   "Repaired city file (CityJSON 2.0; CityJSONSeq for a sequence), written atomically. Each building "
                   "repaired gets lodrefine_outcome, lodrefine_reason and its codes lodrefine_errors_before / "

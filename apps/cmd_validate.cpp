@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <map>
 
+#include "city_argument.h"
 #include "commands.h"
 #include "lodrefine/base/files.h"
 #include "lodrefine/city/validity.h"
@@ -48,9 +49,7 @@ void add_validate_command(CLI::App& app) {
       "validate",
       "Check every building of a city file as a solid; report its defects with val3dity's error codes "
       "(exit 0: all valid, 1: some invalid, 2: bad input)");
-  cmd->add_option("city", args.city, "City file (" + formats_text(kCityFormatNames) + ")")
-      ->required()
-      ->check(CLI::ExistingFile);
+  add_city_argument(cmd, args.city);
   cmd->add_option("--json", args.json,
                   "Write the report as JSON in val3dity's shape (features: id, type, validity, errors with code, "
                   "description, id, info)");

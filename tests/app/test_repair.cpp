@@ -57,7 +57,7 @@ TEST(RepairCommand, RepairsTheInvalidAndKeepsTheValidAsRead) {
   for (const char* id : {"open", "flipped"}) {
     const json& a = out["CityObjects"][id]["attributes"];
     EXPECT_EQ(a["lodrefine_outcome"], "repaired") << id;
-    EXPECT_EQ(a["name"], id);  // the building's own attributes stay
+    EXPECT_EQ(a["name"], std::string(id));  // the building's own attributes stay
     EXPECT_EQ(a["lodrefine_errors_after"], json::array()) << id;
   }
   EXPECT_EQ(out["CityObjects"]["open"]["attributes"]["lodrefine_errors_before"], json({302}));
@@ -86,10 +86,12 @@ TEST(RepairCommand, WholeDelfshavenWithoutAScan) {
   const json rep = load(dir + "/report.json");
   EXPECT_EQ(rep["buildings"], 853);
   EXPECT_EQ(rep["outcomes"].size(), 853u);
-  EXPECT_LE(rep["kept_invalid"].get<int>(), 71);
+  EXPECT_LE(rep["kept_invalid"].get<int>(), 71);  // measured: 735 repaired, 2 kept, 71 kept-invalid
   const json out = load(dir + "/out.city.json"), input = load(data_path.string());
   EXPECT_EQ(out["CityObjects"].size(), input["CityObjects"].size());
-  if (const std::string verdict = schema_verdict(dir + "/out.city.json"); !verdict.empty()) EXPECT_EQ(verdict, "valid");
+  if (const std::string verdict = schema_verdict(dir + "/out.city.json"); !verdict.empty()) {
+    EXPECT_EQ(verdict, "valid");
+  }
   ASSERT_NE(run_cli("validate " + dir + "/out.city.json --json " + dir + "/after.json", dir).exit, 2);
   std::map<std::string, bool> valid_after;
   for (const json& f : load(dir + "/after.json")["features"]) valid_after[f["id"]] = f["validity"];
