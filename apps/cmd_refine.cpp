@@ -19,6 +19,7 @@
 #include "lodrefine/formats/cloud.h"
 #include "lodrefine/formats/obj.h"
 #include "lodrefine/tools/review.h"
+#include "lodrefine/version.h"
 #include "options.h"
 
 namespace lodrefine::app {
@@ -120,21 +121,6 @@ void write_review(const RefineArgs& a, const std::vector<std::string>& clouds, c
   write_file_atomic(a.html, city_review_html(review));
 }
 
-// Fails before any work when an output could not be written (so nothing is left half done):
-// its folder must exist and take a new file (a temporary is created and removed again).
-void check_output_dir(const std::string& path) {
-  if (path.empty()) return;
-  const std::filesystem::path dir = std::filesystem::absolute(path).parent_path();
-  if (!std::filesystem::is_directory(dir))
-    throw InputError(path + ": output directory " + dir.string() + " does not exist");
-  if (std::filesystem::is_directory(path)) throw InputError(path + ": is a directory");
-  try {
-    AtomicFile probe(path);
-  } catch (const std::runtime_error& e) {
-    throw InputError(e.what());
-  }
-}
-
 // Refuses, before anything is read, an output that is an input or another output (compared
 // as files: links and other spellings of one path count). --html too: it replaced the model,
 // a cloud file or the city file out without a word.
@@ -201,7 +187,8 @@ void run_city(const RefineArgs& a, const std::vector<std::string>& clouds, const
   if (refine) refine->finish();
   if (!a.html.empty()) write_review(a, clouds, s, review);
   if (!a.report.empty()) {
-    nlohmann::json j = {{"model", a.model},
+    nlohmann::json j = {{"lodrefine_version", LODREFINE_VERSION},
+                        {"model", a.model},
                         {"cloud", cloud_json(s.clouds, skipped)},
                         {"written", a.out},
                         {"input", s.input_format},
@@ -223,14 +210,7 @@ void run_city(const RefineArgs& a, const std::vector<std::string>& clouds, const
                         {"params", params_json(a.params)},
                         {"outcomes", nlohmann::json::array()}};
     if (!s.warnings.empty()) j["warnings"] = s.warnings;
-    for (const auto& b : s.outcomes)
-      j["outcomes"].push_back({{"id", b.id},
-                               {"outcome", outcome_name(b.outcome)},
-                               {"reason", b.reason},
-                               {"facades_moved", b.facades_moved},
-                               {"refused_by", check_name(b.refused_by)},
-                               {"points", b.points},
-                               {"seconds", b.seconds}});
+    for (const auto& b : s.outcomes) j["outcomes"].push_back(city_outcome_json(b));
     write_file_atomic(a.report, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   }
   std::string refused;  // "; never worse refused N (building a, wall b)"
@@ -311,14 +291,15 @@ void add_refine_command(CLI::App& app) {
   static RefineArgs args;
   auto* cmd = app.add_subcommand("refine", "Refine one building model with an MLS point cloud");
   cmd->add_option("--model", args.model,
-                  "Coarse building model (OBJ, CityGML fan-out export), or a city file (CityJSON, CityJSONSeq, "
-                  "CityGML): then --out is a CityJSON 2.0 city file")
+                  "Coarse building model (OBJ, CityGML fan-out export), or a city file (" +
+                      formats_text(kCityFormatNames) + "): then --out is a CityJSON 2.0 city file")
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--cloud", args.clouds,
-                  "MLS point cloud (PLY, LAS or LAZ): the building's crop, or a city file's tile; a folder gives "
-                  "its cloud files by name; repeat for several (one per drive or tile): read one after another "
-                  "as one cloud")
+                  "MLS point cloud (" + formats_text(kCloudFormatNames) +
+                      "): the building's crop, or a city file's tile; a folder gives "
+                      "its cloud files by name; repeat for several (one per drive or tile): read one after another "
+                      "as one cloud")
       ->required()
       ->check(CLI::ExistingPath);
   cmd->add_option("--out", args.out, "Refined model (OBJ; CityJSON for a city file), written atomically")->required();

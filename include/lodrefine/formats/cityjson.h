@@ -21,6 +21,10 @@
 
 namespace lodrefine {
 
+// The city file formats the city readers take (read_cityjson, read_citygml), as the commands'
+// help names them (one list: tests/app/test_help.cpp checks every command that reads one).
+inline const std::vector<std::string> kCityFormatNames = {"CityJSON", "CityJSONSeq", "CityGML"};
+
 struct CityJsonBuilding {
   Mesh mesh;                  // polygon soup, georeferenced, mesh.id = CityObject id; its fins last
   std::string type;           // "Building" or "BuildingPart"
