@@ -23,10 +23,15 @@ namespace lodrefine {
 
 std::string building_extent_problem(const Mesh& model) {
   const Eigen::AlignedBox3d box = bounding_box(model.vertices);
-  const double size = box.isEmpty() ? 0.0 : box.sizes().head<2>().maxCoeff();
-  if (size <= kMaxBuildingExtent) return "";
-  return "spans " + std::to_string(long(size / 1000.0)) + " km, more than a building can (" +
-         std::to_string(int(kMaxBuildingExtent / 1000.0)) + " km): a stray vertex?";
+  if (box.isEmpty()) return "";
+  const double width = box.sizes().head<2>().maxCoeff(), height = box.sizes().z();
+  if (width > kMaxBuildingExtent)
+    return "spans " + std::to_string(long(width / 1000.0)) + " km, more than a building can (" +
+           std::to_string(int(kMaxBuildingExtent / 1000.0)) + " km): a stray vertex?";
+  if (height > kMaxBuildingHeight)
+    return "rises " + std::to_string(long(height / 1000.0)) + " km, more than a building can (" +
+           std::to_string(int(kMaxBuildingHeight / 1000.0)) + " km): a stray vertex?";
+  return "";
 }
 
 CropTarget crop_target(const Mesh& model, double relative, double absolute) {

@@ -120,6 +120,24 @@ TEST(VanTile, AModelOfKilometresIsRefusedAtOnce) {
   fs::remove_all(root);
 }
 
+// Height counts too: one vertex 100 km below the building set its ground there (an empty scan,
+// exit 0), and a truth 20 km tall had the van scan storey after storey until it was killed.
+TEST(VanTile, AModelOfKilometresInHeightIsRefusedAtOnce) {
+  const fs::path root = test_root();
+  const fs::path tile = write_tile(root);
+  for (const char* z : {"-100000", "20000"}) {
+    write_tile(root);
+    const std::string stray =
+        "v " + std::to_string(kTileOrigin.x()) + " " + std::to_string(kTileOrigin.y()) + " " + z + "\nf 1 5 9\n";
+    write_text(tile / "truth" / "B.obj", box_obj_text(0, 0, stray));
+    const std::string why = refusal(tile, "", root / "out");
+    EXPECT_NE(why.find("truth/B.obj: rises "), std::string::npos) << why;
+    EXPECT_NE(why.find("km, more than a building can (1 km)"), std::string::npos) << why;
+    EXPECT_FALSE(fs::exists(root / "out"));
+  }
+  fs::remove_all(root);
+}
+
 // meta.json is checked whole before anything is written: a key of the wrong type is named in one
 // line (cityjson_id: 5 gave the JSON library's own message), and a refusal, for a missing file or
 // an id no file can have, leaves no output folder behind; an output folder that was there before

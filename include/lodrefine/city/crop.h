@@ -18,10 +18,13 @@ struct CropTarget {
 // A model wider than this (m, in x or y) is no building: a stray vertex, or a wrong unit. Its
 // crop would hold a whole tile.
 constexpr double kMaxBuildingExtent = 5000.0;
+// A model taller than this (m, in z) is no building either (the tallest stands 828 m): a stray
+// vertex above or below it would set its ground or have a van scan kilometres of wall.
+constexpr double kMaxBuildingHeight = 1000.0;
 
 // "spans N km, more than a building can (5 km): a stray vertex?" for a model wider than
-// kMaxBuildingExtent in x or y, else empty: crop, a city refine and synth --rescan refuse such a
-// model, each naming it.
+// kMaxBuildingExtent in x or y, "rises N km, … (1 km) …" for one taller than kMaxBuildingHeight,
+// else empty: crop, a city refine and synth --rescan refuse such a model, each naming it.
 std::string building_extent_problem(const Mesh& model);
 
 // The model's bounding box grown by `relative` of its size and `absolute` metres on each side
