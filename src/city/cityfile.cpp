@@ -138,7 +138,7 @@ void run_job(BuildingJob& job, const CityJsonBuilding& b, const RefineConfig& pa
   const auto t0 = Clock::now();
   std::vector<ValidityError> before;
   try {
-    before = validate_soup(b.mesh).errors;
+    before = validate_soup(solid_soup(b)).errors;
     if (only_invalid && before.empty()) {
       job.has_points = false;
       job.valid_as_read = true;
@@ -177,6 +177,17 @@ BuildingJob take_job(std::size_t i, std::vector<CropTarget>& targets, const std:
   return job;
 }
 
+// The codes before and after only where there is something to say (the building had or has
+// errors): a valid building's own attributes stay as read but for the outcome. A pass over a
+// file lodrefine wrote drops the codes an earlier pass left.
+void write_error_codes(json& attributes, const CityBuildingOutcome& o) {
+  attributes.erase("lodrefine_errors_before");
+  attributes.erase("lodrefine_errors_after");
+  if (o.errors_before.empty() && o.errors_after.empty()) return;
+  attributes["lodrefine_errors_before"] = error_codes(o.errors_before);
+  attributes["lodrefine_errors_after"] = error_codes(o.errors_after);
+}
+
 // Writes a finished job into the document (in input order: new vertices are appended).
 // `hook` (may be empty) sees the building (`index` over the file), its outcome, result and crop;
 // the crop is freed after.
@@ -211,8 +222,7 @@ void apply_job(json& doc, const CityJsonTransform& tf, const CityJsonBuilding& b
   obj["attributes"]["lodrefine_outcome"] = outcome_name(o.outcome);
   obj["attributes"]["lodrefine_reason"] = o.reason;
   obj["attributes"]["lodrefine_facades_moved"] = o.facades_moved;
-  obj["attributes"]["lodrefine_errors_before"] = error_codes(o.errors_before);
-  obj["attributes"]["lodrefine_errors_after"] = error_codes(o.errors_after);
+  write_error_codes(obj["attributes"], o);
   if (hook) hook(index, b.mesh, &o, job.returned ? &job.result : nullptr, &job.cloud);
   job.cloud = PointCloud();  // the crop is no longer needed: free it now
   sum.outcomes.push_back(std::move(o));

@@ -34,7 +34,7 @@ CityValidity validate_city(const std::string& path, const std::string& lod, cons
                      std::to_string(file.objects_without_lod2) +
                      " building object(s) without one); nothing to validate");
   for (const CityJsonBuilding& b : file.buildings) {
-    BuildingValidity v{b.mesh.id, b.type, b.lod, b.geometry_type, validate_soup(b.mesh, tolerances)};
+    BuildingValidity v{b.mesh.id, b.type, b.lod, b.geometry_type, validate_soup(solid_soup(b), tolerances)};
     if (b.skipped_rings > 0) {  // dropped by the reader: the faces validated are without them
       v.validation.errors.insert(
           v.validation.errors.begin(),

@@ -95,13 +95,16 @@ TEST(RepairCommand, WholeDelfshavenWithoutAScan) {
     EXPECT_EQ(verdict, "valid");
   }
   ASSERT_NE(run_cli("validate " + dir + "/out.city.json --json " + dir + "/after.json", dir).exit, 2);
+  // Held in a variable: a range-for over load(...)["features"] reads the temporary after it is gone.
+  const json after = load(dir + "/after.json");
   std::map<std::string, bool> valid_after;
-  for (const json& f : load(dir + "/after.json")["features"]) valid_after[f["id"]] = f["validity"];
+  for (const json& f : after["features"]) valid_after[f["id"].get<std::string>()] = f["validity"].get<bool>();
   int repaired = 0;
   for (const json& o : rep["outcomes"]) {
     if (o["outcome"] != "repaired") continue;
     ++repaired;
-    EXPECT_TRUE(valid_after.at(o["id"])) << o["id"] << ": " << o["reason"];
+    ASSERT_TRUE(valid_after.count(o["id"].get<std::string>())) << o["id"];
+    EXPECT_TRUE(valid_after[o["id"].get<std::string>()]) << o["id"] << ": " << o["reason"];
     EXPECT_EQ(o["errors_after"], json::array()) << o["id"];
   }
   EXPECT_GE(repaired, 1);

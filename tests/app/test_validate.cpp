@@ -2,6 +2,8 @@
 // under val3dity's codes, exit 0 when all are valid and 1 when not; the report in val3dity's shape.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <fstream>
 #include <set>
 #include <string>
 
@@ -103,4 +105,23 @@ TEST(ValidateCommand, SnapToleranceDecidesWhatIsOnePoint) {
   std::ofstream(dir + "/city.json") << city.dump();
   EXPECT_EQ(run_cli("validate " + dir + "/city.json", dir).exit, 1);
   EXPECT_EQ(run_cli("validate " + dir + "/city.json --snap-tol 0.01", dir).exit, 0);
+}
+
+// A Solid lodrefine wrote with a fin beside it (a MultiSurface of its LoD after it, in an object
+// with lodrefine_outcome): the fin is a surface, not part of the solid. Validated with the solid
+// it was 4 open edges and a second component (302, 305), on every building `repair` had written
+// with fins (23 of Delfshaven's repaired ones).
+TEST(ValidateCommand, FinsBesideASolidAreNotPartOfIt) {
+  const std::string dir = cli_fixtures::test_dir("validate");
+  json doc = json::parse(box_city({{"fin", {}, {}, 0}}));
+  const long long base = (long long)doc["vertices"].size();
+  for (const auto& p : std::vector<std::array<int, 3>>{{2, 2, 6}, {2, 6, 6}, {2, 6, 7}, {2, 2, 7}})  // on the roof
+    doc["vertices"].push_back({p[0] * 1000, p[1] * 1000, p[2] * 1000});
+  doc["CityObjects"]["fin"]["attributes"]["lodrefine_outcome"] = "repaired";
+  doc["CityObjects"]["fin"]["geometry"].push_back(
+      {{"type", "MultiSurface"}, {"lod", "2.2"}, {"boundaries", {{{base, base + 1, base + 2, base + 3}}}}});
+  std::ofstream(dir + "/city.json") << doc.dump();
+  const cli_fixtures::Cli r = run_cli("validate " + dir + "/city.json", dir);
+  EXPECT_EQ(r.exit, 0) << r.err;
+  EXPECT_NE(r.out.find("\"fin\": valid\n"), std::string::npos) << r.out;
 }

@@ -140,7 +140,8 @@ void check_city_output(const json& in, const std::string& out_path, const CityRe
   ASSERT_EQ(out["CityObjects"].size(), in["CityObjects"].size());
   EXPECT_EQ(s.refined + s.repaired + s.kept + s.kept_invalid + s.untouched, s.buildings);
   std::map<std::string, std::string> outcome;
-  for (const auto& o : s.outcomes) outcome[o.id] = outcome_name(o.outcome);
+  std::map<std::string, const CityBuildingOutcome*> reported;
+  for (const auto& o : s.outcomes) outcome[o.id] = outcome_name(o.outcome), reported[o.id] = &o;
   int identical = 0;
   std::size_t vertex_mismatches = 0;
   for (const auto& [id, obj] : in["CityObjects"].items()) {
@@ -149,7 +150,18 @@ void check_city_output(const json& in, const std::string& out_path, const CityRe
     const auto it = outcome.find(id);
     if (it != outcome.end()) {
       EXPECT_EQ(o["attributes"]["lodrefine_outcome"], it->second) << id;
-      for (const char* k : {"lodrefine_outcome", "lodrefine_reason", "lodrefine_facades_moved"})
+      // The codes only where the building had or has errors (issue 50): a valid one's
+      // attributes stay as read but for its outcome.
+      const CityBuildingOutcome& r = *reported.at(id);
+      const bool codes = !r.errors_before.empty() || !r.errors_after.empty();
+      EXPECT_EQ(o["attributes"].contains("lodrefine_errors_before"), codes) << id;
+      EXPECT_EQ(o["attributes"].contains("lodrefine_errors_after"), codes) << id;
+      if (codes) {
+        EXPECT_EQ(o["attributes"]["lodrefine_errors_before"], json(error_codes(r.errors_before))) << id;
+        EXPECT_EQ(o["attributes"]["lodrefine_errors_after"], json(error_codes(r.errors_after))) << id;
+      }
+      for (const char* k : {"lodrefine_outcome", "lodrefine_reason", "lodrefine_facades_moved",
+                            "lodrefine_errors_before", "lodrefine_errors_after"})
         o["attributes"].erase(k);
       if (o["attributes"].empty() && !obj.contains("attributes")) o.erase("attributes");
     }
@@ -395,8 +407,16 @@ TEST(CityFile, RotterdamDelfshaven) {
   CityRefineSummary s;
   s.buildings = rep["buildings"], s.refined = rep["refined"], s.kept = rep["kept"];
   s.kept_invalid = rep["kept_invalid"], s.untouched = rep["untouched"];
-  for (const auto& o : rep["outcomes"])
+  const auto codes = [](const json& errors) {  // the report's errors: their codes are what is checked
+    std::vector<ValidityError> out;
+    for (const auto& e : errors) out.push_back({ValidityCode(e["code"].get<int>()), {}, e["info"]});
+    return out;
+  };
+  for (const auto& o : rep["outcomes"]) {
     s.outcomes.push_back({o["id"], parse_outcome(o["outcome"]).value(), o["reason"], o["facades_moved"], {}});
+    s.outcomes.back().errors_before = codes(o["errors_before"]);
+    s.outcomes.back().errors_after = codes(o["errors_after"]);
+  }
   EXPECT_EQ(s.buildings, 853);
   EXPECT_GE(s.refined, 1);
   check_city_output(load(path.string()), dir + "/rotterdam.city.json", s);

@@ -112,8 +112,9 @@ struct CityRefineSummary {
 // reason. `cloud_paths` are files (cloud_files expands folders), read in that order as one cloud:
 // the output is that of one file holding their points in that order; none at all only with
 // repair_all (every building is then repaired without a scan). Every building the refinement
-// reaches gets the attributes lodrefine_outcome, lodrefine_reason, lodrefine_facades_moved and
-// lodrefine_errors_before / lodrefine_errors_after (the codes of errors_before / errors_after).
+// reaches gets the attributes lodrefine_outcome, lodrefine_reason, lodrefine_facades_moved and,
+// when it had or has errors (errors_before or errors_after not empty), lodrefine_errors_before /
+// lodrefine_errors_after (their codes); a valid building's other attributes stay as read.
 CityRefineSummary refine_city(const std::string& model_path, const std::vector<std::string>& cloud_paths,
                               const std::string& out_path, const RefineConfig& params,
                               const CityRefineOptions& options);

@@ -42,6 +42,11 @@ struct CityJsonBuilding {
   nlohmann::json attributes;  // CityGML input: the object's attributes (CityJSON input keeps its own JSON)
 };
 
+// `b`'s soup without its fins (the last fin_faces faces): the shell its geometry holds, what is
+// validated as one solid. Fins are surfaces beside the solid (val3dity too checks a MultiSurface
+// apart from a Solid): validated with it, each would be open edges and a component of its own.
+Mesh solid_soup(const CityJsonBuilding& b);
+
 struct CityJsonFile {
   std::string format = "CityJSON";  // or "CityGML"
   std::string version;              // "1.0", "1.1", "2.0"
