@@ -186,6 +186,7 @@ class ObjBuild {
       std::string joined;  // `g a b` is one group to us: semantic_from_name looks for substrings
       for (int i = 0; i < n; ++i) joined += (i ? " " : "") + std::string(names[i]);
       static_cast<ObjBuild*>(self)->group_sem_ = semantic_from_name(joined);
+      static_cast<ObjBuild*>(self)->group_provenance_ = provenance_from_group(joined);
     };
     cb.usemtl_cb = [](void* self, const char* name, int) {
       static_cast<ObjBuild*>(self)->mtl_sem_ = semantic_from_name(std::string(trim(name)));
@@ -215,6 +216,7 @@ class ObjBuild {
       f.v.push_back(i > 0 ? i - 1 : known + i);
     }
     f.sem = group_sem_ != Semantic::Other ? group_sem_ : mtl_sem_;
+    f.provenance = group_provenance_;
     f.source = int(mesh_.faces.size());
     mesh_.faces.push_back(std::move(f));
   }
@@ -249,6 +251,7 @@ class ObjBuild {
   std::size_t vertices_seen_ = 0, faces_seen_ = 0;
   int skipped_ = 0;
   Semantic group_sem_ = Semantic::Other, mtl_sem_ = Semantic::Other;
+  Provenance group_provenance_ = Provenance::None;
 };
 
 void append_fixed(std::string& out, double v) {
@@ -256,6 +259,36 @@ void append_fixed(std::string& out, double v) {
   const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed, 6);  // µm
   if (r.ec != std::errc()) throw std::runtime_error("cannot print coordinate");
   out.append(buf, r.ptr);
+}
+
+// The faces of one semantic and provenance: `g WallSurface` (no provenance) or `g WallSurface scan`,
+// a scan face after a `# lodrefine_coverage 0.85` comment.
+void append_group(std::string& out, const Mesh& mesh, Semantic sem, Provenance from, AtomicFile& file) {
+  bool header = false;
+  for (std::size_t k = 0; k < mesh.faces.size(); ++k) {
+    const Face& f = mesh.faces[k];
+    if (f.sem != sem || f.provenance != from) continue;
+    if (f.v.size() < 3) file.fail("face " + std::to_string(k) + " has fewer than 3 vertices");
+    if (!header) {
+      out += std::string("g ") + semantic_name(sem);
+      if (from != Provenance::None) out += std::string(" ") + provenance_name(from);
+      out += '\n';
+      header = true;
+    }
+    if (from == Provenance::Scan) {
+      char buf[16];  // a share 0..1 in hundredths, locale-free like the coordinates
+      const auto r =
+          std::to_chars(buf, buf + sizeof buf, std::clamp(f.coverage, 0.0, 1.0), std::chars_format::fixed, 2);
+      out += "# lodrefine_coverage " + std::string(buf, r.ptr) + "\n";
+    }
+    out += 'f';
+    for (int i : f.v) {
+      if (i < 0 || std::size_t(i) >= mesh.vertices.size())
+        file.fail("face " + std::to_string(k) + " references missing vertex " + std::to_string(i));
+      out += ' ' + std::to_string(i + 1);
+    }
+    out += '\n';
+  }
 }
 
 std::string obj_text(const Mesh& mesh, const Vec3& origin, AtomicFile& file) {
@@ -276,22 +309,9 @@ std::string obj_text(const Mesh& mesh, const Vec3& origin, AtomicFile& file) {
     append_fixed(out, p.x()), out += ' ', append_fixed(out, p.y()), out += ' ', append_fixed(out, p.z());
     out += '\n';
   }
-  for (Semantic sem : {Semantic::Wall, Semantic::Roof, Semantic::Ground, Semantic::Other}) {
-    bool header = false;
-    for (std::size_t k = 0; k < mesh.faces.size(); ++k) {
-      const Face& f = mesh.faces[k];
-      if (f.sem != sem) continue;
-      if (f.v.size() < 3) file.fail("face " + std::to_string(k) + " has fewer than 3 vertices");
-      if (!header) out += std::string("g ") + semantic_name(sem) + "\n", header = true;
-      out += 'f';
-      for (int i : f.v) {
-        if (i < 0 || std::size_t(i) >= mesh.vertices.size())
-          file.fail("face " + std::to_string(k) + " references missing vertex " + std::to_string(i));
-        out += ' ' + std::to_string(i + 1);
-      }
-      out += '\n';
-    }
-  }
+  for (Semantic sem : {Semantic::Wall, Semantic::Roof, Semantic::Ground, Semantic::Other})
+    for (Provenance from : {Provenance::None, Provenance::Model, Provenance::Scan, Provenance::Added})
+      append_group(out, mesh, sem, from, file);
   return out;
 }
 

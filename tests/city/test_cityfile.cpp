@@ -9,6 +9,7 @@
 #include "support/io_fixtures.h"
 #include "support/mesh_fixtures.h"
 #include "support/scan_fixtures.h"
+#include "support/schema_fixtures.h"
 
 #include <chrono>
 #include <filesystem>
@@ -54,22 +55,8 @@ json load(const std::string& path) {
   return json::parse(in);
 }
 
-fs::path shared_dir() { return fs::path(LODREFINE_SOURCE_DIR) / ".." / "shared"; }
-
-// "valid", or the validator's complaint; "" when the schemas or python3-jsonschema are absent.
-std::string schema_verdict(const std::string& path) {
-  const fs::path schemas = shared_dir() / "schemas" / "cityjson-2.0.2";
-  if (!fs::exists(schemas) || !fs::exists("/usr/bin/python3")) return "";
-  const std::string out = path + ".verdict";
-  const std::string cmd = "/usr/bin/python3 " + std::string(LODREFINE_SOURCE_DIR) + "/scripts/validate_cityjson.py " +
-                          schemas.string() + " " + path + " >" + out + " 2>&1";
-  const int st = std::system(cmd.c_str());
-  std::ifstream in(out);
-  std::string text((std::istreambuf_iterator<char>(in)), {});
-  if (WIFEXITED(st) && WEXITSTATUS(st) == 2) return "";
-  while (!text.empty() && text.back() == '\n') text.pop_back();
-  return text;
-}
+using schema_fixtures::schema_verdict;
+using schema_fixtures::shared_dir;
 
 // The building's faces welded on identical coordinates (the file's integers), then checked.
 std::string geometry_problem(const Mesh& soup) {
@@ -571,17 +558,9 @@ TEST(CityFile, CityJsonSeqStreamedThrough) {
       if (b.mesh.id == o.id && o.outcome == Outcome::Refined) {
         EXPECT_EQ(geometry_problem(b.mesh), "") << b.mesh.id;
       }
-  const fs::path schemas = shared_dir() / "schemas" / "cityjson-2.0.2";
-  if (fs::exists(schemas) && fs::exists("/usr/bin/python3")) {
-    const int st =
-        std::system(("/usr/bin/python3 " + std::string(LODREFINE_SOURCE_DIR) + "/scripts/validate_cityjson.py " +
-                     schemas.string() + " " + dir + "/out.city.jsonl --seq >" + dir + "/v.txt 2>&1")
-                        .c_str());
-    std::ifstream v(dir + "/v.txt");
-    const std::string verdict((std::istreambuf_iterator<char>(v)), {});
-    if (!(WIFEXITED(st) && WEXITSTATUS(st) == 2)) {
-      EXPECT_EQ(verdict, "valid\n");
-    }
+  const std::string verdict = schema_verdict(dir + "/out.city.jsonl", true);
+  if (!verdict.empty()) {
+    EXPECT_EQ(verdict, "valid");
   }
 }
 

@@ -197,6 +197,35 @@ TEST(IoObj, CoordinatesBeyondAMillionKilometresAreRefused) {
   }
 }
 
+// A refined building's faces say where they come from: `g WallSurface scan` with the coverage in
+// a comment before each scan face; a face without one in the plain group. tinyobjloader (our
+// reader) still takes the semantic from the group, and the provenance comes back.
+TEST(IoObj, ProvenanceInGroupNamesAndCoverageInComments) {
+  Mesh m;
+  m.id = "b";
+  m.vertices = {{0, 0, 0}, {4, 0, 0}, {4, 0, 3}, {0, 0, 3}, {0, 2, 3}};
+  m.faces = {{{0, 1, 2, 3}, Semantic::Wall, 0, Provenance::Scan, 0.857},
+             {{3, 2, 4}, Semantic::Roof, 1, Provenance::Model},
+             {{0, 3, 4}, Semantic::Wall, 2, Provenance::Added},
+             {{1, 4, 2}, Semantic::Wall, 3}};
+  const std::string path = temp_path("prov.obj");
+  write_obj(path, m);
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("g WallSurface\nf 2 5 3\ng WallSurface scan\n# lodrefine_coverage 0.86\nf 1 2 3 4\n"
+                      "g WallSurface added\nf 1 4 5\ng RoofSurface model\nf 4 3 5\n"),
+            std::string::npos)
+      << text;
+  const Mesh r = read_obj(path);
+  ASSERT_EQ(r.faces.size(), 4u);
+  const Provenance expected[] = {Provenance::None, Provenance::Scan, Provenance::Added, Provenance::Model};
+  const Semantic sems[] = {Semantic::Wall, Semantic::Wall, Semantic::Wall, Semantic::Roof};
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_EQ(r.faces[k].provenance, expected[k]) << k;
+    EXPECT_EQ(r.faces[k].sem, sems[k]) << k;
+  }
+}
+
 // tests/fuzz/regressions/fuzz_obj/writer_huge_coordinate.obj: read_obj accepts any finite
 // coordinate, so write_obj must print any finite coordinate readably.
 TEST(BadInputRegression, ObjWriterRoundTripsHugeCoordinates) {

@@ -36,7 +36,11 @@ CityReviewBuilding reviewed(const std::string& id, Outcome outcome, double fit_a
   b.fit_after = fit_after;
   const Mesh m = fixtures::box({x, 0, 0}, {x + 8, 6, 5});
   b.outline = review_outline(m, Vec3::Zero());
-  if (outcome == Outcome::Refined) b.view = review_view(id, m, fixtures::box({x + 0.3, 0, 0}, {x + 8, 6, 5}), {}, 100);
+  if (outcome == Outcome::Refined || outcome == Outcome::Repaired) {
+    Mesh written = fixtures::box({x + 0.3, 0, 0}, {x + 8, 6, 5});
+    for (Face& f : written.faces) f.provenance = f.sem == Semantic::Wall ? Provenance::Scan : Provenance::Model;
+    b.view = review_view(id, m, written, {}, 100);
+  }
   return b;
 }
 
@@ -67,15 +71,25 @@ TEST(Review, HostileIdsEscapedAndTableWorstFirst) {
             std::string::npos)
       << views.substr(0, 400);
   // Worst first: kept before refined, the worse fit first; untouched buildings are not listed.
-  const auto k1 = h.find("<td>k1</td>"), bad = h.find("<td><a href=\"#view-&lt;/script&gt;"),
+  const auto k1 = h.find("<td>k1</td>"), bad = h.find("<td><a href=\"#" + view_anchor(kHostile) + "\">&lt;/script"),
              good = h.find("<td><a href=\"#view-good\">good</a></td>");
+  EXPECT_EQ(view_anchor(kHostile).find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_-."), std::string::npos)
+      << view_anchor(kHostile);
   ASSERT_NE(k1, std::string::npos);
   ASSERT_NE(bad, std::string::npos);
   ASSERT_NE(good, std::string::npos);
   EXPECT_LT(k1, bad);
   EXPECT_LT(bad, good);
-  EXPECT_EQ(h.find("<td>u</td>"), std::string::npos);
-  EXPECT_NE(h.find("id=\"view-good\""), std::string::npos);
+  // Untouched buildings are listed last, hidden until their box of the filter is ticked.
+  EXPECT_NE(h.find("<tr class=\"untouched\" data-outcome=\"untouched\" hidden><td>u</td>"), std::string::npos);
+  EXPECT_NE(h.find("<input type=\"checkbox\" data-outcome=\"untouched\"> untouched (1)"), std::string::npos);
+  EXPECT_NE(h.find("<input type=\"checkbox\" data-outcome=\"kept\" checked> kept (2)"), std::string::npos);
+  // The reason without the id the row shows beside it.
+  EXPECT_NE(h.find("<td>i1</td><td>kept-invalid</td><td>not closable: 2 non-manifold edges"), std::string::npos);
+  EXPECT_NE(h.find("id=\"view-good\" data-outcome=\"refined\""), std::string::npos);
+  // The written faces by source, one per triangle (a box: ground and roof the model's, 8 wall
+  // triangles the scan's).
+  EXPECT_NE(h.find("\"sources\":[1,1,1,1,2,2,2,2,2,2,2,2]"), std::string::npos) << h.substr(h.find("\"sources\""), 80);
   EXPECT_EQ(h.find("id=\"view-k1\""), std::string::npos) << "only refined buildings get a view";
   // The refusals by check, numbers folded.
   EXPECT_NE(h.find("1  kept: the refinement does not fit the scan better"), std::string::npos);
@@ -84,6 +98,103 @@ TEST(Review, HostileIdsEscapedAndTableWorstFirst) {
   // The map: every building outlined, refined ones linked to their view.
   EXPECT_NE(h.find("<a href=\"#view-good\"><path"), std::string::npos);
   EXPECT_NE(h.find("<title>u: untouched</title>"), std::string::npos);
+}
+
+namespace {
+
+// Drives the page in Chromium after its views rendered, noting in <html> data attributes what a
+// reader would see: where the view of the map's link `first` lies before and after a click on its
+// outline; the rows shown per outcome before and after unticking "refined"; then a click on
+// `second`'s outline (its view hidden by the filter now) and whether its view is shown.
+std::string page_driver(const std::string& first, const std::string& second) {
+  return R"js(<script>
+(() => {
+  const el = document.documentElement, outcomes = ['refined', 'repaired', 'kept', 'untouched'];
+  const shown = () => outcomes.map(o => o + ':' +
+      [...document.querySelectorAll('tr[data-outcome="' + o + '"]')].filter(r => !r.hidden).length).join(' ');
+  const click = id => document.querySelector('.map a[href="#' + id + '"] path')
+      .dispatchEvent(new MouseEvent('click', {bubbles: true, cancelable: true, view: window}));
+  const top = id => Math.round(document.getElementById(id).getBoundingClientRect().top);
+  const step = () => {
+    if (el.dataset.rendered === undefined) return setTimeout(step, 50);
+    el.dataset.topBefore = top(FIRST);
+    click(FIRST);
+    setTimeout(() => {
+      el.dataset.hash = location.hash;
+      el.dataset.topAfter = top(FIRST);
+      el.dataset.scrolled = Math.round(scrollY);
+      el.dataset.rowsBefore = shown();
+      document.querySelector('.filter input[data-outcome="refined"]').click();
+      el.dataset.rowsAfter = shown();
+      el.dataset.refinedViewsHidden = [...document.querySelectorAll('section[data-outcome="refined"]')]
+          .every(s => s.hidden);
+      click(SECOND);
+      setTimeout(() => {
+        el.dataset.hash2 = location.hash;
+        el.dataset.secondShown = !document.getElementById(SECOND).hidden;
+        el.dataset.top2 = top(SECOND);
+      }, 300);
+    }, 300);
+  };
+  step();
+})();
+</script>)js";
+}
+
+std::string replaced(std::string s, const std::string& from, const std::string& to) {
+  for (std::size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size()))
+    s.replace(at, from.size(), to);
+  return s;
+}
+
+// A data attribute of the dumped <html> start tag.
+std::string attribute(const std::string& root, const std::string& name) {
+  std::smatch m;
+  return std::regex_search(root, m, std::regex(name + "=\"([^\"]*)\"")) ? m.str(1) : "(absent)";
+}
+
+}  // namespace
+
+// The page for deciding, in headless Chromium: unticking an outcome hides its rows and views; a
+// click on a building of the map scrolls to its 3D view, and shows it when the filter hid it.
+TEST(Review, FilterAndMapClickThroughInChromium) {
+  if (!chromium_available()) GTEST_SKIP() << "chromium not installed (Debian: chromium; .ci/run installs it)";
+  const fs::path dir = fresh_dir("review_filter");
+  CityReview r;
+  r.title = "filter";
+  r.summary = "4 buildings";
+  r.buildings = {reviewed("rep", Outcome::Repaired, 0.02, 0), reviewed("good", Outcome::Refined, 0.01, 20),
+                 reviewed(kHostile, Outcome::Refined, 0.03, 40), reviewed("k1", Outcome::Kept, 0.3, 60),
+                 reviewed("u", Outcome::Untouched, 0, 80)};
+  const std::string first = view_anchor(kHostile), second = view_anchor("good");
+  std::string html = city_review_html(r);
+  const std::string driver =
+      replaced(replaced(page_driver(first, second), "FIRST", "'" + first + "'"), "SECOND", "'" + second + "'");
+  html.insert(html.rfind("</body>"), driver);
+  std::ofstream(dir / "review.html") << html;
+
+  const PageDump d = dump_page(dir / "review.html", dir);
+  ASSERT_EQ(d.exit, 0) << d.log;
+  EXPECT_EQ(d.root.find("data-errors"), std::string::npos) << d.root;
+  EXPECT_EQ(attribute(d.root, "data-rendered"), "3") << d.root;
+  EXPECT_EQ(attribute(d.root, "data-rows-before"), "refined:2 repaired:1 kept:1 untouched:0");
+  EXPECT_EQ(attribute(d.root, "data-rows-after"), "refined:0 repaired:1 kept:1 untouched:0");
+  EXPECT_EQ(attribute(d.root, "data-refined-views-hidden"), "true");
+  // The click on the hostile id's outline scrolls its view into the window; the click on good's
+  // shows its view the filter hid, in the window.
+  EXPECT_EQ(attribute(d.root, "data-hash"), "#" + first);
+  EXPECT_GT(std::stoi(attribute(d.root, "data-scrolled")), 0);
+  const int before = std::stoi(attribute(d.root, "data-top-before")),
+            after = std::stoi(attribute(d.root, "data-top-after"));
+  EXPECT_GT(before, 900) << "below the window before the click";
+  EXPECT_GE(after, 0);
+  EXPECT_LT(after, 450) << "before the click at " << before;
+  EXPECT_EQ(attribute(d.root, "data-hash2"), "#" + second);
+  EXPECT_EQ(attribute(d.root, "data-second-shown"), "true");
+  EXPECT_GE(std::stoi(attribute(d.root, "data-top2")), 0);
+  EXPECT_LT(std::stoi(attribute(d.root, "data-top2")), 450);
+  for (const std::string& line : d.console_errors) ADD_FAILURE() << line;
+  if (!HasFailure()) fs::remove_all(dir);
 }
 
 TEST(Review, ViewKeepsOnlyPointsNearTheRefinedModelAndCapsThem) {
@@ -140,8 +251,11 @@ TEST(Review, DelfshavenRefinePageRendersEveryRefinedBuilding) {
       << read_text(dir / "refine.log");
   const json rep = json::parse(read_text(dir / "report.json"));
   std::vector<std::string> refined;
-  for (const auto& o : rep["outcomes"])
+  std::size_t viewed = 0;  // refined and repaired buildings have a view
+  for (const auto& o : rep["outcomes"]) {
     if (o["outcome"] == "refined") refined.push_back(o["id"]);
+    viewed += o["outcome"] == "refined" || o["outcome"] == "repaired";
+  }
   ASSERT_GE(refined.size(), 1u) << rep.dump(1);
   const std::string html = read_text(dir / "review.html");
   EXPECT_EQ(html.find("</script><img"), std::string::npos);
@@ -156,9 +270,8 @@ TEST(Review, DelfshavenRefinePageRendersEveryRefinedBuilding) {
   ASSERT_FALSE(d.root.empty()) << page.substr(0, 500);
   EXPECT_EQ(d.root.find("data-errors"), std::string::npos) << d.root;
   EXPECT_EQ(d.root.find("data-pwned"), std::string::npos) << "the hostile id ran";
-  EXPECT_NE(d.root.find("data-rendered=\"" + std::to_string(refined.size()) + "\""), std::string::npos)
-      << d.root << "\n"
-      << d.log;
+  EXPECT_NE(d.root.find("data-rendered=\"" + std::to_string(viewed) + "\""), std::string::npos) << d.root << "\n"
+                                                                                                << d.log;
   for (const std::string& line : d.console_errors) ADD_FAILURE() << line;
 
   // Every refined building's canvas, in one screenshot tall enough for all of them.
@@ -166,7 +279,7 @@ TEST(Review, DelfshavenRefinePageRendersEveryRefinedBuilding) {
   const std::regex rect("data-rect=\"(\\d+),(\\d+),(\\d+),(\\d+)\"");
   for (auto it = std::sregex_iterator(page.begin(), page.end(), rect); it != std::sregex_iterator(); ++it)
     rects.push_back({std::stoi((*it)[1]), std::stoi((*it)[2]), std::stoi((*it)[3]), std::stoi((*it)[4])});
-  ASSERT_EQ(rects.size(), refined.size());
+  ASSERT_EQ(rects.size(), viewed);
   int bottom = 0;
   for (const auto& r : rects) bottom = std::max(bottom, r[1] + r[3]);
   const fs::path shot = dir / "shot.png";
