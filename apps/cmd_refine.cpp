@@ -49,12 +49,12 @@ void refuse_city_options(const RefineArgs& a) {
                        ") applies to a city file as --model (CityJSON, CityJSONSeq, CityGML), not to an OBJ");
 }
 
-// Scan points per refined building on the review page: enough to see each facade, and what
-// bounds the collector's memory (only refined buildings keep meshes and points).
+// Scan points per refined or repaired building on the review page: enough to see each facade, and
+// what bounds the collector's memory (only those buildings keep meshes and points).
 constexpr std::size_t kReviewPoints = 3000;
 
 // Collects the review page's data while the city is refined (CityRefineOptions::on_building):
-// every building's outline; for a refined one its view (meshes + capped points), built outside
+// every building's outline; for a refined or repaired one its view (meshes + capped points), built outside
 // the lock as the hook may be called from several threads, in any order: page() puts them in file
 // order, so the page is the same whatever finished first.
 struct ReviewCollector {
@@ -74,9 +74,9 @@ struct ReviewCollector {
     if (o) b.reason = o->reason, b.points = o->points, b.facades_moved = std::size_t(o->facades_moved);
     if (r && r->trace.judgement && r->trace.judgement->building.points > 0)  // the judge's fit on the scan near it
       b.fit_before = r->trace.judgement->building.rms_before, b.fit_after = r->trace.judgement->building.rms_after;
-    if (r && b.outcome == Outcome::Refined) {
-      add_moves(b, r->trace.facades);
-      if (crop) b.view = review_view(b.id, model, r->mesh, crop->points, kReviewPoints);
+    if (r && (b.outcome == Outcome::Refined || b.outcome == Outcome::Repaired)) {
+      if (b.outcome == Outcome::Refined) add_moves(b, r->trace.facades);
+      b.view = review_view(b.id, model, r->mesh, crop ? crop->points : std::vector<Vec3>{}, kReviewPoints);
     }
     b.outline = review_outline(model, Vec3::Zero());
     const std::lock_guard<std::mutex> lock(mutex);

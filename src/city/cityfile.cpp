@@ -1,6 +1,7 @@
 // City file in, city file out (see cityfile.h).
 #include "lodrefine/city/cityfile.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -8,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <sstream>
+#include <tuple>
 
 #include "cityjson_upgrade.h"
 #include "lodrefine/base/files.h"
@@ -490,7 +492,8 @@ json cityjson_surfaces(const Mesh& mesh, bool solid, const std::string& lod, con
     vertices.push_back(std::move(q));
   }
   json shell = json::array(), values = json::array();
-  std::map<Semantic, int> surface_of;
+  // One semantic surface per semantic, provenance and coverage (in hundredths).
+  std::map<std::tuple<Semantic, Provenance, long>, int> surface_of;
   json surfaces = json::array();
   for (const Face& f : mesh.faces) {
     json ring = json::array();
@@ -500,10 +503,15 @@ json cityjson_surfaces(const Mesh& mesh, bool solid, const std::string& lod, con
       values.push_back(nullptr);
       continue;
     }
-    auto it = surface_of.find(f.sem);
+    const bool scan = f.provenance == Provenance::Scan;
+    const long hundredths = scan ? std::lround(std::clamp(f.coverage, 0.0, 1.0) * 100.0) : 0;
+    auto it = surface_of.find({f.sem, f.provenance, hundredths});
     if (it == surface_of.end()) {
-      it = surface_of.emplace(f.sem, int(surfaces.size())).first;
-      surfaces.push_back({{"type", semantic_name(f.sem)}});
+      it = surface_of.emplace(std::make_tuple(f.sem, f.provenance, hundredths), int(surfaces.size())).first;
+      json surface = {{"type", semantic_name(f.sem)}};
+      if (f.provenance != Provenance::None) surface["lodrefine_source"] = provenance_name(f.provenance);
+      if (scan) surface["lodrefine_coverage"] = double(hundredths) / 100.0;
+      surfaces.push_back(std::move(surface));
     }
     values.push_back(it->second);
   }

@@ -510,12 +510,12 @@ int split_warped_faces(Mesh& mesh, double tolerance) {
         clash = clash || (!boundary && edges.count(std::minmax(f.v[ia], f.v[ib])));
       }
     if (!clash) {
-      for (const auto& t : tris) faces.push_back({{f.v[t[0]], f.v[t[1]], f.v[t[2]]}, f.sem, f.source});
+      for (const auto& t : tris) faces.push_back(with_corners(f, {f.v[t[0]], f.v[t[1]], f.v[t[2]]}));
       continue;
     }
     const int centre = int(mesh.vertices.size());
     mesh.vertices.push_back(polygon_centroid(pts));
-    for (int k = 0; k < n; ++k) faces.push_back({{f.v[k], f.v[(k + 1) % n], centre}, f.sem, f.source});
+    for (int k = 0; k < n; ++k) faces.push_back(with_corners(f, {f.v[k], f.v[(k + 1) % n], centre}));
   }
   mesh.faces = std::move(faces);
   return split;
@@ -535,7 +535,7 @@ Mesh merge_coplanar_faces(const Mesh& mesh, double angle_deg, double distance) {
       return polygon_area(positions(mesh.vertices, mesh.faces[a].v)) <
              polygon_area(positions(mesh.vertices, mesh.faces[b].v));
     });
-    merged[id] = {*outline, mesh.faces[largest].sem, mesh.faces[largest].source};
+    merged[id] = with_corners(mesh.faces[largest], *outline);
   }
   // Input order is kept: a merged polygon takes the place of its region's first face.
   std::vector<Face> faces;

@@ -10,6 +10,7 @@
 
 #include "support/cli_fixtures.h"
 #include "support/realdata.h"
+#include "support/schema_fixtures.h"
 #include "support/validity_fixtures.h"
 
 using cli_fixtures::run_cli;
@@ -18,20 +19,6 @@ using json = nlohmann::json;
 namespace {
 
 json load(const std::string& path) { return json::parse(cli_fixtures::slurp(path)); }
-
-// "valid", or the schema validator's complaint; "" when the schemas or python3-jsonschema are absent.
-std::string schema_verdict(const std::string& path) {
-  const std::filesystem::path schemas = lodrefine::fixtures::realdata_dir() / ".." / "schemas" / "cityjson-2.0.2";
-  if (!std::filesystem::exists(schemas)) return "";
-  const std::string out = path + ".verdict";
-  const int st = std::system(("/usr/bin/python3 " + std::string(LODREFINE_SOURCE_DIR) +
-                              "/scripts/validate_cityjson.py " + schemas.string() + " " + path + " >" + out + " 2>&1")
-                                 .c_str());
-  std::string text = cli_fixtures::slurp(out);
-  if (WIFEXITED(st) && WEXITSTATUS(st) == 2) return "";
-  while (!text.empty() && text.back() == '\n') text.pop_back();
-  return text;
-}
 
 }  // namespace
 
@@ -91,7 +78,8 @@ TEST(RepairCommand, WholeDelfshavenWithoutAScan) {
   EXPECT_LE(rep["kept_invalid"].get<int>(), 71);  // measured: 735 repaired, 2 kept, 71 kept-invalid
   const json out = load(dir + "/out.city.json"), input = load(data_path.string());
   EXPECT_EQ(out["CityObjects"].size(), input["CityObjects"].size());
-  if (const std::string verdict = schema_verdict(dir + "/out.city.json"); !verdict.empty()) {
+  if (const std::string verdict = lodrefine::schema_fixtures::schema_verdict(dir + "/out.city.json");
+      !verdict.empty()) {
     EXPECT_EQ(verdict, "valid");
   }
   ASSERT_NE(run_cli("validate " + dir + "/out.city.json --json " + dir + "/after.json", dir).exit, 2);
