@@ -16,6 +16,7 @@
 #include "lodrefine/city/crop.h"
 #include "lodrefine/city/in_order_pool.h"
 #include "lodrefine/city/validity.h"
+#include "lodrefine/core/provenance.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/formats/citygml.h"
 #include "lodrefine/formats/cityjson.h"
@@ -129,6 +130,7 @@ void repaired_by_weld(BuildingJob& job, const CityJsonTransform& tf) {
   add(rr.flipped_faces, "faces turned outward");
   add(rr.filled_holes, "holes filled");
   add(rr.split_warped_faces, "warped faces split");
+  complete_provenance(job.result.mesh);  // written: its faces the model's, a filled hole's added
   job.outcome.outcome = Outcome::Repaired;
   job.outcome.reason = "the repair made it a valid solid (" + (what.empty() ? std::string("faces merged") : what) + ")";
   job.outcome.errors_after = std::move(after);

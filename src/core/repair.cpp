@@ -272,7 +272,8 @@ std::vector<std::vector<int>> hole_loops(const std::vector<Face>& faces) {
 }
 
 // Closes each hole with one polygon when it is planar within kHolePlanarity, else with the
-// triangles of its projection (noted). New faces are appended with source -1.
+// triangles of its projection (noted). New faces are appended with source -1, added to close the
+// shell (Provenance::Added: no model face lies there).
 void fill_holes(const std::vector<Vec3>& V, std::vector<Face>& faces, RepairReport& r) {
   for (const auto& loop : hole_loops(faces)) {
     const std::vector<Vec3> pts = positions(V, loop);
@@ -281,11 +282,12 @@ void fill_holes(const std::vector<Vec3>& V, std::vector<Face>& faces, RepairRepo
     for (const Vec3& p : pts) err = std::max(err, std::abs(plane.distance(p)));
     ++r.filled_holes;
     if (err <= kHolePlanarity) {
-      faces.push_back({loop, Semantic::Other, -1});
+      faces.push_back({loop, Semantic::Other, -1, Provenance::Added});
       continue;
     }
     const auto tris = triangulate_polygon(pts);
-    for (const auto& t : tris) faces.push_back({{loop[t[0]], loop[t[1]], loop[t[2]]}, Semantic::Other, -1});
+    for (const auto& t : tris)
+      faces.push_back({{loop[t[0]], loop[t[1]], loop[t[2]]}, Semantic::Other, -1, Provenance::Added});
     r.notes.push_back("hole of " + std::to_string(loop.size()) + " vertices is not planar (" +
                       std::to_string(int(std::round(err * 1000))) + " mm): filled with " + std::to_string(tris.size()) +
                       " triangles");

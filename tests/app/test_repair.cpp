@@ -47,6 +47,22 @@ TEST(RepairCommand, RepairsTheInvalidAndKeepsTheValidAsRead) {
     EXPECT_EQ(a["name"], std::string(id));  // the building's own attributes stay
     EXPECT_EQ(a["lodrefine_errors_after"], json::array()) << id;
   }
+  // Where each surface comes from: the faces read are the model's, the roof that closes the open
+  // box is added (the weld repair wrote them without a source before).
+  for (const char* id : {"open", "flipped"}) {
+    const json& sem = out["CityObjects"][id]["geometry"][std::size_t(0)]["semantics"];
+    std::map<std::string, int> sources;
+    for (const json& v : sem["values"][std::size_t(0)]) {
+      const json& s = sem["surfaces"][v.get<std::size_t>()];
+      ++sources[s.value("lodrefine_source", "(none)") + " " + s["type"].get<std::string>()];
+    }
+    const std::map<std::string, int> expected =
+        id == std::string("open")
+            ? std::map<std::string, int>{{"model GroundSurface", 1}, {"model WallSurface", 4}, {"added RoofSurface", 1}}
+            : std::map<std::string, int>{
+                  {"model GroundSurface", 1}, {"model WallSurface", 4}, {"model RoofSurface", 1}};
+    EXPECT_EQ(sources, expected) << id;
+  }
   EXPECT_EQ(out["CityObjects"]["open"]["attributes"]["lodrefine_errors_before"], json({302}));
   EXPECT_EQ(out["CityObjects"]["flipped"]["attributes"]["lodrefine_errors_before"], json({307}));
   const json rep = load(dir + "/report.json");
@@ -94,6 +110,10 @@ TEST(RepairCommand, WholeDelfshavenWithoutAScan) {
     ASSERT_TRUE(valid_after.count(o["id"].get<std::string>())) << o["id"];
     EXPECT_TRUE(valid_after[o["id"].get<std::string>()]) << o["id"] << ": " << o["reason"];
     EXPECT_EQ(o["errors_after"], json::array()) << o["id"];
+    // Each of its semantic surfaces says where it comes from (the weld repairs wrote none).
+    for (const json& g : out["CityObjects"][o["id"].get<std::string>()]["geometry"])
+      for (const json& surface : g.value("semantics", json::object()).value("surfaces", json::array()))
+        EXPECT_TRUE(surface.contains("lodrefine_source")) << o["id"] << ": " << surface.dump();
   }
   EXPECT_GE(repaired, 1);
 }
