@@ -232,12 +232,13 @@ void expect_canvases_show_their_models(const std::string& page, const fs::path& 
     ASSERT_GE(img.width, x0 + w);
     ASSERT_GE(img.height, y0 + h);
     const CanvasShares c = canvas_shares(img, x0, y0, w, h);
-    std::printf("3D canvas at (%d, %d): %.1f %% drawn, %.1f %% scan orange, %.1f %% model grey\n", x0, y0,
-                100.0 * c.drawn, 100.0 * c.orange, 100.0 * c.grey);
+    std::printf("3D canvas at (%d, %d): %.1f %% drawn, %.1f %% scan orange, %.1f %% model grey, %.1f %% added purple\n",
+                x0, y0, 100.0 * c.drawn, 100.0 * c.orange, 100.0 * c.grey, 100.0 * c.purple);
     EXPECT_GT(c.drawn, 0.05) << "a 3D view looks empty";
     // The written model in its colours by source: the moved wall may face away from the camera,
-    // the model's faces (roof, the walls the scan confirms) are in view.
-    EXPECT_GT(c.orange + c.grey, 0.05) << "a refined model is not visible";
+    // the model's faces (roof, the walls the scan confirms) or the added ones (a hole the repair
+    // closed) are in view.
+    EXPECT_GT(c.orange + c.grey + c.purple, 0.05) << "a refined model is not visible";
   }
 }
 
