@@ -172,13 +172,15 @@ void run(const CropArgs& a) {
 
 void add_crop_command(CLI::App& app) {
   static CropArgs args;
-  auto* cmd = app.add_subcommand("crop", "Cut one cloud per building from a large PLY or LAS tile (streaming)");
+  auto* cmd = app.add_subcommand(
+      "crop", "Cut one cloud per building from a large " + formats_text(kCloudFormatNames) + " tile (streaming)");
   cmd->add_option("--tile", args.tiles,
-                  "Large point cloud tile (PLY, LAS or LAZ); a folder gives its cloud files by name; repeat for "
-                  "several (one per drive or tile): read one after another as one cloud")
+                  "Large point cloud tile (" + formats_text(kCloudFormatNames) +
+                      "); a folder gives its cloud files by name; repeat for "
+                      "several (one per drive or tile): read one after another as one cloud")
       ->required()
       ->check(CLI::ExistingPath);
-  cmd->add_option("--models", args.models, "Folder of models: *.obj or <id>/coarse.obj")->required();
+  cmd->add_option("--models", args.models, "Folder of models (OBJ): *.obj or <id>/coarse.obj")->required();
   cmd->add_option("--out", args.out,
                   "Run folder: writes <name>/cloud.ply and <name>/coarse.obj (<name>: the id when it is a safe folder "
                   "name, else a safe form with a hash)")

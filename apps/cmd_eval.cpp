@@ -54,8 +54,9 @@ void add_eval_command(CLI::App& app) {
   auto* orig = cmd->add_option("--original", a.original, "Coarse model (OBJ)")->check(CLI::ExistingFile);
   cmd->add_option("--refined", a.refined, "Refined model (OBJ); a missing file is reported as a failure");
   cmd->add_option("--cloud", a.clouds,
-                  "MLS crop (PLY, LAS or LAZ); a folder gives its cloud files by name; repeat for several: read "
-                  "one after another as one cloud")
+                  "MLS crop (" + formats_text(kCloudFormatNames) +
+                      "); a folder gives its cloud files by name; repeat for several: read "
+                      "one after another as one cloud")
       ->check(CLI::ExistingPath);
   cmd->add_option("--truth", a.truth, "Truth model (OBJ): adds truth_facade_* / truth_roof_* distances")
       ->check(CLI::ExistingFile);

@@ -19,6 +19,7 @@
 #include "lodrefine/formats/cloud.h"
 #include "lodrefine/formats/obj.h"
 #include "lodrefine/tools/review.h"
+#include "lodrefine/version.h"
 #include "options.h"
 
 namespace lodrefine::app {
@@ -48,12 +49,12 @@ void refuse_city_options(const RefineArgs& a) {
                        ") applies to a city file as --model (CityJSON, CityJSONSeq, CityGML), not to an OBJ");
 }
 
-// Scan points per refined building on the review page: enough to see each facade, and what
-// bounds the collector's memory (only refined buildings keep meshes and points).
+// Scan points per refined or repaired building on the review page: enough to see each facade, and
+// what bounds the collector's memory (only those buildings keep meshes and points).
 constexpr std::size_t kReviewPoints = 3000;
 
 // Collects the review page's data while the city is refined (CityRefineOptions::on_building):
-// every building's outline; for a refined one its view (meshes + capped points), built outside
+// every building's outline; for a refined or repaired one its view (meshes + capped points), built outside
 // the lock as the hook may be called from several threads, in any order: page() puts them in file
 // order, so the page is the same whatever finished first.
 struct ReviewCollector {
@@ -73,9 +74,9 @@ struct ReviewCollector {
     if (o) b.reason = o->reason, b.points = o->points, b.facades_moved = std::size_t(o->facades_moved);
     if (r && r->trace.judgement && r->trace.judgement->building.points > 0)  // the judge's fit on the scan near it
       b.fit_before = r->trace.judgement->building.rms_before, b.fit_after = r->trace.judgement->building.rms_after;
-    if (r && b.outcome == Outcome::Refined) {
-      add_moves(b, r->trace.facades);
-      if (crop) b.view = review_view(b.id, model, r->mesh, crop->points, kReviewPoints);
+    if (r && (b.outcome == Outcome::Refined || b.outcome == Outcome::Repaired)) {
+      if (b.outcome == Outcome::Refined) add_moves(b, r->trace.facades);
+      b.view = review_view(b.id, model, r->mesh, crop ? crop->points : std::vector<Vec3>{}, kReviewPoints);
     }
     b.outline = review_outline(model, Vec3::Zero());
     const std::lock_guard<std::mutex> lock(mutex);
@@ -118,21 +119,6 @@ void write_review(const RefineArgs& a, const std::vector<std::string>& clouds, c
                 (unsigned long long)s.cloud_points, (unsigned long long)s.cropped_points);
   review.summary = line;
   write_file_atomic(a.html, city_review_html(review));
-}
-
-// Fails before any work when an output could not be written (so nothing is left half done):
-// its folder must exist and take a new file (a temporary is created and removed again).
-void check_output_dir(const std::string& path) {
-  if (path.empty()) return;
-  const std::filesystem::path dir = std::filesystem::absolute(path).parent_path();
-  if (!std::filesystem::is_directory(dir))
-    throw InputError(path + ": output directory " + dir.string() + " does not exist");
-  if (std::filesystem::is_directory(path)) throw InputError(path + ": is a directory");
-  try {
-    AtomicFile probe(path);
-  } catch (const std::runtime_error& e) {
-    throw InputError(e.what());
-  }
 }
 
 // Refuses, before anything is read, an output that is an input or another output (compared
@@ -201,7 +187,8 @@ void run_city(const RefineArgs& a, const std::vector<std::string>& clouds, const
   if (refine) refine->finish();
   if (!a.html.empty()) write_review(a, clouds, s, review);
   if (!a.report.empty()) {
-    nlohmann::json j = {{"model", a.model},
+    nlohmann::json j = {{"lodrefine_version", LODREFINE_VERSION},
+                        {"model", a.model},
                         {"cloud", cloud_json(s.clouds, skipped)},
                         {"written", a.out},
                         {"input", s.input_format},
@@ -223,14 +210,7 @@ void run_city(const RefineArgs& a, const std::vector<std::string>& clouds, const
                         {"params", params_json(a.params)},
                         {"outcomes", nlohmann::json::array()}};
     if (!s.warnings.empty()) j["warnings"] = s.warnings;
-    for (const auto& b : s.outcomes)
-      j["outcomes"].push_back({{"id", b.id},
-                               {"outcome", outcome_name(b.outcome)},
-                               {"reason", b.reason},
-                               {"facades_moved", b.facades_moved},
-                               {"refused_by", check_name(b.refused_by)},
-                               {"points", b.points},
-                               {"seconds", b.seconds}});
+    for (const auto& b : s.outcomes) j["outcomes"].push_back(city_outcome_json(b));
     write_file_atomic(a.report, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   }
   std::string refused;  // "; never worse refused N (building a, wall b)"
@@ -316,14 +296,15 @@ void add_refine_command(CLI::App& app) {
   static RefineArgs args;
   auto* cmd = app.add_subcommand("refine", "Refine one building model with an MLS point cloud");
   cmd->add_option("--model", args.model,
-                  "Coarse building model (OBJ, CityGML fan-out export), or a city file (CityJSON, CityJSONSeq, "
-                  "CityGML): then --out is a CityJSON 2.0 city file")
+                  "Coarse building model (OBJ, CityGML fan-out export), or a city file (" +
+                      formats_text(kCityFormatNames) + "): then --out is a CityJSON 2.0 city file")
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--cloud", args.clouds,
-                  "MLS point cloud (PLY, LAS or LAZ): the building's crop, or a city file's tile; a folder gives "
-                  "its cloud files by name; repeat for several (one per drive or tile): read one after another "
-                  "as one cloud")
+                  "MLS point cloud (" + formats_text(kCloudFormatNames) +
+                      "): the building's crop, or a city file's tile; a folder gives "
+                      "its cloud files by name; repeat for several (one per drive or tile): read one after another "
+                      "as one cloud")
       ->required()
       ->check(CLI::ExistingPath);
   cmd->add_option("--out", args.out, "Refined model (OBJ; CityJSON for a city file), written atomically")->required();

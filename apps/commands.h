@@ -16,5 +16,7 @@ void add_crop_command(CLI::App& app);
 void add_params_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_convert_command(CLI::App& app);
+void add_validate_command(CLI::App& app);
+void add_repair_command(CLI::App& app);
 
 }  // namespace lodrefine::app

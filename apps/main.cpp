@@ -59,6 +59,8 @@ int main(int argc, char** argv) {
   app::add_params_command(app);
   app::add_bench_command(app);
   app::add_convert_command(app);
+  app::add_validate_command(app);
+  app::add_repair_command(app);
   app::require_finite_numbers(app);
   try {
     app.parse(argc, argv);

@@ -2,16 +2,26 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <thread>
 
 #include <CLI/CLI.hpp>
 
+#include "lodrefine/base/files.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/formats/cityjson.h"
 #include "lodrefine/formats/cloud.h"
 
 namespace lodrefine::app {
+
+// "PLY, LAS or LAZ": a list of format names (kCloudFormatNames, kCityFormatNames) in a help text.
+inline std::string formats_text(const std::vector<std::string>& names) {
+  std::string out;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    out += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  return out;
+}
 
 inline std::string option_name(const std::string& field) {
   std::string s = "--" + field;
@@ -54,6 +64,21 @@ inline void add_cloud_options(CLI::App* cmd, CloudOptions& options) {
 inline CLI::Validator lod_validator() {
   return CLI::Validator(
       [](std::string& s) { return lod_number(s) ? std::string() : "must be an LoD such as 2.2, not " + s; }, "LOD");
+}
+
+// Fails before any work when an output could not be written (so nothing is left half done):
+// its folder must exist and take a new file (a temporary is created and removed again).
+inline void check_output_dir(const std::string& path) {
+  if (path.empty()) return;
+  const std::filesystem::path dir = std::filesystem::absolute(path).parent_path();
+  if (!std::filesystem::is_directory(dir))
+    throw InputError(path + ": output directory " + dir.string() + " does not exist");
+  if (std::filesystem::is_directory(path)) throw InputError(path + ": is a directory");
+  try {
+    AtomicFile probe(path);
+  } catch (const std::runtime_error& e) {
+    throw InputError(e.what());
+  }
 }
 
 // Checks every floating option of `app` and its subcommands for a finite value: "nan" and "inf"

@@ -21,6 +21,29 @@ const char* semantic_name(Semantic s) {
   }
 }
 
+const char* provenance_name(Provenance p) {
+  switch (p) {
+    case Provenance::Model: return "model";
+    case Provenance::Scan: return "scan";
+    case Provenance::Added: return "added";
+    default: return "";
+  }
+}
+
+Provenance provenance_from_group(const std::string& group) {
+  std::string word;
+  for (std::size_t i = 0; i <= group.size(); ++i) {
+    if (i < group.size() && !std::isspace(static_cast<unsigned char>(group[i]))) {
+      word += group[i];
+      continue;
+    }
+    for (Provenance p : {Provenance::Model, Provenance::Scan, Provenance::Added})
+      if (word == provenance_name(p)) return p;
+    word.clear();
+  }
+  return Provenance::None;
+}
+
 Semantic semantic_from_name(const std::string& group) {
   std::string g = group;
   std::transform(g.begin(), g.end(), g.begin(), [](unsigned char c) { return char(std::tolower(c)); });

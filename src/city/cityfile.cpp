@@ -1,6 +1,7 @@
 // City file in, city file out (see cityfile.h).
 #include "lodrefine/city/cityfile.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -8,10 +9,14 @@
 #include <map>
 #include <memory>
 #include <sstream>
+#include <tuple>
 
+#include "cityjson_upgrade.h"
 #include "lodrefine/base/files.h"
 #include "lodrefine/city/crop.h"
 #include "lodrefine/city/in_order_pool.h"
+#include "lodrefine/city/validity.h"
+#include "lodrefine/core/provenance.h"
 #include "lodrefine/core/refine.h"
 #include "lodrefine/formats/citygml.h"
 #include "lodrefine/formats/cityjson.h"
@@ -88,14 +93,61 @@ struct BuildingJob {
   std::string refused;      // why its crop target was refused (e.g. an absurd extent)
   PointCloud cloud;
   RefineResult result;
-  bool returned = false;  // refine_building returned (result is set)
+  bool returned = false;       // refine_building returned (result is set)
+  bool valid_as_read = false;  // only_invalid: validated, found valid and left untouched
   CityBuildingOutcome outcome;
 };
 
-void run_job(BuildingJob& job, const CityJsonBuilding& b, const RefineConfig& params) {
+// `mesh` as the document will hold it: each coordinate on the transform's grid (cityjson_surfaces
+// rounds them so), what validate finds when it reads the file back.
+Mesh as_written(const Mesh& mesh, const CityJsonTransform& tf) {
+  Mesh out = mesh;
+  for (Vec3& p : out.vertices) {
+    const std::array<long long, 3> q = tf.quantise(p);
+    p = Vec3(double(q[0]), double(q[1]), double(q[2])).cwiseProduct(tf.scale) + tf.translate;
+  }
+  return out;
+}
+
+// lodrefine repair: a building invalid as read whose repair alone (welds, orientation, holes
+// filled) made it a valid solid is written so, as repaired, when val3dity's tolerances find the
+// result valid too; else it stays kept as read, and says what the repair still has.
+void repaired_by_weld(BuildingJob& job, const CityJsonTransform& tf) {
+  std::vector<ValidityError> after = validate_soup(as_written(job.result.mesh, tf)).errors;
+  if (!after.empty() || !job.result.trace.repair) {
+    job.outcome.reason = "kept as read: its repair (welds, orientation, holes) still has " + errors_text(after);
+    return;
+  }
+  const RepairReport& rr = *job.result.trace.repair;
+  std::string what;
+  const auto add = [&](int n, const char* text) {
+    if (n > 0) what += (what.empty() ? "" : ", ") + std::to_string(n) + " " + text;
+  };
+  add(rr.welded_vertices, "vertices welded");
+  add(rr.removed_degenerate_faces, "degenerate faces dropped");
+  add(rr.removed_duplicate_faces, "duplicate faces dropped");
+  add(rr.split_t_junctions, "T-junctions split");
+  add(rr.flipped_faces, "faces turned outward");
+  add(rr.filled_holes, "holes filled");
+  add(rr.split_warped_faces, "warped faces split");
+  complete_provenance(job.result.mesh);  // written: its faces the model's, a filled hole's added
+  job.outcome.outcome = Outcome::Repaired;
+  job.outcome.reason = "the repair made it a valid solid (" + (what.empty() ? std::string("faces merged") : what) + ")";
+  job.outcome.errors_after = std::move(after);
+}
+
+void run_job(BuildingJob& job, const CityJsonBuilding& b, const RefineConfig& params, bool only_invalid,
+             const CityJsonTransform& tf) {
   if (!job.has_points) return;
   const auto t0 = Clock::now();
+  std::vector<ValidityError> before;
   try {
+    before = validate_soup(solid_soup(b)).errors;
+    if (only_invalid && before.empty()) {
+      job.has_points = false;
+      job.valid_as_read = true;
+      return;
+    }
     if (!job.refused.empty()) throw InputError(job.refused);
     job.result = refine_building(b.mesh, job.cloud, params);
     job.returned = true;
@@ -104,6 +156,10 @@ void run_job(BuildingJob& job, const CityJsonBuilding& b, const RefineConfig& pa
     job.outcome.outcome = Outcome::KeptInvalid;
     job.outcome.reason = e.what();
   }
+  const bool rewritten = job.outcome.outcome == Outcome::Refined || job.outcome.outcome == Outcome::Repaired;
+  job.outcome.errors_after = rewritten ? validate_soup(as_written(job.result.mesh, tf)).errors : before;
+  if (only_invalid && job.outcome.outcome == Outcome::Kept && job.result.valid) repaired_by_weld(job, tf);
+  job.outcome.errors_before = std::move(before);
   job.outcome.id = b.mesh.id;
   job.outcome.points = job.cloud.points.size();
   job.outcome.seconds = seconds_since(t0);
@@ -125,6 +181,17 @@ BuildingJob take_job(std::size_t i, std::vector<CropTarget>& targets, const std:
   return job;
 }
 
+// The codes before and after only where there is something to say (the building had or has
+// errors): a valid building's own attributes stay as read but for the outcome. A pass over a
+// file lodrefine wrote drops the codes an earlier pass left.
+void write_error_codes(json& attributes, const CityBuildingOutcome& o) {
+  attributes.erase("lodrefine_errors_before");
+  attributes.erase("lodrefine_errors_after");
+  if (o.errors_before.empty() && o.errors_after.empty()) return;
+  attributes["lodrefine_errors_before"] = error_codes(o.errors_before);
+  attributes["lodrefine_errors_after"] = error_codes(o.errors_after);
+}
+
 // Writes a finished job into the document (in input order: new vertices are appended).
 // `hook` (may be empty) sees the building (`index` over the file), its outcome, result and crop;
 // the crop is freed after.
@@ -132,6 +199,7 @@ void apply_job(json& doc, const CityJsonTransform& tf, const CityJsonBuilding& b
                const CityBuildingHook& hook, CityRefineSummary& sum) {
   if (!job.has_points) {
     ++sum.untouched;
+    if (job.valid_as_read) sum.outcomes.push_back({b.mesh.id, Outcome::Untouched, "a valid solid as read"});
     if (hook) hook(index, b.mesh, nullptr, nullptr, nullptr);
     return;
   }
@@ -158,6 +226,7 @@ void apply_job(json& doc, const CityJsonTransform& tf, const CityJsonBuilding& b
   obj["attributes"]["lodrefine_outcome"] = outcome_name(o.outcome);
   obj["attributes"]["lodrefine_reason"] = o.reason;
   obj["attributes"]["lodrefine_facades_moved"] = o.facades_moved;
+  write_error_codes(obj["attributes"], o);
   if (hook) hook(index, b.mesh, &o, job.returned ? &job.result : nullptr, &job.cloud);
   job.cloud = PointCloud();  // the crop is no longer needed: free it now
   sum.outcomes.push_back(std::move(o));
@@ -181,63 +250,21 @@ void merge_into(CityRefineSummary& sum, CityRefineSummary&& part) {
 // empty) is called after each building with the summary so far.
 void refine_document(json& doc, const CityJsonTransform& tf, const std::vector<CityJsonBuilding>& buildings,
                      std::vector<CropTarget>& targets, const std::vector<std::size_t>& target_of, std::size_t first,
-                     bool repair_all, const RefineConfig& params, int jobs, const CityBuildingHook& hook,
-                     CityRefineSummary& sum, const std::function<void(const CityRefineSummary&)>& progress) {
+                     const CityRefineOptions& options, const RefineConfig& params, int jobs, CityRefineSummary& sum,
+                     const std::function<void(const CityRefineSummary&)>& progress) {
   std::size_t next = 0;
   in_order_pool<BuildingJob>(
       jobs,
       [&]() -> std::shared_ptr<BuildingJob> {
         if (next == buildings.size()) return nullptr;
         const std::size_t i = next++;
-        return std::make_shared<BuildingJob>(take_job(i, targets, target_of, first, repair_all));
+        return std::make_shared<BuildingJob>(take_job(i, targets, target_of, first, options.repair_all));
       },
-      [&](BuildingJob& job) { run_job(job, buildings[job.index], params); },
+      [&](BuildingJob& job) { run_job(job, buildings[job.index], params, options.only_invalid, tf); },
       [&](BuildingJob& job) {
-        apply_job(doc, tf, buildings[job.index], first + job.index, std::move(job), hook, sum);
+        apply_job(doc, tf, buildings[job.index], first + job.index, std::move(job), options.on_building, sum);
         if (progress) progress(sum);
       });
-}
-
-// CityJSON 1.0 / 1.1 objects as 2.0 wants them: "lod" a string (1.0 wrote numbers), the
-// GenericCityObject extension type now core. A 2.0 input is not touched.
-void upgrade_objects(json& objects) {
-  for (auto& [id, obj] : objects.items()) {
-    if (text_member(obj, "type") == "+GenericCityObject") obj["type"] = "GenericCityObject";
-    if (!obj.contains("geometry") || !obj["geometry"].is_array()) continue;
-    for (auto& g : obj["geometry"])
-      if (g.is_object() && g.contains("lod") && g["lod"].is_number()) {
-        std::ostringstream s;
-        s << g["lod"].get<double>();
-        g["lod"] = s.str();
-      }
-  }
-}
-
-// The 1.x header fields 2.0 changed: the CRS as a URL, a point of contact's address an object.
-void upgrade_header(json& doc) {
-  json& md = doc["metadata"];
-  if (!md.is_object()) {
-    doc.erase("metadata");
-    return;
-  }
-  if (md.contains("referenceSystem") && md["referenceSystem"].is_string())
-    md["referenceSystem"] = crs_url(md["referenceSystem"].get<std::string>());
-  if (md.contains("pointOfContact") && md["pointOfContact"].is_object()) {
-    json& poc = md["pointOfContact"];
-    if (poc.contains("address") && poc["address"].is_string()) poc["address"] = {{"addressLine", poc["address"]}};
-  }
-}
-
-// CityJSON 1.x without a transform: 2.0 needs integer vertices, so one is made (0.1 mm).
-void ensure_transform(json& doc) {
-  if (doc.contains("transform")) return;
-  Eigen::AlignedBox3d box;
-  for (const auto& v : doc["vertices"]) box.extend(Vec3(v[0].get<double>(), v[1].get<double>(), v[2].get<double>()));
-  const Vec3 translate = box.isEmpty() ? Vec3::Zero() : Vec3(box.min().array().floor());
-  const double scale = kCityGmlResolution;
-  for (auto& v : doc["vertices"])
-    for (int a = 0; a < 3; ++a) v[a] = std::llround((v[a].get<double>() - translate[a]) / scale);
-  doc["transform"] = {{"scale", {scale, scale, scale}}, {"translate", {translate.x(), translate.y(), translate.z()}}};
 }
 
 std::string read_text(const std::string& path) {
@@ -286,6 +313,10 @@ void check_targets(const std::vector<CropTarget>& targets, const std::string& mo
 // model while others reach it gets a warning of its own.
 void crop_clouds(const std::vector<std::string>& cloud_paths, std::vector<CropTarget>& targets,
                  const Eigen::AlignedBox3d& city_box, const CityRefineOptions& o, CityRefineSummary& sum) {
+  if (cloud_paths.empty()) {  // lodrefine repair: every building without a scan
+    if (!o.repair_all) throw InputError("no cloud file: only a repair of every building runs without one");
+    return;
+  }
   sum.cloud_points = crop_tile(cloud_paths, targets, o.cloud, &sum.clouds, o.crop_progress, o.max_crop_points);
   std::uint64_t held = 0;
   for (const auto& t : targets) held += t.cloud.points.size();
@@ -436,8 +467,7 @@ CityRefineSummary refine_sequence(const json& header, const std::string& model_p
         json feature = parse_feature(job.text, where);
         const CityJsonFile f = read_cityjson_document(feature_document(header, feature), where, options.lod);
         if (upgrade) upgrade_objects(feature["CityObjects"]);
-        refine_document(feature, tf, f.buildings, targets, target_of, job.first, options.repair_all, params, 1,
-                        options.on_building, job.part, {});
+        refine_document(feature, tf, f.buildings, targets, target_of, job.first, options, params, 1, job.part, {});
         job.text = feature.dump(-1, ' ', false, json::error_handler_t::replace) + "\n";
       },
       [&](FeatureJob& job) {
@@ -465,7 +495,8 @@ json cityjson_surfaces(const Mesh& mesh, bool solid, const std::string& lod, con
     vertices.push_back(std::move(q));
   }
   json shell = json::array(), values = json::array();
-  std::map<Semantic, int> surface_of;
+  // One semantic surface per semantic, provenance and coverage (in hundredths).
+  std::map<std::tuple<Semantic, Provenance, long>, int> surface_of;
   json surfaces = json::array();
   for (const Face& f : mesh.faces) {
     json ring = json::array();
@@ -475,10 +506,15 @@ json cityjson_surfaces(const Mesh& mesh, bool solid, const std::string& lod, con
       values.push_back(nullptr);
       continue;
     }
-    auto it = surface_of.find(f.sem);
+    const bool scan = f.provenance == Provenance::Scan;
+    const long hundredths = scan ? std::lround(std::clamp(f.coverage, 0.0, 1.0) * 100.0) : 0;
+    auto it = surface_of.find({f.sem, f.provenance, hundredths});
     if (it == surface_of.end()) {
-      it = surface_of.emplace(f.sem, int(surfaces.size())).first;
-      surfaces.push_back({{"type", semantic_name(f.sem)}});
+      it = surface_of.emplace(std::make_tuple(f.sem, f.provenance, hundredths), int(surfaces.size())).first;
+      json surface = {{"type", semantic_name(f.sem)}};
+      if (f.provenance != Provenance::None) surface["lodrefine_source"] = provenance_name(f.provenance);
+      if (scan) surface["lodrefine_coverage"] = double(hundredths) / 100.0;
+      surfaces.push_back(std::move(surface));
     }
     values.push_back(it->second);
   }
@@ -543,8 +579,8 @@ CityRefineSummary refine_city(const std::string& model_path, const std::vector<s
     upgrade_objects(doc["CityObjects"]);
   }
   ensure_transform(doc);
-  refine_document(doc, transform_of(doc), file.buildings, targets, target_of, 0, options.repair_all, params,
-                  options.jobs, options.on_building, sum, options.progress);
+  refine_document(doc, transform_of(doc), file.buildings, targets, target_of, 0, options, params, options.jobs, sum,
+                  options.progress);
   sum.seconds_refine = seconds_since(t);
 
   t = Clock::now();

@@ -1,6 +1,8 @@
 // The refine report: RefineResult's trace as JSON (see refine_report.h).
 #include "lodrefine/city/refine_report.h"
 
+#include "lodrefine/version.h"
+
 namespace lodrefine {
 namespace {
 
@@ -131,6 +133,31 @@ json judgement_json(const Judgement& j) {
 
 }  // namespace
 
+json validity_errors_json(const std::vector<ValidityError>& errors) {
+  json out = json::array();
+  for (const ValidityError& e : errors) {
+    json j = {{"code", code_number(e.code)},
+              {"description", code_name(e.code)},
+              {"id", e.faces.empty() ? std::string() : "face=" + std::to_string(e.faces.front())},
+              {"info", e.info}};
+    if (!e.faces.empty()) j["faces"] = e.faces;
+    out.push_back(std::move(j));
+  }
+  return out;
+}
+
+json city_outcome_json(const CityBuildingOutcome& b) {
+  return {{"id", b.id},
+          {"outcome", outcome_name(b.outcome)},
+          {"reason", b.reason},
+          {"facades_moved", b.facades_moved},
+          {"refused_by", check_name(b.refused_by)},
+          {"points", b.points},
+          {"seconds", b.seconds},
+          {"errors_before", validity_errors_json(b.errors_before)},
+          {"errors_after", validity_errors_json(b.errors_after)}};
+}
+
 json validation_json(const Validation& v) {
   return {{"watertight", v.watertight()},
           {"valid", v.valid()},
@@ -140,13 +167,15 @@ json validation_json(const Validation& v) {
           {"outward", v.outward},
           {"volume", v.volume},
           {"max_planarity_error", v.max_planarity_error},
-          {"self_intersecting", v.self_intersecting}};
+          {"self_intersecting", v.self_intersecting},
+          {"errors", validity_errors_json(v.errors)}};
 }
 
 json refine_report(const RefineResult& r) {
   const RefineTrace& t = r.trace;
   json rep;
   rep["report_version"] = kRefineReportVersion;
+  rep["lodrefine_version"] = LODREFINE_VERSION;
   rep["id"] = t.id;
   rep["origin"] = {t.origin.x(), t.origin.y(), t.origin.z()};
   rep["outcome"] = outcome_name(r.outcome);

@@ -10,6 +10,7 @@
 
 #include "lodrefine/core/corners.h"
 #include "lodrefine/core/distance.h"
+#include "lodrefine/core/provenance.h"
 #include "lodrefine/core/shell_rebuild.h"
 #include "lodrefine/core/shell_selection.h"
 #include "lodrefine/core/substitute.h"
@@ -164,6 +165,10 @@ class Refinement {
     if (out_.trace.rebuild && out_.trace.rebuild->ok && out_.outcome != Outcome::KeptInvalid) {
       out_.fins = translated(out_.trace.rebuild->fins, origin_);
       out_.fins.id = id_;
+    }
+    if (out_.outcome == Outcome::Refined || out_.outcome == Outcome::Repaired) {  // written: each face says whence
+      complete_provenance(out_.mesh);
+      complete_provenance(out_.fins);
     }
     return out_;
   }
@@ -354,12 +359,15 @@ RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::
   if (trace.rebuild && !fins_stay_on(trace.rebuild->fins, kept, shell, prm.repair.weld_tolerance))
     return refinement.finish(Outcome::Kept, "not written: a fin beside the shell would stand apart from it", kept);
   const std::string moved_walls = std::to_string(trace.facades.size()) + " wall(s) moved";
+  Mesh written = shell;
+  measure_coverage(written, local, planes, prm);
   if (!chosen.ok)
     return refinement.finish(
         Outcome::Refined, moved_walls + " by substitution (the selection found no valid shell: " + chosen.reason + ")",
-        shell);
-  return refinement.finish(
-      Outcome::Refined, std::to_string(chosen.stats.faces_from_selection) + " face(s) selected, " + moved_walls, shell);
+        written);
+  return refinement.finish(Outcome::Refined,
+                           std::to_string(chosen.stats.faces_from_selection) + " face(s) selected, " + moved_walls,
+                           written);
 }
 
 }  // namespace

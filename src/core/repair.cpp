@@ -273,7 +273,8 @@ std::vector<std::vector<int>> hole_loops(const std::vector<Face>& faces) {
 }
 
 // Closes each hole with one polygon when it is planar within kHolePlanarity, else with the
-// triangles of its projection (noted). New faces are appended with source -1.
+// triangles of its projection (noted). New faces are appended with source -1, added to close the
+// shell (Provenance::Added: no model face lies there).
 void fill_holes(const std::vector<Vec3>& V, std::vector<Face>& faces, RepairReport& r) {
   for (const auto& loop : hole_loops(faces)) {
     const std::vector<Vec3> pts = positions(V, loop);
@@ -282,11 +283,12 @@ void fill_holes(const std::vector<Vec3>& V, std::vector<Face>& faces, RepairRepo
     for (const Vec3& p : pts) err = std::max(err, std::abs(plane.distance(p)));
     ++r.filled_holes;
     if (err <= kHolePlanarity) {
-      faces.push_back({loop, Semantic::Other, -1});
+      faces.push_back({loop, Semantic::Other, -1, Provenance::Added});
       continue;
     }
     const auto tris = triangulate_polygon(pts);
-    for (const auto& t : tris) faces.push_back({{loop[t[0]], loop[t[1]], loop[t[2]]}, Semantic::Other, -1});
+    for (const auto& t : tris)
+      faces.push_back({{loop[t[0]], loop[t[1]], loop[t[2]]}, Semantic::Other, -1, Provenance::Added});
     r.notes.push_back("hole of " + std::to_string(loop.size()) + " vertices is not planar (" +
                       std::to_string(int(std::round(err * 1000))) + " mm): filled with " + std::to_string(tris.size()) +
                       " triangles");
@@ -511,12 +513,12 @@ int split_warped_faces(Mesh& mesh, double tolerance) {
         clash = clash || (!boundary && edges.count(std::minmax(f.v[ia], f.v[ib])));
       }
     if (!clash) {
-      for (const auto& t : tris) faces.push_back({{f.v[t[0]], f.v[t[1]], f.v[t[2]]}, f.sem, f.source});
+      for (const auto& t : tris) faces.push_back(with_corners(f, {f.v[t[0]], f.v[t[1]], f.v[t[2]]}));
       continue;
     }
     const int centre = int(mesh.vertices.size());
     mesh.vertices.push_back(polygon_centroid(pts));
-    for (int k = 0; k < n; ++k) faces.push_back({{f.v[k], f.v[(k + 1) % n], centre}, f.sem, f.source});
+    for (int k = 0; k < n; ++k) faces.push_back(with_corners(f, {f.v[k], f.v[(k + 1) % n], centre}));
   }
   mesh.faces = std::move(faces);
   return split;
@@ -536,7 +538,7 @@ Mesh merge_coplanar_faces(const Mesh& mesh, double angle_deg, double distance) {
       return polygon_area(positions(mesh.vertices, mesh.faces[a].v)) <
              polygon_area(positions(mesh.vertices, mesh.faces[b].v));
     });
-    merged[id] = {*outline, mesh.faces[largest].sem, mesh.faces[largest].source};
+    merged[id] = with_corners(mesh.faces[largest], *outline);
   }
   // Input order is kept: a merged polygon takes the place of its region's first face.
   std::vector<Face> faces;

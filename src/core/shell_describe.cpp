@@ -18,26 +18,9 @@ constexpr double kSeeThrough = 3.0;
 // Planes of the starting shell within kSurfaceAngleDeg and kSurfaceDistance are one supporting
 // plane (matching.h: the tolerance of a model surface).
 
-using CellSet = std::unordered_set<std::int64_t>;
 // In unsigned arithmetic: shifting a negative index is undefined before C++20.
 std::int64_t cell_key(long long i, long long j) {
   return std::int64_t((std::uint64_t(i) << 32) ^ std::uint64_t(std::uint32_t(j)));
-}
-
-// A point marks its cell and those within kFill cells: a facade's windows and the gaps of its
-// scan lines (up to about a metre) count as scanned, so that a scanned facade's coverage is near
-// 1 and the coverage of a face it does not reach near 0. Each cell holding points is filled
-// around once, not once per point.
-constexpr int kFill = 2;
-void mark(CellSet& cells, const std::vector<Vec3>& pts, const Frame2& frame) {
-  CellSet occupied;
-  for (const auto& p : pts) {
-    const Vec2 q = frame(p);
-    const long long i = (long long)std::floor(q.x() / kCell), j = (long long)std::floor(q.y() / kCell);
-    if (!occupied.insert(cell_key(i, j)).second) continue;
-    for (long long di = -kFill; di <= kFill; ++di)
-      for (long long dj = -kFill; dj <= kFill; ++dj) cells.insert(cell_key(i + di, j + dj));
-  }
 }
 
 // fn(i, j) for every grid cell of a polygon's bounding box.
@@ -48,23 +31,6 @@ void for_box_cells(const std::vector<Vec2>& poly, Fn&& fn) {
   const long long j0 = (long long)std::floor(box.min().y() / kCell), j1 = (long long)std::floor(box.max().y() / kCell);
   for (long long i = i0; i <= i1; ++i)
     for (long long j = j0; j <= j1; ++j) fn(i, j);
-}
-
-// Share of a convex polygon's grid cells (by centre) that are in `cells`; a polygon holding no
-// cell centre is judged by the cell of its centroid.
-double share(const std::vector<Vec2>& poly, const CellSet& cells) {
-  if (cells.empty()) return 0.0;
-  long long total = 0, hit = 0;
-  for_box_cells(poly, [&](long long i, long long j) {
-    if (!point_in_polygon_2d(Vec2((i + 0.5) * kCell, (j + 0.5) * kCell), poly)) return;
-    ++total;
-    hit += cells.count(cell_key(i, j));
-  });
-  if (total > 0) return double(hit) / double(total);
-  Vec2 c = Vec2::Zero();
-  for (const auto& p : poly) c += p;
-  c /= double(poly.size());
-  return cells.count(cell_key((long long)std::floor(c.x() / kCell), (long long)std::floor(c.y() / kCell))) ? 1.0 : 0.0;
 }
 
 // PolyFit's data-fitting term (its compute_confidences' supporting points): the scan points of
@@ -122,13 +88,43 @@ double fitted_area(const FitPoints& fp, int k, const std::vector<Vec2>& poly) {
 
 }  // namespace
 
+// A point marks its cell and those within kFill cells (shell_supports.h): a scanned facade's
+// coverage is near 1 and that of a face it does not reach near 0. Each cell holding points is
+// filled around once, not once per point.
+constexpr int kFill = 2;
+void mark_scanned(CellSet& cells, const std::vector<Vec3>& pts, const Frame2& frame) {
+  CellSet occupied;
+  for (const auto& p : pts) {
+    const Vec2 q = frame(p);
+    const long long i = (long long)std::floor(q.x() / kCell), j = (long long)std::floor(q.y() / kCell);
+    if (!occupied.insert(cell_key(i, j)).second) continue;
+    for (long long di = -kFill; di <= kFill; ++di)
+      for (long long dj = -kFill; dj <= kFill; ++dj) cells.insert(cell_key(i + di, j + dj));
+  }
+}
+
+double scanned_share(const std::vector<Vec2>& poly, const CellSet& cells) {
+  if (cells.empty() || poly.empty()) return 0.0;
+  long long total = 0, hit = 0;
+  for_box_cells(poly, [&](long long i, long long j) {
+    if (!point_in_polygon_2d(Vec2((i + 0.5) * kCell, (j + 0.5) * kCell), poly)) return;
+    ++total;
+    hit += cells.count(cell_key(i, j));
+  });
+  if (total > 0) return double(hit) / double(total);
+  Vec2 c = Vec2::Zero();
+  for (const auto& p : poly) c += p;
+  c /= double(poly.size());
+  return cells.count(cell_key((long long)std::floor(c.x() / kCell), (long long)std::floor(c.y() / kCell))) ? 1.0 : 0.0;
+}
+
 FaceProps describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s, const RefineConfig& prm) {
   const int np = int(s.planes.size());
   std::vector<Frame2> frames;
   for (const auto& sp : s.planes) frames.push_back(frame_of(sp.plane, cs.region.center));
   // Own occupancy and the cells where another parallel scanned facade lies near.
   std::vector<CellSet> own(np), other(np);
-  for (int k = 0; k < np; ++k) mark(own[k], s.points[k], frames[k]);
+  for (int k = 0; k < np; ++k) mark_scanned(own[k], s.points[k], frames[k]);
   for (int k = 0; k < np; ++k) {
     if (!near_vertical(s.planes[k].plane, prm.plane.facade_max_tilt_deg)) continue;
     for (int j = 0; j < np; ++j) {
@@ -139,7 +135,7 @@ FaceProps describe_candidates(CandidateSet& cs, const Mesh& start, const Support
       for (const auto& p : s.points[j]) sum += std::abs(s.planes[k].plane.distance(p));
       const double d = sum / double(s.points[j].size());
       if (d <= prm.selection.merge_distance || d > kSeeThrough) continue;
-      mark(other[k], s.points[j], frames[k]);
+      mark_scanned(other[k], s.points[j], frames[k]);
     }
   }
   // The start's faces per plane, in that plane's frame.
@@ -187,8 +183,8 @@ FaceProps describe_candidates(CandidateSet& cs, const Mesh& start, const Support
         source[fi] = start.faces[sf].source;
         break;
       }
-    const double scanned = share(poly, own[k]);
-    const double prior = in_start[fi] ? 1.0 - share(poly, other[k]) : 0.0;
+    const double scanned = scanned_share(poly, own[k]);
+    const double prior = in_start[fi] ? 1.0 - scanned_share(poly, other[k]) : 0.0;
     confidence[fi] = std::max(scanned, prior);
     // On a plane of the starting shell only its own faces are credited: points running on along
     // it past its outline are no evidence that it runs on (a flush neighbour's facade; corners.h).

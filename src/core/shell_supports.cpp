@@ -134,6 +134,17 @@ void add_start_planes(const Mesh& start, double planarity_tolerance, Supports& s
     for (int f : surf.faces) s.face_plane[f] = k;
   }
   s.start_planes = int(s.planes.size());
+  // A plane a wall was moved onto is the scan's; one only added faces lie on is added; else the model's.
+  std::vector<char> scan(s.planes.size(), 0), model(s.planes.size(), 0);
+  for (std::size_t f = 0; f < start.faces.size(); ++f) {
+    const int k = s.face_plane[f];
+    if (k < 0) continue;
+    const Provenance p = start.faces[f].provenance;
+    if (p == Provenance::Scan) scan[std::size_t(k)] = 1;
+    else if (p != Provenance::Added) model[std::size_t(k)] = 1;  // None: a model as read
+  }
+  for (std::size_t k = 0; k < s.planes.size(); ++k)
+    s.planes[k].provenance = scan[k] ? Provenance::Scan : model[k] ? Provenance::Model : Provenance::Added;
   s.points.assign(s.planes.size(), {});
 }
 
@@ -165,7 +176,7 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
     }
     if (k < 0) {
       k = int(s.planes.size());
-      s.planes.push_back({scan[i].plane, Semantic::Wall, true, i});
+      s.planes.push_back({scan[i].plane, Semantic::Wall, true, i, Provenance::Scan});
       s.points.emplace_back();
       ++s.added;
     }
@@ -240,7 +251,7 @@ void add_step_walls(const Mesh& start, const RefineConfig& prm, Supports& s) {
                           unoriented_angle_deg(sp.plane.n, u) <= prm.selection.merge_angle_deg &&
                           std::abs(sp.plane.distance(x)) <= kSameStep);
       if (there) continue;
-      s.planes.push_back({Plane::through(x, u), Semantic::Wall, true, -1});
+      s.planes.push_back({Plane::through(x, u), Semantic::Wall, true, -1, Provenance::Added});
       s.points.emplace_back();
     }
   }
@@ -324,7 +335,7 @@ void add_hole_planes(const Mesh& soup, Supports& s) {
     }
     const Plane wall = Plane::through(a, n.normalized());
     if (carried(s, wall, a, b)) continue;
-    s.planes.push_back({wall, Semantic::Wall, false, -1});
+    s.planes.push_back({wall, Semantic::Wall, false, -1, Provenance::Added});
     s.points.emplace_back();
     ++s.hole_planes;
   }

@@ -2,7 +2,9 @@
 // shell's planes, the scan's facades none of them carries, and the hypothesised walls across the
 // steps of a facade line; and the region the arrangement covers. Internal to shell_selection.
 #pragma once
+#include <cstdint>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "lodrefine/base/geometry.h"
@@ -37,6 +39,8 @@ inline bool near_vertical(const Plane& pl, double max_tilt_deg) {
 // The start's planes, one per set of its surfaces within kSurfaceAngleDeg / kSurfaceDistance
 // (matching.h), largest first; a surface on none of them goes to the one nearest in angle of
 // those its vertices all lie within `planarity_tolerance` (m) of (a sliver: counted in slivers).
+// A plane's provenance: the scan's when a start face on it is (a moved wall), added when only
+// added faces lie on it, else the model's.
 void add_start_planes(const Mesh& start, double planarity_tolerance, Supports& s);
 // The scan's facade planes near the footprint (within match_distance + bbox_margin, and along the
 // facade no farther past the start's ends than the facade's own corner: a facade line running on
@@ -127,6 +131,15 @@ struct Frame2 {
 };
 // `pl`'s frame with its origin where `centre` projects onto it.
 Frame2 frame_of(const Plane& pl, const Vec3& centre);
+
+// A plane's kCell grid cells (in its Frame2) that the scan covers, keyed by (i, j).
+using CellSet = std::unordered_set<std::int64_t>;
+// Marks the cells of `pts` (in `frame`) and those within 2 cells around each: a facade's windows
+// and the gaps between scan lines (up to about a metre) count as scanned.
+void mark_scanned(CellSet& cells, const std::vector<Vec3>& pts, const Frame2& frame);
+// The share of a polygon's cells (by centre; `poly` in the frame's coordinates) in `cells`; a
+// polygon holding no cell centre is judged by its centroid's cell.
+double scanned_share(const std::vector<Vec2>& poly, const CellSet& cells);
 
 // A boolean face map of `cs` as 0/1 per candidate (a selection).
 std::vector<char> face_flags(const CandidateSet& cs, const CandidateMap<bool>& map);

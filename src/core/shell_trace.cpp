@@ -61,6 +61,7 @@ void trace_faces(const CandidateSet& cs, Trace& t) {
     drop_repeats(face.v);
     if (face.v.size() < 3) continue;
     face.sem = cs.planes[support[FaceIndex(f)]].sem;
+    face.provenance = cs.planes[support[FaceIndex(f)]].provenance;
     face.source = source.second ? source.first[FaceIndex(f)] : -1;
     t.face_of[f] = int(t.faces.size());
     t.candidate.push_back(f);
@@ -173,7 +174,7 @@ bool coplanar(const CandidateSet& cs, const Trace& t, int f, int g) {
 }
 
 // Chosen neighbours in one plane as one polygon (in place of the first of them, with the
-// semantic and source of the largest); returns each output face's group of neighbours in one
+// semantic, source and provenance of the largest); returns each output face's group of neighbours in one
 // plane (faces left apart, their outline not one loop, share it).
 std::vector<int> merge_coplanar(const CandidateSet& cs, const std::vector<Meeting>& meet, Trace& t) {
   const int n = int(t.faces.size());
@@ -201,7 +202,7 @@ std::vector<int> merge_coplanar(const CandidateSet& cs, const std::vector<Meetin
         return polygon_area(pts);
       };
       const int largest = *std::max_element(fs.begin(), fs.end(), [&](int a, int b) { return area(a) < area(b); });
-      faces.push_back({loop, t.faces[largest].sem, t.faces[largest].source});
+      faces.push_back(with_corners(t.faces[largest], loop));
     } else {
       continue;
     }

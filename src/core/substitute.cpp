@@ -133,6 +133,8 @@ SubstitutionResult substitute_walls(const Mesh& mesh, const std::vector<ModelSur
   for (int m = 0; m < int(moves.size()); ++m) moved_plane[moves[m].surface] = m;
   const auto vertex_surfaces = surfaces_at_vertices(mesh, surfaces);
   res.mesh = mesh;
+  for (const auto& m : moves)  // on the scan's plane now (a corner move's: where the scan shows the corner)
+    for (int f : surfaces[m.surface].faces) res.mesh.faces[f].provenance = Provenance::Scan;
   for (int v = 0; v < int(mesh.vertices.size()); ++v) {
     const auto& ss = vertex_surfaces[v];
     if (std::none_of(ss.begin(), ss.end(), [&](int s) { return s >= 0 && moved_plane[s] >= 0; })) continue;

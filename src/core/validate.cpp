@@ -15,6 +15,7 @@
 #include <iterator>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -52,31 +53,58 @@ bool degenerate(const std::vector<Vec3>& pts) {
   return newell_normal(pts).norm() <= kDegenerateFaceRatio * longest;
 }
 
-// Index errors and degenerate polygons make every other check meaningless.
-std::string malformed(const Mesh& m) {
+bool sorted_less(const Vec3& a, const Vec3& b) {
+  return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+}
+
+// What is wrong with face k's index list (empty when nothing): fewer than 3 vertices (101), a
+// missing vertex (no code: the mesh is not one), a vertex twice in a row (102) or apart (104).
+std::optional<ValidityError> malformed_indices(const Mesh& m, std::size_t k) {
+  const auto& v = m.faces[k].v;
+  const std::string face = "face " + std::to_string(k);
+  const std::vector<int> which = {int(k)};
+  if (v.size() < 3) return ValidityError{ValidityCode::TooFewPoints, which, face + " has fewer than 3 vertices"};
+  for (int i : v)
+    if (i < 0 || std::size_t(i) >= m.vertices.size())
+      return ValidityError{ValidityCode::Unknown, which, face + " references missing vertex " + std::to_string(i)};
+  if (std::set<int>(v.begin(), v.end()).size() == v.size()) return std::nullopt;
+  bool in_a_row = false;
+  for (std::size_t i = 0; i < v.size(); ++i) in_a_row |= v[i] == v[(i + 1) % v.size()];
+  return ValidityError{in_a_row ? ValidityCode::ConsecutivePointsSame : ValidityCode::RingSelfIntersection, which,
+                       face + " repeats a vertex"};
+}
+
+// What is wrong with face k's geometry: no area (104), two vertices at one point (102 when
+// they follow each other, else 104).
+std::optional<ValidityError> malformed_geometry(const Mesh& m, std::size_t k) {
+  std::vector<Vec3> pts = face_points(m, m.faces[k]);
+  const std::vector<int> which = {int(k)};
+  if (degenerate(pts))
+    return ValidityError{
+        ValidityCode::RingSelfIntersection, which,
+        "face " + std::to_string(k) + " is degenerate (no area: its vertices are on one line or it folds onto itself)"};
+  bool in_a_row = false;
+  for (std::size_t i = 0; i < pts.size(); ++i) in_a_row |= pts[i] == pts[(i + 1) % pts.size()];
+  // Two vertices at one point make CGAL's constrained triangulation of the face crash.
+  std::sort(pts.begin(), pts.end(), sorted_less);
+  if (std::adjacent_find(pts.begin(), pts.end()) == pts.end()) return std::nullopt;
+  return ValidityError{in_a_row ? ValidityCode::ConsecutivePointsSame : ValidityCode::RingSelfIntersection, which,
+                       "face " + std::to_string(k) + " has two vertices at one point"};
+}
+
+// Index errors and degenerate polygons make every other check meaningless: every face's, in
+// face order, the index lists' before the geometry's (the first is the validation's problem).
+std::vector<ValidityError> malformed(const Mesh& m) {
   for (std::size_t i = 0; i < m.vertices.size(); ++i)
-    if (!m.vertices[i].allFinite()) return "vertex " + std::to_string(i) + " is not finite";
-  for (std::size_t k = 0; k < m.faces.size(); ++k) {
-    const auto& v = m.faces[k].v;
-    const std::string face = "face " + std::to_string(k);
-    if (v.size() < 3) return face + " has fewer than 3 vertices";
-    for (int i : v)
-      if (i < 0 || std::size_t(i) >= m.vertices.size()) return face + " references missing vertex " + std::to_string(i);
-    if (std::set<int>(v.begin(), v.end()).size() != v.size()) return face + " repeats a vertex";
-  }
-  for (std::size_t k = 0; k < m.faces.size(); ++k) {
-    std::vector<Vec3> pts = face_points(m, m.faces[k]);
-    if (degenerate(pts))
-      return "face " + std::to_string(k) +
-             " is degenerate (no area: its vertices are on one line or it folds onto itself)";
-    // Two vertices at one point make CGAL's constrained triangulation of the face crash.
-    std::sort(pts.begin(), pts.end(), [](const Vec3& a, const Vec3& b) {
-      return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
-    });
-    if (std::adjacent_find(pts.begin(), pts.end()) != pts.end())
-      return "face " + std::to_string(k) + " has two vertices at one point";
-  }
-  return {};
+    if (!m.vertices[i].allFinite())
+      return {{ValidityCode::Unknown, {}, "vertex " + std::to_string(i) + " is not finite"}};
+  std::vector<ValidityError> out;
+  for (std::size_t k = 0; k < m.faces.size(); ++k)
+    if (auto e = malformed_indices(m, k)) out.push_back(std::move(*e));
+  if (!out.empty()) return out;
+  for (std::size_t k = 0; k < m.faces.size(); ++k)
+    if (auto e = malformed_geometry(m, k)) out.push_back(std::move(*e));
+  return out;
 }
 
 void count_edge_defects(const EdgeUses& uses, Validation& v) {
@@ -108,14 +136,17 @@ std::vector<int> fanned_vertices(const Mesh& m, const EdgeUses& uses) {
   return out;
 }
 
-double max_planarity_error(const Mesh& m) {
-  double err = 0.0;
+// Each face's largest vertex distance from its plane.
+std::vector<double> planarity_errors(const Mesh& m) {
+  std::vector<double> out;
   for (const Face& f : m.faces) {
     const auto pts = face_points(m, f);
     const Plane plane = polygon_plane(pts);
+    double err = 0.0;
     for (const Vec3& p : pts) err = std::max(err, std::abs(plane.distance(p)));
+    out.push_back(err);
   }
-  return err;
+  return out;
 }
 
 // Whether two edges of the outline that share no vertex touch or cross, or come within a
@@ -232,21 +263,48 @@ bool self_intersects(const Mesh& m) {
   return false;
 }
 
-std::string first_problem(const Validation& v, double planarity_tolerance, bool single_component) {
+// The shell's defects, in the order the first of them is its problem: its topology (302, 303,
+// 307, and 305 when one component is expected); on a shell whose topology holds (val3dity checks
+// the geometry only then) a flat (306) or inward (405) shell; its faces' planarity (203); then
+// self-intersections (306, again on a sound topology only); 301 last (a solid of fewer than 4
+// faces shows another defect first).
+std::vector<ValidityError> shell_errors(const Validation& v, const std::vector<double>& planarity,
+                                        double planarity_tolerance, bool single_component) {
   const auto n = [](int k) { return std::to_string(k); };
-  if (v.boundary_edges) return n(v.boundary_edges) + " boundary edges (mesh not closed)";
-  if (v.nonmanifold_edges) return n(v.nonmanifold_edges) + " non-manifold edges (more than two faces)";
-  if (v.nonmanifold_vertices) return n(v.nonmanifold_vertices) + " non-manifold vertices (faces meet only at a point)";
-  if (v.inconsistent_edges) return n(v.inconsistent_edges) + " inconsistently oriented edges";
-  if (single_component && v.components != 1) return n(v.components) + " connected components (expected one)";
-  if (std::abs(v.volume) < kFlatShellVolume)
-    return "the shell encloses no volume (signed volume " + format_number(v.volume) + " m^3)";
-  if (!v.outward) return "faces point inward (signed volume " + format_number(v.volume) + " m^3)";
-  if (v.max_planarity_error > planarity_tolerance)
-    return "face planarity error " + format_number(v.max_planarity_error) + " m exceeds " +
-           format_number(planarity_tolerance) + " m";
-  if (v.self_intersecting) return "faces intersect each other";
-  return {};
+  std::vector<ValidityError> out;
+  const auto add = [&](ValidityCode code, std::string info) { out.push_back({code, {}, std::move(info)}); };
+  if (v.boundary_edges) add(ValidityCode::ShellNotClosed, n(v.boundary_edges) + " boundary edges (mesh not closed)");
+  if (v.nonmanifold_edges)
+    add(ValidityCode::NonManifoldCase, n(v.nonmanifold_edges) + " non-manifold edges (more than two faces)");
+  if (v.nonmanifold_vertices)
+    add(ValidityCode::NonManifoldCase,
+        n(v.nonmanifold_vertices) + " non-manifold vertices (faces meet only at a point)");
+  if (v.inconsistent_edges)
+    add(ValidityCode::PolygonWrongOrientation, n(v.inconsistent_edges) + " inconsistently oriented edges");
+  if (single_component && v.components != 1)
+    add(ValidityCode::MultipleConnectedComponents, n(v.components) + " connected components (expected one)");
+  const bool sound = out.empty();
+  if (sound && std::abs(v.volume) < kFlatShellVolume)
+    add(ValidityCode::ShellSelfIntersection,
+        "the shell encloses no volume (signed volume " + format_number(v.volume) + " m^3)");
+  else if (sound && !v.outward)
+    add(ValidityCode::WrongOrientationShell, "faces point inward (signed volume " + format_number(v.volume) + " m^3)");
+  ValidityError warped{ValidityCode::NonPlanarPolygonDistancePlane, {}, {}};
+  for (std::size_t k = 0; k < planarity.size(); ++k)
+    if (planarity[k] > planarity_tolerance) warped.faces.push_back(int(k));
+  if (!warped.faces.empty()) {
+    warped.info = "face planarity error " + format_number(v.max_planarity_error) + " m exceeds " +
+                  format_number(planarity_tolerance) + " m";
+    out.push_back(std::move(warped));
+  }
+  if (sound && v.self_intersecting) add(ValidityCode::ShellSelfIntersection, "faces intersect each other");
+  if (planarity.size() < 4) add(ValidityCode::TooFewPolygons, n(int(planarity.size())) + " faces (a solid needs 4)");
+  return out;
+}
+
+void sort_by_code(std::vector<ValidityError>& errors) {
+  std::stable_sort(errors.begin(), errors.end(),
+                   [](const ValidityError& a, const ValidityError& b) { return a.code < b.code; });
 }
 
 }  // namespace
@@ -298,19 +356,75 @@ std::vector<int> pinched_vertices(const Mesh& mesh) {
 Validation validate_mesh(const Mesh& mesh, double planarity_tolerance, bool check_self_intersections,
                          bool single_component) {
   Validation v;
-  v.problem = mesh.faces.empty() ? "no faces" : size_problem(mesh);
-  if (v.problem.empty()) v.problem = malformed(mesh);
-  if (!v.problem.empty()) return v;
+  if (mesh.faces.empty()) {
+    v.errors = {{ValidityCode::TooFewPolygons, {}, "no faces"}};
+  } else if (std::string why = size_problem(mesh); !why.empty()) {
+    v.errors = {{ValidityCode::Unknown, {}, std::move(why)}};
+  } else {
+    v.errors = malformed(mesh);
+  }
+  if (!v.errors.empty()) {
+    v.problem = v.errors.front().info;
+    sort_by_code(v.errors);
+    return v;
+  }
   const EdgeUses uses = edge_uses(mesh.faces);
   count_edge_defects(uses, v);
   v.nonmanifold_vertices = int(fanned_vertices(mesh, uses).size());
   v.components = count_components(mesh.faces.size(), uses);
   v.volume = signed_volume(mesh.vertices, mesh.faces);
   v.outward = v.volume > 0;
-  v.max_planarity_error = max_planarity_error(mesh);
+  const std::vector<double> planarity = planarity_errors(mesh);
+  v.max_planarity_error = planarity.empty() ? 0.0 : *std::max_element(planarity.begin(), planarity.end());
   if (check_self_intersections) v.self_intersecting = self_intersects(mesh);
-  v.problem = first_problem(v, planarity_tolerance, single_component);
+  v.errors = shell_errors(v, planarity, planarity_tolerance, single_component);
+  if (!v.errors.empty()) v.problem = v.errors.front().info;
+  sort_by_code(v.errors);
   return v;
+}
+
+const char* code_name(ValidityCode code) {
+  switch (code) {
+    case ValidityCode::TooFewPoints: return "TOO_FEW_POINTS";
+    case ValidityCode::ConsecutivePointsSame: return "CONSECUTIVE_POINTS_SAME";
+    case ValidityCode::RingSelfIntersection: return "RING_SELF_INTERSECTION";
+    case ValidityCode::NonPlanarPolygonDistancePlane: return "NON_PLANAR_POLYGON_DISTANCE_PLANE";
+    case ValidityCode::TooFewPolygons: return "TOO_FEW_POLYGONS";
+    case ValidityCode::ShellNotClosed: return "SHELL_NOT_CLOSED";
+    case ValidityCode::NonManifoldCase: return "NON_MANIFOLD_CASE";
+    case ValidityCode::MultipleConnectedComponents: return "MULTIPLE_CONNECTED_COMPONENTS";
+    case ValidityCode::ShellSelfIntersection: return "SHELL_SELF_INTERSECTION";
+    case ValidityCode::PolygonWrongOrientation: return "POLYGON_WRONG_ORIENTATION";
+    case ValidityCode::WrongOrientationShell: return "WRONG_ORIENTATION_SHELL";
+    case ValidityCode::Unknown: break;
+  }
+  return "UNKNOWN_ERROR";
+}
+
+std::vector<int> error_codes(const std::vector<ValidityError>& errors) {
+  std::vector<int> out;
+  for (const ValidityError& e : errors)
+    if (out.empty() || out.back() != code_number(e.code)) out.push_back(code_number(e.code));
+  return out;
+}
+
+Validation validate_soup(const Mesh& soup, const ValidityTolerances& tolerances) {
+  Eigen::AlignedBox3d box;
+  for (const Vec3& p : soup.vertices)
+    if (p.allFinite()) box.extend(p);
+  const Vec3 origin = box.isEmpty() ? Vec3::Zero() : Vec3((box.min() / 100.0).array().floor() * 100.0);
+  Mesh welded;
+  welded.id = soup.id;
+  PointWelder welder(tolerances.snap);
+  std::vector<int> index(soup.vertices.size());
+  for (std::size_t i = 0; i < soup.vertices.size(); ++i)
+    index[i] = soup.vertices[i].allFinite() ? welder.add(soup.vertices[i] - origin) : -1;
+  welded.vertices = welder.points();
+  for (Face f : soup.faces) {
+    for (int& i : f.v) i = i >= 0 && std::size_t(i) < index.size() ? index[std::size_t(i)] : -1;
+    welded.faces.push_back(std::move(f));
+  }
+  return validate_mesh(welded, tolerances.planarity);
 }
 
 }  // namespace lodrefine

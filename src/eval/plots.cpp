@@ -441,7 +441,7 @@ std::string svg_district_map(const std::vector<MapOutline>& buildings, const std
                        "\" fill-opacity=\"0.75\" stroke=\"#555\" "
                        "stroke-width=\"0.6\"><title>" +
                        escape(b.id + ": " + outcome_name(b.outcome)) + "</title></path>";
-    if (b.linked) path = "<a href=\"#view-" + escape(b.id) + "\">" + path + "</a>";
+    if (!b.link.empty()) path = "<a href=\"" + escape(b.link) + "\">" + path + "</a>";
     svg.raw(path);
   }
   scale_bar(svg, v, span, margin, header + plot_h + 28);

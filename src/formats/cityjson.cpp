@@ -541,6 +541,12 @@ nlohmann::json parse_json(std::string_view text, const std::string& name) {
   }
 }
 
+Mesh solid_soup(const CityJsonBuilding& b) {
+  Mesh solid = b.mesh;
+  solid.faces.resize(solid.faces.size() - std::min(solid.faces.size(), std::size_t(std::max(b.fin_faces, 0))));
+  return solid;
+}
+
 Semantic semantic_from_cityjson(const std::string& type) {
   if (type == "WallSurface") return Semantic::Wall;
   if (type == "RoofSurface") return Semantic::Roof;

@@ -193,6 +193,7 @@ class ObjBuild {
       }
       static_cast<ObjBuild*>(self)->group_sem_ = semantic_from_name(joined);
       static_cast<ObjBuild*>(self)->in_fins_ = fins;
+      static_cast<ObjBuild*>(self)->group_provenance_ = provenance_from_group(joined);
     };
     cb.usemtl_cb = [](void* self, const char* name, int) {
       static_cast<ObjBuild*>(self)->mtl_sem_ = semantic_from_name(std::string(trim(name)));
@@ -223,6 +224,7 @@ class ObjBuild {
       f.v.push_back(i > 0 ? i - 1 : known + i);
     }
     f.sem = group_sem_ != Semantic::Other ? group_sem_ : mtl_sem_;
+    f.provenance = group_provenance_;
     f.source = int(mesh_.faces.size());
     mesh_.faces.push_back(std::move(f));
     fins_.push_back(in_fins_);
@@ -260,6 +262,7 @@ class ObjBuild {
   Semantic group_sem_ = Semantic::Other, mtl_sem_ = Semantic::Other;
   bool in_fins_ = false;    // the current group is a fins group
   std::vector<char> fins_;  // per face of mesh_: in a fins group
+  Provenance group_provenance_ = Provenance::None;
 };
 
 void append_fixed(std::string& out, double v) {
@@ -269,25 +272,49 @@ void append_fixed(std::string& out, double v) {
   out.append(buf, r.ptr);
 }
 
-// Appends `mesh`'s faces grouped by semantic (`g <prefix><semantic>`), indices offset by `base`.
-void append_faces(std::string& out, const Mesh& mesh, std::size_t base, const std::string& prefix,
-                  const std::string& what, AtomicFile& file) {
-  for (Semantic sem : {Semantic::Wall, Semantic::Roof, Semantic::Ground, Semantic::Other}) {
-    bool header = false;
-    for (std::size_t k = 0; k < mesh.faces.size(); ++k) {
-      const Face& f = mesh.faces[k];
-      if (f.sem != sem) continue;
-      if (f.v.size() < 3) file.fail(what + std::to_string(k) + " has fewer than 3 vertices");
-      if (!header) out += "g " + prefix + semantic_name(sem) + "\n", header = true;
-      out += 'f';
-      for (int i : f.v) {
-        if (i < 0 || std::size_t(i) >= mesh.vertices.size())
-          file.fail(what + std::to_string(k) + " references missing vertex " + std::to_string(i));
-        out += ' ' + std::to_string(base + std::size_t(i) + 1);
-      }
+// Where a mesh's faces go in the file: its vertices' offset, the prefix of its groups ("" or
+// "fins "), and what a refusal calls its faces ("face ", "fin face ").
+struct FaceBlock {
+  std::size_t base = 0;
+  std::string prefix, what;
+};
+
+// The faces of one semantic and provenance: `g <prefix>WallSurface` (no provenance) or
+// `g <prefix>WallSurface scan`, a scan face after a `# lodrefine_coverage 0.85` comment.
+void append_group(std::string& out, const Mesh& mesh, Semantic sem, Provenance from, const FaceBlock& block,
+                  AtomicFile& file) {
+  bool header = false;
+  for (std::size_t k = 0; k < mesh.faces.size(); ++k) {
+    const Face& f = mesh.faces[k];
+    if (f.sem != sem || f.provenance != from) continue;
+    if (f.v.size() < 3) file.fail(block.what + std::to_string(k) + " has fewer than 3 vertices");
+    if (!header) {
+      out += "g " + block.prefix + semantic_name(sem);
+      if (from != Provenance::None) out += std::string(" ") + provenance_name(from);
       out += '\n';
+      header = true;
     }
+    if (from == Provenance::Scan) {
+      char buf[16];  // a share 0..1 in hundredths, locale-free like the coordinates
+      const auto r =
+          std::to_chars(buf, buf + sizeof buf, std::clamp(f.coverage, 0.0, 1.0), std::chars_format::fixed, 2);
+      out += "# lodrefine_coverage " + std::string(buf, r.ptr) + "\n";
+    }
+    out += 'f';
+    for (int i : f.v) {
+      if (i < 0 || std::size_t(i) >= mesh.vertices.size())
+        file.fail(block.what + std::to_string(k) + " references missing vertex " + std::to_string(i));
+      out += ' ' + std::to_string(block.base + std::size_t(i) + 1);
+    }
+    out += '\n';
   }
+}
+
+// `mesh`'s faces by semantic, then provenance.
+void append_faces(std::string& out, const Mesh& mesh, const FaceBlock& block, AtomicFile& file) {
+  for (Semantic sem : {Semantic::Wall, Semantic::Roof, Semantic::Ground, Semantic::Other})
+    for (Provenance from : {Provenance::None, Provenance::Model, Provenance::Scan, Provenance::Added})
+      append_group(out, mesh, sem, from, block, file);
 }
 
 void append_vertices(std::string& out, const Mesh& mesh, const Vec3& origin, const std::string& what,
@@ -315,8 +342,8 @@ std::string obj_text(const Mesh& mesh, const Mesh& fins, const Vec3& origin, Ato
   else if (!mesh.id.empty()) out += "o " + token + "\n";
   append_vertices(out, mesh, origin, "vertex ", file);
   append_vertices(out, fins, origin, "fin vertex ", file);
-  append_faces(out, mesh, 0, "", "face ", file);
-  append_faces(out, fins, mesh.vertices.size(), std::string(kFinsGroup) + " ", "fin face ", file);
+  append_faces(out, mesh, {0, "", "face "}, file);
+  append_faces(out, fins, {mesh.vertices.size(), std::string(kFinsGroup) + " ", "fin face "}, file);
   return out;
 }
 

@@ -11,13 +11,16 @@ namespace {
 
 using nlohmann::json;
 
-std::vector<float> triangles(const Mesh& mesh) {
+// The faces as triangles (x, y, z per corner); with `sources`, each triangle's face's provenance.
+std::vector<float> triangles(const Mesh& mesh, std::vector<unsigned char>* sources = nullptr) {
   std::vector<float> out;
   for (const Face& f : mesh.faces) {
     const auto poly = face_points(mesh, f);
-    for (const auto& t : triangulate_polygon(poly))
+    for (const auto& t : triangulate_polygon(poly)) {
+      if (sources) sources->push_back(static_cast<unsigned char>(f.provenance));
       for (int k : t)
         for (int c = 0; c < 3; ++c) out.push_back(float(poly[std::size_t(k)][c]));
+    }
   }
   return out;
 }
@@ -75,6 +78,7 @@ tr.failed { background: #fdd; } tr.kept { background: #ffd; }
 canvas.view3d { border: 1px solid #ccc; cursor: grab; }
 .legend { font-size: 12px; }
 .map svg { max-width: 100%; height: auto; border: 1px solid #ccc; }
+.filter { margin: .5em 0; } .filter label { margin-right: 1em; }
 )css";
 
 // Renders every view with one WebGL renderer into its own 2D canvas (browsers allow only a few
@@ -91,14 +95,21 @@ function c2mColor(d) {
   const t = Math.max(-1, Math.min(1, d / RANGE)), a = Math.abs(t), end = t < 0 ? [0.1, 0.25, 1] : [0.9, 0.05, 0.05];
   return [0.1, 0.7, 0.2].map((g, k) => g + a * (end[k] - g));
 }
-function meshLayer(tris, color, opacity) {
+// Refined faces by provenance (Face::provenance): none and scan orange, model grey, added purple.
+const SOURCE_COLORS = [0xe8871e, 0x9a9a9a, 0xe8871e, 0x8e44ad].map(hex => new THREE.Color(hex).toArray());
+function meshLayer(tris, color, opacity, sources) {
   const g = new THREE.BufferGeometry();
   g.setAttribute('position', new THREE.Float32BufferAttribute(tris, 3));
   g.computeVertexNormals();
+  const bySource = sources && sources.length > 0;
+  if (bySource)
+    g.setAttribute('color', new THREE.Float32BufferAttribute(
+        sources.flatMap(s => { const c = SOURCE_COLORS[s] || SOURCE_COLORS[0]; return [...c, ...c, ...c]; }), 3));
   const group = new THREE.Group();
-  group.add(new THREE.Mesh(g, new THREE.MeshLambertMaterial({color, transparent: opacity < 1, opacity,
-      side: THREE.DoubleSide, depthWrite: opacity >= 1})));
-  group.add(new THREE.LineSegments(new THREE.EdgesGeometry(g, 10), new THREE.LineBasicMaterial({color})));
+  group.add(new THREE.Mesh(g, new THREE.MeshLambertMaterial({color: bySource ? 0xffffff : color,
+      vertexColors: bySource, transparent: opacity < 1, opacity, side: THREE.DoubleSide, depthWrite: opacity >= 1})));
+  group.add(new THREE.LineSegments(new THREE.EdgesGeometry(g, 10),
+      new THREE.LineBasicMaterial({color: bySource ? 0x444444 : color})));
   return group;
 }
 function setup(view, canvas) {
@@ -109,7 +120,7 @@ function setup(view, canvas) {
   scene.add(sun);
   const layers = {
     original: meshLayer(view.original, 0x3b6fd6, 0.25),
-    refined: view.refined.length ? meshLayer(view.refined, 0xe8871e, 1.0) : new THREE.Group(),
+    refined: view.refined.length ? meshLayer(view.refined, 0xe8871e, 1.0, view.sources) : new THREE.Group(),
   };
   const pg = new THREE.BufferGeometry();
   pg.setAttribute('position', new THREE.Float32BufferAttribute(view.points, 3));
@@ -154,6 +165,30 @@ data.forEach((view, i) => {
 document.documentElement.dataset.rendered = String(data.length);
 )js";
 
+// The filter by outcome (HtmlReport::filter): a box unticked hides its rows and views; a link to
+// a hidden view (the district map's) ticks its outcome again and shows it.
+const char* kFilter = R"js(
+(() => {
+  const boxes = [...document.querySelectorAll('.filter input[data-outcome]')];
+  const apply = () => {
+    const on = new Set(boxes.filter(b => b.checked).map(b => b.dataset.outcome));
+    for (const el of document.querySelectorAll('tr[data-outcome], section[data-outcome]'))
+      el.hidden = !on.has(el.dataset.outcome);
+  };
+  for (const b of boxes) b.addEventListener('change', apply);
+  const reveal = () => {
+    const el = location.hash.length > 1 ? document.getElementById(location.hash.slice(1)) : null;
+    if (!el || !el.hidden) return;
+    const box = boxes.find(b => b.dataset.outcome === el.dataset.outcome);
+    if (box) box.checked = true;
+    apply();
+    el.scrollIntoView();
+  };
+  addEventListener('hashchange', reveal);
+  reveal();
+})();
+)js";
+
 // First in <head>: records script errors (and console.error) where a headless test sees them.
 const char* kErrorTrap = R"js(
 (() => {
@@ -166,7 +201,42 @@ const char* kErrorTrap = R"js(
 })();
 )js";
 
+// The attributes of a filtered element (a row, a view) of `outcome`: its data-outcome, and
+// hidden when its box starts unticked. Nothing without a filter.
+std::string filtered(const HtmlReport& r, const std::string& outcome) {
+  if (r.filter.empty() || outcome.empty()) return "";
+  const bool off = std::find(r.filter_off.begin(), r.filter_off.end(), outcome) != r.filter_off.end();
+  return " data-outcome=\"" + html_escape(outcome) + "\"" + (off ? " hidden" : "");
+}
+
+// The filter's boxes, each with its outcome's count of rows.
+std::string filter_html(const HtmlReport& r) {
+  if (r.filter.empty()) return "";
+  std::string h = "<div class=\"filter\">Show:";
+  for (const std::string& outcome : r.filter) {
+    const auto n = std::count_if(r.rows.begin(), r.rows.end(),
+                                 [&](const json& row) { return row.value("outcome", std::string()) == outcome; });
+    const bool off = std::find(r.filter_off.begin(), r.filter_off.end(), outcome) != r.filter_off.end();
+    h += " <label><input type=\"checkbox\" data-outcome=\"" + html_escape(outcome) + "\"" + (off ? "" : " checked") +
+         "> " + html_escape(outcome) + " (" + std::to_string(n) + ")</label>";
+  }
+  return h + "</div>\n";
+}
+
 }  // namespace
+
+std::string view_anchor(const std::string& id) {
+  static const char* hex = "0123456789abcdef";
+  std::string out = "view-";
+  for (char c : id) {
+    const auto u = static_cast<unsigned char>(c);
+    const bool plain =
+        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' || c == '-';
+    if (plain) out += c;
+    else out += {'_', hex[u >> 4], hex[u & 15]};
+  }
+  return out;
+}
 
 BuildingView make_building_view(const std::string& id, const Mesh& original, const Mesh& refined,
                                 const std::vector<Vec3>& points, const std::vector<double>& c2m,
@@ -174,7 +244,8 @@ BuildingView make_building_view(const std::string& id, const Mesh& original, con
   BuildingView v;
   v.id = id;
   v.original = triangles(original);
-  v.refined = triangles(refined);
+  v.refined = triangles(refined, &v.sources);
+  if (std::all_of(v.sources.begin(), v.sources.end(), [](unsigned char p) { return p == 0; })) v.sources.clear();
   const std::size_t n = std::min(points.size(), c2m.size());
   const std::size_t step = max_points == 0 ? n + 1 : std::max<std::size_t>(1, (n + max_points - 1) / max_points);
   for (std::size_t i = 0; i < n; i += step) {
@@ -191,18 +262,18 @@ std::string html_report(const HtmlReport& r) {
        html_escape(r.table1) + "</pre>\n<div class=\"plots\">" + r.histogram_svg + r.boxplot_svg + "</div>\n";
   if (!r.map_svg.empty()) h += "<div class=\"map\">" + r.map_svg + "</div>\n";
 
-  h += "<h2>" + html_escape(r.table_heading) + "</h2>\n<table class=\"buildings\"><thead><tr>";
+  h += "<h2>" + html_escape(r.table_heading) + "</h2>\n" + filter_html(r) + "<table class=\"buildings\"><thead><tr>";
   for (const auto& c : r.columns) h += "<th>" + html_escape(c[1].get<std::string>()) + "</th>";
   h += "</tr></thead><tbody>\n";
   std::vector<std::string> shown;
   for (const auto& v : r.views) shown.push_back(v.id);
   for (const auto& row : r.rows) {
     const std::string id = row.value("id", std::string()), outcome = row.value("outcome", std::string());
-    h += "<tr class=\"" + html_escape(outcome) + "\">";
+    h += "<tr class=\"" + html_escape(outcome) + "\"" + filtered(r, outcome) + ">";
     for (const auto& c : r.columns) {
       const std::string text = html_escape(cell_text(row.value(c[0].get<std::string>(), json())));
       const bool link = c[0] == "id" && std::find(shown.begin(), shown.end(), id) != shown.end();
-      h += "<td>" + (link ? "<a href=\"#view-" + html_escape(id) + "\">" + text + "</a>" : text) + "</td>";
+      h += "<td>" + (link ? "<a href=\"#" + view_anchor(id) + "\">" + text + "</a>" : text) + "</td>";
     }
     h += "</tr>\n";
   }
@@ -212,15 +283,20 @@ std::string html_report(const HtmlReport& r) {
     h += "<h2>Before / after</h2>\n<p class=\"legend\">" + html_escape(r.views_legend) + "</p>\n";
     json views = json::array();
     for (const auto& v : r.views) {
-      h += "<section id=\"view-" + html_escape(v.id) + "\"><h3>" + html_escape(v.id) + " &mdash; " +
-           html_escape(v.caption) + "</h3>\n<div class=\"view\"><div class=\"footprint\">" + v.footprint_svg +
+      h += "<section id=\"" + view_anchor(v.id) + "\"" + filtered(r, v.outcome) + "><h3>" + html_escape(v.id) +
+           " &mdash; " + html_escape(v.caption) + "</h3>\n<div class=\"view\"><div class=\"footprint\">" +
+           v.footprint_svg +
            "</div><div><canvas class=\"view3d\" width=\"560\" height=\"420\"></canvas><div class=\"legend\">";
       for (const char* layer : {"original", "refined", "points"})
         h +=
             std::string("<label><input type=\"checkbox\" checked data-layer=\"") + layer + "\"> " + layer + "</label> ";
       h += "</div></div></div></section>\n";
-      views.push_back(
-          {{"id", v.id}, {"original", v.original}, {"refined", v.refined}, {"points", v.points}, {"c2m", v.c2m}});
+      views.push_back({{"id", v.id},
+                       {"original", v.original},
+                       {"refined", v.refined},
+                       {"sources", v.sources},
+                       {"points", v.points},
+                       {"c2m", v.c2m}});
     }
     h += "<script type=\"application/json\" id=\"lodrefine-views\">" +
          script_safe(views.dump(-1, ' ', false, json::error_handler_t::replace)) + "</script>\n";
@@ -229,6 +305,7 @@ std::string html_report(const HtmlReport& r) {
   } else {
     h += "<script>document.documentElement.dataset.rendered = '0';</script>\n";
   }
+  if (!r.filter.empty()) h += std::string("<script>") + kFilter + "</script>\n";
   return h + "</body></html>\n";
 }
 

@@ -43,16 +43,17 @@ std::vector<T> thinned(const std::vector<T>& v, std::size_t cap) {
   return out;
 }
 
-// kept-invalid, kept, repaired, refined; then the worst fit after refinement first, unmeasured last.
-std::vector<const CityReviewBuilding*> reached_worst_first(const CityReview& r) {
+// kept-invalid, kept, repaired, refined, untouched; then the worst fit after refinement first,
+// unmeasured last.
+std::vector<const CityReviewBuilding*> worst_first(const CityReview& r) {
   std::vector<const CityReviewBuilding*> order;
-  for (const auto& b : r.buildings)
-    if (b.outcome != Outcome::Untouched) order.push_back(&b);
+  for (const auto& b : r.buildings) order.push_back(&b);
   auto key = [](const CityReviewBuilding* b) {
     const int rank = b->outcome == Outcome::KeptInvalid ? 0
                      : b->outcome == Outcome::Kept      ? 1
                      : b->outcome == Outcome::Repaired  ? 2
-                                                        : 3;
+                     : b->outcome == Outcome::Refined   ? 3
+                                                        : 4;
     return std::make_tuple(rank, -b->fit_after.value_or(-1.0), b->id);
   };
   std::stable_sort(order.begin(), order.end(), [&](auto* a, auto* b) { return key(a) < key(b); });
@@ -69,10 +70,24 @@ const json kColumns = json::array({{"id", "building"},
                                    {"fit_before", "fit before (m)"},
                                    {"fit_after", "fit after (m)"}});
 
+// A building's reason without its id, which the page shows beside it: a leading "building <id>: "
+// or "<id>: " dropped, "building <id>" as "building", the id quoted dropped.
+std::string without_id(const std::string& id, std::string reason) {
+  if (id.empty()) return reason;
+  for (const std::string& lead : {"building " + line_id(id) + ": ", line_id(id) + ": "})
+    if (reason.rfind(lead, 0) == 0) reason.erase(0, lead.size());
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{" '" + id + "'", ""},
+                                 {" \"" + id + "\"", ""},
+                                 {"building " + id, "building"}})
+    for (std::size_t at = reason.find(from); at != std::string::npos; at = reason.find(from, at + to.size()))
+      reason.replace(at, from.size(), to);
+  return reason;
+}
+
 json row(const CityReviewBuilding& b) {
   return {{"id", b.id},
           {"outcome", outcome_name(b.outcome)},
-          {"reason", b.reason},
+          {"reason", without_id(b.id, b.reason)},
           {"points", b.points},
           {"moved", b.facades_moved},
           {"moved_max", number_or_null(b.moved_max)},
@@ -88,11 +103,10 @@ std::string caption(const CityReviewBuilding& b) {
   return c;
 }
 
-// The check a kept building's reason names: its text before any ':' or '(' with numbers as "N"
-// (reasons carry the figures of the building, e.g. "... better (RMS 0.12 -> 0.15 m)"), without
-// a leading "building <id>: ".
-std::string check_of(const std::string& id, std::string reason) {
-  if (const std::string own = "building " + line_id(id) + ": "; reason.rfind(own, 0) == 0) reason.erase(0, own.size());
+// The check a kept building's reason names: its text (without_id) before any ':' or '(' with
+// numbers as "N" (reasons carry the figures of the building, e.g. "... better (RMS 0.12 -> 0.15 m)").
+std::string check_of(const std::string& id, const std::string& text) {
+  const std::string reason = without_id(id, text);
   std::string key = reason.substr(0, std::min(reason.find(':'), reason.find('(')));
   std::string out;
   for (std::size_t i = 0; i < key.size(); ++i) {
@@ -165,23 +179,29 @@ std::string city_review_html(const CityReview& r) {
   h.title = r.title;
   h.table1 = r.summary + refusals_text(r);
   h.summary_heading = "City summary";
-  h.table_heading = "Buildings the cloud reached, worst first";
+  h.table_heading = "Buildings, worst first";
   h.views_legend =
-      "Each refined building. Left: top view, coarse (blue, dashed) and refined (orange) over its scan "
-      "points. Right: 3D, drag to turn, wheel to zoom; coarse blue (transparent), refined orange, scan "
-      "points within 1 m coloured by their signed distance to the refined model (blue -0.3 m, green 0, "
-      "red +0.3 m).";
+      "Each refined and repaired building. Left: top view, coarse (blue, dashed) and written model (orange) "
+      "over its scan points. Right: 3D, drag to turn, wheel to zoom; coarse blue (transparent), the written "
+      "model's faces by where they come from (lodrefine_source: scan orange, model grey, added purple), "
+      "scan points within 1 m coloured by their signed distance to it (blue -0.3 m, green 0, red +0.3 m). "
+      "A click on a building of the map shows its view.";
   h.columns = kColumns;
   h.rows = json::array();
+  for (const Outcome o : {Outcome::Refined, Outcome::Repaired, Outcome::KeptInvalid, Outcome::Kept, Outcome::Untouched})
+    h.filter.push_back(outcome_name(o));
+  h.filter_off = {outcome_name(Outcome::Untouched)};
   std::vector<MapOutline> map;
-  for (const auto& b : r.buildings) map.push_back({b.id, b.outcome, b.outline, b.view.has_value()});
-  h.map_svg = svg_district_map(map, "The district: refined buildings in orange");
-  for (const CityReviewBuilding* b : reached_worst_first(r)) {
+  for (const auto& b : r.buildings)
+    map.push_back({b.id, b.outcome, b.outline, b.view ? "#" + view_anchor(b.id) : std::string()});
+  h.map_svg = svg_district_map(map, "The district: a click on a refined or repaired building shows its 3D view");
+  for (const CityReviewBuilding* b : worst_first(r)) {
     h.rows.push_back(row(*b));
     if (!b->view) continue;
     h.views.push_back(*b->view);
     h.views.back().id = b->id;
     h.views.back().caption = caption(*b);
+    h.views.back().outcome = outcome_name(b->outcome);
   }
   return html_report(h);
 }

@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <tuple>
 
+#include "lodrefine/version.h"
+
 namespace lodrefine {
 namespace {
 
@@ -220,7 +222,10 @@ std::string totals_text(const RunTotals& t) {
 
 json run_json(const std::vector<const RunRow*>& order, const PooledEval& pooled, const RunTotals& totals,
               const json& params, const std::string& run_dir) {
-  json j = {{"pooled", pooled_json(pooled)}, {"buildings", json::array()}, {"params", params}};
+  json j = {{"lodrefine_version", LODREFINE_VERSION},
+            {"pooled", pooled_json(pooled)},
+            {"buildings", json::array()},
+            {"params", params}};
   j["pooled"].update(totals_json(totals));
   for (const RunRow* r : order) j["buildings"].push_back(row_json(*r));
   if (!run_dir.empty()) j["run_dir"] = run_dir;

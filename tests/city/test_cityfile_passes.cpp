@@ -97,6 +97,17 @@ TEST(CityFilePasses, ASecondPassKeepsEveryFinOnItsSolid) {
   EXPECT_NE(s2.outcomes[0].reason.find("a fin beside the shell would stand apart from it"), std::string::npos)
       << s2.outcomes[0].reason;
   expect_fins_on_solid(dir + "/pass2.city.json", "pass 2");
+  // The codes: pass 1 read a soup that is no solid; pass 2 reads a valid Solid (its fin beside
+  // it is no part of it), so it has nothing to say and the codes pass 1 wrote are gone.
+  const json a1 = load(dir + "/pass1.city.json")["CityObjects"]["fin"]["attributes"];
+  EXPECT_FALSE(s1.outcomes[0].errors_before.empty());
+  EXPECT_EQ(a1["lodrefine_errors_before"], json(error_codes(s1.outcomes[0].errors_before)));
+  EXPECT_EQ(a1["lodrefine_errors_after"], json::array());
+  EXPECT_EQ(error_codes(s2.outcomes[0].errors_before), std::vector<int>{});
+  EXPECT_EQ(error_codes(s2.outcomes[0].errors_after), std::vector<int>{});
+  const json a2 = load(dir + "/pass2.city.json")["CityObjects"]["fin"]["attributes"];
+  EXPECT_FALSE(a2.contains("lodrefine_errors_before")) << a2.dump();
+  EXPECT_FALSE(a2.contains("lodrefine_errors_after")) << a2.dump();
 }
 
 // A CityGML ring closes by repeating its first position; the CityJSON written (untouched and

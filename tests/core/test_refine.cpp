@@ -83,6 +83,29 @@ TEST(Refine, MovesAnOutdatedFacadeOntoTheScan) {
 // street goes on), but a few points of the side wall itself (too few for a plane) stand where
 // the model has it. The corner move makes those farther, so the judge refuses it, and the
 // building is refined once more on the facade's own points: the facade moves, the side stays.
+// Where each face comes from (Face::provenance): the moved front wall from the scan, with the
+// share of it the scan covers (x 0.5..11.5 of 12 m, z 0.2..5 of 7 m, each point covering 0.5 m
+// around it: about 5.5 / 7), the roof and the other walls from the model.
+TEST(Refine, TheMovedWallIsTheScansAndTheRoofTheModels) {
+  const RefineResult r = refine_building(box_soup(0, 12, -0.5, 8, 7), scan_front(0.0, 0.5, 11.5, 5.0, 1), {});
+  ASSERT_EQ(r.outcome, Outcome::Refined) << r.reason;
+  int front = 0, roofs = 0;
+  for (const Face& f : r.mesh.faces) {
+    SCOPED_TRACE(semantic_name(f.sem));
+    if (f.sem == Semantic::Wall && polygon_plane(face_points(r.mesh, f)).n.y() < -0.9) {
+      ++front;
+      EXPECT_EQ(f.provenance, Provenance::Scan);
+      EXPECT_GT(f.coverage, 0.7);
+      EXPECT_LT(f.coverage, 0.9);
+      continue;
+    }
+    roofs += f.sem == Semantic::Roof;
+    EXPECT_EQ(f.provenance, Provenance::Model);
+  }
+  EXPECT_EQ(front, 1);
+  EXPECT_EQ(roofs, 1);
+}
+
 TEST(Refine, ACornerMoveTheJudgeRefusesIsDroppedAndTheFacadeStillMoves) {
   const Mesh coarse = box_soup(0, 12, -0.5, 8, 7);
   PointCloud cloud = scan_front(0.0, 0.02, 11.2, 5.0, 3);
@@ -238,6 +261,17 @@ TEST(Refine, AHouseMissingThreeWallsIsRepairedOnItsPlanes) {
   EXPECT_FALSE(r.trace.invalid_input.empty());
   EXPECT_NEAR(validate_mesh(r.mesh, kPlanarity).volume, 12 * 8 * 7, 1e-6);
   EXPECT_LE(largest_vertex_move(r.mesh, coarse), 1e-6);
+  // The soup's three faces are the model's; the three walls closing the hole are added.
+  int model = 0, added = 0;
+  for (const Face& f : r.mesh.faces) {
+    model += f.provenance == Provenance::Model;
+    added += f.provenance == Provenance::Added;
+    if (f.provenance == Provenance::Added) {
+      EXPECT_EQ(f.sem, Semantic::Wall);
+    }
+  }
+  EXPECT_EQ(model, 3);
+  EXPECT_EQ(added, 3);
 }
 
 // The same house with its street facade scanned 0.5 m inside the model: the rebuilt shell is the

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 
+#include "lodrefine/base/geometry.h"
+#include "lodrefine/core/provenance.h"
 #include "lodrefine/core/shell_selection.h"
 #include "lodrefine/core/validate.h"
 #include "support/mesh_fixtures.h"
@@ -188,6 +190,40 @@ TEST(ShellSelection, TakesAFacadeLineSteppingForwardBeyondTwoMetres) {
 // step.
 TEST(ShellSelection, TakesAFacadeLineSteppingForwardBeyondTheScanPlaneReach) {
   EXPECT_NEAR(selected_volume(box({0, 0, 0}, {10, 8, 6}), stepped_facade(0.0, -2.4)), 480 + 5 * 2.4 * 6, 1e-6);
+}
+
+// Where each face comes from: the front line the scan shows 2.2 m out lies on the scan's plane
+// (covered whole), the step wall across to the line the scan confirms is added (no point on it),
+// that line, the roof, the ground and the other walls are the model's planes.
+TEST(ShellSelection, SaysWhereEachFaceComesFrom) {
+  const Scan s = stepped_facade(0.0, -2.2);
+  RefineConfig prm;
+  ShellSelection r = select_shell(box({0, 0, 0}, {10, 8, 6}), s.cloud, s.planes, prm);
+  ASSERT_TRUE(r.ok) << r.reason;
+  measure_coverage(r.mesh, s.cloud, s.planes, prm);
+  int scan = 0, added = 0, roofs = 0;
+  for (const Face& f : r.mesh.faces) {
+    const std::vector<Vec3> pts = face_points(r.mesh, f);
+    const Plane pl = polygon_plane(pts);
+    const Vec3 c = polygon_centroid(pts);
+    SCOPED_TRACE(std::string(semantic_name(f.sem)) + " at " + std::to_string(c.x()) + ", " + std::to_string(c.y()));
+    if (std::abs(pl.n.y()) > 0.99 && std::abs(c.y() + 2.2) < 1e-6) {
+      ++scan;
+      EXPECT_EQ(f.provenance, Provenance::Scan);
+      EXPECT_GT(f.coverage, 0.95);
+      EXPECT_LE(f.coverage, 1.0);
+    } else if (std::abs(pl.n.x()) > 0.99 && std::abs(c.x() - 5.0) < 1e-6) {
+      ++added;
+      EXPECT_EQ(f.provenance, Provenance::Added);
+    } else {
+      roofs += f.sem == Semantic::Roof;
+      EXPECT_EQ(f.provenance, Provenance::Model);
+      EXPECT_EQ(f.coverage, 0.0);
+    }
+  }
+  EXPECT_EQ(scan, 1);
+  EXPECT_EQ(added, 1);
+  EXPECT_EQ(roofs, 1);
 }
 
 // A neighbour's side wall 2.2 m beyond the start's unscanned end wall (seen down the alley) is

@@ -8,6 +8,7 @@
 #include "lodrefine/base/topology.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/validate.h"
+#include "support/mesh_fixtures.h"
 
 using namespace lodrefine;
 
@@ -272,4 +273,110 @@ TEST(Validate, AFaceTouchingItselfIsTriangulatedWithoutHanging) {
         std::exit(validate_mesh(shell, kPlanarity).valid() ? 1 : 0);
       },
       testing::ExitedWithCode(0), "");
+}
+
+// Issue 50: every defect under val3dity's code (src/definitions.h of val3dity 2.6), each on a
+// crafted solid; the problem text stays the first defect's.
+namespace {
+std::vector<int> codes(const Validation& v) { return error_codes(v); }
+}  // namespace
+
+TEST(ValidityCodes, AValidCubeHasNone) {
+  const Validation v = validate_mesh(unit_cube(), kPlanarity);
+  EXPECT_TRUE(v.errors.empty());
+  EXPECT_TRUE(codes(v).empty());
+}
+
+TEST(ValidityCodes, AMissingFaceIs302ShellNotClosed) {
+  Mesh m = unit_cube();
+  m.faces.pop_back();
+  const Validation v = validate_mesh(m, kPlanarity);
+  EXPECT_EQ(codes(v), std::vector<int>({302}));
+  EXPECT_STREQ(code_name(v.errors[0].code), "SHELL_NOT_CLOSED");
+  EXPECT_EQ(v.errors[0].info, v.problem);
+}
+
+TEST(ValidityCodes, NonManifoldEdgesAndVerticesAre303) {
+  const Validation edge = validate_mesh(combined(unit_cube(), translated(unit_cube(), {1, 1, 0})), kPlanarity);
+  EXPECT_EQ(codes(edge), std::vector<int>({303}));
+  EXPECT_STREQ(code_name(edge.errors[0].code), "NON_MANIFOLD_CASE");
+  // Two cubes touching at a corner: a non-manifold vertex, and two parts.
+  const Validation vertex = validate_mesh(combined(unit_cube(), translated(unit_cube(), {1, 1, 1})), kPlanarity);
+  EXPECT_EQ(codes(vertex), std::vector<int>({303, 305}));
+  EXPECT_EQ(vertex.problem, "1 non-manifold vertices (faces meet only at a point)");
+}
+
+TEST(ValidityCodes, SeparateCubesAre305UnlessSeveralPartsAreAllowed) {
+  const Mesh two = combined(unit_cube(), translated(unit_cube(), {3, 0, 0}));
+  const Validation v = validate_mesh(two, kPlanarity);
+  EXPECT_EQ(codes(v), std::vector<int>({305}));
+  EXPECT_STREQ(code_name(v.errors[0].code), "MULTIPLE_CONNECTED_COMPONENTS");
+  EXPECT_TRUE(validate_mesh(two, kPlanarity, true, false).errors.empty());
+}
+
+TEST(ValidityCodes, FacesCrossingEachOtherAre306AndAFlatShellToo) {
+  Mesh m = unit_cube();
+  m.vertices[6] = Vec3(0.8, 0.8, -0.5);
+  const Validation v = validate_mesh(m, 10.0);
+  EXPECT_EQ(codes(v), std::vector<int>({306}));
+  EXPECT_STREQ(code_name(v.errors[0].code), "SHELL_SELF_INTERSECTION");
+  Mesh sheet;  // two triangles back to back: closed, no volume, and too few faces for a solid
+  sheet.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  sheet.faces = {{{0, 1, 2}, Semantic::Roof, 0}, {{0, 2, 1}, Semantic::Ground, 1}};
+  EXPECT_EQ(codes(validate_mesh(sheet, kPlanarity)), std::vector<int>({301, 306}));
+}
+
+TEST(ValidityCodes, AFlippedFaceIs307AndAnInvertedShell405) {
+  Mesh m = unit_cube();
+  reverse_face(m.faces[2]);
+  const Validation flipped = validate_mesh(m, kPlanarity);
+  EXPECT_EQ(codes(flipped), std::vector<int>({307}));
+  EXPECT_STREQ(code_name(flipped.errors[0].code), "POLYGON_WRONG_ORIENTATION");
+  for (Face& f : m.faces) reverse_face(f);
+  reverse_face(m.faces[2]);  // now every face is reversed: consistent, inward
+  const Validation inward = validate_mesh(m, kPlanarity);
+  EXPECT_EQ(codes(inward), std::vector<int>({405}));
+  EXPECT_STREQ(code_name(inward.errors[0].code), "WRONG_ORIENTATION_SHELL");
+}
+
+TEST(ValidityCodes, AWarpedFaceIs203WithItsFace) {
+  Mesh m = unit_cube();
+  m.vertices[6].z() += 0.05;
+  const Validation v = validate_mesh(m, 0.01);
+  EXPECT_EQ(codes(v), std::vector<int>({203}));
+  EXPECT_STREQ(code_name(v.errors[0].code), "NON_PLANAR_POLYGON_DISTANCE_PLANE");
+  EXPECT_EQ(v.errors[0].faces, std::vector<int>({4}));  // the roof; its walls stay planar
+}
+
+TEST(ValidityCodes, RingDefectsAre101And102And104PerFace) {
+  Mesh m = unit_cube();
+  m.faces[1].v = {0, 1};
+  m.faces[3].v = {3, 3, 7, 4, 0};  // a vertex twice in a row
+  const Validation v = validate_mesh(m, kPlanarity);
+  EXPECT_EQ(codes(v), std::vector<int>({101, 102}));
+  EXPECT_EQ(v.errors[0].faces, std::vector<int>({1}));
+  EXPECT_EQ(v.errors[1].faces, std::vector<int>({3}));
+  EXPECT_EQ(v.problem, "face 1 has fewer than 3 vertices");
+  m = unit_cube();
+  m.faces[0].v = {0, 1, 5, 0, 4};  // a vertex again, not in a row
+  EXPECT_EQ(codes(validate_mesh(m, kPlanarity)), std::vector<int>({104}));
+  Mesh flat = prism({{0, 0}, {10, 0}, {10, 4}, {0, 4}}, 2.5, 2.5);  // walls collapsed to lines
+  const Validation collapsed = validate_mesh(flat, kPlanarity);
+  EXPECT_EQ(codes(collapsed), std::vector<int>({104}));
+  ASSERT_EQ(collapsed.errors.size(), 4u);  // one per face
+  EXPECT_EQ(collapsed.errors[3].faces, std::vector<int>({3}));
+  EXPECT_STREQ(code_name(collapsed.errors[0].code), "RING_SELF_INTERSECTION");
+}
+
+// A city file's soup: each face its own vertices, georeferenced. Snapped at val3dity's 1 mm, a
+// corner 0.4 mm apart is one point; 3 mm apart it leaves the shell open.
+TEST(ValidityCodes, ASoupIsWeldedAtTheSnapToleranceInALocalFrame) {
+  const Mesh cube = translated(prism({{0, 0}, {10, 0}, {10, 8}, {0, 8}}, 0, 6), {92345.678, 437654.321, 1.5});
+  Mesh soup = lodrefine::fixtures::as_soup(cube);
+  EXPECT_TRUE(validate_soup(soup).errors.empty()) << validate_soup(soup).problem;
+  soup.vertices[0].x() += 0.0004;
+  EXPECT_TRUE(validate_soup(soup).valid()) << validate_soup(soup).problem;
+  soup.vertices[0].x() += 0.003;
+  EXPECT_EQ(codes(validate_soup(soup)), std::vector<int>({302}));
+  EXPECT_TRUE(validate_soup(soup, {0.01, 0.01}).valid());
 }

@@ -197,6 +197,35 @@ TEST(IoObj, CoordinatesBeyondAMillionKilometresAreRefused) {
   }
 }
 
+// A refined building's faces say where they come from: `g WallSurface scan` with the coverage in
+// a comment before each scan face; a face without one in the plain group. tinyobjloader (our
+// reader) still takes the semantic from the group, and the provenance comes back.
+TEST(IoObj, ProvenanceInGroupNamesAndCoverageInComments) {
+  Mesh m;
+  m.id = "b";
+  m.vertices = {{0, 0, 0}, {4, 0, 0}, {4, 0, 3}, {0, 0, 3}, {0, 2, 3}};
+  m.faces = {{{0, 1, 2, 3}, Semantic::Wall, 0, Provenance::Scan, 0.857},
+             {{3, 2, 4}, Semantic::Roof, 1, Provenance::Model},
+             {{0, 3, 4}, Semantic::Wall, 2, Provenance::Added},
+             {{1, 4, 2}, Semantic::Wall, 3}};
+  const std::string path = temp_path("prov.obj");
+  write_obj(path, m);
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("g WallSurface\nf 2 5 3\ng WallSurface scan\n# lodrefine_coverage 0.86\nf 1 2 3 4\n"
+                      "g WallSurface added\nf 1 4 5\ng RoofSurface model\nf 4 3 5\n"),
+            std::string::npos)
+      << text;
+  const Mesh r = read_obj(path);
+  ASSERT_EQ(r.faces.size(), 4u);
+  const Provenance expected[] = {Provenance::None, Provenance::Scan, Provenance::Added, Provenance::Model};
+  const Semantic sems[] = {Semantic::Wall, Semantic::Wall, Semantic::Wall, Semantic::Roof};
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_EQ(r.faces[k].provenance, expected[k]) << k;
+    EXPECT_EQ(r.faces[k].sem, sems[k]) << k;
+  }
+}
+
 // tests/fuzz/regressions/fuzz_obj/writer_huge_coordinate.obj: read_obj accepts any finite
 // coordinate, so write_obj must print any finite coordinate readably.
 TEST(BadInputRegression, ObjWriterRoundTripsHugeCoordinates) {
@@ -254,6 +283,37 @@ TEST(IoObj, FinsAreWrittenAfterTheSolidInTheirOwnGroup) {
   const Mesh all = read_obj(path);
   ASSERT_EQ(all.faces.size(), 5u);
   EXPECT_EQ(all.faces.back().sem, Semantic::Wall);
+}
+
+// A refined building's fins say where they come from as its solid's faces do: `g fins
+// WallSurface model` after the solid's `g WallSurface scan` (the merge of the fins group and the
+// provenance words), both read back.
+TEST(IoObj, FinsCarryTheirProvenanceInTheirGroup) {
+  Mesh solid;
+  solid.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  solid.faces = {{{0, 2, 1}, Semantic::Ground, 0, Provenance::Model},
+                 {{0, 1, 3}, Semantic::Wall, 1, Provenance::Scan, 0.5},
+                 {{1, 2, 3}, Semantic::Roof, 2, Provenance::Model},
+                 {{2, 0, 3}, Semantic::Wall, 3, Provenance::Added}};
+  Mesh fins;
+  fins.vertices = {{0, 0, 1}, {0, 1, 0}, {0, 1, 2}, {0, 0, 2}};
+  fins.faces = {{{0, 1, 2, 3}, Semantic::Wall, 4, Provenance::Model}};
+  const std::string path = temp_path("fins_provenance.obj");
+  write_obj(path, solid, fins);
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), {});
+  const std::size_t scan = text.find("g WallSurface scan\n# lodrefine_coverage 0.50\nf 1 2 4\n"),
+                    fin = text.find("g fins WallSurface model\nf 5 6 7 8\n");
+  ASSERT_NE(scan, std::string::npos) << text;
+  ASSERT_NE(fin, std::string::npos) << text;
+  EXPECT_LT(scan, fin);
+  const ObjModel m = read_obj_model(path);
+  ASSERT_EQ(m.fins.faces.size(), 1u);
+  EXPECT_EQ(m.fins.faces[0].provenance, Provenance::Model);
+  ASSERT_EQ(m.solid.faces.size(), 4u);
+  int scanned = 0;
+  for (const Face& f : m.solid.faces) scanned += f.provenance == Provenance::Scan;
+  EXPECT_EQ(scanned, 1);
 }
 
 // A foreign OBJ's groups: only a group named exactly `fins` (any name of its `g` line) holds

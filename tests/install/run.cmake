@@ -2,7 +2,9 @@
 # tests/install/consumer against it with find_package(lodrefine), and reads CityGML with the
 # installed app. Catches a package that no longer installs a header, exports a target, finds a
 # dependency or installs the CityGML module where the app looks for it.
-#   cmake -DBUILD=<build dir> -DSOURCE=<source dir> -DWORK=<scratch dir> -P tests/install/run.cmake
+# The consumer asks for the version built (VERSION, project(VERSION)): the package's version file
+# accepts the same minor version only (SameMinorVersion: before 1.0 a minor release may break).
+#   cmake -DBUILD=<build dir> -DSOURCE=<source dir> -DWORK=<scratch dir> -DVERSION=<x.y.z> -P tests/install/run.cmake
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 
@@ -27,10 +29,13 @@ if(EXISTS ${WORK}/prefix/include/lodrefine/synth)
   message(FATAL_ERROR "install test: the synth headers are installed, their library is not")
 endif()
 run("configure the consumer" ${CMAKE_COMMAND} -S ${SOURCE}/tests/install/consumer -B ${WORK}/build
-    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${WORK}/prefix)
+    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${WORK}/prefix -DLODREFINE_WANTED=${VERSION})
 run("build the consumer" ${CMAKE_COMMAND} --build ${WORK}/build)
 run("run the consumer" ${WORK}/build/consumer ${WORK}/box.obj)
 message(STATUS "${last_output}")
+if(NOT last_output MATCHES "^lodrefine ${VERSION}:")
+  message(FATAL_ERROR "install test: the installed version.h does not say ${VERSION}:\n${last_output}")
+endif()
 # The installed app finds its CityGML module (<libdir>/lodrefine/, relative to bin/).
 run("convert CityGML with the installed app" ${WORK}/prefix/bin/lodrefine convert
     --citygml ${SOURCE}/tests/fuzz/corpus/fuzz_citygml/thematic.gml --out-dir ${WORK}/citygml)

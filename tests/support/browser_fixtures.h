@@ -127,22 +127,26 @@ inline PageDump dump_page(const fs::path& html, const fs::path& dir) {
 }
 
 // Shares of the pixels inside a canvas rectangle (3 px in from its border) that are drawn (not
-// the white background) and of the refined model's orange.
+// the white background), of the refined model's orange (its scan faces on the review page), of
+// grey (the page's model faces: no other layer is grey; the coarse model is blue) and of purple
+// (its added faces).
 struct CanvasShares {
-  double drawn = 0.0, orange = 0.0;
+  double drawn = 0.0, orange = 0.0, grey = 0.0, purple = 0.0;
 };
 
 inline CanvasShares canvas_shares(const Image& img, int x0, int y0, int w, int h) {
-  std::size_t drawn = 0, orange = 0, total = 0;
+  std::size_t drawn = 0, orange = 0, grey = 0, purple = 0, total = 0;
   for (int y = y0 + 3; y < y0 + h - 3; ++y)
     for (int x = x0 + 3; x < x0 + w - 3; ++x) {
       const auto& p = img.at(x, y);
       ++total;
       drawn += std::max({255 - p[0], 255 - p[1], 255 - p[2]}) > 30;
       orange += p[0] > 150 && p[1] > 60 && p[1] < 170 && p[2] < 90;
+      grey += std::max({p[0], p[1], p[2]}) - std::min({p[0], p[1], p[2]}) < 12 && p[0] > 50 && p[0] < 210;
+      purple += p[2] > p[1] + 50 && p[0] > p[1] + 30;
     }
-  return {double(drawn) / double(std::max<std::size_t>(1, total)),
-          double(orange) / double(std::max<std::size_t>(1, total))};
+  const double n = double(std::max<std::size_t>(1, total));
+  return {double(drawn) / n, double(orange) / n, double(grey) / n, double(purple) / n};
 }
 
 }  // namespace lodrefine::browser_fixtures

@@ -18,13 +18,32 @@ enum class Semantic { Wall, Roof, Ground, Other };
 const char* semantic_name(Semantic s);                  // "WallSurface", "RoofSurface", ...
 Semantic semantic_from_name(const std::string& group);  // case-insensitive substring match
 
+// Where a face of a refined or repaired building comes from: its plane is the model's (kept,
+// perhaps trimmed or extended), the scan's (a wall moved onto a scan plane, a facade the model
+// lacked), or neither (added to close the shell: a step wall, a wall across a hole). None: a
+// model as read, which says nothing (writers add nothing for it).
+enum class Provenance : unsigned char { None, Model, Scan, Added };
+const char* provenance_name(Provenance p);  // "model", "scan", "added"; "" for None
+// The provenance an OBJ group names as one of its blank-separated words (`g WallSurface scan`);
+// None when no word is a provenance_name.
+Provenance provenance_from_group(const std::string& group);
+
 // One planar polygon of a building, vertices indexing Mesh::vertices (counter-clockwise seen
 // from outside once the mesh is oriented).
 struct Face {
   std::vector<int> v;
   Semantic sem = Semantic::Other;
   int source = -1;  // index of the input face this one descends from (-1: new)
+  Provenance provenance = Provenance::None;
+  double coverage = 0.0;  // Provenance::Scan: the share of its area the scan covers (0..1)
 };
+
+// A face like `f` (semantic, source, provenance, coverage) on the corners `v`.
+inline Face with_corners(const Face& f, std::vector<int> v) {
+  Face g = f;
+  g.v = std::move(v);
+  return g;
+}
 
 // A polygonal building model. Coordinates are in whatever frame the caller uses: readers
 // return the file's (georeferenced) frame, the pipeline works in a local frame.

@@ -25,6 +25,7 @@
 #include "lodrefine/core/judge.h"
 #include "lodrefine/core/outcome.h"
 #include "lodrefine/core/params.h"
+#include "lodrefine/core/validate.h"
 #include "lodrefine/formats/cloud.h"
 
 namespace lodrefine {
@@ -60,8 +61,13 @@ struct CityRefineOptions {
   // The output is the same bytes whatever the number.
   int jobs = 1;
   // Every building goes through refinement, with or without cloud points: each one that is no
-  // valid solid is repaired (or kept-invalid) and says so; the others are kept as read.
+  // valid solid is repaired (or kept-invalid) and says so; the others are kept as read. With it,
+  // the cloud may be no file at all (refine_city's cloud_paths empty: lodrefine repair).
   bool repair_all = false;
+  // With repair_all: only the buildings validate_soup finds invalid (val3dity's tolerances) go
+  // through refinement; the valid ones are written exactly as read, and are in the summary's
+  // outcomes as untouched (lodrefine repair).
+  bool only_invalid = false;
   // Called after each building (CityJSONSeq: each feature) is written into the output, in
   // file order on the caller's thread, with the counts so far (may be empty).
   std::function<void(const CityRefineSummary&)> progress;
@@ -76,6 +82,9 @@ struct CityBuildingOutcome {
   JudgeCheck refused_by = JudgeCheck::None;  // the never-worse check that refused its refinement (judge.h)
   std::size_t points = 0;                    // cloud points in the building's crop box
   double seconds = 0.0;
+  // The defects under val3dity's codes (validate.h: validate_soup, val3dity's tolerances) of the
+  // geometry as read and of the geometry written (the same when it is kept as read).
+  std::vector<ValidityError> errors_before{}, errors_after{};
 };
 
 struct CityRefineSummary {
@@ -90,8 +99,9 @@ struct CityRefineSummary {
   // One line per cloud file whose bounds miss the city model ("<file>: cloud x .. does not overlap
   // the city model ..: wrong CRS or tile?") when other files reach it (else the run is refused).
   std::vector<std::string> warnings;
-  std::uint64_t cropped_points = 0;           // points held in the crops after the cloud pass (the memory that grows)
-  std::vector<CityBuildingOutcome> outcomes;  // the buildings the cloud reached, in file order
+  std::uint64_t cropped_points = 0;  // points held in the crops after the cloud pass (the memory that grows)
+  // The buildings the cloud reached (only_invalid: every building), in file order.
+  std::vector<CityBuildingOutcome> outcomes;
   double seconds_read = 0.0, seconds_crop = 0.0, seconds_refine = 0.0, seconds_write = 0.0;
 };
 
@@ -100,13 +110,21 @@ struct CityRefineSummary {
 // cloud file reaches a building ("cloud x..y does not overlap the city model x..y: wrong CRS or
 // tile?"). A building whose refinement throws is kept as read with outcome kept-invalid and the
 // reason. `cloud_paths` are files (cloud_files expands folders), read in that order as one cloud:
-// the output is that of one file holding their points in that order.
+// the output is that of one file holding their points in that order; none at all only with
+// repair_all (every building is then repaired without a scan). Every building the refinement
+// reaches gets the attributes lodrefine_outcome, lodrefine_reason, lodrefine_facades_moved and,
+// when it had or has errors (errors_before or errors_after not empty), lodrefine_errors_before /
+// lodrefine_errors_after (their codes); a valid building's other attributes stay as read.
 CityRefineSummary refine_city(const std::string& model_path, const std::vector<std::string>& cloud_paths,
                               const std::string& out_path, const RefineConfig& params,
                               const CityRefineOptions& options);
 
 // The refined mesh as a CityJSON Solid geometry of LoD `lod` with semantics, its vertices
-// appended to `vertices` quantised by the document's transform (`scale`, `translate`).
+// appended to `vertices` quantised by the document's transform (`scale`, `translate`). A face
+// with a provenance (Face::provenance) has it on its semantic surface object as
+// "lodrefine_source" ("model", "scan", "added"), a scan face its coverage as
+// "lodrefine_coverage" (0..1, in hundredths): one surface object per semantic, source and
+// coverage. Faces of no semantic (Semantic::Other) have none (a null value).
 nlohmann::ordered_json cityjson_solid(const Mesh& mesh, const std::string& lod, const Vec3& scale,
                                       const Vec3& translate, nlohmann::ordered_json& vertices);
 // The same as a MultiSurface (the fins written beside a rebuilt shell: RefineResult::fins).

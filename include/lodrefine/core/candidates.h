@@ -24,6 +24,9 @@ struct SupportPlane {
   Semantic sem = Semantic::Other;
   bool from_scan = false;  // an MLS facade plane (else a kept model plane)
   int source = -1;         // model surface or scan plane index
+  // What a face on it is (Face::provenance): the model's plane, the scan's (a facade, or a
+  // start plane a wall was moved onto), or a hypothesis (a step wall, a wall across a hole).
+  Provenance provenance = Provenance::Model;
 };
 
 // An oriented box: the region where candidates are generated.

@@ -26,7 +26,8 @@ struct RepairReport {
 // nothing usable remains (e.g. < 4 faces, or a non-closable shape). Face::sem and Face::source
 // are carried over; filled holes get Semantic::Ground if they are horizontal facing down,
 // Semantic::Roof if horizontal facing up, else the semantic of their neighbours (by shared edge
-// length). A hole planar within 2 cm becomes one face, a non-planar one is triangulated (noted).
+// length), and Provenance::Added (Face::provenance: the other faces keep theirs). A hole planar
+// within 2 cm becomes one face, a non-planar one is triangulated (noted).
 // Welding joins the closest pairs first: vertices of different faces within
 // max(weld_tolerance, gap_tolerance) (export gaps, jittered corners), two vertices of one face
 // only within weld_tolerance, so a face's own short edges never collapse.

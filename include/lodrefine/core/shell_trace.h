@@ -24,12 +24,12 @@ constexpr double kCollapsedEdge = 1e-3;
 
 // The polygon mesh of the candidates chosen in `cs.mesh`'s candidate_props::selected (bool, required: the
 // selection's answer, select_faces).
-// Per output face: the semantic of its supporting plane (CandidateSet::planes[].sem) and the
-// source in the face map candidate_props::source (int, optional: -1 without it); a merged polygon takes its
-// largest piece's. Vertex positions are CandidateSet::vertices (same frame). The mesh is
-// closed, 2-manifold and outward when the selection uses every edge 0 or 2 times and its
-// pieces meet only along edges; it is not validated here (validate_mesh).
-// Precondition: `cs` comes from build_candidates or kept_candidates (its mesh holds the faces).
+// Per output face: the semantic and provenance of its supporting plane (CandidateSet::planes[].sem,
+// .provenance) and the source in the face map candidate_props::source (int, optional: -1 without
+// it); a merged polygon takes its largest piece's. Vertex positions are CandidateSet::vertices (same frame). The mesh
+// is closed, 2-manifold and outward when the selection uses every edge 0 or 2 times and its pieces meet only along
+// edges; it is not validated here (validate_mesh). Precondition: `cs` comes from build_candidates or kept_candidates
+// (its mesh holds the faces).
 Mesh traced_shell(const CandidateSet& cs);
 
 }  // namespace lodrefine

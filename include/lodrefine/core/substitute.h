@@ -27,7 +27,7 @@ struct WallMove {
 struct SubstitutionResult {
   bool ok = false;
   std::string reason;  // why not, when !ok
-  Mesh mesh;           // the moved model (closed, same faces; split where needed)
+  Mesh mesh;           // the moved model (closed, same faces; split where needed); moved walls' faces Provenance::Scan
   int moved_vertices = 0;
   int split_faces = 0;         // faces that no longer were planar and were triangulated
   double max_vertex_move = 0;  // (m)

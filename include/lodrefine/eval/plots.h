@@ -37,7 +37,7 @@ struct MapOutline {
   std::string id;
   Outcome outcome = Outcome::Untouched;  // refined, repaired, kept, kept-invalid, untouched; any other as kept-invalid
   std::vector<std::vector<Vec2>> rings;
-  bool linked = false;  // a link to "#view-<id>" (its view on the same page)
+  std::string link;  // where a click on it leads (its view on the same page: "#view-..."); none when empty
 };
 
 // Top view of a district, north up, about `width` pixels wide: each outline filled by its

@@ -21,6 +21,10 @@
 
 namespace lodrefine {
 
+// The city file formats the city readers take (read_cityjson, read_citygml), as the commands'
+// help names them (one list: tests/app/test_help.cpp checks every command that reads one).
+inline const std::vector<std::string> kCityFormatNames = {"CityJSON", "CityJSONSeq", "CityGML"};
+
 struct CityJsonBuilding {
   Mesh mesh;                  // polygon soup, georeferenced, mesh.id = CityObject id; its fins last
   std::string type;           // "Building" or "BuildingPart"
@@ -37,6 +41,11 @@ struct CityJsonBuilding {
   int skipped_shells = 0;     // interior shells of solids, dropped
   nlohmann::json attributes;  // CityGML input: the object's attributes (CityJSON input keeps its own JSON)
 };
+
+// `b`'s soup without its fins (the last fin_faces faces): the shell its geometry holds, what is
+// validated as one solid. Fins are surfaces beside the solid (val3dity too checks a MultiSurface
+// apart from a Solid): validated with it, each would be open edges and a component of its own.
+Mesh solid_soup(const CityJsonBuilding& b);
 
 struct CityJsonFile {
   std::string format = "CityJSON";  // or "CityGML"

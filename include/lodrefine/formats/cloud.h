@@ -15,6 +15,10 @@ namespace lodrefine {
 
 enum class CloudFormat { Ply, Las };
 
+// The cloud formats read_cloud and stream_cloud take, as the commands' help names them (one
+// list: tests/app/test_help.cpp checks every command that reads a cloud names each).
+inline const std::vector<std::string> kCloudFormatNames = {"PLY", "LAS", "LAZ"};
+
 inline constexpr std::uint64_t kDefaultMaxPoints = 20000000;
 
 struct CloudOptions {

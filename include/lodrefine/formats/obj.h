@@ -12,7 +12,8 @@ namespace lodrefine {
 // Reads an OBJ polygon soup as exported per building from CityGML: `g WallSurface` /
 // `g RoofSurface` / `g GroundSurface` groups (also `usemtl`), polygons of 3+ vertices,
 // georeferenced doubles. Building id from `o NAME`, else a `# id: X` comment, else the file
-// stem. Faces are kept as given (no welding); Face::source is the face's index in the file.
+// stem. Faces are kept as given (no welding); Face::source is the face's index in the file, and
+// Face::provenance the one a group names (`g WallSurface scan`: provenance_from_group).
 Mesh read_obj(const std::string& path);
 // Same, also reporting how many `f` statements with fewer than 3 vertices were skipped (they
 // are no polygons and get no Face::source number; the file is rejected only when no face
@@ -41,12 +42,15 @@ Mesh read_obj(const std::string& path, std::vector<char>& in_fins);
 // part with only the vertices its faces use and the mesh's id.
 ObjModel split_fins(const Mesh& mesh, const std::vector<char>& in_fins);
 
-// Writes polygons grouped by semantic (`g WallSurface` ...), `o <id>`, vertices offset by
+// Writes polygons grouped by semantic (`g WallSurface` ...) and provenance (`g WallSurface scan`,
+// `g RoofSurface model`, `g WallSurface added`; a face without one in its semantic's plain group),
+// each scan face after a `# lodrefine_coverage 0.85` comment (Face::coverage), `o <id>`, vertices offset by
 // `origin` (the local frame's origin) and printed with enough digits for < 0.1 mm at 7-digit
 // magnitudes. Atomic (temp + rename). Throws std::runtime_error if the target is not writable.
 void write_obj(const std::string& path, const Mesh& mesh, const Vec3& origin = Vec3::Zero());
 // The same with `fins` (faces no solid holds, beside a repaired building's solid) after the
-// mesh's faces, in groups `g fins <semantic>` (kFinsGroup), so that readers tell them apart.
+// mesh's faces, in groups `g fins <semantic>` (kFinsGroup; with their provenance word as the
+// solid's: `g fins WallSurface model`), so that readers tell them apart.
 void write_obj(const std::string& path, const Mesh& mesh, const Mesh& fins, const Vec3& origin = Vec3::Zero());
 
 }  // namespace lodrefine

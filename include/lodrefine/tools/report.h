@@ -18,8 +18,12 @@ struct BuildingView {
   std::string footprint_svg;    // svg_footprint() of the building
   std::vector<float> original;  // triangles: x, y, z per corner
   std::vector<float> refined;   // idem (empty when nothing was written)
-  std::vector<float> points;    // scan points: x, y, z each
-  std::vector<float> c2m;       // signed C2M of each point to the refined model (m)
+  // Per refined triangle: its face's Provenance (0 none, 1 model, 2 scan, 3 added); the view
+  // colours the refined model by it when any is set.
+  std::vector<unsigned char> sources;
+  std::string outcome;        // the building's (outcome_name), for the page's filter; may be empty
+  std::vector<float> points;  // scan points: x, y, z each
+  std::vector<float> c2m;     // signed C2M of each point to the refined model (m)
 };
 
 // A view of `original` and `refined` (both local) with at most `max_points` of `points`, a
@@ -43,7 +47,15 @@ struct HtmlReport {
   nlohmann::json columns;           // [[key, heading], ...] of the building table
   nlohmann::json rows;              // one object per building, worst first
   std::vector<BuildingView> views;  // the buildings shown in 3D (a subset of rows)
+  // The filter by outcome above the table: a box per value of `filter` (the rows' "outcome"),
+  // ticked unless in `filter_off`; unticked, its rows and views are hidden. None when empty.
+  std::vector<std::string> filter, filter_off;
 };
+
+// The id of the element holding `id`'s view ("view-" and the id, every byte but ASCII letters,
+// digits, '.' and '-' as "_" and two hex digits): a link "#" + view_anchor(id) reaches it whatever
+// the id holds.
+std::string view_anchor(const std::string& id);
 
 // The page (ids, captions and cells escaped, JSON inside <script> made safe: "</", "<!--",
 // U+2028/9 escaped, bytes that are not UTF-8 replaced); the embedded three.js ES module (three_module_js()) renders the

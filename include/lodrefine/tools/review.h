@@ -1,8 +1,10 @@
 // The review page of a city refine (`refine --model CITY ... --html`): one self-contained page
 // (html_report()'s machinery, three.js embedded) with the city summary, the buildings the cloud
-// reached worst first, a 2D map of the district, and a 3D view of each refined building, coarse
-// vs refined over its scan points coloured by their distance to the refined model.
-// Plain data in: the caller collects it while refining (only refined buildings carry a view).
+// worst first (a filter by outcome; the untouched hidden at first), a 2D map of the district
+// whose refined and repaired buildings link to their 3D view, coarse vs written over its scan
+// points coloured by their distance to it, the written faces by provenance.
+// Plain data in: the caller collects it while refining (only refined and repaired buildings
+// carry a view).
 #pragma once
 #include <cmath>
 #include <optional>
@@ -25,7 +27,7 @@ struct CityReviewBuilding {
   std::optional<double> fit_before,
       fit_after;  // RMS distance of the scan points near the building, as the judge measured them (m)
   std::vector<std::vector<Vec2>> outline;  // XY rings in the district frame (review_outline())
-  std::optional<BuildingView> view;        // refined buildings (review_view())
+  std::optional<BuildingView> view;        // refined and repaired buildings (review_view())
 };
 
 struct CityReview {
@@ -46,9 +48,10 @@ std::vector<std::vector<Vec2>> review_outline(const Mesh& model, const Vec3& ori
 BuildingView review_view(const std::string& id, const Mesh& coarse, const Mesh& refined,
                          const std::vector<Vec3>& points, std::size_t max_points);
 
-// The page. Ids, reasons and captions are escaped (ids may be hostile); the table lists the
-// buildings the cloud reached (not the untouched ones): kept-invalid, kept, repaired, then refined, each
-// by fit after refinement, worst first.
+// The page. Ids, reasons and captions are escaped (ids may be hostile), reasons shown without
+// the building's id; the table lists every building: kept-invalid, kept, repaired, refined, then
+// untouched (hidden until its box of the filter is ticked), each by fit after refinement, worst
+// first.
 std::string city_review_html(const CityReview& review);
 
 }  // namespace lodrefine
