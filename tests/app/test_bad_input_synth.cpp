@@ -286,8 +286,9 @@ TEST(BadInputSynth, RescanMemoryDoesNotGrowWithTheTile) {
 TEST(BadInputSynth, AKilledRescanLeavesNoEmptyFolders) {
   const std::string dir = temp_dir("synth_rescan_killed");
   const std::string tile = rescan_fixtures::write_row_tile(dir + "/in", 2);
-  const std::string cmd = "timeout -s KILL 1 " + shell_quote(test_paths::lodrefine_binary()) + " synth --scanner van --rescan " +
-                          tile + " --van-drives 8 --van-rate 200 --out " + dir + "/out >/dev/null 2>&1";
+  const std::string cmd = "timeout -s KILL 1 " + shell_quote(test_paths::lodrefine_binary()) +
+                          " synth --scanner van --rescan " + tile + " --van-drives 8 --van-rate 200 --out " + dir +
+                          "/out >/dev/null 2>&1";
   const int st = std::system(cmd.c_str());
   ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 137) << "killed while the van scans (the first building takes 5 s)";
   EXPECT_EQ(empty_folders(dir + "/out"), std::vector<std::string>{});

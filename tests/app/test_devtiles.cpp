@@ -22,8 +22,8 @@
 #include "lodrefine/formats/ply.h"
 #include "support/cli_fixtures.h"
 #include "support/fins_fixtures.h"
-#include "support/test_paths.h"
 #include "support/schema_fixtures.h"
+#include "support/test_paths.h"
 
 using namespace lodrefine;
 
