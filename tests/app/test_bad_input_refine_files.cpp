@@ -262,7 +262,8 @@ TEST(BadInputAttack, OutcomeLineEscapesCarriageReturns) {
       run_cli("refine --model " + dir + "/model.obj --cloud " + dir + "/cloud.ply --out " + dir + "/out.obj", dir);
   EXPECT_EQ(r.exit, 0) << r.err;
   EXPECT_EQ(r.out.find('\r'), std::string::npos) << r.out;
-  EXPECT_EQ(r.out.rfind("ok\\rFAKE: refined (all good): ", 0), 0u) << r.out;
+  // No plain name: shown quoted, its CR escaped (line_id).
+  EXPECT_EQ(r.out.rfind("\"ok\\rFAKE: refined (all good)\": ", 0), 0u) << r.out;
   add_row("OBJ name with a CR (`o ok\\rFAKE: refined`)", "escaped in the outcome line", r.exit);
 }
 
