@@ -71,13 +71,14 @@ const json kColumns = json::array({{"id", "building"},
                                    {"fit_after", "fit after (m)"}});
 
 // A building's reason without its id, which the page shows beside it: a leading "building <id>: "
-// or "<id>: " dropped, "building <id>" as "building", the id quoted dropped.
+// or "<id>: " dropped (as line_id shows it), "building <id>" as "building", the id quoted (as
+// shown_id quotes it, cut past 80 bytes) dropped.
 std::string without_id(const std::string& id, std::string reason) {
   if (id.empty()) return reason;
   for (const std::string& lead : {"building " + line_id(id) + ": ", line_id(id) + ": "})
     if (reason.rfind(lead, 0) == 0) reason.erase(0, lead.size());
   for (const auto& [from, to] : {std::pair<std::string, std::string>{" '" + id + "'", ""},
-                                 {" \"" + id + "\"", ""},
+                                 {" " + shown_id(id), ""},
                                  {"building " + id, "building"}})
     for (std::size_t at = reason.find(from); at != std::string::npos; at = reason.find(from, at + to.size()))
       reason.replace(at, from.size(), to);
