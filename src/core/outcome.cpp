@@ -14,6 +14,19 @@ const char* outcome_name(Outcome outcome) {
   return "?";
 }
 
+Outcome decide_outcome(const OutcomeFacts& facts) {
+  switch (facts.ending) {
+    case Ending::Untouched: return Outcome::Untouched;
+    case Ending::NoModel: return Outcome::Failed;
+    case Ending::AsRead: return Outcome::KeptInvalid;
+    case Ending::Refined:
+    case Ending::Kept: break;
+  }
+  if (!facts.valid) return Outcome::KeptInvalid;  // no output is written that does not validate
+  if (facts.ending == Ending::Refined) return Outcome::Refined;
+  return facts.mended ? Outcome::Repaired : Outcome::Kept;
+}
+
 std::optional<Outcome> parse_outcome(const std::string& name) {
   for (Outcome o :
        {Outcome::Refined, Outcome::Kept, Outcome::Repaired, Outcome::KeptInvalid, Outcome::Untouched, Outcome::Failed})

@@ -10,6 +10,7 @@
 
 #include "lodrefine/core/corners.h"
 #include "lodrefine/core/distance.h"
+#include "lodrefine/core/move_plan.h"
 #include "lodrefine/core/provenance.h"
 #include "lodrefine/core/shell_rebuild.h"
 #include "lodrefine/core/shell_selection.h"
@@ -25,20 +26,28 @@ constexpr double kOriginGrid = 100.0;
 // steps (the same wall re-found after another moved has the same position within rounding).
 constexpr double kPositionSteps = 100.0;
 
-// A moved wall for the report, on the mesh (and its surfaces) the move was made on.
-RefineTrace::FacadeMove describe_move(const Mesh& mesh, const std::vector<ModelSurface>& surfaces, const WallMove& move,
-                                      const char* evidence) {
+// What moved a wall: the scan's plane in front of it, or the scan's corner beside it.
+enum class Evidence { Scan, Corner };
+
+// A wall the starting shell moved, on the mesh (and its surfaces) the move was made on: handed to
+// the judge in `moved` (scan_surface: SubstitutedWall's) and recorded in the trace's facades.
+SubstitutedWall& add_moved(const Mesh& mesh, const std::vector<ModelSurface>& surfaces, const WallMove& move,
+                           Evidence evidence, int scan_surface, std::vector<SubstitutedWall>& moved,
+                           RefineTrace& trace) {
   const ModelSurface& s = surfaces[move.surface];
   RefineTrace::FacadeMove d;
   for (int f : s.faces) d.input_faces.insert(mesh.faces[f].source);
-  d.evidence = evidence;
+  d.evidence = evidence == Evidence::Corner ? "corner" : "scan";
   d.max_move = surface_deviation(mesh, s, move.plane);
   d.mean_move = surface_mean_deviation(mesh, s, move.plane);
-  for (int f : s.faces) d.wall.polygons.push_back(face_points(mesh, mesh.faces[f]));
-  d.wall.from = s.plane;
-  d.wall.to = move.plane;
-  d.wall.corner = d.evidence == "corner";
-  return d;
+  trace.facades.push_back(std::move(d));
+  SubstitutedWall& w = moved.emplace_back();
+  for (int f : s.faces) w.wall.polygons.push_back(face_points(mesh, mesh.faces[f]));
+  w.wall.from = s.plane;
+  w.wall.to = move.plane;
+  w.wall.corner = evidence == Evidence::Corner;
+  w.scan_surface = scan_surface;
+  return w;
 }
 
 // Substitution on `mesh`, merged and validated; `attempt` says what happened.
@@ -68,9 +77,10 @@ std::optional<Mesh> substitute_valid(const Mesh& mesh, const std::vector<ModelSu
 
 // The starting shell's fallback: one wall at a time, the best-matching outdated one first, each
 // by substitution, re-matching on the new model after each. Returns the model once any wall
-// moved.
+// moved; the walls moved go to `moved`.
 std::optional<Mesh> one_wall_at_a_time(const Mesh& start, const PointCloud& local, const std::vector<ScanPlane>& planes,
-                                       const RefineConfig& prm, RefineTrace& trace) {
+                                       const RefineConfig& prm, std::vector<SubstitutedWall>& moved,
+                                       RefineTrace& trace) {
   // Each (scan plane, wall position) is tried once: a wall that would not move is not retried,
   // and the loop ends even when moves undo each other.
   const int max_steps = 4 * int(planes.size()) + 4;
@@ -107,7 +117,7 @@ std::optional<Mesh> one_wall_at_a_time(const Mesh& start, const PointCloud& loca
     if (!m) step.reason = attempt.reason;
     steps.push_back(step);
     if (m) {
-      trace.facades.push_back(describe_move(step_mesh, ss, {next->surface, plane}, "scan"));
+      add_moved(step_mesh, ss, {next->surface, plane}, Evidence::Scan, -1, moved, trace);
       step_mesh = std::move(*m);
       step_mesh.id = start.id;
       any = true;
@@ -133,7 +143,8 @@ std::string rebuild_summary(const ShellRebuild& rb) {
   return out;
 }
 
-// One building's refinement under way: the result being filled, its local frame and the stage timer.
+// One building's refinement under way: the result being filled, its local frame, the input as
+// read in it, its rebuild's fins (when the input was rebuilt) and the stage timer.
 class Refinement {
  public:
   Refinement(const Mesh& model, double planarity_tolerance) : planarity_tolerance_(planarity_tolerance) {
@@ -141,29 +152,45 @@ class Refinement {
     origin_ = local_origin(model);
     out_.trace.origin = origin_;
     id_ = model.id;
+    as_read_ = translated(model, -origin_);
   }
   const Vec3& origin() const { return origin_; }
+  const Mesh& as_read() const { return as_read_; }  // the input in the local frame
   RefineTrace& trace() { return out_.trace; }
+  // The input was no valid solid and was rebuilt on its planes (`summary`: rebuild_summary);
+  // `fins` stand beside the shell.
+  void rebuilt(Mesh fins, std::string summary) {
+    fins_ = std::move(fins);
+    rebuild_summary_ = std::move(summary);
+  }
+  const std::optional<Mesh>& fins() const { return fins_; }  // set once rebuilt
   // Records the time since the last lap as `stage`'s.
   void lap(RefineStage stage) {
     out_.trace.seconds.emplace_back(stage_name(stage), seconds_since(t_));
     t_ = Clock::now();
   }
-  // The result: `local_mesh` validated and written back in the input frame.
-  RefineResult finish(Outcome outcome, const std::string& reason, const Mesh& local_mesh, bool single_shell = true) {
-    const bool repaired = outcome == Outcome::Kept && out_.trace.rebuild && out_.trace.rebuild->ok;
-    out_.outcome = repaired ? Outcome::Repaired : outcome;
-    out_.reason = repaired ? rebuild_summary(*out_.trace.rebuild) + "; " + reason : reason;
+  // The result: `local_mesh` validated, its outcome decided (decide_outcome: an output that does
+  // not validate gives way to the input as read), written back in the input frame.
+  RefineResult finish(Ending ending, const std::string& reason, const Mesh& local_mesh, bool single_shell = true) {
     RefineTrace& trace = out_.trace;
     trace.output_validation = validate_mesh(local_mesh, planarity_tolerance_, true, single_shell);
+    const bool mended = fins_.has_value();
+    out_.outcome = decide_outcome({ending, mended, trace.output_validation.valid()});
+    out_.reason = ending == Ending::Kept && mended ? rebuild_summary_ + "; " + reason : reason;
+    const bool refused = out_.outcome == Outcome::KeptInvalid && ending != Ending::AsRead;
+    if (refused) {
+      out_.reason += " (not valid: " + trace.output_validation.problem + ")";
+      trace.output_validation = validate_mesh(as_read_, planarity_tolerance_, true, single_shell);
+    }
+    const Mesh& written = refused ? as_read_ : local_mesh;
     out_.valid = trace.output_validation.valid();
-    trace.faces = local_mesh.faces.size();
+    trace.faces = written.faces.size();
     lap(RefineStage::Validation);
     trace.seconds.emplace_back("total", seconds_since(t_start_));
-    out_.mesh = translated(local_mesh, origin_);
+    out_.mesh = translated(written, origin_);
     out_.mesh.id = id_;
-    if (out_.trace.rebuild && out_.trace.rebuild->ok && out_.outcome != Outcome::KeptInvalid) {
-      out_.fins = translated(out_.trace.rebuild->fins, origin_);
+    if (fins_ && out_.outcome != Outcome::KeptInvalid) {
+      out_.fins = translated(*fins_, origin_);
       out_.fins.id = id_;
     }
     if (out_.outcome == Outcome::Refined || out_.outcome == Outcome::Repaired) {  // written: each face says whence
@@ -177,6 +204,9 @@ class Refinement {
   RefineResult out_;
   Vec3 origin_;
   std::string id_;
+  Mesh as_read_;
+  std::optional<Mesh> fins_;
+  std::string rebuild_summary_;
   double planarity_tolerance_;
   Clock::time_point t_start_ = Clock::now(), t_ = t_start_;
 };
@@ -191,7 +221,7 @@ std::optional<RefineResult> repair_or_stop(const Mesh& local_model, const Refine
   RefineTrace& trace = refinement.trace();
   if (const std::string too_large = size_problem(local_model); !too_large.empty()) {
     refinement.lap(RefineStage::Repair);
-    return refinement.finish(Outcome::KeptInvalid, too_large, local_model);
+    return refinement.finish(Ending::AsRead, too_large, local_model);
   }
   std::string invalid;
   try {
@@ -207,7 +237,7 @@ std::optional<RefineResult> repair_or_stop(const Mesh& local_model, const Refine
     }
     if (v0.components > 1 && validate_mesh(kept, cfg.repair.planarity_tolerance, true, false).valid()) {
       refinement.lap(RefineStage::Repair);
-      return refinement.finish(Outcome::Kept, std::to_string(v0.components) + " separate closed shells: kept whole",
+      return refinement.finish(Ending::Kept, std::to_string(v0.components) + " separate closed shells: kept whole",
                                kept, false);
     }
     invalid = "the input is no valid solid: " + v0.problem;
@@ -245,18 +275,21 @@ std::optional<RefineResult> repair_or_stop(const Mesh& local_model, const Refine
   }
   Mesh rebuilt = std::move(rb.mesh);
   rb.mesh = Mesh();  // the trace keeps the figures; the shell goes on as `kept`
+  if (rb.ok) refinement.rebuilt(rb.fins, rebuild_summary(rb));
   trace.rebuild = rb;
-  if (!rb.ok) return refinement.finish(Outcome::KeptInvalid, invalid + "; not rebuilt: " + rb.reason, local_model);
+  if (!rb.ok) return refinement.finish(Ending::AsRead, invalid + "; not rebuilt: " + rb.reason, local_model);
   kept = std::move(rebuilt);
   kept.id = local_model.id;
   return std::nullopt;
 }
 
 // The walls the scan sees, each on its scan plane (oriented like the wall), and of those the
-// outdated ones (off their plane by more than change_tolerance) as moves; recorded in the trace.
-void outdated_walls(const Mesh& current, const std::vector<ModelSurface>& surfaces, const MatchResult& mr,
-                    const std::vector<ScanPlane>& planes, const PointCloud& local, const MatchConfig& cfg,
-                    RefineTrace& trace, std::vector<WallMove>& moves, std::vector<ScannedWall>& scanned) {
+// outdated ones (off their plane by more than change_tolerance) as the plan's scan moves (on
+// plan.surfaces); recorded in the trace.
+void outdated_walls(const Mesh& current, const MatchResult& mr, const std::vector<ScanPlane>& planes,
+                    const PointCloud& local, const MatchConfig& cfg, RefineTrace& trace, MovePlan& plan,
+                    std::vector<ScannedWall>& scanned) {
+  const std::vector<ModelSurface>& surfaces = plan.surfaces;
   RefineTrace::Matching& matching = trace.matching.emplace(RefineTrace::Matching{});
   for (const auto& m : mr.matches) {
     Plane pl = planes[m.scan_plane].plane;
@@ -264,45 +297,41 @@ void outdated_walls(const Mesh& current, const std::vector<ModelSurface>& surfac
     scanned.push_back({m.surface, m.scan_plane, pl});
     const double dev = surface_deviation(current, surfaces[m.surface], pl);
     if (dev > cfg.change_tolerance)
-      moves.push_back({m.surface, pl, eave_follows_roof(current, surfaces, m, pl, local)});
+      plan.scan.push_back({m.surface, pl, eave_follows_roof(current, surfaces, m, pl, local)});
     matching.walls.push_back({m, dev, surfaces[m.surface].faces});
   }
   matching.rejected = mr.rejected;
   matching.q_model = mr.q_model;
 }
 
-// The starting shell: every outdated wall takes its scan plane at once, the model's topology
-// kept (without the corner moves if those spoil it; else one wall at a time); none when no
-// wall is outdated or none could be moved. The moved walls go to trace.facades.
-std::optional<Mesh> starting_shell(const Mesh& current, const std::vector<ModelSurface>& surfaces,
-                                   const std::vector<WallMove>& moves, const std::vector<CornerMove>& corners,
-                                   const PointCloud& local, const std::vector<ScanPlane>& planes,
-                                   const RefineConfig& prm, RefineTrace& trace) {
-  std::vector<WallMove> all = moves;
-  for (const auto& c : corners) all.push_back(c.move);
+// The starting shell: every move of the plan at once, the model's topology kept (without the
+// corner moves if those spoil it; else one wall at a time); none when no wall is outdated or none
+// could be moved. The walls it moved go to plan.moved (and the trace's facades).
+std::optional<Mesh> starting_shell(const Mesh& current, MovePlan& plan, const PointCloud& local,
+                                   const std::vector<ScanPlane>& planes, const RefineConfig& prm, RefineTrace& trace) {
+  plan.moved.clear();
+  std::vector<WallMove> all = plan.scan;
+  for (const auto& c : plan.corners) all.push_back(c.move);
   std::optional<Mesh> refined;
   if (!all.empty())
-    refined =
-        substitute_valid(current, surfaces, all, prm.repair, trace.substitution.emplace(RefineTrace::Substitution{}));
-  auto describe_scan_moves = [&] {
-    for (const auto& mv : moves) {
-      trace.facades.push_back(describe_move(current, surfaces, mv, "scan"));
-      trace.facades.back().surface = mv.surface;
-    }
+    refined = substitute_valid(current, plan.surfaces, all, prm.repair,
+                               trace.substitution.emplace(RefineTrace::Substitution{}));
+  auto add_scan_moves = [&] {
+    for (const auto& mv : plan.scan)
+      add_moved(current, plan.surfaces, mv, Evidence::Scan, mv.surface, plan.moved, trace);
   };
   if (refined) {
-    describe_scan_moves();
-    for (const auto& c : corners) {
-      trace.facades.push_back(describe_move(current, surfaces, c.move, "corner"));
-      trace.facades.back().wall.flush_facade = c.flush_facade;
-    }
-  } else if (!corners.empty() && !moves.empty()) {
-    refined = substitute_valid(current, surfaces, moves, prm.repair,
+    add_scan_moves();
+    for (const auto& c : plan.corners)
+      add_moved(current, plan.surfaces, c.move, Evidence::Corner, -1, plan.moved, trace).wall.flush_facade =
+          c.flush_facade;
+  } else if (!plan.corners.empty() && !plan.scan.empty()) {
+    refined = substitute_valid(current, plan.surfaces, plan.scan, prm.repair,
                                trace.substitution_without_corners.emplace(RefineTrace::Substitution{}));
-    if (refined) describe_scan_moves();
+    if (refined) add_scan_moves();
   }
   trace.replacements.emplace();
-  if (!refined && !all.empty()) refined = one_wall_at_a_time(current, local, planes, prm, trace);
+  if (!refined && !all.empty()) refined = one_wall_at_a_time(current, local, planes, prm, plan.moved, trace);
   return refined;
 }
 
@@ -330,42 +359,41 @@ std::string kept_by_selection(const ShellSelectionStats& stats, bool any_match) 
 
 // The selection decides every face: the candidate arrangement over the starting shell's planes
 // and the scan's facades, the starting shell as GLPK's first incumbent (without a substitution,
-// with the outdated walls `moves` on their scan planes: select_shell's `outdated`). The result is
-// written only when it is never worse, on every scan point near the building and on each moved
-// wall's own points (judge.h).
+// with the plan's scan moves on their scan planes: select_shell's `outdated`). The result is
+// written only when it is never worse, on every scan point near the building and on each wall
+// the starting shell moved (plan.moved), on its own points (judge.h); `verdict` is the judge's,
+// when it judged.
 RefineResult select_and_judge(const Mesh& kept, const Mesh& current, const std::optional<Mesh>& refined, bool any_match,
-                              const std::vector<WallMove>& moves, const PointCloud& local,
-                              const std::vector<ScanPlane>& planes, const RefineConfig& prm, Refinement& refinement) {
+                              const MovePlan& plan, const PointCloud& local, const std::vector<ScanPlane>& planes,
+                              const RefineConfig& prm, Refinement& refinement, std::optional<Judgement>& verdict) {
   RefineTrace& trace = refinement.trace();
   const ShellSelection chosen =
-      refined ? select_shell(*refined, local, planes, prm) : select_shell(current, local, planes, prm, moves);
+      refined ? select_shell(*refined, local, planes, prm) : select_shell(current, local, planes, prm, plan);
   trace.selection = chosen.stats;
   trace.selection_reason = chosen.reason;
   refinement.lap(RefineStage::Selection);
   // A search that ends with no shell falls back to the best shell known: the substitution's.
   if (!chosen.ok && !refined)
-    return refinement.finish(Outcome::Kept, "the selection found no valid shell: " + chosen.reason, kept);
+    return refinement.finish(Ending::Kept, "the selection found no valid shell: " + chosen.reason, kept);
   const Mesh& shell = chosen.ok ? chosen.mesh : *refined;
   if (chosen.ok && !refined && chosen.stats.candidates_changed == 0) {
     trace.facades.clear();
-    return refinement.finish(Outcome::Kept, kept_by_selection(chosen.stats, any_match), kept);
+    return refinement.finish(Ending::Kept, kept_by_selection(chosen.stats, any_match), kept);
   }
-  std::vector<JudgedWall> moved;
-  for (const auto& f : trace.facades) moved.push_back(f.wall);
-  const Judgement& verdict = trace.judgement.emplace(
-      judge_refinement(kept, shell, moved, local, prm.match, prm.plane, planes, prm.scan_reach()));
+  verdict = judge_refinement(kept, shell, judged_walls(plan), local, prm.match, prm.plane, planes, prm.scan_reach());
+  trace.judgement = verdict;
   refinement.lap(RefineStage::Judge);
-  if (!verdict.ok) return refinement.finish(Outcome::Kept, "not written: never worse, " + verdict.refusal(), kept);
-  if (trace.rebuild && !fins_stay_on(trace.rebuild->fins, kept, shell, prm.repair.weld_tolerance))
-    return refinement.finish(Outcome::Kept, "not written: a fin beside the shell would stand apart from it", kept);
-  const std::string moved_walls = std::to_string(trace.facades.size()) + " wall(s) moved";
+  if (!verdict->ok) return refinement.finish(Ending::Kept, "not written: never worse, " + verdict->refusal(), kept);
+  if (refinement.fins() && !fins_stay_on(*refinement.fins(), kept, shell, prm.repair.weld_tolerance))
+    return refinement.finish(Ending::Kept, "not written: a fin beside the shell would stand apart from it", kept);
+  const std::string moved_walls = std::to_string(plan.moved.size()) + " wall(s) moved";
   Mesh written = shell;
   measure_coverage(written, local, planes, prm);
   if (!chosen.ok)
     return refinement.finish(
-        Outcome::Refined, moved_walls + " by substitution (the selection found no valid shell: " + chosen.reason + ")",
+        Ending::Refined, moved_walls + " by substitution (the selection found no valid shell: " + chosen.reason + ")",
         written);
-  return refinement.finish(Outcome::Refined,
+  return refinement.finish(Ending::Refined,
                            std::to_string(chosen.stats.faces_from_selection) + " face(s) selected, " + moved_walls,
                            written);
 }
@@ -432,9 +460,8 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const R
   prm.validate();
   Refinement refinement(model, prm.repair.planarity_tolerance);
   RefineTrace& trace = refinement.trace();
-  const Mesh local_model = translated(model, -refinement.origin());
   Mesh kept;
-  if (auto stopped = repair_or_stop(local_model, prm, refinement, kept)) return *stopped;
+  if (auto stopped = repair_or_stop(refinement.as_read(), prm, refinement, kept)) return *stopped;
   Mesh current = merge_coplanar_faces(kept);
   current.id = model.id;
 
@@ -446,54 +473,54 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const R
   trace.scan = scan_summary(planes, relief, local.points.size());
   refinement.lap(RefineStage::Planes);
   trace.planes = planes;
-  if (planes.empty()) return refinement.finish(Outcome::Kept, "no planes found in the cloud near the model", kept);
+  if (planes.empty()) return refinement.finish(Ending::Kept, "no planes found in the cloud near the model", kept);
 
   // Matching on the input: which walls the scan sees, where, and by which points; the outdated
   // ones move onto their planes, and unscanned walls at a scanned facade's end to where the
-  // scan shows the corner.
-  const auto surfaces = model_surfaces(current);
-  const MatchResult mr = match_surfaces(current, surfaces, local, planes, prm.match);
-  std::vector<WallMove> moves;
+  // scan shows the corner. The plan carries them to the later stages (move_plan.h).
+  MovePlan plan;
+  plan.surfaces = model_surfaces(current);
+  const MatchResult mr = match_surfaces(current, plan.surfaces, local, planes, prm.match);
   std::vector<ScannedWall> scanned;
-  outdated_walls(current, surfaces, mr, planes, local, prm.match, trace, moves, scanned);
-  const auto corners = corner_moves(current, surfaces, scanned, local, planes, prm.match, prm.plane);
+  outdated_walls(current, mr, planes, local, prm.match, trace, plan, scanned);
+  plan.corners = corner_moves(current, plan.surfaces, scanned, local, planes, prm.match, prm.plane);
   refinement.lap(RefineStage::Matching);
 
   // The corners are the least certain evidence: a refinement the judge refuses with them is
   // tried once more on the walls' own points alone.
-  auto attempt = [&](const std::vector<CornerMove>& with_corners) {
+  std::optional<Judgement> verdict;
+  auto attempt = [&] {
     trace.facades.clear();
     trace.substitution.reset();
     trace.substitution_without_corners.reset();
-    const std::optional<Mesh> refined =
-        starting_shell(current, surfaces, moves, with_corners, local, planes, prm, trace);
+    const std::optional<Mesh> refined = starting_shell(current, plan, local, planes, prm, trace);
     refinement.lap(RefineStage::Substitution);
-    return select_and_judge(kept, current, refined, !mr.matches.empty(), moves, local, planes, prm, refinement);
+    return select_and_judge(kept, current, refined, !mr.matches.empty(), plan, local, planes, prm, refinement, verdict);
   };
-  RefineResult result = attempt(corners);
-  auto refused = [&] { return trace.judgement && !trace.judgement->ok; };
-  auto again = [&](const std::vector<CornerMove>& with_corners) {
+  RefineResult result = attempt();
+  auto refused = [&] { return verdict && !verdict->ok; };
+  auto again = [&] {
+    verdict.reset();
     trace.judgement.reset();
     trace.seconds.pop_back();  // the last attempt's total; its other laps add up in the report
-    return attempt(with_corners);
+    return attempt();
   };
-  std::vector<CornerMove> kept_corners = corners;
-  if (!corners.empty() && refused()) {
-    trace.corners_refused = trace.judgement->refusal();
-    kept_corners.clear();
-    result = again(kept_corners);
+  if (!plan.corners.empty() && refused()) {
+    trace.corners_refused = verdict->refusal();
+    plan.corners.clear();
+    result = again();
   }
   // A scan move whose own wall the judge refuses (its points got farther, or it has none: a
   // plane matched that is not the wall's) says nothing of the other walls: it is dropped and the
   // building refined again on theirs.
-  while (refused() && trace.judgement->check == JudgeCheck::Wall) {
-    const RefineTrace::FacadeMove& wall = trace.facades[std::size_t(trace.judgement->wall)];
+  while (refused() && verdict->check == JudgeCheck::Wall) {
+    const int surface = plan.moved[std::size_t(verdict->wall)].scan_surface;
     const auto dropped =
-        std::remove_if(moves.begin(), moves.end(), [&](const WallMove& m) { return m.surface == wall.surface; });
-    if (wall.surface < 0 || dropped == moves.end()) break;
-    moves.erase(dropped, moves.end());
-    trace.walls_refused.push_back(trace.judgement->refusal());
-    result = again(kept_corners);
+        std::remove_if(plan.scan.begin(), plan.scan.end(), [&](const WallMove& m) { return m.surface == surface; });
+    if (surface < 0 || dropped == plan.scan.end()) break;
+    plan.scan.erase(dropped, plan.scan.end());
+    trace.walls_refused.push_back(verdict->refusal());
+    result = again();
   }
   return result;
 }

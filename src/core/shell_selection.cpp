@@ -160,12 +160,12 @@ int carrying_plane(const Supports& s, const Plane& plane, const Vec3& at, int se
 // plane those within its outline off, on the plane carrying its scan plane those within the same
 // outline on (by centroid). Not closed: the strips between the two planes are left to
 // nearest_closed_selection. False when a wall's scan plane carries no supporting plane.
-bool swap_onto_scan_planes(const CandidateSet& cs, const Mesh& start, const Supports& s,
-                           const std::vector<WallMove>& outdated, const SelectionConfig& prm, std::vector<char>& sel) {
-  const auto surfaces = model_surfaces(start);
+bool swap_onto_scan_planes(const CandidateSet& cs, const Mesh& start, const Supports& s, const MovePlan& outdated,
+                           const SelectionConfig& prm, std::vector<char>& sel) {
+  const std::vector<ModelSurface>& surfaces = outdated.surfaces;
   const auto support = cs.supports();
   const auto centroid = cs.centroids();
-  for (const WallMove& mv : outdated) {
+  for (const WallMove& mv : outdated.scan) {
     if (mv.surface < 0 || mv.surface >= int(surfaces.size())) return false;
     const ModelSurface& wall = surfaces[std::size_t(mv.surface)];
     const int from = s.face_plane[std::size_t(wall.faces.front())];
@@ -197,7 +197,7 @@ bool swap_onto_scan_planes(const CandidateSet& cs, const Mesh& start, const Supp
 // their scan planes, closed by the nearest closed selection; `base` itself when that fails or
 // changes a candidate `pg` fixes.
 std::vector<char> warm_with_walls_moved(CandidateSet& cs, const SelectionProgram& pg, const std::vector<char>& base,
-                                        const Mesh& start, const Supports& s, const std::vector<WallMove>& outdated,
+                                        const Mesh& start, const Supports& s, const MovePlan& outdated,
                                         const SelectionConfig& prm) {
   std::vector<char> swapped = base;
   if (!swap_onto_scan_planes(cs, start, s, outdated, prm, swapped)) return base;
@@ -305,7 +305,7 @@ Pruned pruned(CandidateSet& all, const FaceProps& all_props, const std::vector<c
 std::optional<ShellSelection> select_shell_joining_slivers(const Mesh& start, const PointCloud& cloud,
                                                            const std::vector<ScanPlane>& planes,
                                                            const RefineConfig& prm, double sliver_tolerance,
-                                                           const std::vector<WallMove>& outdated) {
+                                                           const MovePlan& outdated) {
   const auto t0 = Clock::now();
   ShellSelection out;
   auto& st = out.stats;
@@ -345,7 +345,7 @@ std::optional<ShellSelection> select_shell_joining_slivers(const Mesh& start, co
   const EvidenceReach evidence(reach_of);
   if (!warm.empty()) {
     for (int f : beyond_evidence(cs, evidence)) pg.fixed[f] = int(base[f]);
-    if (!outdated.empty()) pg.warm = warm_with_walls_moved(cs, pg, base, start, s, outdated, prm.selection);
+    if (!outdated.scan.empty()) pg.warm = warm_with_walls_moved(cs, pg, base, start, s, outdated, prm.selection);
     pg.warm = improved_by_neighbourhoods(cs, pg, s, prm.selection, st.neighbourhoods_improved);
   }
   std::string problem;
@@ -386,7 +386,7 @@ std::optional<ShellSelection> select_shell_joining_slivers(const Mesh& start, co
 }  // namespace
 
 ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
-                            const RefineConfig& prm, const std::vector<WallMove>& outdated) {
+                            const RefineConfig& prm, const MovePlan& outdated) {
   if (auto joined = select_shell_joining_slivers(start, cloud, planes, prm, prm.repair.planarity_tolerance, outdated))
     return *joined;
   return *select_shell_joining_slivers(start, cloud, planes, prm, -1.0, outdated);  // no slivers: always one

@@ -295,3 +295,27 @@ TEST(ShellSelection, MovesWallsWhenTheBudgetEndsTheSearchAtTheRoot) {
     EXPECT_NEAR(v.volume, 480.0, 1e-6) << "budget " << budget;  // the start: 11.6 x 9.6 x 6 = 668.16
   }
 }
+
+// The matching's plan hands the selection its outdated walls (move_plan.h): each scan move names
+// its wall by the plan's surfaces (select_shell no longer derives them again), GLPK's first
+// incumbent has that wall on its scan plane, and the selection ends with it there.
+TEST(ShellSelection, TakesThePlansScanMovesByThePlansSurfaces) {
+  const Mesh start = box({0, 0, 0}, {10, 8, 6});
+  Scan s;
+  s.planes.push_back(grid_scan_plane(s.cloud, wall_patch({0, -0.8, 0}, Vec3::UnitX(), 10.0, 0.0, 6.0), kStep));
+  MovePlan plan;
+  plan.surfaces = model_surfaces(start);
+  for (int i = 0; i < int(plan.surfaces.size()); ++i)
+    if (plan.surfaces[std::size_t(i)].plane.n.y() < -0.99) {
+      Plane to = s.planes.front().plane;
+      if (to.n.dot(plan.surfaces[std::size_t(i)].plane.n) < 0) to = to.flipped();
+      plan.scan.push_back({i, to});
+    }
+  ASSERT_EQ(plan.scan.size(), 1u);
+  RefineConfig prm;
+  prm.selection.mip_work_limit = 0.001;
+  const ShellSelection r = select_shell(start, s.cloud, s.planes, prm, plan);
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_TRUE(r.stats.selection.warm_given && r.stats.selection.warm_feasible) << r.stats.selection.warm_text();
+  EXPECT_NEAR(validate_mesh(r.mesh, prm.repair.planarity_tolerance).volume, 10 * 8.8 * 6, 1e-6);
+}

@@ -1,6 +1,8 @@
-// What became of one building, as refine_building decides it (refine.h) and as the city
-// refine, the evaluation and the gate read it back from reports: one enum, named only where
-// written (outcome_name) and checked where read (parse_outcome).
+// What became of one building, decided once (decide_outcome) by refine_building (refine.h), and
+// by the city refine and the evaluation only for what the core cannot know (a building no scan
+// point reaches, a run's building with no model); the city refine, the evaluation and the gate
+// report it and read it back from reports: one enum, named only where written (outcome_name) and
+// checked where read (parse_outcome).
 #pragma once
 #include <optional>
 #include <string>
@@ -17,6 +19,31 @@ namespace lodrefine {
 // reach, written exactly as read (cityfile.h); "failed", a building of an evaluated run whose
 // refinement left no model to measure (eval/run.h, eval/gate.h).
 enum class Outcome { Refined, Kept, Repaired, KeptInvalid, Untouched, Failed };
+
+// How the handling of a building ended, before its output is checked: what decide_outcome takes.
+enum class Ending {
+  Refined,    // the judge accepted a refinement
+  Kept,       // the (repaired) input stands: nothing to change, or the refinement was refused
+  AsRead,     // the input cannot be made a valid solid, or its handling failed: written as read
+  Untouched,  // not handled: a city file's building the cloud does not reach, or one found valid
+              // as read by lodrefine repair (cityfile.h)
+  NoModel,    // a building of an evaluated run whose refinement left no model to measure
+};
+
+struct OutcomeFacts {
+  Ending ending = Ending::AsRead;
+  // The input was no valid solid and the output is it made one: its shell rebuilt on its own
+  // planes (refine_building), or a city file's building invalid as read that its repair alone
+  // made valid to val3dity's tolerances (lodrefine repair, cityfile.h).
+  bool mended = false;
+  bool valid = false;  // the output passed validation (validate_mesh)
+};
+
+// The one rule that names a building's outcome, for refine_building, the city refine and the
+// evaluated run alike: an ending of Untouched is untouched, NoModel failed, AsRead kept-invalid;
+// otherwise an output that does not validate is kept-invalid (its input is written as read), a
+// refinement is refined, and a kept input is repaired when it was mended, else kept.
+Outcome decide_outcome(const OutcomeFacts& facts);
 const char* outcome_name(Outcome outcome);
 // The outcome outcome_name() calls `name`; none for any other text (what outcomes read back
 // from reports and files are checked with).

@@ -30,8 +30,10 @@ inline constexpr std::array<const char*, 7> kRefineStageNames = {"repair",    "p
                                                                  "selection", "judge",  "validation"};
 inline const char* stage_name(RefineStage stage) { return kRefineStageNames[std::size_t(stage)]; }
 
-// What each stage found, kept for the report (built outside the core: io/refine_report.h).
-// A stage the building did not reach leaves its member empty.
+// What each stage found, kept for the report (built outside the core: city/refine_report.h).
+// A record only: the stages hand their results to each other as values (the walls moved:
+// move_plan.h) and never read them back from here. A stage the building did not reach leaves its
+// member empty.
 struct RefineTrace {
   struct MatchedWall {
     Match match;
@@ -62,8 +64,6 @@ struct RefineTrace {
     std::set<int> input_faces;  // Face::source of its faces
     std::string evidence;       // "scan" or "corner"
     double max_move = 0.0, mean_move = 0.0;
-    JudgedWall wall;   // the wall before the move and its new plane, for the judge
-    int surface = -1;  // the moved model surface of the merged input (-1: moved one wall at a time)
   };
 
   std::string id;

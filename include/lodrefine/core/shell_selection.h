@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "lodrefine/base/types.h"
+#include "lodrefine/core/move_plan.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/planes.h"
 #include "lodrefine/core/selection.h"
@@ -62,16 +63,17 @@ struct ShellSelection {
 // planarity_tolerance of a larger face's plane, though its own normal is off (a sliver), is a
 // piece of that plane, unless the start then cannot be expressed in the candidates. Never throws
 // for geometry; !ok with the reason when the program has no solution or no valid shell.
-// `outdated`: walls of `start` the scan puts on another plane that `start` still has where the
-// model put them (no substitution moved them; WallMove::surface indexes model_surfaces(start) at
-// its default tolerances, WallMove::plane is the wall's scan plane). GLPK's first incumbent then
-// has each such wall on the supporting plane carrying its scan plane (the wall's outline, seen
-// along its normal), the rest closed by the nearest closed selection; `start` stays what no
-// evidence reaches is fixed to, what changes are counted from and what a refused change goes
-// back to. A wall whose scan plane carries no supporting plane, or a warm start that cannot be
-// closed or changes a fixed candidate, leaves the incumbent `start`. Empty (the default): `start`
-// is the incumbent.
+// `outdated` (move_plan.h; its `surfaces` and `scan` only): walls of `start` the scan puts on
+// another plane that `start` still has where the model put them (no substitution moved them).
+// Its `surfaces` are model_surfaces(start) at their default tolerances, as the matching made them
+// (each WallMove::surface indexes them), each WallMove::plane the wall's scan plane. GLPK's first
+// incumbent then has each such wall on the supporting plane carrying its scan plane (the wall's
+// outline, seen along its normal), the rest closed by the nearest closed selection; `start` stays
+// what no evidence reaches is fixed to, what changes are counted from and what a refused change
+// goes back to. A wall whose scan plane carries no supporting plane, or a warm start that cannot
+// be closed or changes a fixed candidate, leaves the incumbent `start`. Empty (the default):
+// `start` is the incumbent.
 ShellSelection select_shell(const Mesh& start, const PointCloud& cloud, const std::vector<ScanPlane>& planes,
-                            const RefineConfig& params, const std::vector<WallMove>& outdated = {});
+                            const RefineConfig& params, const MovePlan& outdated = MovePlan{});
 
 }  // namespace lodrefine
