@@ -40,30 +40,25 @@ std::string text_member(const json& j, const char* key, const std::string& other
   return it != j.end() && it->is_string() ? it->get<std::string>() : otherwise;
 }
 
-// The outcome of one building in the words of the report, with its reason: a valid refined or
-// repaired building is written; anything else is kept (its original geometry stays), and a kept
-// building whose repaired original is not valid either is kept-invalid.
+// One building's outcome as refine_building decided it, in the words of the report: a refined or
+// repaired building is written; anything else is kept (its original geometry stays).
 CityBuildingOutcome classify(const RefineResult& r) {
   CityBuildingOutcome o;
-  if (r.refined() && r.valid) {
-    o.outcome = Outcome::Refined;
+  o.outcome = r.outcome;
+  if (r.outcome == Outcome::Refined) {
     o.facades_moved = int(r.trace.facades.size());
     return o;
   }
-  if (r.outcome == Outcome::Repaired && r.valid) {
-    o.outcome = Outcome::Repaired;
+  if (r.outcome == Outcome::Repaired) {
     o.reason = r.reason;
     return o;
   }
-  o.outcome = (!r.valid || r.outcome == Outcome::KeptInvalid) ? Outcome::KeptInvalid : Outcome::Kept;
   o.reason = r.reason.empty() ? std::string(outcome_name(r.outcome)) : r.reason;
   if (r.trace.judgement && !r.trace.judgement->ok) o.refused_by = r.trace.judgement->check;
   // A crop that only grazes the building (its box's edge): no wall of it faces a scan plane.
   const bool no_facade =
       (r.trace.planes && r.trace.planes->empty()) || (r.trace.matching && r.trace.matching->walls.empty());
   if (o.outcome == Outcome::Kept && no_facade) o.reason = "scan covers no facade of this building";
-  if (!r.valid && r.outcome != Outcome::KeptInvalid)
-    o.reason += " (not valid: " + r.trace.output_validation.problem + ")";
   return o;
 }
 
@@ -114,7 +109,9 @@ Mesh as_written(const Mesh& mesh, const CityJsonTransform& tf) {
 // result valid too; else it stays kept as read, and says what the repair still has.
 void repaired_by_weld(BuildingJob& job, const CityJsonTransform& tf) {
   std::vector<ValidityError> after = validate_soup(as_written(job.result.mesh, tf)).errors;
-  if (!after.empty() || !job.result.trace.repair) {
+  const bool mended = after.empty() && job.result.trace.repair;
+  job.outcome.outcome = decide_outcome({Ending::Kept, mended, job.result.valid});
+  if (!mended) {
     job.outcome.reason = "kept as read: its repair (welds, orientation, holes) still has " + errors_text(after);
     return;
   }
@@ -131,7 +128,6 @@ void repaired_by_weld(BuildingJob& job, const CityJsonTransform& tf) {
   add(rr.filled_holes, "holes filled");
   add(rr.split_warped_faces, "warped faces split");
   complete_provenance(job.result.mesh);  // written: its faces the model's, a filled hole's added
-  job.outcome.outcome = Outcome::Repaired;
   job.outcome.reason = "the repair made it a valid solid (" + (what.empty() ? std::string("faces merged") : what) + ")";
   job.outcome.errors_after = std::move(after);
 }
@@ -153,7 +149,7 @@ void run_job(BuildingJob& job, const CityJsonBuilding& b, const RefineConfig& pa
     job.returned = true;
     job.outcome = classify(job.result);
   } catch (const std::exception& e) {  // never lose a building: keep it as read
-    job.outcome.outcome = Outcome::KeptInvalid;
+    job.outcome.outcome = decide_outcome({Ending::AsRead});
     job.outcome.reason = e.what();
   }
   const bool rewritten = job.outcome.outcome == Outcome::Refined || job.outcome.outcome == Outcome::Repaired;
@@ -199,7 +195,8 @@ void apply_job(json& doc, const CityJsonTransform& tf, const CityJsonBuilding& b
                const CityBuildingHook& hook, CityRefineSummary& sum) {
   if (!job.has_points) {
     ++sum.untouched;
-    if (job.valid_as_read) sum.outcomes.push_back({b.mesh.id, Outcome::Untouched, "a valid solid as read"});
+    if (job.valid_as_read)
+      sum.outcomes.push_back({b.mesh.id, decide_outcome({Ending::Untouched}), "a valid solid as read"});
     if (hook) hook(index, b.mesh, nullptr, nullptr, nullptr);
     return;
   }

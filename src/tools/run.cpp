@@ -113,7 +113,9 @@ std::vector<MovedFacade> moved_facades(const json& report) {
 
 // Outcome, reason, moved facades and time of a report that is a JSON object.
 void read_report(RunRow& row, const json& report) {
-  row.outcome = parse_outcome(row.refine_outcome) == Outcome::Refined ? Outcome::Refined : Outcome::Kept;
+  // The outcome refine decided, as its report states it; text no refine writes: the model is there,
+  // so it was at least kept.
+  row.outcome = parse_outcome(row.refine_outcome).value_or(Outcome::Kept);
   const json reason = report.value("reason", json());
   row.reason = reason.is_string() ? escaped_line(reason.get<std::string>())
                : reason.is_null() ? std::string()
@@ -217,7 +219,7 @@ void add_refine_record(RunRow& row, const json& report, const std::string& faile
   }
   if (!failed_line.empty()) row.eval.error = failed_line;
   if (!row.eval.ok()) {
-    row.outcome = Outcome::Failed;
+    row.outcome = decide_outcome({Ending::NoModel});
     row.reason = row.eval.error;
     return;
   }

@@ -211,12 +211,17 @@ std::string table1_text(const PooledEval& p, bool batch) {
 }
 
 std::string totals_text(const RunTotals& t) {
+  std::string others;  // the outcomes besides the three always shown, when counted
+  for (Outcome o : {Outcome::Repaired, Outcome::KeptInvalid, Outcome::Untouched}) {
+    const auto it = t.outcomes.find(outcome_name(o));
+    if (it != t.outcomes.end() && it->second > 0) appendf(others, ", %s %zu", outcome_name(o), it->second);
+  }
   std::string out;
-  appendf(
-      out,
-      "\noutcomes: refined %zu, kept %zu, failed %zu; facades moved %zu (max %s m, mean %s m); refine %.1f s in all\n",
-      t.outcomes.at("refined"), t.outcomes.at("kept"), t.outcomes.at("failed"), t.moved.count, fmt(t.moved.max).c_str(),
-      fmt(t.moved.mean).c_str(), t.refine_seconds);
+  appendf(out,
+          "\noutcomes: refined %zu, kept %zu, failed %zu%s; facades moved %zu (max %s m, mean %s m); refine %.1f s in "
+          "all\n",
+          t.outcomes.at("refined"), t.outcomes.at("kept"), t.outcomes.at("failed"), others.c_str(), t.moved.count,
+          fmt(t.moved.max).c_str(), fmt(t.moved.mean).c_str(), t.refine_seconds);
   return out;
 }
 
@@ -300,9 +305,7 @@ BuildingFigures building_figures(const RunRow& r) {
   const BuildingEval& e = r.eval;
   BuildingFigures b;
   b.id = e.id;
-  b.outcome = r.outcome == Outcome::Kept && parse_outcome(r.refine_outcome) == Outcome::KeptInvalid
-                  ? Outcome::KeptInvalid
-                  : r.outcome.value_or(Outcome::Failed);  // a run's rows all have one
+  b.outcome = r.outcome.value_or(Outcome::Failed);  // a run's rows all have one
   b.reason = r.reason;
   if (e.ok() && e.facade_points > 0) b.c2m_rmse = e.after.rmse, b.c2m_mae = e.after.mae;
   if (e.ok() && e.truth_facade_after) b.truth_facade_rmse = e.truth_facade_after->rmse;

@@ -52,9 +52,12 @@ TEST(RunRecord, KeptBuildingMovedNothingAndKeepsItsReason) {
   EXPECT_EQ(r.outcome, Outcome::Kept);
   EXPECT_EQ(r.reason, "judge refused (gain): 12 points closer");
   EXPECT_TRUE(r.moved.empty());
+  // Every outcome is reported as refine decided it, not folded into "kept".
   const RunRow invalid = record_of(run_report("kept-invalid", "not closed"));
-  EXPECT_EQ(invalid.outcome, Outcome::Kept);
+  EXPECT_EQ(invalid.outcome, Outcome::KeptInvalid);
   EXPECT_EQ(invalid.refine_outcome, "kept-invalid");
+  EXPECT_EQ(record_of(run_report("repaired", "shell rebuilt on its planes")).outcome, Outcome::Repaired);
+  EXPECT_EQ(record_of(run_report("no outcome of ours")).outcome, Outcome::Kept);  // a model is there
 }
 
 // The spellings of reports before the "facades" list settled are read no more: a facade without

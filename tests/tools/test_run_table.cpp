@@ -78,6 +78,14 @@ TEST(RunTable, TotalsCountOutcomesMovesAndSeconds) {
   EXPECT_EQ(
       totals_text(t),
       "\noutcomes: refined 1, kept 1, failed 1; facades moved 2 (max 0.400 m, mean 0.300 m); refine 2.5 s in all\n");
+  // The other outcomes refine decides are counted and said after the three, when there are any.
+  rows[1].outcome = Outcome::KeptInvalid;
+  rows.push_back(row("d", 0.4, 0.4, true));
+  rows.back().outcome = Outcome::Repaired;
+  const RunTotals more = run_totals(rows);
+  EXPECT_EQ(more.outcomes.at("kept-invalid"), 1u);
+  EXPECT_EQ(more.outcomes.at("kept"), 0u);
+  EXPECT_EQ(totals_text(more).substr(0, 67), "\noutcomes: refined 1, kept 0, failed 1, repaired 1, kept-invalid 1;");
 }
 
 TEST(RunTable, Table1LinesWithDashesForWhatWasNotMeasured) {
@@ -167,7 +175,7 @@ TEST(RunTable, HtmlRowAndGateFigures) {
   EXPECT_DOUBLE_EQ(*f.moved_max, 0.4);
   EXPECT_DOUBLE_EQ(*f.c2m_rmse, 0.01);
   RunRow invalid = row("b", 0.4, 0.4, false);
-  invalid.outcome = Outcome::Kept, invalid.refine_outcome = "kept-invalid";
+  invalid.outcome = Outcome::KeptInvalid, invalid.refine_outcome = "kept-invalid";
   EXPECT_EQ(building_figures(invalid).outcome, Outcome::KeptInvalid);
   EXPECT_FALSE(building_figures(invalid).watertight);
   EXPECT_FALSE(building_figures(failed_row("c")).c2m_rmse);

@@ -47,7 +47,8 @@ struct RunRow {
   std::string refine_outcome;      // the refine report's "outcome" as written, if any (echoed; parse_outcome reads it)
   std::string selection;           // the report's selection.status (empty when none ran)
   // What the refine step recorded (report.json or FAILED).
-  // Refined, kept (anything else written) or failed; none without a refine record (one building's
+  // The outcome refine decided (its report's "outcome"; kept for text no refine writes, or without
+  // a report), or failed (no model to measure); none without a refine record (one building's
   // eval: written as "").
   std::optional<Outcome> outcome;
   std::string reason;              // why kept / why failed
@@ -81,8 +82,8 @@ RunRow evaluate_building_files(const BuildingFiles& files, const RefineConfig& p
 
 // Fills the refine record of `row` (evaluated already) from what refine left: `failed_line`, the
 // first line of a FAILED file (it replaces any evaluation error), or the `report` (JSON; null when
-// there is none). Reads the current report (io/refine_report.h) only: outcome "refined" or
-// anything else written ("kept"), its "reason", its "facades" (input_faces, max_move) when
+// there is none). Reads the current report (city/refine_report.h) only: its "outcome" as refine
+// decided it (text no refine writes: kept), its "reason", its "facades" (input_faces, max_move) when
 // refined, seconds.total and selection.status. A report without `report_version` is read as
 // version 1 (reports before the field carry the same keys); one of a newer version throws
 // InputError naming `source`. A key of the wrong type keeps the row, with the reason

@@ -27,7 +27,8 @@ struct MovedSummary {
 };
 MovedSummary summarize_moved(const std::vector<MovedFacade>& moved);
 
-// Outcome counts ("refined", "kept", "failed", always present) and moved facades over a run,
+// Outcome counts by outcome_name ("refined", "kept", "failed" always present; the others, e.g.
+// "repaired", "kept-invalid", when a row has them) and moved facades over a run,
 // and the refine seconds summed over the buildings that recorded them.
 struct RunTotals {
   std::map<std::string, std::size_t> outcomes{{"refined", 0}, {"kept", 0}, {"failed", 0}};
@@ -43,7 +44,8 @@ std::vector<const RunRow*> worst_first(const std::vector<RunRow>& rows);
 // The paper's Table 1 (pooled over points; `batch` adds the mean of per-building values), as
 // printed: "-" for what was not measured.
 std::string table1_text(const PooledEval& pooled, bool batch);
-// "\noutcomes: refined N, kept N, failed N; facades moved N (max X m, mean X m); refine S s in all\n"
+// "\noutcomes: refined N, kept N, failed N; facades moved N (max X m, mean X m); refine S s in all\n",
+// with ", <outcome> N" after "failed N" for each other outcome counted (in Outcome's order).
 std::string totals_text(const RunTotals& totals);
 
 // `eval --json`: {"pooled": {... figures, outcomes, facades_moved, refine_seconds_total},
@@ -62,7 +64,7 @@ nlohmann::json html_row(const RunRow& row);
 // inputs cannot be read.
 BuildingView html_view(const RunRow& row, const RefineConfig& params);
 
-// A row's figures for the gate: its outcome in refine's words ("kept-invalid" kept apart).
+// A row's figures for the gate: its outcome as refine decided it (failed without one).
 BuildingFigures building_figures(const RunRow& row);
 RunFigures run_figures(const std::vector<RunRow>& rows, const PooledEval& pooled);
 
