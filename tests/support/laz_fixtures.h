@@ -1,12 +1,14 @@
-// LAZ test helpers shared by tests/laz/test_laz.cpp and test_laz_write.cpp: the records of a LAS
-// or LAZ file, and the independent decoder (the npm package laz-perf under node, run by
+// LAZ test helpers shared by tests/laz/test_laz*.cpp: the records of a LAS or LAZ file, fields
+// read from its bytes, its refusal expected, and the independent decoder (the npm package laz-perf under node, run by
 // tests/laz/laz_reference_dump.js), which the tests skip without.
 #pragma once
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <string>
 
 #include "lodrefine/formats/las.h"
+#include "support/io_fixtures.h"
 #include "support/test_paths.h"
 
 namespace lodrefine::fixtures {
@@ -18,6 +20,25 @@ inline std::string las_records(const std::string& path) {
     all.append(reinterpret_cast<const char*>(r), h.record_length);
   });
   return all;
+}
+
+// sizeof(T) bytes at `at` of a file's bytes (the test machine is little-endian, as LAS is).
+template <class T>
+T peek(const std::string& bytes, std::size_t at) {
+  T v;
+  std::memcpy(&v, &bytes[at], sizeof v);
+  return v;
+}
+template <class T>
+T peek(const unsigned char* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+// The LAS or LAZ file of `bytes` refused by the reader in one line naming it and `fault`.
+inline void expect_laz_refused(const std::string& bytes, const std::string& fault) {
+  expect_bytes_refused("bad.laz", bytes, fault, las_records);
 }
 
 // Where laz-perf's node module may be: $LODREFINE_LAZPERF_MODULES, else the scratch folder
