@@ -62,7 +62,9 @@ TEST(Text, LittleEndianFieldsRoundTripByteForByte) {
 }
 
 TEST(Text, OneTokenReplacesBlanksAndControls) {
-  EXPECT_EQ(one_token("a b\tc\x01" "d"), "a_b_c_d");
+  EXPECT_EQ(one_token("a b\tc\x01"
+                      "d"),
+            "a_b_c_d");
   EXPECT_EQ(one_token("plain"), "plain");
 }
 

@@ -3,12 +3,12 @@
 // progress line.
 #include <gtest/gtest.h>
 
+#include "support/city_fixtures.h"
 #include "support/cli_fixtures.h"
 #include "support/cpu_burners.h"
 #include "support/io_fixtures.h"
 #include "support/mesh_fixtures.h"
 #include "support/scan_fixtures.h"
-#include "support/city_fixtures.h"
 #include "support/schema_fixtures.h"
 
 #include <chrono>

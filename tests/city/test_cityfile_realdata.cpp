@@ -2,12 +2,12 @@
 // district and the Den Haag CityGML, under the same contract as the generated cities.
 #include <gtest/gtest.h>
 
+#include "support/city_fixtures.h"
 #include "support/cli_fixtures.h"
 #include "support/cpu_burners.h"
 #include "support/io_fixtures.h"
 #include "support/mesh_fixtures.h"
 #include "support/scan_fixtures.h"
-#include "support/city_fixtures.h"
 #include "support/schema_fixtures.h"
 
 #include <chrono>

@@ -30,8 +30,10 @@ std::vector<int> codes(const BuildingValidity& b) { return error_codes(b.validat
 
 TEST(Validity, EachBuildingGetsItsCodesInFileOrder) {
   // box_city writes the objects in the order of their ids.
-  const std::string path = city_of(
-      {{"a_valid", {}, {}, 0}, {"b_open", {1}, {}, 20}, {"c_flipped", {}, {3}, 40}, {"d_inward", {}, {0, 1, 2, 3, 4, 5}, 60}});
+  const std::string path = city_of({{"a_valid", {}, {}, 0},
+                                    {"b_open", {1}, {}, 20},
+                                    {"c_flipped", {}, {3}, 40},
+                                    {"d_inward", {}, {0, 1, 2, 3, 4, 5}, 60}});
   const CityValidity v = validate_city(path, "", ValidityTolerances{});
   EXPECT_EQ(v.path, path);
   EXPECT_EQ(v.input_format, "CityJSON 2.0");

@@ -46,7 +46,8 @@ TEST(XmlGuard, TextInPiecesBecomesOneCdataSection) {
 }
 
 TEST(XmlGuard, DeclarationsOtherThanCommentsAndCdataAreRefused) {
-  const std::string doctype = refusal("<?xml version=\"1.0\"?><!DOCTYPE c [<!ENTITY e SYSTEM \"/etc/passwd\">]><c>&e;</c>");
+  const std::string doctype =
+      refusal("<?xml version=\"1.0\"?><!DOCTYPE c [<!ENTITY e SYSTEM \"/etc/passwd\">]><c>&e;</c>");
   EXPECT_EQ(doctype.rfind("city.gml: the XML has a document type or entity declaration ('<!DOCTYPE", 0), 0u) << doctype;
   EXPECT_EQ(doctype.find('\n'), std::string::npos);
   EXPECT_EQ(refusal("<c><![CDATA[<!DOCTYPE x>]]></c>"), "accepted");
@@ -61,7 +62,8 @@ TEST(XmlGuard, WideAndUnknownEncodingsAreRefused) {
 }
 
 TEST(XmlGuard, Latin1IsTranscodedAndSaysSo) {
-  const std::string out = safe_citygml_text("<?xml version=\"1.0\" encoding=\"ISO-8859-1\"?><n>Caf\xE9</n>", "city.gml");
+  const std::string out =
+      safe_citygml_text("<?xml version=\"1.0\" encoding=\"ISO-8859-1\"?><n>Caf\xE9</n>", "city.gml");
   EXPECT_EQ(out, "<?xml version=\"1.0\" encoding=\"UTF-8\"?><n>Caf\xC3\xA9</n>");
 }
 

@@ -52,20 +52,20 @@ TEST(LasHeader, Version12BlockHoldsTheFieldsAtTheirOffsets) {
   EXPECT_EQ(int(h[24]), 1);
   EXPECT_EQ(int(h[25]), 2);
   EXPECT_EQ(h.substr(26, 9), "lodrefine");
-  EXPECT_EQ(at<std::uint16_t>(h, 94), 227);     // header size
-  EXPECT_EQ(at<std::uint32_t>(h, 96), 1000u);   // offset to the point data
-  EXPECT_EQ(at<std::uint32_t>(h, 100), 1u);     // VLRs
-  EXPECT_EQ(std::uint8_t(h[104]), 0x83);        // format 3, compressed
-  EXPECT_EQ(at<std::uint16_t>(h, 105), 36);     // record length
-  EXPECT_EQ(at<std::uint32_t>(h, 107), 500u);   // legacy count
-  EXPECT_EQ(at<std::uint32_t>(h, 111), 499u);   // first returns
-  EXPECT_EQ(at<std::uint32_t>(h, 115), 1u);     // second returns
-  EXPECT_EQ(at<double>(h, 131), 0.01);          // x scale
-  EXPECT_EQ(at<double>(h, 147), 0.001);         // z scale
-  EXPECT_EQ(at<double>(h, 155), 93000.0);       // x offset
-  EXPECT_EQ(at<double>(h, 179), 93101.0);       // max x
-  EXPECT_EQ(at<double>(h, 187), 93001.0);       // min x
-  EXPECT_EQ(at<double>(h, 219), -3.0);          // min z
+  EXPECT_EQ(at<std::uint16_t>(h, 94), 227);    // header size
+  EXPECT_EQ(at<std::uint32_t>(h, 96), 1000u);  // offset to the point data
+  EXPECT_EQ(at<std::uint32_t>(h, 100), 1u);    // VLRs
+  EXPECT_EQ(std::uint8_t(h[104]), 0x83);       // format 3, compressed
+  EXPECT_EQ(at<std::uint16_t>(h, 105), 36);    // record length
+  EXPECT_EQ(at<std::uint32_t>(h, 107), 500u);  // legacy count
+  EXPECT_EQ(at<std::uint32_t>(h, 111), 499u);  // first returns
+  EXPECT_EQ(at<std::uint32_t>(h, 115), 1u);    // second returns
+  EXPECT_EQ(at<double>(h, 131), 0.01);         // x scale
+  EXPECT_EQ(at<double>(h, 147), 0.001);        // z scale
+  EXPECT_EQ(at<double>(h, 155), 93000.0);      // x offset
+  EXPECT_EQ(at<double>(h, 179), 93101.0);      // max x
+  EXPECT_EQ(at<double>(h, 187), 93001.0);      // min x
+  EXPECT_EQ(at<double>(h, 219), -3.0);         // min z
 }
 
 TEST(LasHeader, Version14CountsAre64BitAndFormatsSixToTenLeaveTheLegacyOnesZero) {
@@ -74,11 +74,11 @@ TEST(LasHeader, Version14CountsAre64BitAndFormatsSixToTenLeaveTheLegacyOnesZero)
   EXPECT_EQ(at<std::uint16_t>(h, 94), 375);
   EXPECT_EQ(at<std::uint32_t>(h, 107), 0u);  // legacy count
   EXPECT_EQ(at<std::uint32_t>(h, 111), 0u);
-  EXPECT_EQ(at<std::uint64_t>(h, 227), 0u);               // waveform data packet record
-  EXPECT_EQ(at<std::uint64_t>(h, 235), 0u);               // first EVLR
-  EXPECT_EQ(at<std::uint32_t>(h, 243), 0u);               // EVLR count
-  EXPECT_EQ(at<std::uint64_t>(h, 247), 5000000000ull);    // the 64-bit count
-  EXPECT_EQ(at<std::uint64_t>(h, 255), 4999999999ull);    // first returns
+  EXPECT_EQ(at<std::uint64_t>(h, 227), 0u);             // waveform data packet record
+  EXPECT_EQ(at<std::uint64_t>(h, 235), 0u);             // first EVLR
+  EXPECT_EQ(at<std::uint32_t>(h, 243), 0u);             // EVLR count
+  EXPECT_EQ(at<std::uint64_t>(h, 247), 5000000000ull);  // the 64-bit count
+  EXPECT_EQ(at<std::uint64_t>(h, 255), 4999999999ull);  // first returns
   // Formats 0-5 fill the legacy count when it fits, in 1.4 too; 1.3 has the waveform field.
   EXPECT_EQ(at<std::uint32_t>(laz::las_header_block(block(4, 1, 7)), 107), 7u);
   EXPECT_EQ(at<std::uint32_t>(laz::las_header_block(block(4, 1, 1ull << 33)), 107), 0u);

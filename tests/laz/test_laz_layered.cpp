@@ -109,10 +109,9 @@ TEST(Laz, ExtraByteModelsAreBoundedPerChunk) {
     return all;
   };
   expect_laz_refused(cli_fixtures::slurp(write_laz("models.laz", 30 + 4200, records(4200, 8, true))),
-               "more than 16384 extra-byte models in one chunk");
+                     "more than 16384 extra-byte models in one chunk");
   for (const bool vary : {true, false}) {
     const std::string want = records(1000, 12, vary);
     EXPECT_TRUE(fixtures::las_records(write_laz("models_ok.laz", 30 + 1000, want)) == want);
   }
 }
-

@@ -202,8 +202,8 @@ inline void check_city_output(const json& in, const std::string& out_path, const
 }
 
 // Generated buildings 80 m apart along x and the clouds of the first `scanned` of them.
-inline std::vector<SynthBuilding> synth_street(const std::vector<BuildingType>& types, std::uint64_t first_seed, int points,
-                                        std::size_t scanned, PointCloud& cloud) {
+inline std::vector<SynthBuilding> synth_street(const std::vector<BuildingType>& types, std::uint64_t first_seed,
+                                               int points, std::size_t scanned, PointCloud& cloud) {
   std::vector<SynthBuilding> bs;
   SynthOptions so;
   so.target_points = points;

@@ -14,7 +14,6 @@ using namespace lodrefine::synth;
 using synth_fixtures::box_mesh;
 using synth_fixtures::box_spec;
 
-
 TEST(SynthPerturb, WallsOfABoxFaceOutwardWithTheirLengths) {
   const Mesh m = box_mesh();
   std::vector<WallInfo> walls = wall_infos(m);

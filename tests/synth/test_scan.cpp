@@ -13,7 +13,6 @@ using namespace lodrefine;
 using namespace lodrefine::synth;
 using synth_fixtures::box_mesh;
 
-
 TEST(SynthScan, ScannedWallsAreARunOfAdjacentWalls) {
   const Mesh m = box_mesh();
   const std::vector<WallInfo> walls = wall_infos(m);

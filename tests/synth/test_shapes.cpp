@@ -34,8 +34,8 @@ TEST(SynthShapes, RoofPlanesGiveTheirHeights) {
 
 TEST(SynthShapes, SegmentsCross) {
   EXPECT_TRUE(segments_cross(Vec2(0, 0), Vec2(2, 2), Vec2(0, 2), Vec2(2, 0)));
-  EXPECT_FALSE(segments_cross(Vec2(0, 0), Vec2(1, 0), Vec2(0, 1), Vec2(1, 1)));    // parallel
-  EXPECT_FALSE(segments_cross(Vec2(0, 0), Vec2(1, 1), Vec2(3, 0), Vec2(2, 5)));    // apart
+  EXPECT_FALSE(segments_cross(Vec2(0, 0), Vec2(1, 0), Vec2(0, 1), Vec2(1, 1)));  // parallel
+  EXPECT_FALSE(segments_cross(Vec2(0, 0), Vec2(1, 1), Vec2(3, 0), Vec2(2, 5)));  // apart
 }
 
 TEST(SynthShapes, EveryTypesSpecStandsOnItsGround) {

@@ -3,9 +3,9 @@
 // and a spec that folds refused.
 #include <gtest/gtest.h>
 
-#include "support/synth_shape_fixtures.h"
 #include "lodrefine/base/geometry.h"
 #include "lodrefine/core/validate.h"
+#include "support/synth_shape_fixtures.h"
 
 using namespace lodrefine;
 using namespace lodrefine::synth;
@@ -17,7 +17,8 @@ double volume(const Mesh& m) {
   double v = 0.0;
   for (const Face& f : m.faces)
     for (std::size_t i = 1; i + 1 < f.v.size(); ++i)
-      v += m.vertices[std::size_t(f.v[0])].dot(m.vertices[std::size_t(f.v[i])].cross(m.vertices[std::size_t(f.v[i + 1])]));
+      v += m.vertices[std::size_t(f.v[0])].dot(
+          m.vertices[std::size_t(f.v[i])].cross(m.vertices[std::size_t(f.v[i + 1])]));
   return v / 6.0;
 }
 
@@ -48,7 +49,8 @@ TEST(SynthShell, FlatBoxIsSixOutwardFaces) {
 
 TEST(SynthShell, GableIsTheLowerEnvelopeOfItsRoofPlanes) {
   const double k = 2.0 / 3.0;  // 2 m up over 3 m: ridge at y = 3, z = 7
-  const Mesh m = build_mesh(box_spec({sloped_roof(Vec2(0, 0), Vec2(0, 1), 5.0, k), sloped_roof(Vec2(0, 6), Vec2(0, -1), 5.0, k)}));
+  const Mesh m =
+      build_mesh(box_spec({sloped_roof(Vec2(0, 0), Vec2(0, 1), 5.0, k), sloped_roof(Vec2(0, 6), Vec2(0, -1), 5.0, k)}));
   EXPECT_EQ(count(m, Semantic::Roof), 2);
   EXPECT_EQ(count(m, Semantic::Wall), 4);
   EXPECT_NEAR(volume(m), 300.0 + 10.0 * 6.0 * 2.0 / 2.0, 1e-9);
@@ -60,7 +62,7 @@ TEST(SynthShell, GableIsTheLowerEnvelopeOfItsRoofPlanes) {
 
 TEST(SynthShell, ASpecThatFoldsIsAShapeError) {
   EXPECT_THROW(build_mesh(box_spec({flat_roof(0.3)})), ShapeError);  // roof within 0.5 m of the ground
-  Spec crossed;  // a bow-tie footprint
+  Spec crossed;                                                      // a bow-tie footprint
   Part p;
   p.lines = {add_line(crossed, Vec2(0, 0), Vec2(1, 0)), add_line(crossed, Vec2(10, 0), Vec2(0, 1)),
              add_line(crossed, Vec2(0, 6), Vec2(1, -1)), add_line(crossed, Vec2(10, 6), Vec2(-1, -1))};
