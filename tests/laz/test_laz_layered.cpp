@@ -21,35 +21,14 @@ namespace {
 
 using fixtures::expect_laz_refused;
 using fixtures::peek;
+using fixtures::point14;
 using fixtures::poke;
 using fixtures::temp_path;
+using fixtures::write_laz14;
 
 }  // namespace
 
 namespace {
-
-// Format-6 records (30 bytes + `extra`): returns 1 of 1, scanner channel `channel`.
-std::string point14(std::int32_t x, double gps, int channel, std::size_t extra = 0) {
-  std::string r(30 + extra, '\0');
-  poke<std::int32_t>(r, 0, x);
-  r[14] = 0x11;
-  r[15] = char((channel & 3) << 4);
-  r[16] = 2;
-  poke<double>(r, 22, gps);
-  return r;
-}
-
-std::string write_laz(const std::string& name, std::uint32_t record_length, const std::string& records,
-                      std::uint32_t chunk = 50000) {
-  const std::string path = temp_path(name);
-  LasRecordFormat f;
-  f.version_minor = 4, f.point_format = 6, f.record_length = record_length;
-  LasRecordWriter w(path, f, true, chunk);
-  for (std::size_t at = 0; at < records.size(); at += record_length)
-    w.add(reinterpret_cast<const unsigned char*>(records.data() + at));
-  w.finish();
-  return path;
-}
 
 // A format-6 LAZ of one chunk whose second point says "GPS time changed" and whose GPS time
 // layer is `gps_bytes` of 0xff: every code the time decoder reads is a switch to another time
@@ -64,7 +43,7 @@ std::string gps_switch_loop_laz(std::size_t gps_bytes) {
     for (std::size_t i = 30; i < r.size(); ++i) r[i] = char(rng());
     all += r;
   }
-  std::string b = cli_fixtures::slurp(write_laz("gps_source.laz", 30 + kExtra, all));
+  std::string b = cli_fixtures::slurp(write_laz14("gps_source.laz", 30 + kExtra, all));
   const std::size_t chunk = peek<std::uint32_t>(b, 96) + 8;
   const std::size_t sizes = chunk + 30 + kExtra + 4, layers = 9 + kExtra;
   std::vector<std::uint32_t> size(layers);
@@ -108,10 +87,10 @@ TEST(Laz, ExtraByteModelsAreBoundedPerChunk) {
     }
     return all;
   };
-  expect_laz_refused(cli_fixtures::slurp(write_laz("models.laz", 30 + 4200, records(4200, 8, true))),
+  expect_laz_refused(cli_fixtures::slurp(write_laz14("models.laz", 30 + 4200, records(4200, 8, true))),
                      "more than 16384 extra-byte models in one chunk");
   for (const bool vary : {true, false}) {
     const std::string want = records(1000, 12, vary);
-    EXPECT_TRUE(fixtures::las_records(write_laz("models_ok.laz", 30 + 1000, want)) == want);
+    EXPECT_TRUE(fixtures::las_records(write_laz14("models_ok.laz", 30 + 1000, want)) == want);
   }
 }

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "lodrefine/formats/las.h"
+#include "lodrefine/laz/laz_write.h"
 #include "support/io_fixtures.h"
 #include "support/test_paths.h"
 
@@ -34,6 +35,30 @@ T peek(const unsigned char* p) {
   T v;
   std::memcpy(&v, p, sizeof v);
   return v;
+}
+
+// Format-6 records (30 bytes + `extra`): returns 1 of 1, scanner channel `channel`.
+inline std::string point14(std::int32_t x, double gps, int channel, std::size_t extra = 0) {
+  std::string r(30 + extra, '\0');
+  poke<std::int32_t>(r, 0, x);
+  r[14] = 0x11;
+  r[15] = char((channel & 3) << 4);
+  r[16] = 2;
+  poke<double>(r, 22, gps);
+  return r;
+}
+
+// The LAS 1.4 format-6 LAZ of `records` (`record_length` bytes each) in the test's file `name`.
+inline std::string write_laz14(const std::string& name, std::uint32_t record_length, const std::string& records,
+                               std::uint32_t chunk = 50000) {
+  const std::string path = temp_path(name);
+  LasRecordFormat f;
+  f.version_minor = 4, f.point_format = 6, f.record_length = record_length;
+  LasRecordWriter w(path, f, true, chunk);
+  for (std::size_t at = 0; at < records.size(); at += record_length)
+    w.add(reinterpret_cast<const unsigned char*>(records.data() + at));
+  w.finish();
+  return path;
 }
 
 // The LAS or LAZ file of `bytes` refused by the reader in one line naming it and `fault`.
