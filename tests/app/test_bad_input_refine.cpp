@@ -83,19 +83,18 @@ std::vector<Vec3> shifted(std::vector<Vec3> pts, const Vec3& d) {
   return pts;
 }
 
-std::vector<Case> cases() {
-  std::vector<Case> c;
-  const std::string box = valid_model();
-  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
-
-  // --- the good path
+// The good path: a valid box and its wall scan in each PLY encoding.
+void add_good_path(std::vector<Case>& c) {
   c.push_back({"valid box + wall scan 0.4 m off (binary LE doubles)", both_valid, Expect::Refined});
   c.push_back(
       {"valid box + same scan as ASCII PLY", [](Paths& p) { cloud_is(p, ply_ascii(wall_scan())); }, Expect::Refined});
   c.push_back({"valid box + same scan as big-endian PLY", [](Paths& p) { cloud_is(p, ply_binary(wall_scan(), true)); },
                Expect::Refined});
+}
 
-  // --- malformed models
+// Malformed models.
+void add_model_cases(std::vector<Case>& c) {
+  const std::string box = valid_model();
   c.push_back({"model: empty file (0 bytes)", [](Paths& p) { model_is(p, ""); }, Expect::Error, "empty"});
   c.push_back(
       {"model: only comments and blank lines", [](Paths& p) { model_is(p, "# nothing\n\n  \n"); }, Expect::Error});
@@ -168,8 +167,10 @@ std::vector<Case> cases() {
                  model_is(p, ply_ascii({{0, 0, 0}}));
                },
                Expect::Error});
+}
 
-  // --- malformed clouds
+// Malformed cloud files: truncated, lying headers, unknown types and formats.
+void add_cloud_file_cases(std::vector<Case>& c) {
   c.push_back({"cloud: empty file (0 bytes)", [](Paths& p) { cloud_is(p, ""); }, Expect::Error, "empty"});
   {
     // A LAZ (the fuzz seed: 6 points, one per chunk) cut inside its chunk table, and with a
@@ -238,6 +239,11 @@ std::vector<Case> cases() {
        },
        Expect::Error, "no scalar property x"});
   c.push_back({"cloud: not a PLY (an OBJ)", [](Paths& p) { cloud_is(p, valid_model()); }, Expect::Error, "not a PLY"});
+}
+
+// Clouds whose file reads: non-finite, empty, far, clutter, duplicates, huge counts.
+void add_cloud_content_cases(std::vector<Case>& c) {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
   c.push_back({"cloud: NaN coordinate (binary)",
                [nan](Paths& p) {
                  auto pts = wall_scan();
@@ -310,8 +316,10 @@ std::vector<Case> cases() {
                           "property float y\nproperty float z\nend_header\n1 2 3\n");
                },
                Expect::Error, "", 10.0});
+}
 
-  // --- paths
+// Paths that do not exist or cannot be written.
+void add_path_cases(std::vector<Case>& c) {
   c.push_back({"model path does not exist",
                [](Paths& p) {
                  both_valid(p);
@@ -356,8 +364,11 @@ std::vector<Case> cases() {
                  p.report = p.dir + "/no/such/dir/report.json";
                },
                Expect::Error});
+}
 
-  // --- every input a fuzz target ever crashed on (tests/fuzz/regressions/<target>/), replayed
+// Every input a fuzz target ever crashed on, replayed through the CLI.
+void add_fuzz_regressions(std::vector<Case>& c) {
+  // Every input a fuzz target ever crashed on (tests/fuzz/regressions/<target>/), replayed
   // through the CLI: fuzz_obj inputs as the model, fuzz_ply inputs as the cloud, fuzz_refine
   // inputs split as the target splits them (its "tiny" flag becomes the same parameters).
   const fs::path reg = fs::path(test_paths::source_dir()) / "tests" / "fuzz" / "regressions";
@@ -388,15 +399,98 @@ std::vector<Case> cases() {
            Expect::ErrorOrValid, "", 60.0});
     }
   }
+}
 
-  // --- solver limits through the CLI
+// Solver limits through the CLI.
+void add_solver_limits(std::vector<Case>& c) {
   c.push_back({"valid input, --mip-time-limit 0.01",
                [](Paths& p) {
                  both_valid(p);
                  p.args = "--mip-time-limit 0.01";
                },
                Expect::Valid});
+}
+
+// Every case, in a fixed order: the parameter index names a case in the test's name.
+std::vector<Case> cases() {
+  std::vector<Case> c;
+  add_good_path(c);
+  add_model_cases(c);
+  add_cloud_file_cases(c);
+  add_cloud_content_cases(c);
+  add_path_cases(c);
+  add_fuzz_regressions(c);
+  add_solver_limits(c);
   return c;
+}
+
+// Runs `refine` on the case's files (made in p.dir); fills `out` with the output path passed.
+CliRun run_case(const Case& k, Paths& p, std::string& out) {
+  p.model = p.dir + "/model.obj";
+  p.cloud = p.dir + "/cloud.ply";
+  p.out = p.dir + "/refined.obj";
+  p.report = p.dir + "/report.json";
+  k.make(p);
+  const std::string model = p.model_arg.empty() ? p.model : p.model_arg;
+  const std::string cloud = p.cloud_arg.empty() ? p.cloud : p.cloud_arg;
+  out = p.out_arg.empty() ? p.out : p.out_arg;
+  return run_cli("refine --model " + shell_quote(model) + " --cloud " + shell_quote(cloud) + " --out " +
+                     shell_quote(out) + " --report " + shell_quote(p.report) + " " + p.args,
+                 p.dir, k.max_seconds);
+}
+
+// The report as JSON (null when there is none; a failure when it is no JSON).
+json read_report(const std::string& path) {
+  json report;
+  if (fs::exists(path)) {
+    try {
+      report = json::parse(read_text(path));
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "report is not JSON: " << e.what();
+    }
+  }
+  return report;
+}
+
+// A refusal: one line on stderr, no output, and a case that expects one.
+void expect_refusal(const Case& k, const CliRun& r, const std::string& out) {
+  const auto err = lines(r.err);
+  EXPECT_EQ(err.size(), 1u) << "expected exactly one stderr line";
+  EXPECT_EQ(r.err.rfind("lodrefine: error: ", 0), 0u) << "stderr must start with 'lodrefine: error: '";
+  EXPECT_FALSE(fs::exists(out) && fs::is_regular_file(out)) << "a failed run left an output file";
+  add_row(k.name, first_line(r.err), r.exit);
+  EXPECT_TRUE(k.expect == Expect::Error || k.expect == Expect::ErrorOrValid) << "refused, expected success";
+  if (k.expect == Expect::Error && !k.fragment.empty()) {
+    EXPECT_NE(r.err.find(k.fragment), std::string::npos) << "message should mention '" << k.fragment << "'";
+  }
+}
+
+// A valid output: refined with the front wall on the scan (y = 0), or kept, as the case expects.
+void expect_valid_output(const Case& k, const std::string& out, const json& report) {
+  const std::string outcome = report.value("outcome", std::string());
+  const std::string reason = report.value("reason", std::string());
+  EXPECT_EQ(output_problem(out), "");
+  EXPECT_TRUE(report["output_validation"].value("valid", false));
+  if (k.expect == Expect::Refined) {
+    EXPECT_EQ(outcome, "refined");
+    const Mesh m = read_obj(out);
+    double worst = 0;
+    for (const auto& f : m.faces) {
+      if (f.sem != Semantic::Wall) continue;
+      std::vector<Vec3> poly;
+      for (int v : f.v) poly.push_back(m.vertices[v] - kOrigin);
+      if (newell_normal(poly).normalized().y() > -0.9) continue;
+      for (const auto& q : poly) worst = std::max(worst, std::abs(q.y()));
+    }
+    EXPECT_LT(worst, 0.03) << "front wall not moved onto the scan";
+  }
+  if (k.expect == Expect::Kept) {
+    EXPECT_EQ(outcome, "kept") << reason;
+    EXPECT_FALSE(report.value("refined", true));
+    if (!k.fragment.empty()) {
+      EXPECT_NE(reason.find(k.fragment), std::string::npos) << reason;
+    }
+  }
 }
 
 }  // namespace
@@ -415,17 +509,8 @@ TEST_P(BadInput, Contract) {
       if (!testing::Test::HasFailure()) fs::remove_all(dir, ec);
     }
   } cleanup{p.dir};
-  p.model = p.dir + "/model.obj";
-  p.cloud = p.dir + "/cloud.ply";
-  p.out = p.dir + "/refined.obj";
-  p.report = p.dir + "/report.json";
-  k.make(p);
-  const std::string model = p.model_arg.empty() ? p.model : p.model_arg;
-  const std::string cloud = p.cloud_arg.empty() ? p.cloud : p.cloud_arg;
-  const std::string out = p.out_arg.empty() ? p.out : p.out_arg;
-  const CliRun r = run_cli("refine --model " + shell_quote(model) + " --cloud " + shell_quote(cloud) + " --out " +
-                               shell_quote(out) + " --report " + shell_quote(p.report) + " " + p.args,
-                           p.dir, k.max_seconds);
+  std::string out;
+  const CliRun r = run_case(k, p, out);
   SCOPED_TRACE(k.name + "\nstdout: " + r.out + "\nstderr: " + r.err);
 
   // Never a crash (signal / sanitizer abort) nor a hang.
@@ -437,29 +522,9 @@ TEST_P(BadInput, Contract) {
   EXPECT_LT(r.seconds, k.max_seconds) << "too slow";
   EXPECT_TRUE(temp_leftovers(p.dir).empty()) << "temporary file left behind: " << temp_leftovers(p.dir)[0];
 
-  json report;
-  if (fs::exists(p.report)) {
-    try {
-      report = json::parse(read_text(p.report));
-    } catch (const std::exception& e) {
-      ADD_FAILURE() << "report is not JSON: " << e.what();
-    }
-  }
+  const json report = read_report(p.report);
   const std::string outcome = report.is_object() ? report.value("outcome", std::string()) : std::string();
-
-  const bool refused = r.exit != 0;
-  if (refused) {
-    const auto err = lines(r.err);
-    EXPECT_EQ(err.size(), 1u) << "expected exactly one stderr line";
-    EXPECT_EQ(r.err.rfind("lodrefine: error: ", 0), 0u) << "stderr must start with 'lodrefine: error: '";
-    EXPECT_FALSE(fs::exists(out) && fs::is_regular_file(out)) << "a failed run left an output file";
-    add_row(k.name, first_line(r.err), r.exit);
-    EXPECT_TRUE(k.expect == Expect::Error || k.expect == Expect::ErrorOrValid) << "refused, expected success";
-    if (k.expect == Expect::Error && !k.fragment.empty()) {
-      EXPECT_NE(r.err.find(k.fragment), std::string::npos) << "message should mention '" << k.fragment << "'";
-    }
-    return;
-  }
+  if (r.exit != 0) return expect_refusal(k, r, out);
 
   // Success: a complete, valid building and a report that tells what was written.
   add_row(k.name, "exit 0, outcome: " + (outcome.empty() ? std::string("(no report)") : outcome), r.exit);
@@ -468,8 +533,8 @@ TEST_P(BadInput, Contract) {
   ASSERT_TRUE(fs::is_regular_file(out)) << "exit 0 but no output: the building was dropped";
   ASSERT_TRUE(report.is_object()) << "no report";
   EXPECT_EQ(report.value("written", std::string()), out);
-  const std::string reason = report.value("reason", std::string());
   if (k.expect == Expect::KeptInvalid || outcome == "kept-invalid") {
+    const std::string reason = report.value("reason", std::string());
     EXPECT_TRUE(k.expect == Expect::KeptInvalid || k.expect == Expect::ErrorOrValid) << outcome << ": " << reason;
     EXPECT_EQ(outcome, "kept-invalid");
     EXPECT_FALSE(reason.empty());
@@ -479,28 +544,7 @@ TEST_P(BadInput, Contract) {
     EXPECT_EQ(read_obj(out).faces.size(), read_obj(p.model).faces.size()) << "kept-invalid is the input as read";
     return;
   }
-  EXPECT_EQ(output_problem(out), "");
-  EXPECT_TRUE(report["output_validation"].value("valid", false));
-  if (k.expect == Expect::Refined) {
-    EXPECT_EQ(outcome, "refined");
-    const Mesh m = read_obj(out);
-    double worst = 0;  // the front wall now lies on the scan (y = 0)
-    for (const auto& f : m.faces) {
-      if (f.sem != Semantic::Wall) continue;
-      std::vector<Vec3> poly;
-      for (int v : f.v) poly.push_back(m.vertices[v] - kOrigin);
-      if (newell_normal(poly).normalized().y() > -0.9) continue;
-      for (const auto& q : poly) worst = std::max(worst, std::abs(q.y()));
-    }
-    EXPECT_LT(worst, 0.03) << "front wall not moved onto the scan";
-  }
-  if (k.expect == Expect::Kept) {
-    EXPECT_EQ(outcome, "kept") << reason;
-    EXPECT_FALSE(report.value("refined", true));
-    if (!k.fragment.empty()) {
-      EXPECT_NE(reason.find(k.fragment), std::string::npos) << reason;
-    }
-  }
+  expect_valid_output(k, out, report);
 }
 
 std::string case_name(const testing::TestParamInfo<std::size_t>& info) {

@@ -17,6 +17,20 @@ using namespace lodrefine::batch_fixtures;
 
 namespace {
 
+// Runs the batch; returns the building ids it refined (its "ok <id>:" / "FAILED <id>:" lines).
+std::vector<std::string> rerun(const fs::path& run) {
+  const fs::path log = run.parent_path() / (run.filename().string() + ".log");
+  EXPECT_EQ(shell(batch_command(run) + " > " + shell_quoted(log) + " 2>&1"), 0) << read_text(log);
+  std::vector<std::string> ids;
+  std::istringstream in(read_text(log));
+  for (std::string line; std::getline(in, line);) {
+    for (const std::string tag : {"ok ", "FAILED "})
+      if (line.rfind(tag, 0) == 0) ids.push_back(line.substr(tag.size(), line.find(':') - tag.size()));
+  }
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
+
 class Batch : public testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -29,20 +43,6 @@ class Batch : public testing::Test {
   static void TearDownTestSuite() {
     fs::remove_all(*inputs_);
     fs::remove_all(*done_);
-  }
-
-  // Runs the batch; returns the building ids it refined (its "ok <id>:" / "FAILED <id>:" lines).
-  static std::vector<std::string> rerun(const fs::path& run) {
-    const fs::path log = run.parent_path() / (run.filename().string() + ".log");
-    EXPECT_EQ(shell(batch_command(run) + " > " + shell_quoted(log) + " 2>&1"), 0) << read_text(log);
-    std::vector<std::string> ids;
-    std::istringstream in(read_text(log));
-    for (std::string line; std::getline(in, line);) {
-      for (const std::string tag : {"ok ", "FAILED "})
-        if (line.rfind(tag, 0) == 0) ids.push_back(line.substr(tag.size(), line.find(':') - tag.size()));
-    }
-    std::sort(ids.begin(), ids.end());
-    return ids;
   }
 
   static std::vector<std::string> ids(const fs::path& run) {
@@ -193,6 +193,59 @@ TEST_F(Batch, SigkillAnywhereThenRerunEqualsUninterruptedRun) {
 
 namespace {
 
+// The CSV lists the buildings of `rows` in the same order.
+void expect_csv_rows(const fs::path& done, const json& rows) {
+  std::istringstream csv(read_text(done / "summary.csv"));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line.rfind("id,outcome,reason,facades_moved,displacement_max,displacement_mean,", 0), 0u) << line;
+  for (const auto& row : rows) {
+    ASSERT_TRUE(std::getline(csv, line));
+    EXPECT_EQ(line.substr(0, line.find(',')), row["id"].get<std::string>());
+  }
+}
+
+// A report's "facades" list is read as such: input faces with their largest move (the retired
+// "surface"/"displacement" spelling counts for nothing); a kept building moved nothing
+// whatever the list says.
+void expect_facades_lists_read(const fs::path& done, const json& rows) {
+  const fs::path run = fresh_dir("batch_facades");
+  copy_run(done, run);
+  const std::string a = rows[0]["id"], b = rows[1]["id"], c = rows[2]["id"];
+  auto edit_report = [&](const std::string& id, const std::string& outcome, const json& facades) {
+    json report = json::parse(read_text(run / id / "report.json"));
+    report["outcome"] = outcome;
+    report["facades"] = facades;
+    std::ofstream(run / id / "report.json") << report.dump(2);
+  };
+  edit_report(a, "refined",
+              {{{"input_faces", {7}}, {"evidence", "scan"}, {"max_move", 0.5}, {"mean_move", 0.5}},
+               {{"input_faces", {8}}, {"evidence", "corner"}, {"max_move", -0.25}, {"mean_move", 0.1}}});
+  edit_report(b, "refined",
+              {{{"input_faces", {3, 4}}, {"evidence", "scan"}, {"max_move", 0.6}, {"mean_move", 0.4}},
+               {{"surface", "wall-8"}, {"displacement", 0.9}}});
+  edit_report(c, "kept", {{{"input_faces", {1}}, {"evidence", "scan"}, {"max_move", 0.9}, {"mean_move", 0.9}}});
+  EXPECT_TRUE(rerun(run).empty());
+  const json updated = json::parse(read_text(run / "summary.json"));
+  for (const auto& row : updated["buildings"]) {
+    const json& m = row["facades_moved"];
+    if (row["id"] == a) {
+      EXPECT_EQ(m["count"], 2);
+      EXPECT_DOUBLE_EQ(m["max"].get<double>(), 0.5);
+      EXPECT_DOUBLE_EQ(m["mean"].get<double>(), 0.375);
+      EXPECT_EQ(m["facades"][1]["surface"], json({8}));
+    } else if (row["id"] == b) {
+      EXPECT_EQ(m["count"], 1);
+      EXPECT_DOUBLE_EQ(m["max"].get<double>(), 0.6);
+      EXPECT_EQ(m["facades"][0]["surface"], json({3, 4}));
+    } else if (row["id"] == c) {
+      EXPECT_EQ(row["outcome"], "kept");
+      EXPECT_EQ(m["count"], 0);
+    }
+  }
+  fs::remove_all(run);
+}
+
 // The tile table (summary.json / summary.csv): worst first, outcome and moved facades as the
 // refine reports say, and a lead-style "facades" list (surface ids) used when present.
 TEST_F(Batch, TileTableWorstFirstWithOutcomesAndMovedFacades) {
@@ -229,54 +282,8 @@ TEST_F(Batch, TileTableWorstFirstWithOutcomesAndMovedFacades) {
   EXPECT_GT(moved_total, 0u) << "the generated buildings have misplaced scanned walls";
   EXPECT_EQ(summary["pooled"]["facades_moved"]["count"], moved_total);
   EXPECT_EQ(summary["pooled"]["outcomes"]["failed"], 0);
-  // The CSV lists the same buildings in the same order.
-  std::istringstream csv(read_text(*done_ / "summary.csv"));
-  std::string line;
-  std::getline(csv, line);
-  EXPECT_EQ(line.rfind("id,outcome,reason,facades_moved,displacement_max,displacement_mean,", 0), 0u) << line;
-  for (const auto& row : rows) {
-    ASSERT_TRUE(std::getline(csv, line));
-    EXPECT_EQ(line.substr(0, line.find(',')), row["id"].get<std::string>());
-  }
-
-  // A report's "facades" list is read as such: input faces with their largest move (the retired
-  // "surface"/"displacement" spelling counts for nothing); a kept building moved nothing
-  // whatever the list says.
-  const fs::path run = fresh_dir("batch_facades");
-  copy_run(*done_, run);
-  const std::string a = rows[0]["id"], b = rows[1]["id"], c = rows[2]["id"];
-  auto edit_report = [&](const std::string& id, const std::string& outcome, const json& facades) {
-    json report = json::parse(read_text(run / id / "report.json"));
-    report["outcome"] = outcome;
-    report["facades"] = facades;
-    std::ofstream(run / id / "report.json") << report.dump(2);
-  };
-  edit_report(a, "refined",
-              {{{"input_faces", {7}}, {"evidence", "scan"}, {"max_move", 0.5}, {"mean_move", 0.5}},
-               {{"input_faces", {8}}, {"evidence", "corner"}, {"max_move", -0.25}, {"mean_move", 0.1}}});
-  edit_report(b, "refined",
-              {{{"input_faces", {3, 4}}, {"evidence", "scan"}, {"max_move", 0.6}, {"mean_move", 0.4}},
-               {{"surface", "wall-8"}, {"displacement", 0.9}}});
-  edit_report(c, "kept", {{{"input_faces", {1}}, {"evidence", "scan"}, {"max_move", 0.9}, {"mean_move", 0.9}}});
-  EXPECT_TRUE(rerun(run).empty());
-  const json updated = json::parse(read_text(run / "summary.json"));
-  for (const auto& row : updated["buildings"]) {
-    const json& m = row["facades_moved"];
-    if (row["id"] == a) {
-      EXPECT_EQ(m["count"], 2);
-      EXPECT_DOUBLE_EQ(m["max"].get<double>(), 0.5);
-      EXPECT_DOUBLE_EQ(m["mean"].get<double>(), 0.375);
-      EXPECT_EQ(m["facades"][1]["surface"], json({8}));
-    } else if (row["id"] == b) {
-      EXPECT_EQ(m["count"], 1);
-      EXPECT_DOUBLE_EQ(m["max"].get<double>(), 0.6);
-      EXPECT_EQ(m["facades"][0]["surface"], json({3, 4}));
-    } else if (row["id"] == c) {
-      EXPECT_EQ(row["outcome"], "kept");
-      EXPECT_EQ(m["count"], 0);
-    }
-  }
-  fs::remove_all(run);
+  expect_csv_rows(*done_, rows);
+  expect_facades_lists_read(*done_, rows);
 }
 
 }  // namespace

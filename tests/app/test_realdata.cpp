@@ -191,6 +191,36 @@ void record_trace(const RefineTrace& t, Row& row) {
   row.mip_rows = t.selection->selection.constraints;
 }
 
+// The refined building (local frame) checked: valid, refined, the first `facade` scan points on a
+// face parallel to the wall within kMaxRms, no roof vertex far from the wall moved.
+void check_refined(const RefineResult& r, const Mesh& refined, const Mesh& repaired, const Plane& wall_plane,
+                   const PointCloud& scan_local, int facade, Row& row) {
+  const Validation val = validate_mesh(refined, 0.01);
+  if (!r.valid || !val.valid())
+    row.failures.push_back("invalid result: " + (val.problem.empty() ? std::string("r.valid false") : val.problem));
+  if (!r.refined())
+    row.failures.push_back(std::string("not refined: ") + outcome_name(r.outcome) + " (" + r.reason + ")");
+
+  // Scan facade points to the nearest refined face parallel to the wall (within 5 degrees).
+  std::vector<std::vector<Vec3>> parallel;
+  for (const auto& f : refined.faces) {
+    auto p = face_points(refined, f);
+    const Vec3 n = newell_normal(p).normalized();
+    if (n.allFinite() && n.dot(wall_plane.n) > std::cos(radians(5.0))) parallel.push_back(std::move(p));
+  }
+  double sum2 = 0.0;
+  for (int i = 0; i < facade; ++i) {
+    double d = 1e300;
+    for (const auto& p : parallel) d = std::min(d, point_polygon_distance(scan_local.points[i], p));
+    sum2 += d * d;
+  }
+  row.rms = facade > 0 ? std::sqrt(sum2 / facade) : NAN;
+  if (!(row.rms <= kMaxRms)) row.failures.push_back("scan RMS to the refined wall " + std::to_string(row.rms) + " m");
+  row.roof_moved = moved_far_roof_vertices(refined, repaired, wall_plane);
+  if (row.roof_moved > 0)
+    row.failures.push_back(std::to_string(row.roof_moved) + " roof vertices > 2 m from the wall moved");
+}
+
 // The moved-wall experiment on one georeferenced soup.
 Row run_building(const Mesh& soup) {
   Row row;
@@ -257,31 +287,7 @@ Row run_building(const Mesh& soup) {
   record_trace(r.trace, row);
   dump_case(soup, scan, r.mesh);
 
-  const Mesh refined = translated(r.mesh, -origin);
-  const Validation val = validate_mesh(refined, 0.01);
-  if (!r.valid || !val.valid())
-    row.failures.push_back("invalid result: " + (val.problem.empty() ? std::string("r.valid false") : val.problem));
-  if (!r.refined())
-    row.failures.push_back(std::string("not refined: ") + outcome_name(r.outcome) + " (" + r.reason + ")");
-
-  // Scan facade points to the nearest refined face parallel to the wall (within 5 degrees).
-  std::vector<std::vector<Vec3>> parallel;
-  for (const auto& f : refined.faces) {
-    auto p = face_points(refined, f);
-    const Vec3 n = newell_normal(p).normalized();
-    if (n.allFinite() && n.dot(wall_plane.n) > std::cos(radians(5.0))) parallel.push_back(std::move(p));
-  }
-  double sum2 = 0.0;
-  for (int i = 0; i < facade; ++i) {
-    double d = 1e300;
-    for (const auto& p : parallel) d = std::min(d, point_polygon_distance(scan_local.points[i], p));
-    sum2 += d * d;
-  }
-  row.rms = facade > 0 ? std::sqrt(sum2 / facade) : NAN;
-  if (!(row.rms <= kMaxRms)) row.failures.push_back("scan RMS to the refined wall " + std::to_string(row.rms) + " m");
-  row.roof_moved = moved_far_roof_vertices(refined, repaired, wall_plane);
-  if (row.roof_moved > 0)
-    row.failures.push_back(std::to_string(row.roof_moved) + " roof vertices > 2 m from the wall moved");
+  check_refined(r, translated(r.mesh, -origin), repaired, wall_plane, scan_local, facade, row);
   return row;
 }
 

@@ -39,24 +39,9 @@ using fixtures::write_bytes;
 const char* const kAhn3 = "3dfier/example_data/ahn3/ahn3_cropped_1.laz";
 const char* const kAhn3Small = "3dfier/example_data/ahn3/ahn3_cropped_2.laz";
 
-template <class T>
-T peek(const std::string& bytes, std::size_t at) {
-  T v;
-  std::memcpy(&v, &bytes[at], sizeof v);
-  return v;
-}
-template <class T>
-T peek(const unsigned char* p) {
-  T v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-
-std::string records(const std::string& path) { return fixtures::las_records(path); }
-
-void expect_error(const std::string& bytes, const std::string& fault) {
-  fixtures::expect_bytes_refused("bad.laz", bytes, fault, records);
-}
+using fixtures::expect_laz_refused;
+using fixtures::las_records;
+using fixtures::peek;
 
 }  // namespace
 
@@ -122,7 +107,7 @@ TEST(Laz, DecodedRecordsEqualLazPerfByteForByte) {
     const std::string dump = temp_path(laz.filename().string() + ".ref");
     const std::string cmd = fixtures::lazperf_command(laz.string(), dump);
     ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
-    const std::string ref = cli_fixtures::slurp(dump), ours = records(laz.string());
+    const std::string ref = cli_fixtures::slurp(dump), ours = las_records(laz.string());
     ASSERT_EQ(ours.size(), ref.size()) << rel;
     const LasHeader h = read_las_header(laz.string());
     ASSERT_EQ(ours.size(), h.point_count * h.record_length);
@@ -169,7 +154,7 @@ TEST(Laz, LyingHeadersAndTruncatedChunksAreOneLine) {
   for (const auto& [edit, fault] : lies) {
     std::string b = good;
     edit(b);
-    expect_error(b, fault);
+    expect_laz_refused(b, fault);
     // read_las_header refuses the same way (the table is checked before any point).
     try {
       read_las_header(write_bytes("bad_header.laz", b));
@@ -180,13 +165,13 @@ TEST(Laz, LyingHeadersAndTruncatedChunksAreOneLine) {
   }
   // Truncated files: the table is at the end, so it goes first; a file cut inside the chunks
   // but given its table back (offset fixed) has chunks that no longer fit before it.
-  expect_error(good.substr(0, good.size() - 10), "LAZ chunk");
-  expect_error(good.substr(0, 2000), "LAZ chunk table offset");
+  expect_laz_refused(good.substr(0, good.size() - 10), "LAZ chunk");
+  expect_laz_refused(good.substr(0, 2000), "LAZ chunk table offset");
   {
     const std::size_t cut = 300000;
     std::string b = good.substr(0, cut) + good.substr(table);
     poke<std::uint64_t>(b, point_offset, cut);
-    expect_error(b, "does not fit the point data before the chunk table");
+    expect_laz_refused(b, "does not fit the point data before the chunk table");
   }
   {
     // The header's count cut to the first chunk: exactly its points, the rest is not read.
@@ -194,12 +179,12 @@ TEST(Laz, LyingHeadersAndTruncatedChunksAreOneLine) {
     // decodes other points; it never crashes or hangs.
     std::string b = good;
     poke<std::uint32_t>(b, 107, 50000);
-    const std::string first = records(write_bytes("first_chunk.laz", b));
-    EXPECT_EQ(first, records(data_path.string()).substr(0, first.size()));
+    const std::string first = las_records(write_bytes("first_chunk.laz", b));
+    EXPECT_EQ(first, las_records(data_path.string()).substr(0, first.size()));
     EXPECT_EQ(first.size(), 50000u * 28u);
     std::fill(b.begin() + point_offset + 8 + 28, b.begin() + point_offset + 8 + 20000, '\0');
     try {
-      records(write_bytes("zeroed.laz", b));
+      las_records(write_bytes("zeroed.laz", b));
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find("truncated or corrupt"), std::string::npos) << e.what();
     }
@@ -225,7 +210,7 @@ TEST(Laz, CorpusSeedsReadAsTheirLasTwins) {
     EXPECT_TRUE(h.compressed) << e.path();
     if (!fs::exists(twin)) {
       EXPECT_EQ(h.point_count, 0u) << e.path();
-      EXPECT_EQ(records(e.path().string()), "");
+      EXPECT_EQ(las_records(e.path().string()), "");
       continue;
     }
     const LasHeader t = read_las_header(twin.string());
@@ -233,7 +218,7 @@ TEST(Laz, CorpusSeedsReadAsTheirLasTwins) {
     EXPECT_EQ(h.record_length, t.record_length) << e.path();
     EXPECT_EQ(h.point_count, t.point_count) << e.path();
     EXPECT_GT(h.point_count, 0u) << e.path();
-    EXPECT_EQ(records(e.path().string()), records(twin.string())) << e.path();
+    EXPECT_EQ(las_records(e.path().string()), las_records(twin.string())) << e.path();
     const PointCloud a = read_cloud(e.path().string(), {{6}}), b = read_cloud(twin.string(), {{6}});
     EXPECT_EQ(a.points, b.points) << e.path();
     ++pairs;
@@ -248,12 +233,12 @@ TEST(Laz, EveryTruncationAndByteFlipIsOneLineOrTheSamePoints) {
   for (const char* seed : {"v12_f1_extra.laz", "v14_f8_extra.laz"}) {
     const std::string good = cli_fixtures::slurp(corpus_dir() + "/" + seed);
     ASSERT_FALSE(good.empty()) << seed;
-    const std::string want = records(corpus_dir() + "/" + seed);
+    const std::string want = las_records(corpus_dir() + "/" + seed);
     const auto check = [&](const std::string& bytes, bool truncated) {
       const std::string path = write_bytes("edit.laz", bytes);
       try {
         const LasHeader h = read_las_header(path);
-        const std::string got = records(path);
+        const std::string got = las_records(path);
         if (truncated) {
           EXPECT_EQ(got, want) << seed << ": truncated at " << bytes.size();
         }
@@ -289,7 +274,7 @@ TEST(Laz, SampleFolderEqualsLazPerf) {
     const std::string cmd = fixtures::lazperf_command(e.path().string(), dump) + " 2>/dev/null";
     const bool reference = std::system(cmd.c_str()) == 0 && fs::exists(dump) && fs::file_size(dump) > 0;
     try {
-      const std::string ours = records(e.path().string());
+      const std::string ours = las_records(e.path().string());
       if (reference) {
         EXPECT_EQ(ours, cli_fixtures::slurp(dump)) << e.path();
         ++same;
@@ -319,139 +304,4 @@ TEST(Laz, HugeDeclaredCountsAllocateLittle) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("truncated or corrupt"), std::string::npos) << e.what();
   }
-}
-
-namespace {
-
-// Format-6 records (30 bytes + `extra`): returns 1 of 1, scanner channel `channel`.
-std::string point14(std::int32_t x, double gps, int channel, std::size_t extra = 0) {
-  std::string r(30 + extra, '\0');
-  poke<std::int32_t>(r, 0, x);
-  r[14] = 0x11;
-  r[15] = char((channel & 3) << 4);
-  r[16] = 2;
-  poke<double>(r, 22, gps);
-  return r;
-}
-
-std::string write_laz(const std::string& name, std::uint32_t record_length, const std::string& records,
-                      std::uint32_t chunk = 50000) {
-  const std::string path = temp_path(name);
-  LasRecordFormat f;
-  f.version_minor = 4, f.point_format = 6, f.record_length = record_length;
-  LasRecordWriter w(path, f, true, chunk);
-  for (std::size_t at = 0; at < records.size(); at += record_length)
-    w.add(reinterpret_cast<const unsigned char*>(records.data() + at));
-  w.finish();
-  return path;
-}
-
-// A format-6 LAZ of one chunk whose second point says "GPS time changed" and whose GPS time
-// layer is `gps_bytes` of 0xff: every code the time decoder reads is a switch to another time
-// sequence. The chunk keeps its size (the table stays valid): 32 random extra bytes a point fill
-// it, and their layers give their bytes to the time layer.
-std::string gps_switch_loop_laz(std::size_t gps_bytes) {
-  constexpr std::size_t kExtra = 32;
-  std::mt19937 rng(5);
-  std::string all = point14(0, 1.0, 0, kExtra) + point14(100, 2.0, 0, kExtra);
-  while (all.size() < (gps_bytes + 4096) / kExtra * (30 + kExtra)) {
-    std::string r = point14(100, 2.0, 0, kExtra);
-    for (std::size_t i = 30; i < r.size(); ++i) r[i] = char(rng());
-    all += r;
-  }
-  std::string b = cli_fixtures::slurp(write_laz("gps_source.laz", 30 + kExtra, all));
-  const std::size_t chunk = peek<std::uint32_t>(b, 96) + 8;
-  const std::size_t sizes = chunk + 30 + kExtra + 4, layers = 9 + kExtra;
-  std::vector<std::uint32_t> size(layers);
-  for (std::size_t i = 0; i < layers; ++i) size[i] = peek<std::uint32_t>(b, sizes + 4 * i);
-  std::size_t rest = 0;
-  for (std::size_t i = 1; i < layers; ++i) rest += size[i];
-  EXPECT_GE(rest, gps_bytes);
-  for (std::size_t i = 1; i < layers; ++i) poke<std::uint32_t>(b, sizes + 4 * i, i == 8 ? std::uint32_t(rest) : 0);
-  const std::size_t data = sizes + 4 * layers + size[0];
-  std::fill(b.begin() + std::ptrdiff_t(data), b.begin() + std::ptrdiff_t(data + rest), char(0xff));
-  return b;
-}
-
-}  // namespace
-
-// A time layer that only ever switches sequence consumes no bytes: the decoder ends it after a
-// switch to each other sequence, at once, where it used to spin until the layer ran out (12 s for
-// 64 KB, minutes for 1 MB).
-TEST(Laz, GpsTimeSwitchLoopFailsAtOnce) {
-  for (const std::size_t kb : {64, 1024}) {
-    SCOPED_TRACE(std::to_string(kb) + " KB of switches");
-    const std::string b = gps_switch_loop_laz(kb * 1024);
-    const auto t0 = std::chrono::steady_clock::now();
-    expect_error(b, "GPS time switches sequence without end");
-    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
-  }
-}
-
-// BYTE14 models are made per extra byte and channel as a layer first changes, bounded per chunk:
-// 4,200 changing extra bytes in four channels (16,800 models, 34 MB) are refused; 1,000 in four
-// channels read back as written, changing or not.
-TEST(Laz, ExtraByteModelsAreBoundedPerChunk) {
-  const auto records = [](std::size_t extra, std::size_t n, bool vary) {
-    std::mt19937 rng(9);
-    std::string all;
-    for (std::size_t k = 0; k < n; ++k) {
-      std::string r = point14(std::int32_t(k), 1.0 + double(k), int(k % 4), extra);
-      if (vary)
-        for (std::size_t i = 30; i < r.size(); ++i) r[i] = char(rng());
-      all += r;
-    }
-    return all;
-  };
-  expect_error(cli_fixtures::slurp(write_laz("models.laz", 30 + 4200, records(4200, 8, true))),
-               "more than 16384 extra-byte models in one chunk");
-  for (const bool vary : {true, false}) {
-    const std::string want = records(1000, 12, vary);
-    EXPECT_TRUE(fixtures::las_records(write_laz("models_ok.laz", 30 + 1000, want)) == want);
-  }
-}
-
-namespace {
-
-// Resident memory of this process (kB).
-long resident_kb() {
-  std::ifstream statm("/proc/self/statm");
-  long size = 0, resident = 0;
-  statm >> size >> resident;
-  return resident * (::sysconf(_SC_PAGESIZE) / 1024);
-}
-
-}  // namespace
-
-// BYTE v2 models are made on a chunk's second point: 40 chunks of one point with 65,000 extra
-// bytes each made 65,000 models (130 MB) per chunk, 272 MB peak for 40 points. Read in a child
-// whose peak resident memory is measured.
-TEST(Laz, OnePointChunksOfManyExtraBytesMakeNoModels) {
-  constexpr std::uint32_t kExtra = 65000;
-  const std::string path = temp_path("one_point_chunks.laz");
-  {
-    LasRecordFormat f;
-    f.point_format = 0, f.record_length = 20 + kExtra;
-    LasRecordWriter w(path, f, true, 1);
-    std::string r(20 + kExtra, '\0');
-    for (int k = 0; k < 40; ++k) {
-      poke<std::int32_t>(r, 0, k);
-      r[20 + std::size_t(k)] = char(k);
-      w.add(reinterpret_cast<const unsigned char*>(r.data()));
-    }
-    w.finish();
-  }
-  const long before = resident_kb();
-  const pid_t child = ::fork();
-  ASSERT_GE(child, 0);
-  if (child == 0) {
-    std::size_t n = 0;
-    stream_las_records(path, [&](const LasHeader&, const unsigned char*) { ++n; });
-    ::_exit(n == 40 ? 0 : 1);
-  }
-  int status = 0;
-  struct rusage usage {};
-  ASSERT_EQ(::wait4(child, &status, 0, &usage), child);
-  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
-  EXPECT_LT(usage.ru_maxrss - before, 64 * 1024) << "peak " << usage.ru_maxrss << " kB, " << before << " kB before";
 }

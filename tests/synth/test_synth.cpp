@@ -434,31 +434,6 @@ TEST(SynthDefects, LoggedDefectsArePresentInTheSoup) {
   EXPECT_GT(gaps, 0);
 }
 
-TEST(SynthWrite, WritesFourFilesAndMeta) {
-  const auto dir = std::filesystem::temp_directory_path() / "lodrefine_test_synth";
-  std::filesystem::remove_all(dir);
-  SynthOptions o;
-  o.target_points = 3000;
-  const auto b = make_building(BuildingType::TShape, 3, o);
-  OutputTree out(dir.string());
-  write_synth_building(out, b);
-  out.keep();
-  const auto d = dir / b.id;
-  for (const char* f : {"truth.obj", "coarse.obj", "cloud.ply", "meta.json"})
-    EXPECT_TRUE(std::filesystem::exists(d / f)) << f;
-  std::ifstream in(d / "meta.json");
-  const auto meta = nlohmann::json::parse(in);
-  EXPECT_EQ(meta["id"], b.id);
-  EXPECT_EQ(meta["type"], "tshape");
-  EXPECT_EQ(meta["seed"], 3);
-  EXPECT_EQ(meta["moved_walls"].size(), b.moved_walls.size());
-  EXPECT_EQ(meta["scanned_truth_faces"].get<std::vector<int>>(), b.scanned_truth_faces);
-  EXPECT_EQ(meta["counts"]["points"], b.cloud.points.size());
-  // Binary PLY: header + 3 doubles + 1 float per point.
-  EXPECT_GT(std::filesystem::file_size(d / "cloud.ply"), b.cloud.points.size() * 28);
-  std::filesystem::remove_all(dir);
-}
-
 TEST(SynthDeterminism, DefectsFlagLeavesGeometryAndCloudAlone) {
   const auto a = make_building(BuildingType::Hip, 9), b = make_building(BuildingType::Hip, 9, clean_options());
   EXPECT_EQ(a.point_label, b.point_label);

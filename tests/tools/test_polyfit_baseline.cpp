@@ -1,7 +1,6 @@
 // CGAL's PolyFit as a baseline: on a box building with a clean scan of every face it closes a mesh
 // within centimetres of the truth (in the input's georeferenced frame), in this process and in
-// the bounded child; its failures are statuses, never exceptions; the bench's summary counts
-// them and pools the truth RMSE over the buildings PolyFit closed.
+// the bounded child; its failures are statuses, never exceptions.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,31 +10,14 @@
 #include "lodrefine/core/distance.h"
 #include "lodrefine/eval/eval.h"
 #include "lodrefine/tools/polyfit_baseline.h"
-#include "lodrefine/tools/polyfit_bench.h"
 #include "support/mesh_fixtures.h"
+#include "support/polyfit_fixtures.h"
 #include "support/scan_fixtures.h"
 
 using namespace lodrefine;
 using namespace lodrefine::fixtures;
 
 namespace {
-
-const Vec3 kOrigin(85012.0, 446034.0, 2.0);  // georeferenced, as a Dutch tile (EPSG:28992)
-
-// The truth: a 12 × 8 × 6 m box.
-Mesh truth_box() { return translated(box(Vec3::Zero(), Vec3(12, 8, 6)), kOrigin); }
-
-// A clean scan of every face of `m` (5 mm noise, a point every 0.1 m).
-PointCloud scan_of(const Mesh& m, const std::vector<int>& faces) {
-  std::mt19937 rng(7);
-  PointCloud cloud;
-  for (int f : faces) sample_face(face_points(m, m.faces[std::size_t(f)]), 0.0, 0.1, rng, cloud);
-  return cloud;
-}
-PointCloud full_scan(const Mesh& m) { return scan_of(m, {0, 1, 2, 3, 4, 5}); }
-
-// The coarse model: the truth with its wall x = 12 moved 0.4 m out.
-Mesh coarse_box() { return translated(box(Vec3::Zero(), Vec3(12.4, 8, 6)), kOrigin); }
 
 // RMS distance of points sampled on every truth face to `m` (m).
 double truth_rms(const Mesh& m, const Mesh& truth) {
@@ -116,11 +98,11 @@ TEST(PolyfitBaseline, IsolatedChildStopsAtItsCpuLimit) {
   for (int k = 0; k < 30; ++k) {
     const Vec3 n(std::cos(angle(rng)), std::sin(angle(rng)), 0.3 * std::cos(angle(rng)));
     const auto [u, v] = Plane::through(Vec3::Zero(), n.normalized()).basis();
-    add_grid(cloud, {kOrigin + Vec3(at(rng), at(rng), at(rng)), u, v, -4, 4, -4, 4}, 0.1, 0.005, unsigned(k));
+    add_grid(cloud, {kTileOrigin + Vec3(at(rng), at(rng), at(rng)), u, v, -4, 4, -4, 4}, 0.1, 0.005, unsigned(k));
   }
   PolyfitOptions options{PolyfitPlanes::Scan};
   options.cpu_limit = 1.0;
-  const Mesh model = translated(box(Vec3::Zero(), Vec3(20, 20, 20)), kOrigin);
+  const Mesh model = translated(box(Vec3::Zero(), Vec3(20, 20, 20)), kTileOrigin);
   const PolyfitResult r = polyfit_baseline_isolated(model, cloud, RefineConfig{}, options);
   EXPECT_EQ(r.status, PolyfitStatus::TimeLimit) << polyfit_status_name(r.status) << ": " << r.reason;
   EXPECT_NE(r.reason.find("1 s CPU"), std::string::npos) << r.reason;
@@ -129,72 +111,4 @@ TEST(PolyfitBaseline, IsolatedChildStopsAtItsCpuLimit) {
   // parent's clock: a fresh checkout's run read 0.99995 s of wall clock.
   EXPECT_GE(r.seconds, 0.95);
   EXPECT_DOUBLE_EQ(r.cpu_seconds, 1.0);
-}
-
-TEST(PolyfitBench, CompareMeasuresBothMethodsOnTheTruth) {
-  BenchBuilding b;
-  b.id = "box";
-  b.truth = truth_box();
-  b.coarse = coarse_box();
-  b.cloud = full_scan(b.truth);
-  const PolyfitComparisonRow row = compare_with_polyfit(b, RefineConfig{}, {});
-  EXPECT_EQ(row.id, "box");
-  ASSERT_TRUE(row.coarse_facade && row.lodrefine.truth_facade && row.polyfit.truth_facade);
-  EXPECT_GT(row.coarse_facade->rmse, 0.1);
-  EXPECT_LT(row.polyfit.truth_facade->rmse, 0.02);
-  EXPECT_LT(row.lodrefine.truth_facade->rmse, 0.02);
-  EXPECT_TRUE(row.polyfit.produced && row.polyfit.watertight && row.lodrefine.watertight);
-  EXPECT_GT(row.lodrefine.seconds, 0.0);
-  EXPECT_GT(row.polyfit.seconds, 0.0);
-  EXPECT_TRUE(row.baseline.mesh.faces.empty());  // dropped: rows hold figures only
-}
-
-TEST(PolyfitBench, SummaryCountsFailuresAndPoolsOverClosedBuildings) {
-  auto stats = [](double rmse, std::size_t count) {
-    DistanceStats s;
-    s.rmse = rmse, s.count = count;
-    return s;
-  };
-  PolyfitComparisonRow closed, failed;
-  closed.lodrefine = {1.0, 1.0, true, true, stats(0.01, 100), stats(0.02, 100)};
-  closed.polyfit = {10.0, 9.0, true, true, stats(0.03, 100), stats(0.04, 100)};
-  closed.coarse_facade = stats(0.5, 100);
-  closed.baseline.status = PolyfitStatus::Closed;
-  failed.lodrefine = {3.0, 2.0, true, true, stats(0.05, 300), stats(0.02, 100)};
-  failed.polyfit = {60.0, 60.0, false, false, std::nullopt, std::nullopt};
-  failed.coarse_facade = stats(0.5, 300);
-  failed.baseline.status = PolyfitStatus::TimeLimit;
-  const PolyfitComparison s = summarize_comparison({closed, failed});
-  EXPECT_EQ(s.buildings, 2);
-  EXPECT_EQ(s.polyfit_closed, 1);
-  ASSERT_EQ(s.failures.size(), 1u);
-  EXPECT_EQ(s.failures[0], std::make_pair(std::string("time-limit"), 1));
-  EXPECT_DOUBLE_EQ(s.lodrefine_median, 2.0);
-  EXPECT_DOUBLE_EQ(s.polyfit_max, 60.0);
-  EXPECT_DOUBLE_EQ(s.ratio_min, 10.0);
-  EXPECT_DOUBLE_EQ(s.cpu_ratio_of_medians, 34.5 / 1.5);
-  EXPECT_NEAR(s.facade_lodrefine, std::sqrt((0.01 * 0.01 * 100 + 0.05 * 0.05 * 300) / 400), 1e-12);
-  EXPECT_NEAR(s.facade_lodrefine_closed, 0.01, 1e-12);
-  EXPECT_NEAR(s.facade_polyfit_closed, 0.03, 1e-12);
-  EXPECT_NEAR(s.roof_polyfit_closed, 0.04, 1e-12);
-}
-
-// A tile's building id (a model's file name) and PolyFit's reason are printed escaped: a CR in a
-// file name printed "ALL GOOD" over the row.
-TEST(PolyfitBench, RowsEscapeIdsAndReasons) {
-  PolyfitComparisonRow row;
-  row.id = "B\r\x1b[2KALL GOOD";
-  row.outcome = Outcome::Kept;
-  row.baseline.status = PolyfitStatus::TooFewPlanes;
-  row.baseline.reason = "few\rplanes";
-  std::FILE* f = std::tmpfile();
-  ASSERT_NE(f, nullptr);
-  print_comparison_row(row, f);
-  std::rewind(f);
-  std::string text;
-  for (int c; (c = std::fgetc(f)) != EOF;) text += char(c);
-  std::fclose(f);
-  EXPECT_EQ(text.find_first_of("\r\x1b"), std::string::npos) << text;
-  EXPECT_NE(text.find("B\\r\\x1b[2KALL GOOD"), std::string::npos) << text;
-  EXPECT_NE(text.find("few\\rplanes"), std::string::npos) << text;
 }
