@@ -205,7 +205,6 @@ json refine_report(const RefineResult& r) {
   }
   if (t.substitution) {
     json sub = substitution_json(*t.substitution);
-    if (t.substitution_without_corners) sub["without_corners"] = substitution_json(*t.substitution_without_corners);
     rep["substitution"] = sub;
   }
   if (t.replacements) {

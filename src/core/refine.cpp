@@ -304,9 +304,8 @@ void outdated_walls(const Mesh& current, const MatchResult& mr, const std::vecto
   matching.q_model = mr.q_model;
 }
 
-// The starting shell: every move of the plan at once, the model's topology kept (without the
-// corner moves if those spoil it; else one wall at a time); none when no wall is outdated or none
-// could be moved. The walls it moved go to plan.moved (and the trace's facades).
+// The starting shell: every move of the plan at once, the model's topology kept, else one wall at
+// a time; none when no wall is outdated or none could be moved. The walls it moved go to plan.moved (and the trace's facades).
 std::optional<Mesh> starting_shell(const Mesh& current, MovePlan& plan, const PointCloud& local,
                                    const std::vector<ScanPlane>& planes, const RefineConfig& prm, RefineTrace& trace) {
   plan.moved.clear();
@@ -316,19 +315,12 @@ std::optional<Mesh> starting_shell(const Mesh& current, MovePlan& plan, const Po
   if (!all.empty())
     refined = substitute_valid(current, plan.surfaces, all, prm.repair,
                                trace.substitution.emplace(RefineTrace::Substitution{}));
-  auto add_scan_moves = [&] {
+  if (refined) {
     for (const auto& mv : plan.scan)
       add_moved(current, plan.surfaces, mv, Evidence::Scan, mv.surface, plan.moved, trace);
-  };
-  if (refined) {
-    add_scan_moves();
     for (const auto& c : plan.corners)
       add_moved(current, plan.surfaces, c.move, Evidence::Corner, -1, plan.moved, trace).wall.flush_facade =
           c.flush_facade;
-  } else if (!plan.corners.empty() && !plan.scan.empty()) {
-    refined = substitute_valid(current, plan.surfaces, plan.scan, prm.repair,
-                               trace.substitution_without_corners.emplace(RefineTrace::Substitution{}));
-    if (refined) add_scan_moves();
   }
   trace.replacements.emplace();
   if (!refined && !all.empty()) refined = one_wall_at_a_time(current, local, planes, prm, plan.moved, trace);
@@ -492,7 +484,6 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const R
   auto attempt = [&] {
     trace.facades.clear();
     trace.substitution.reset();
-    trace.substitution_without_corners.reset();
     const std::optional<Mesh> refined = starting_shell(current, plan, local, planes, prm, trace);
     refinement.lap(RefineStage::Substitution);
     return select_and_judge(kept, current, refined, !mr.matches.empty(), plan, local, planes, prm, refinement, verdict);

@@ -89,7 +89,7 @@ struct RefineTrace {
   };
   std::optional<Scan> scan;
   std::optional<Matching> matching;
-  std::optional<Substitution> substitution, substitution_without_corners;
+  std::optional<Substitution> substitution;
   std::optional<std::vector<Step>> replacements;  // set together with `facades`
   std::vector<FacadeMove> facades;
   std::optional<Judgement> judgement;  // never worse (judge.h), when a refinement was made
