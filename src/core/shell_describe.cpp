@@ -7,6 +7,7 @@
 
 #include "lodrefine/base/geometry.h"
 #include "lodrefine/core/matching.h"
+#include "lodrefine/core/objective.h"
 #include "shell_supports.h"
 
 namespace lodrefine::detail {
@@ -35,8 +36,7 @@ void for_box_cells(const std::vector<Vec2>& poly, Fn&& fn) {
 
 // PolyFit's data-fitting term (its compute_confidences' supporting points): the scan points of
 // a candidate's supporting plane that lie within it, each weighted by how well it fits that
-// plane, 1 - (d / tol)^2 at distance d (tol: ransac_epsilon, a RANSAC inlier's farthest, plus
-// merge_distance, how far a supporting plane may lie from the points merged onto it). Counted
+// plane (objective.h: fit_weight within fit_tolerance). Counted
 // as the area they stand for: the scanned area (kCell cells holding a point, over all planes)
 // over the points, so a candidate explaining its share of an evenly sampled scan is worth about
 // its area, a sparsely sampled one less: PolyFit's share of the points, in the coverage term's
@@ -55,16 +55,15 @@ FitPoints fit_points(const Supports& s, const std::vector<Frame2>& frames, const
   FitPoints fp;
   const int np = int(s.planes.size());
   fp.at.resize(np), fp.weight.resize(np), fp.cells.resize(np);
-  const double tol = prm.plane.ransac_epsilon + prm.selection.merge_distance;
+  const double tol = fit_tolerance(prm);
   long long points = 0, occupied = 0;
   for (int k = 0; k < np; ++k) {
     for (const auto& p : s.points[k]) {
       const Vec2 q = frames[k](p);
-      const double d = s.planes[k].plane.distance(p) / tol;
       fp.cells[k][cell_key((long long)std::floor(q.x() / kCell), (long long)std::floor(q.y() / kCell))].push_back(
           int(fp.at[k].size()));
       fp.at[k].push_back(q);
-      fp.weight[k].push_back(std::max(0.0, 1.0 - d * d));
+      fp.weight[k].push_back(fit_weight(s.planes[k].plane.distance(p), tol));
     }
     points += (long long)s.points[k].size();
     occupied += (long long)fp.cells[k].size();
@@ -183,9 +182,8 @@ FaceProps describe_candidates(CandidateSet& cs, const Mesh& start, const Support
         source[fi] = start.faces[sf].source;
         break;
       }
-    const double scanned = scanned_share(poly, own[k]);
-    const double prior = in_start[fi] ? 1.0 - scanned_share(poly, other[k]) : 0.0;
-    confidence[fi] = std::max(scanned, prior);
+    const double contradicted = in_start[fi] ? scanned_share(poly, other[k]) : 0.0;
+    confidence[fi] = face_confidence(scanned_share(poly, own[k]), contradicted, in_start[fi]);
     // On a plane of the starting shell only its own faces are credited: points running on along
     // it past its outline are no evidence that it runs on (a flush neighbour's facade; corners.h).
     if (s.planes[k].from_scan || in_start[fi]) fit[fi] = fitted_area(fp, k, poly);

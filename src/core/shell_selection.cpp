@@ -35,10 +35,6 @@ using detail::nearest_closed_selection;
 using detail::shell_problem;
 using detail::snapped_to_start;
 using detail::Supports;
-// A sharp edge costs lambda_complexity * its length * this width (m): the complexity term in the
-// coverage term's units (m²), independent of how large the region is.
-constexpr double kSharpEdgeWidth = 0.25;
-
 std::vector<char> kept(const std::vector<char>& v, const std::vector<char>& keep) {
   std::vector<char> out;
   for (std::size_t f = 0; f < v.size(); ++f)
@@ -252,17 +248,12 @@ Supports supports_of(const Mesh& start, const PointCloud& cloud, const std::vect
   return s;
 }
 
-// The program over the candidates: coverage and data-fitting terms, sharp edges; with a `warm`
-// start, it is the first incumbent and every candidate no evidence reaches is fixed to it.
+// The program over the candidates: its costs (objective.h); with a `warm` start, it is the first
+// incumbent and every candidate no evidence reaches is fixed to it.
 SelectionProgram program_of(CandidateSet& cs, const FaceProps& props, const std::vector<char>& warm,
                             const SelectionConfig& prm) {
   SelectionProgram pg;
-  const auto area = cs.areas();
-  for (int f = 0; f < cs.size(); ++f) {
-    pg.cost.push_back(coverage_cost(area[FaceIndex(f)], props.confidence[FaceIndex(f)], prm.tau_cov));
-    pg.fit.push_back(props.fit[FaceIndex(f)]);
-  }
-  for (const auto& e : cs.edges) pg.sharp_cost.push_back(prm.lambda_complexity * cs.length(e) * kSharpEdgeWidth);
+  set_selection_costs(cs, props.confidence, props.fit, prm, pg);
   if (!warm.empty()) {
     pg.warm = warm;
     for (int f = 0; f < cs.size(); ++f) pg.fixed.push_back(props.in_zone[FaceIndex(f)] ? -1 : int(warm[f]));

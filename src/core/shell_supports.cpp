@@ -10,6 +10,7 @@
 #include "lodrefine/base/topology.h"
 #include "lodrefine/core/distance.h"
 #include "lodrefine/core/matching.h"
+#include "lodrefine/core/objective.h"
 #include "lodrefine/core/selection.h"
 #include "lodrefine/core/validate.h"
 
@@ -563,16 +564,10 @@ std::vector<char> nearest_closed_selection(CandidateSet& cs, const std::vector<c
       near.swap(grown);
     }
     SelectionProgram pg;
-    const auto area = cs.areas();
-    for (int f = 0; f < cs.size(); ++f) {
-      pg.cost.push_back(in_start[f] ? -scope.keep_weight * area[FaceIndex(f)] : area[FaceIndex(f)]);
-      pg.fixed.push_back(near[f] ? -1 : int(in_start[f]));
-    }
-    pg.sharp_cost.assign(cs.edges.size(), 0.0);
+    set_mend_costs(cs, in_start, scope.keep_weight, pg);
+    for (int f = 0; f < cs.size(); ++f) pg.fixed.push_back(near[f] ? -1 : int(in_start[f]));
     pg.excluded = excluded;
-    SelectionConfig mend = prm;  // the costs are areas: weight 1
-    mend.lambda_coverage = 1.0;
-    const SelectionResult r = select_faces(cs, pg, mend);
+    const SelectionResult r = select_faces(cs, pg, prm);
     if (r.ok) return selected_faces(cs);
   }
   return {};
