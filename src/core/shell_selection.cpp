@@ -17,6 +17,10 @@
 #include "lodrefine/core/objective.h"
 #include "lodrefine/core/shell_trace.h"
 #include "lodrefine/core/validate.h"
+#include "occupancy.h"
+#include "shell_checks.h"
+#include "shell_describe.h"
+#include "shell_mend.h"
 #include "shell_supports.h"
 
 namespace lodrefine {
@@ -42,6 +46,11 @@ std::vector<char> kept(const std::vector<char>& v, const std::vector<char>& keep
   return out;
 }
 
+// m: a changed candidate with a corner farther than this from every scan point the selection
+// used, in plan, is a change the scan did not ask for (a roof re-cut far from every scanned
+// facade): such candidates keep their starting-shell value. In plan, as the
+// roof above a moved facade must follow it however high it is. A step's facade also reaches the
+// volume between it and the start wall it replaces, however deep (detail::step_volume_samples).
 constexpr double kEvidenceReach = 2.0;
 
 // The scan points the selection used, in plan: built once per building, asked whether a point
