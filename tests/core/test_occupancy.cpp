@@ -10,7 +10,7 @@ TEST(Occupancy, FrameIsThePlanesBasisAtTheCentreProjected) {
   const Plane front = Plane::through({0, 0, 0}, {0, -1, 0});  // the wall y = 0, facing -y
   const Frame2 frame = frame_of(front, {5, 3, 3});
   EXPECT_NEAR((frame.o - Vec3(5, 0, 3)).norm(), 0.0, 1e-12);
-  EXPECT_NEAR((frame(Vec3(6, 0, 4)) - Vec2(1, 1)).norm(), 0.0, 1e-12);  // u along +x, v up
+  EXPECT_NEAR((frame(Vec3(6, 0, 4)) - Vec2(1, 1)).norm(), 0.0, 1e-12);   // u along +x, v up
   EXPECT_NEAR((frame(Vec3(6, -2, 4)) - Vec2(1, 1)).norm(), 0.0, 1e-12);  // projected along the normal
   EXPECT_NEAR((frame.lifted(Vec2(1, 1)) - Vec3(6, 0, 4)).norm(), 0.0, 1e-12);
 }
@@ -26,8 +26,8 @@ TEST(Occupancy, APointMarksItsCellAndTwoAround) {
   const Frame2 frame{Vec3::Zero(), Vec3::UnitX(), Vec3::UnitZ()};
   CellSet cells;
   mark_scanned(cells, {{0.1, 0, 0.1}, {0.2, 0, 0.05}}, frame);  // both in cell (0, 0)
-  EXPECT_EQ(cells.size(), 25u);                                   // 5 x 5
-  mark_scanned(cells, {{0.3, 0, 0.1}}, frame);                    // cell (1, 0): one column more
+  EXPECT_EQ(cells.size(), 25u);                                 // 5 x 5
+  mark_scanned(cells, {{0.3, 0, 0.1}}, frame);                  // cell (1, 0): one column more
   EXPECT_EQ(cells.size(), 30u);
   EXPECT_EQ(cells.count(cell_key(-2, -2)), 1u);
   EXPECT_EQ(cells.count(cell_key(3, 2)), 1u);

@@ -43,8 +43,7 @@ TEST(ShellMend, AMissingFaceIsAddedBackNotTheRestDropped) {
   // A selection of the roof alone: dropping it (80) is nearer than adding the walls and ground.
   std::vector<char> roof(box.size(), 0);
   for (int f = 0; f < cs.size(); ++f) roof[std::size_t(f)] = char(box[std::size_t(f)] && !open[std::size_t(f)]);
-  EXPECT_EQ(nearest_closed_selection(cs, roof, SelectionConfig{}, {true, 1.0}),
-            std::vector<char>(box.size(), 0));
+  EXPECT_EQ(nearest_closed_selection(cs, roof, SelectionConfig{}, {true, 1.0}), std::vector<char>(box.size(), 0));
   // Weighted 10x, keeping the roof wins: the box closes around it.
   EXPECT_EQ(nearest_closed_selection(cs, roof, SelectionConfig{}, {true, 10.0}), box);
 }

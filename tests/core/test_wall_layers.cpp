@@ -95,7 +95,8 @@ TEST(WallLayers, AFacadeOverPartOfAWallsHeightIsRelief) {
   const PlaneConfig prm;
   // 0.5 m before the front wall (9 m high): over 0 - 3 m (a third of the height) relief, over
   // 0 - 8.5 m a wall; 20 m away from every wall, kept (nothing to be relief of).
-  for (const auto& [y, z1, kept] : {std::tuple{-0.5, 3.0, false}, std::tuple{-0.5, 8.5, true}, std::tuple{-20.0, 3.0, true}}) {
+  for (const auto& [y, z1, kept] :
+       {std::tuple{-0.5, 3.0, false}, std::tuple{-0.5, 8.5, true}, std::tuple{-20.0, 3.0, true}}) {
     PointCloud cloud;
     std::vector<ScanPlane> relief;
     const auto out = without_relief({grid_scan_plane(cloud, wall_patch({2, y, 0}, Vec3::UnitX(), 6.0, 0.0, z1), 0.1)},
