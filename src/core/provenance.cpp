@@ -4,7 +4,7 @@
 #include <algorithm>
 
 #include "lodrefine/base/geometry.h"
-#include "shell_supports.h"
+#include "occupancy.h"
 
 namespace lodrefine {
 

@@ -5,6 +5,7 @@
 #include <glpk.h>
 
 #include "lodrefine/core/candidates.h"
+#include "lodrefine/core/objective.h"
 
 #include <algorithm>
 #include <cfloat>
@@ -259,26 +260,15 @@ struct Program {
   }
 };
 
-// The data terms: each free candidate's column costs lambda_coverage times its coverage cost,
-// less lambda_data times the scanned area its points explain.
-void add_coverage_objective(Program& p, const CandidateSet& cs, const Columns& c, const SelectionConfig& prm) {
+// A binary column per free candidate, costing its objective coefficient as built (objective.h).
+void add_face_columns(Program& p, const CandidateSet& cs, const Columns& c) {
   if (c.free > 0) glp_add_cols(p.lp, c.free);
   for (int f = 0; f < cs.size(); ++f) {
     if (c.column(f) == 0) continue;
     glp_set_col_kind(p.lp, c.column(f), GLP_BV);
-    const double fit = c.pg.fit.empty() ? 0.0 : prm.lambda_data * c.pg.fit[f];
-    glp_set_obj_coef(p.lp, c.column(f), prm.lambda_coverage * c.pg.cost[f] - fit);
+    glp_set_obj_coef(p.lp, c.column(f), c.pg.cost[f]);
     p.start.push_back(c.warm(f) ? 1.0 : 0.0);
   }
-}
-
-// The PolyFit complexity per edge when the program gives none: lambda_complexity * total area /
-// edges.
-double uniform_sharp_cost(const CandidateSet& cs, const SelectionConfig& prm) {
-  double total_area = 0.0;
-  const auto area = cs.areas();
-  for (auto f : cs.mesh.faces()) total_area += area[f];
-  return cs.edges.empty() ? 0.0 : prm.lambda_complexity * total_area / double(cs.edges.size());
 }
 
 // Edge e used by 0 or 2 selected faces: sum x_free + constant = 2 y, y binary. Returns false when
@@ -460,7 +450,7 @@ SelectionResult select_faces(CandidateSet& cs, const SelectionProgram& pg, const
 
   glp_term_out(GLP_OFF);
   Program p;
-  add_coverage_objective(p, cs, c, prm);
+  add_face_columns(p, cs, c);
   const bool feasible = add_edges(p, cs, c, prm) && add_exclusions(p, c);
   res.variables = glp_get_num_cols(p.lp);
   res.constraints = glp_get_num_rows(p.lp);

@@ -1,4 +1,6 @@
-// Stage 3's data for the selection: what each candidate face is (shell_supports.h).
+// Stage 4a's data for the selection: what each candidate face is (shell_describe.h).
+#include "shell_describe.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -7,7 +9,8 @@
 
 #include "lodrefine/base/geometry.h"
 #include "lodrefine/core/matching.h"
-#include "shell_supports.h"
+#include "lodrefine/core/objective.h"
+#include "occupancy.h"
 
 namespace lodrefine::detail {
 namespace {
@@ -18,25 +21,9 @@ constexpr double kSeeThrough = 3.0;
 // Planes of the starting shell within kSurfaceAngleDeg and kSurfaceDistance are one supporting
 // plane (matching.h: the tolerance of a model surface).
 
-// In unsigned arithmetic: shifting a negative index is undefined before C++20.
-std::int64_t cell_key(long long i, long long j) {
-  return std::int64_t((std::uint64_t(i) << 32) ^ std::uint64_t(std::uint32_t(j)));
-}
-
-// fn(i, j) for every grid cell of a polygon's bounding box.
-template <class Fn>
-void for_box_cells(const std::vector<Vec2>& poly, Fn&& fn) {
-  const Eigen::AlignedBox2d box = bounding_box(poly);
-  const long long i0 = (long long)std::floor(box.min().x() / kCell), i1 = (long long)std::floor(box.max().x() / kCell);
-  const long long j0 = (long long)std::floor(box.min().y() / kCell), j1 = (long long)std::floor(box.max().y() / kCell);
-  for (long long i = i0; i <= i1; ++i)
-    for (long long j = j0; j <= j1; ++j) fn(i, j);
-}
-
 // PolyFit's data-fitting term (its compute_confidences' supporting points): the scan points of
 // a candidate's supporting plane that lie within it, each weighted by how well it fits that
-// plane, 1 - (d / tol)^2 at distance d (tol: ransac_epsilon, a RANSAC inlier's farthest, plus
-// merge_distance, how far a supporting plane may lie from the points merged onto it). Counted
+// plane (objective.h: fit_weight within fit_tolerance). Counted
 // as the area they stand for: the scanned area (kCell cells holding a point, over all planes)
 // over the points, so a candidate explaining its share of an evenly sampled scan is worth about
 // its area, a sparsely sampled one less: PolyFit's share of the points, in the coverage term's
@@ -55,16 +42,15 @@ FitPoints fit_points(const Supports& s, const std::vector<Frame2>& frames, const
   FitPoints fp;
   const int np = int(s.planes.size());
   fp.at.resize(np), fp.weight.resize(np), fp.cells.resize(np);
-  const double tol = prm.plane.ransac_epsilon + prm.selection.merge_distance;
+  const double tol = fit_tolerance(prm);
   long long points = 0, occupied = 0;
   for (int k = 0; k < np; ++k) {
     for (const auto& p : s.points[k]) {
       const Vec2 q = frames[k](p);
-      const double d = s.planes[k].plane.distance(p) / tol;
       fp.cells[k][cell_key((long long)std::floor(q.x() / kCell), (long long)std::floor(q.y() / kCell))].push_back(
           int(fp.at[k].size()));
       fp.at[k].push_back(q);
-      fp.weight[k].push_back(std::max(0.0, 1.0 - d * d));
+      fp.weight[k].push_back(fit_weight(s.planes[k].plane.distance(p), tol));
     }
     points += (long long)s.points[k].size();
     occupied += (long long)fp.cells[k].size();
@@ -87,36 +73,6 @@ double fitted_area(const FitPoints& fp, int k, const std::vector<Vec2>& poly) {
 }
 
 }  // namespace
-
-// A point marks its cell and those within kFill cells (shell_supports.h): a scanned facade's
-// coverage is near 1 and that of a face it does not reach near 0. Each cell holding points is
-// filled around once, not once per point.
-constexpr int kFill = 2;
-void mark_scanned(CellSet& cells, const std::vector<Vec3>& pts, const Frame2& frame) {
-  CellSet occupied;
-  for (const auto& p : pts) {
-    const Vec2 q = frame(p);
-    const long long i = (long long)std::floor(q.x() / kCell), j = (long long)std::floor(q.y() / kCell);
-    if (!occupied.insert(cell_key(i, j)).second) continue;
-    for (long long di = -kFill; di <= kFill; ++di)
-      for (long long dj = -kFill; dj <= kFill; ++dj) cells.insert(cell_key(i + di, j + dj));
-  }
-}
-
-double scanned_share(const std::vector<Vec2>& poly, const CellSet& cells) {
-  if (cells.empty() || poly.empty()) return 0.0;
-  long long total = 0, hit = 0;
-  for_box_cells(poly, [&](long long i, long long j) {
-    if (!point_in_polygon_2d(Vec2((i + 0.5) * kCell, (j + 0.5) * kCell), poly)) return;
-    ++total;
-    hit += cells.count(cell_key(i, j));
-  });
-  if (total > 0) return double(hit) / double(total);
-  Vec2 c = Vec2::Zero();
-  for (const auto& p : poly) c += p;
-  c /= double(poly.size());
-  return cells.count(cell_key((long long)std::floor(c.x() / kCell), (long long)std::floor(c.y() / kCell))) ? 1.0 : 0.0;
-}
 
 FaceProps describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s, const RefineConfig& prm) {
   const int np = int(s.planes.size());
@@ -183,9 +139,8 @@ FaceProps describe_candidates(CandidateSet& cs, const Mesh& start, const Support
         source[fi] = start.faces[sf].source;
         break;
       }
-    const double scanned = scanned_share(poly, own[k]);
-    const double prior = in_start[fi] ? 1.0 - scanned_share(poly, other[k]) : 0.0;
-    confidence[fi] = std::max(scanned, prior);
+    const double contradicted = in_start[fi] ? scanned_share(poly, other[k]) : 0.0;
+    confidence[fi] = face_confidence(scanned_share(poly, own[k]), contradicted, in_start[fi]);
     // On a plane of the starting shell only its own faces are credited: points running on along
     // it past its outline are no evidence that it runs on (a flush neighbour's facade; corners.h).
     if (s.planes[k].from_scan || in_start[fi]) fit[fi] = fitted_area(fp, k, poly);

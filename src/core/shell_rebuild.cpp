@@ -7,6 +7,7 @@
 #include <optional>
 #include <vector>
 
+#include "hole_planes.h"
 #include "lodrefine/base/geometry.h"
 #include "lodrefine/base/topology.h"
 #include "lodrefine/core/candidates.h"
@@ -14,6 +15,10 @@
 #include "lodrefine/core/selection.h"
 #include "lodrefine/core/shell_trace.h"
 #include "lodrefine/core/validate.h"
+#include "occupancy.h"
+#include "shell_checks.h"
+#include "shell_describe.h"
+#include "shell_mend.h"
 #include "shell_supports.h"
 
 namespace lodrefine {

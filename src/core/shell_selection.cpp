@@ -17,6 +17,10 @@
 #include "lodrefine/core/objective.h"
 #include "lodrefine/core/shell_trace.h"
 #include "lodrefine/core/validate.h"
+#include "occupancy.h"
+#include "shell_checks.h"
+#include "shell_describe.h"
+#include "shell_mend.h"
 #include "shell_supports.h"
 
 namespace lodrefine {
@@ -35,10 +39,6 @@ using detail::nearest_closed_selection;
 using detail::shell_problem;
 using detail::snapped_to_start;
 using detail::Supports;
-// A sharp edge costs lambda_complexity * its length * this width (m): the complexity term in the
-// coverage term's units (m²), independent of how large the region is.
-constexpr double kSharpEdgeWidth = 0.25;
-
 std::vector<char> kept(const std::vector<char>& v, const std::vector<char>& keep) {
   std::vector<char> out;
   for (std::size_t f = 0; f < v.size(); ++f)
@@ -46,6 +46,11 @@ std::vector<char> kept(const std::vector<char>& v, const std::vector<char>& keep
   return out;
 }
 
+// m: a changed candidate with a corner farther than this from every scan point the selection
+// used, in plan, is a change the scan did not ask for (a roof re-cut far from every scanned
+// facade): such candidates keep their starting-shell value. In plan, as the
+// roof above a moved facade must follow it however high it is. A step's facade also reaches the
+// volume between it and the start wall it replaces, however deep (detail::step_volume_samples).
 constexpr double kEvidenceReach = 2.0;
 
 // The scan points the selection used, in plan: built once per building, asked whether a point
@@ -252,17 +257,12 @@ Supports supports_of(const Mesh& start, const PointCloud& cloud, const std::vect
   return s;
 }
 
-// The program over the candidates: coverage and data-fitting terms, sharp edges; with a `warm`
-// start, it is the first incumbent and every candidate no evidence reaches is fixed to it.
+// The program over the candidates: its costs (objective.h); with a `warm` start, it is the first
+// incumbent and every candidate no evidence reaches is fixed to it.
 SelectionProgram program_of(CandidateSet& cs, const FaceProps& props, const std::vector<char>& warm,
                             const SelectionConfig& prm) {
   SelectionProgram pg;
-  const auto area = cs.areas();
-  for (int f = 0; f < cs.size(); ++f) {
-    pg.cost.push_back(coverage_cost(area[FaceIndex(f)], props.confidence[FaceIndex(f)], prm.tau_cov));
-    pg.fit.push_back(props.fit[FaceIndex(f)]);
-  }
-  for (const auto& e : cs.edges) pg.sharp_cost.push_back(prm.lambda_complexity * cs.length(e) * kSharpEdgeWidth);
+  set_selection_costs(cs, props.confidence, props.fit, prm, pg);
   if (!warm.empty()) {
     pg.warm = warm;
     for (int f = 0; f < cs.size(); ++f) pg.fixed.push_back(props.in_zone[FaceIndex(f)] ? -1 : int(warm[f]));

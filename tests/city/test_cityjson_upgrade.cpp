@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
-#include "../src/city/cityjson_upgrade.h"
+#include "city/cityjson_upgrade.h"
 #include "lodrefine/base/files.h"
 #include "lodrefine/city/cityfile.h"
 #include "lodrefine/formats/ply.h"

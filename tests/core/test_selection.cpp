@@ -90,6 +90,27 @@ TEST(Selection, AnExcludedLocalSelectionIsNotMade) {
   EXPECT_EQ(select_faces(cs, pg, prm).status_text(), "infeasible");
 }
 
+// The solver applies no weight: a program's costs are the columns' coefficients as built
+// (objective.h). At lambda_coverage 2 and lambda_data 5 the box's objective is still the sum of
+// its six faces' costs (it was twice that when select_faces weighted them).
+TEST(Selection, TakesEachCostAsBuiltWithoutWeights) {
+  const double a = 10, b = 8, c = 6;
+  CandidateSet cs = build_candidates(box_planes(a, b, c), box_region(a, b, c));
+  SelectionConfig prm;
+  SelectionProgram pg;
+  pg.cost = coverage_costs(cs, box_confidence(cs, a, b, c), prm);
+  pg.sharp_cost.assign(cs.edges.size(), 0.0);
+  prm.lambda_coverage = 2.0;
+  prm.lambda_data = 5.0;
+  const SelectionResult sel = select_faces(cs, pg, prm);
+  ASSERT_TRUE(sel.ok) << sel.status_text();
+  double box_cost = 0.0;
+  for (int f = 0; f < cs.size(); ++f)
+    if (inside_box(centroid_of(cs, f), a, b, c)) box_cost += pg.cost[std::size_t(f)];
+  EXPECT_NEAR(box_cost, 2 * (a * b + b * c + a * c) * (1.0 / (1.0 + std::exp(0.7)) - 0.5), 1e-9);
+  EXPECT_NEAR(sel.objective, box_cost, 1e-6);
+}
+
 TEST(Selection, InfeasibleBoundaryIsReportedNotCrashed) {
   // One plane only: its faces can never close, yet the boundary demands a continuation.
   std::vector<SupportPlane> planes = {{Plane(Vec3(0, 0, 1), -1), Semantic::Roof, false, 0}};

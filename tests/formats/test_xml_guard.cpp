@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "../src/formats/xml_guard.h"
+#include "formats/xml_guard.h"
 #include "lodrefine/base/types.h"
 
 using namespace lodrefine;

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "../src/laz/laz_items.h"
+#include "laz/laz_items.h"
 #include "support/io_fixtures.h"
 #include "support/laz_fixtures.h"
 

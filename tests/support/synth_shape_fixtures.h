@@ -5,7 +5,7 @@
 #include <utility>
 #include <vector>
 
-#include "../src/synth/shapes.h"
+#include "synth/shapes.h"
 
 namespace lodrefine::synth_fixtures {
 

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "../src/synth/perturb.h"
+#include "synth/perturb.h"
 #include "support/synth_shape_fixtures.h"
 
 using namespace lodrefine;

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "../src/synth/scan.h"
+#include "synth/scan.h"
 #include "lodrefine/base/geometry.h"
 #include "support/synth_shape_fixtures.h"
 

@@ -2,7 +2,7 @@
 // roof planes, crossing segments, and the specs drawn for each building type.
 #include <gtest/gtest.h>
 
-#include "../src/synth/shapes.h"
+#include "synth/shapes.h"
 
 using namespace lodrefine;
 using namespace lodrefine::synth;

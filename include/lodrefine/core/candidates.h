@@ -70,7 +70,7 @@ using CandidateFaceProperty = CandidateProperty<CandidateFace, T>;
 //   the same point in every component);
 // - select_faces (selection.h): `variable` (int: a face's GLPK column, 1-based; 0 when fixed)
 //   and `selected` (bool: chosen);
-// - select_shell / rebuild_shell (shell_supports.h's FaceProps): `in_start`, `source` (read
+// - select_shell / rebuild_shell (shell_describe.h's FaceProps): `in_start`, `source` (read
 //   by traced_shell, shell_trace.h), `confidence`, `in_zone`, `fit`.
 namespace candidate_props {
 inline const CandidateFaceProperty<int> support{"f:support", -1};

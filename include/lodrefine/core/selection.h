@@ -1,6 +1,7 @@
-// Stage 4b: face selection as a binary program in GLPK (paper Sec. 3.4): sigmoid coverage
-// cost, PolyFit complexity (sharp edges), and per edge "selected incident faces = 2 x used",
-// with the region's outside surface as a constant incident face on boundary edges.
+// Stage 4b: face selection as a binary program in GLPK (paper Sec. 3.4): the solver driver.
+// The costs come built (objective.h); here the columns, per edge "selected incident faces = 2 x
+// used" (the region's outside surface a constant incident face on boundary edges), the sharp
+// edges' rows, the warm start, the search and its status.
 #pragma once
 #include <string>
 #include <vector>
@@ -50,15 +51,14 @@ struct SelectionResult {
 };
 
 // A selection program over `CandidateSet` (the paper's Sec. 3.4):
-// - `cost[f]`: coverage cost of candidate f (weighted here by lambda_coverage);
-// - `fit[f]`: the data-fitting credit of candidate f, the scanned area its supporting points
-//   explain (m², weighted here by lambda_data); empty: none;
+// - `cost[f]`: candidate f's objective coefficient, as built (objective.h: candidate_cost,
+//   mend_cost), taken unweighted;
 // - `outside[e]`: 1 where a kept surface outside the region continues across edge e (counts as a
 //   selected face), else 0; empty: none;
 // - `fixed[f]`: -1 free, 0 or 1 fixed (folded into the edge constraints as constants); empty:
 //   all free;
 // - `sharp_cost[e]`: cost of edge e when it is sharp (two selected faces of different planes
-//   meet there); empty: the PolyFit complexity lambda_complexity * total area / edges on every
+//   meet there), as built (objective.h: sharp_edge_cost); empty: uniform_sharp_cost on every
 //   edge;
 // - `warm[f]`: a starting selection (0/1 per candidate); empty: none. It must agree with
 //   `fixed`; if it satisfies every edge constraint it is given to GLPK as the first incumbent
@@ -74,13 +74,14 @@ struct LocalSelection {
 };
 struct SelectionProgram {
   std::vector<double> cost;
-  std::vector<double> fit;
   std::vector<int> outside;
   std::vector<int> fixed;
   std::vector<double> sharp_cost;
   std::vector<char> warm;
   std::vector<LocalSelection> excluded;
 };
+// `config` gives the search's limits (mip_gap, mip_work_limit, mip_time_limit) and, for an empty
+// sharp_cost only, lambda_complexity; no other weight is applied here.
 // The search ends at config.mip_work_limit (a count of GLPK's work, so the result does not depend
 // on the machine's load) or, as a last-resort safety ceiling far above it, at `time_limit`
 // (wall-clock s, > 0), explicit so that a caller that solved before passes what is left of
@@ -98,7 +99,8 @@ SelectionResult select_faces(CandidateSet& cs, const SelectionProgram& program, 
 bool every_edge_used_0_or_2(const CandidateSet& cs, const std::vector<char>& selected,
                             const std::vector<int>& outside = {});
 
-// The same with `cost`, `outside` and optionally `fixed` (see SelectionProgram).
+// The same with `cost`, `outside` and optionally `fixed` (see SelectionProgram; no sharp_cost:
+// uniform_sharp_cost).
 SelectionResult select_faces(CandidateSet& cs, const std::vector<double>& cost, const std::vector<int>& outside,
                              const SelectionConfig& config, const std::vector<int>* fixed = nullptr);
 

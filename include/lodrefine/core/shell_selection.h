@@ -14,10 +14,11 @@
 // - where the starting shell has a face, 1 (the model's prior: unscanned parts stay), less the
 //   share of its area behind or before which the scan shows another parallel facade (the scan
 //   saw the facade elsewhere there).
-// Complexity: a cost per length of sharp edge. Constraint: every candidate edge is used by 0 or
-// 2 selected faces. Candidates that no scan evidence reaches are fixed to the starting shell.
-// The starting shell, as a selection of candidates, is GLPK's first incumbent (warm start), or
-// the starting shell with its outdated walls on their scan planes (`outdated` below).
+// Complexity: a cost per length of sharp edge (objective.h builds every cost). Constraint:
+// every candidate edge is used by 0 or 2 selected faces. Candidates that no scan evidence
+// reaches are fixed to the starting shell. The starting shell, as a selection of candidates, is
+// GLPK's first incumbent (warm start), or the starting shell with its outdated walls on their
+// scan planes (`outdated` below).
 #pragma once
 #include <string>
 #include <vector>
