@@ -62,17 +62,17 @@ std::string worse_reason(const Judgement::Fit& f, double slack, bool count) {
   return {};
 }
 
-// The wall's region: the points whose nearest face is the wall's, before the move (a face on
+// The wall's points (WallPoints): the points whose nearest face is the wall's, before the move (a face on
 // its old plane within its outline) or after it (a face on its new plane near that outline),
 // and which lie on its old or its new plane (within `on_plane`). The points farther from both
 // stand on other surfaces near the wall (a return, a neighbour, clutter): the building check
 // judges them, and they must not decide whether the wall itself is scanned.
-struct Region {
+struct WallPoints {
   std::vector<char> before, after;  // per face of each mesh: the wall's
   const JudgedWall& wall;
   double on_plane;
 
-  Region(const JudgedWall& w, const Mesh& mb, const Mesh& ma, double margin, double reach, double band)
+  WallPoints(const JudgedWall& w, const Mesh& mb, const Mesh& ma, double margin, double reach, double band)
       : wall(w), on_plane(band) {
     before = faces_on(w, w.from, mb, margin);
     after = faces_on(w, w.to, ma, reach);
@@ -255,7 +255,7 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
   const bool facade_lines = reach > cap;
   Eigen::AlignedBox3d box = bounding_box(before.vertices);
   box.extend(bounding_box(after.vertices));
-  const double ground = box.min().z() + kGroundBand;
+  const double ground = box.min().z() + kStreetGroundBand;
   Eigen::AlignedBox3d within_cap = box;  // beyond it only a facade line's points are judged
   within_cap.min() -= Vec3::Constant(cap);
   within_cap.max() += Vec3::Constant(cap);
@@ -319,8 +319,8 @@ Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vec
   }
   j.building = fit_of(points, changed, [](const PointFit&) { return true; });
   for (const auto& w : walls) {
-    const Region region(w, before, after, prm.match_margin, cap, on_plane_band(detection));
-    j.walls.push_back(fit_of(points, changed, [&](const PointFit& q) { return region.holds(q); }));
+    const WallPoints own(w, before, after, prm.match_margin, cap, on_plane_band(detection));
+    j.walls.push_back(fit_of(points, changed, [&](const PointFit& q) { return own.holds(q); }));
   }
   if (const std::string why = worse_reason(j.building, kRmsSlack, true); !why.empty()) {
     j.ok = false;

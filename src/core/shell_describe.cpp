@@ -27,8 +27,10 @@ std::int64_t cell_key(long long i, long long j) {
 template <class Fn>
 void for_box_cells(const std::vector<Vec2>& poly, Fn&& fn) {
   const Eigen::AlignedBox2d box = bounding_box(poly);
-  const long long i0 = (long long)std::floor(box.min().x() / kCell), i1 = (long long)std::floor(box.max().x() / kCell);
-  const long long j0 = (long long)std::floor(box.min().y() / kCell), j1 = (long long)std::floor(box.max().y() / kCell);
+  const long long i0 = (long long)std::floor(box.min().x() / kOccupancyCell),
+                  i1 = (long long)std::floor(box.max().x() / kOccupancyCell);
+  const long long j0 = (long long)std::floor(box.min().y() / kOccupancyCell),
+                  j1 = (long long)std::floor(box.max().y() / kOccupancyCell);
   for (long long i = i0; i <= i1; ++i)
     for (long long j = j0; j <= j1; ++j) fn(i, j);
 }
@@ -37,12 +39,12 @@ void for_box_cells(const std::vector<Vec2>& poly, Fn&& fn) {
 // a candidate's supporting plane that lie within it, each weighted by how well it fits that
 // plane, 1 - (d / tol)^2 at distance d (tol: ransac_epsilon, a RANSAC inlier's farthest, plus
 // merge_distance, how far a supporting plane may lie from the points merged onto it). Counted
-// as the area they stand for: the scanned area (kCell cells holding a point, over all planes)
+// as the area they stand for: the scanned area (kOccupancyCell cells holding a point, over all planes)
 // over the points, so a candidate explaining its share of an evenly sampled scan is worth about
 // its area, a sparsely sampled one less: PolyFit's share of the points, in the coverage term's
 // units (m²) rather than the box's.
 //
-// Per plane: its points in the plane's frame, their fit weights, and the points in each kCell
+// Per plane: its points in the plane's frame, their fit weights, and the points in each kOccupancyCell
 // cell; and the scanned area each point stands for (m²).
 struct FitPoints {
   std::vector<std::vector<Vec2>> at;
@@ -61,15 +63,16 @@ FitPoints fit_points(const Supports& s, const std::vector<Frame2>& frames, const
     for (const auto& p : s.points[k]) {
       const Vec2 q = frames[k](p);
       const double d = s.planes[k].plane.distance(p) / tol;
-      fp.cells[k][cell_key((long long)std::floor(q.x() / kCell), (long long)std::floor(q.y() / kCell))].push_back(
-          int(fp.at[k].size()));
+      fp.cells[k]
+              [cell_key((long long)std::floor(q.x() / kOccupancyCell), (long long)std::floor(q.y() / kOccupancyCell))]
+                  .push_back(int(fp.at[k].size()));
       fp.at[k].push_back(q);
       fp.weight[k].push_back(std::max(0.0, 1.0 - d * d));
     }
     points += (long long)s.points[k].size();
     occupied += (long long)fp.cells[k].size();
   }
-  if (points > 0) fp.area_per_point = double(occupied) * kCell * kCell / double(points);
+  if (points > 0) fp.area_per_point = double(occupied) * kOccupancyCell * kOccupancyCell / double(points);
   return fp;
 }
 
@@ -96,7 +99,8 @@ void mark_scanned(CellSet& cells, const std::vector<Vec3>& pts, const Frame2& fr
   CellSet occupied;
   for (const auto& p : pts) {
     const Vec2 q = frame(p);
-    const long long i = (long long)std::floor(q.x() / kCell), j = (long long)std::floor(q.y() / kCell);
+    const long long i = (long long)std::floor(q.x() / kOccupancyCell),
+                    j = (long long)std::floor(q.y() / kOccupancyCell);
     if (!occupied.insert(cell_key(i, j)).second) continue;
     for (long long di = -kFill; di <= kFill; ++di)
       for (long long dj = -kFill; dj <= kFill; ++dj) cells.insert(cell_key(i + di, j + dj));
@@ -107,7 +111,7 @@ double scanned_share(const std::vector<Vec2>& poly, const CellSet& cells) {
   if (cells.empty() || poly.empty()) return 0.0;
   long long total = 0, hit = 0;
   for_box_cells(poly, [&](long long i, long long j) {
-    if (!point_in_polygon_2d(Vec2((i + 0.5) * kCell, (j + 0.5) * kCell), poly)) return;
+    if (!point_in_polygon_2d(Vec2((i + 0.5) * kOccupancyCell, (j + 0.5) * kOccupancyCell), poly)) return;
     ++total;
     hit += cells.count(cell_key(i, j));
   });
@@ -115,7 +119,10 @@ double scanned_share(const std::vector<Vec2>& poly, const CellSet& cells) {
   Vec2 c = Vec2::Zero();
   for (const auto& p : poly) c += p;
   c /= double(poly.size());
-  return cells.count(cell_key((long long)std::floor(c.x() / kCell), (long long)std::floor(c.y() / kCell))) ? 1.0 : 0.0;
+  return cells.count(
+             cell_key((long long)std::floor(c.x() / kOccupancyCell), (long long)std::floor(c.y() / kOccupancyCell)))
+             ? 1.0
+             : 0.0;
 }
 
 FaceProps describe_candidates(CandidateSet& cs, const Mesh& start, const Supports& s, const RefineConfig& prm) {

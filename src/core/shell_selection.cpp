@@ -27,7 +27,7 @@ using detail::enclosing_changes;
 using detail::face_flags;
 using detail::FaceIndex;
 using detail::FaceProps;
-using detail::kCell;
+using detail::kOccupancyCell;
 using detail::kSnapBack;
 using detail::MendScope;
 using detail::near_vertical;

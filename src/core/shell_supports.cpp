@@ -21,18 +21,18 @@ namespace {
 constexpr double kRegionMargin = 1.0;
 
 // Where a scanned facade's points run along its horizontal direction `u` (positions along u;
-// gaps shorter than kRunGap are bridged: a window column still has wall above and below).
+// gaps shorter than kWindowGap are bridged: a window column still has wall above and below).
 struct Interval {
   double a, b;
 };
-constexpr double kRunGap = 2 * kCell;  // m
+constexpr double kWindowGap = 2 * kOccupancyCell;  // m
 std::vector<Interval> intervals_along(const std::vector<Vec3>& pts, const Vec3& u) {
   std::vector<double> t;
   for (const auto& p : pts) t.push_back(u.dot(p));
   std::sort(t.begin(), t.end());
   std::vector<Interval> out;
   for (double x : t) {
-    if (out.empty() || x - out.back().b > kRunGap) out.push_back({x, x});
+    if (out.empty() || x - out.back().b > kWindowGap) out.push_back({x, x});
     else out.back().b = x;
   }
   return out;
@@ -89,14 +89,14 @@ bool continues_another_across_step(const Mesh& start, const Supports& s, const s
 // the start's span, and past one of its ends only up to where a run crossing that end stops
 // within `reach` (the facade's own corner, a wall the model has short). A run going on past the
 // reach is the facade line running into a neighbour's: the party wall between them is not in the
-// scan, so the model's end stands. A run from the end (within kRunGap of it: a bay's return
+// scan, so the model's end stands. A run from the end (within kWindowGap of it: a bay's return
 // starts at the model's front) counts as crossing it; runs that begin farther past an end (across
 // a gap) are another building's.
 Interval own_extent(const std::vector<Interval>& runs, const Interval& span, double reach) {
   Interval own = span;
   for (const Interval& r : runs) {
-    if (r.a <= span.b + kRunGap && r.b > span.b && r.b <= span.b + reach) own.b = std::max(own.b, r.b);
-    if (r.b >= span.a - kRunGap && r.a < span.a && r.a >= span.a - reach) own.a = std::min(own.a, r.a);
+    if (r.a <= span.b + kWindowGap && r.b > span.b && r.b <= span.b + reach) own.b = std::max(own.b, r.b);
+    if (r.b >= span.a - kWindowGap && r.a < span.a && r.a >= span.a - reach) own.a = std::min(own.a, r.a);
   }
   return own;
 }

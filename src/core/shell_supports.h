@@ -17,7 +17,7 @@
 namespace lodrefine::detail {
 
 // Occupancy grid cell (m): several MLS points wide, a fraction of a window.
-constexpr double kCell = 0.25;
+constexpr double kOccupancyCell = 0.25;
 
 // The supporting planes: the starting shell's, then the scan's facades that none of them carries.
 struct Supports {
@@ -132,7 +132,7 @@ struct Frame2 {
 // `pl`'s frame with its origin where `centre` projects onto it.
 Frame2 frame_of(const Plane& pl, const Vec3& centre);
 
-// A plane's kCell grid cells (in its Frame2) that the scan covers, keyed by (i, j).
+// A plane's kOccupancyCell grid cells (in its Frame2) that the scan covers, keyed by (i, j).
 using CellSet = std::unordered_set<std::int64_t>;
 // Marks the cells of `pts` (in `frame`) and those within 2 cells around each: a facade's windows
 // and the gaps between scan lines (up to about a metre) count as scanned.

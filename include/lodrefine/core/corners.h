@@ -46,6 +46,11 @@ struct CornerMove {
 // epsilons), at least the corners' tolerance of 5 cm.
 double on_plane_band(const PlaneEvidence& detection);
 
+// Street ground: points lower than this above the building's foot (m). Corners count them to see
+// the street go on past a facade's end; the judge leaves them out (ground in front of a wall
+// moved inwards would count against a right move).
+constexpr double kStreetGroundBand = 0.3;
+
 std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
                                      const std::vector<ScannedWall>& scanned, const PointCloud& cloud,
                                      const std::vector<ScanPlane>& planes, const MatchConfig& match,
