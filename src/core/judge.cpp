@@ -139,10 +139,7 @@ std::vector<Plane> face_planes(const Mesh& m) {
 // object before the wall (a neighbour across an alley, seen past or over); where the face has
 // no points of its own, it is the building's facade stepping forward (a setback's front line).
 constexpr double kColumn = 0.5;  // m; a column's neighbours count too (window gaps up to ~1 m)
-Vec3 horizontal_along(const Plane& f) { return Vec3(-f.n.y(), f.n.x(), 0.0); }
-long long column_of(const Vec3& p, const Plane& f) {
-  return (long long)std::floor(horizontal_along(f).dot(p) / kColumn);
-}
+long long column_of(const Vec3& p, const Plane& f) { return (long long)std::floor(along_wall(f.n).dot(p) / kColumn); }
 
 // One model as the judge sees it: distances to it, its faces' planes and, when facade lines
 // beyond the cap are judged, the columns of each face's own points.

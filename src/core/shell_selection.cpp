@@ -137,7 +137,7 @@ std::vector<char> improved_by_neighbourhoods(CandidateSet& cs, const SelectionPr
 // parallel to the wall (its scan plane) reads the same outline in it.
 struct WallView {
   Vec3 u;
-  explicit WallView(const Vec3& n) : u(Vec3(-n.y(), n.x(), 0.0).normalized()) {}
+  explicit WallView(const Vec3& n) : u(along_wall(n).normalized()) {}
   Vec2 operator()(const Vec3& p) const { return {u.dot(p), p.z()}; }
 };
 

@@ -75,7 +75,7 @@ bool continues_across_step(const std::vector<Interval>& a, const Interval& span,
 // found once, not per facade tried.
 bool continues_another_across_step(const Mesh& start, const Supports& s, const std::vector<Vec3>& pts, const Vec3& n,
                                    double angle_deg, int self = -1) {
-  const Vec3 u = Vec3(-n.y(), n.x(), 0.0).normalized();
+  const Vec3 u = along_wall(n).normalized();
   const std::vector<Interval> runs = intervals_along(pts, u);
   const Interval span = span_along(start, u);
   for (int k = 0; k < int(s.planes.size()); ++k)
@@ -189,7 +189,7 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
     Vec3 n(sp.plane.n.x(), sp.plane.n.y(), 0.0);
     if (n.norm() < 1e-9) continue;
     n.normalize();
-    const Vec3 u(-n.y(), n.x(), 0.0);
+    const Vec3 u = along_wall(n);
     Eigen::AlignedBox3d box;  // the start in (u, n, z)
     for (const auto& p : start.vertices) box.extend(Vec3(u.dot(p), n.dot(p), p.z()));
     std::vector<Vec3> inliers;
@@ -223,7 +223,7 @@ void add_step_walls(const Mesh& start, const RefineConfig& prm, Supports& s) {
   for (int j = s.start_planes; j < existing; ++j) {
     const Plane& pj = s.planes[j].plane;
     if (!s.planes[j].from_scan || s.points[j].empty() || !near_vertical(pj, tilt)) continue;
-    const Vec3 u = Vec3(-pj.n.y(), pj.n.x(), 0.0).normalized();
+    const Vec3 u = along_wall(pj.n).normalized();
     const auto [lo, hi] = span_along(start, u);
     std::vector<double> ends;
     for (const auto& r : intervals_along(s.points[j], u)) ends.insert(ends.end(), {r.a, r.b});
@@ -357,7 +357,7 @@ Region building_region(const Mesh& start, const Supports& s, double max_tilt_deg
       break;
     }
   Region r;
-  r.axes.col(0) = Vec3(-n.y(), n.x(), 0.0);
+  r.axes.col(0) = along_wall(n);
   r.axes.col(1) = n;
   r.axes.col(2) = Vec3::UnitZ();
   Eigen::AlignedBox3d box;
