@@ -1,4 +1,4 @@
-// Stage 2b: corners from the scan's extent, see corners.h.
+// Stage 3, matching: corners from the scan's extent, see corners.h.
 #include "lodrefine/core/corners.h"
 
 #include <algorithm>

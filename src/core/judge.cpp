@@ -1,4 +1,4 @@
-// Stage 5: never worse, for the whole building (see judge.h).
+// Stage 6, judge: never worse, for the whole building (see judge.h).
 #include "lodrefine/core/judge.h"
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// Stage 3's data for the selection: what each candidate face is (shell_supports.h).
+// Stage 5, selection: the data for the program, what each candidate face is (shell_supports.h).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>

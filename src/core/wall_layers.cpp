@@ -1,4 +1,4 @@
-// Stage 1 besides the shape detection: the plane fitted to a point set; a wall seen twice by two
+// Stage 2, planes, besides the shape detection: the plane fitted to a point set; a wall seen twice by two
 // drives is one plane midway; facade planes over only part of a wall's height are relief.
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-// Stage 2b: corners from the scan's extent. A scanned facade ends where the building's corner
+// Stage 3, matching: corners from the scan's extent. A scanned facade ends where the building's corner
 // is; when it ends short of the model's corner (or runs on a little past it, then stops), the
 // adjacent wall that was not scanned is misplaced, and moves so that the corner is where the
 // scan says. Evidence must hold over the facade's height (an occluding car or tree does not),

@@ -1,4 +1,4 @@
-// Stage 4b: face selection as a binary program in GLPK (paper Sec. 3.4): sigmoid coverage
+// Stage 5, selection: the faces chosen by a binary program in GLPK (paper Sec. 3.4): sigmoid coverage
 // cost, PolyFit complexity (sharp edges), and per edge "selected incident faces = 2 x used",
 // with the region's outside surface as a constant incident face on boundary edges.
 #pragma once

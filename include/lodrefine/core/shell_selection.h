@@ -1,4 +1,4 @@
-// Stage 4 (4 candidates, 4a data term, 4b selection) for the whole building (paper Sec.
+// Stage 5, selection (candidates, data term, program, traced shell) for the whole building (paper Sec.
 // 3.2-3.4): one PolyFit-style candidate
 // arrangement over the building and the scan around it, and the GLPK binary selection that
 // decides every face of the output.
