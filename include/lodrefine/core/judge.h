@@ -1,7 +1,7 @@
 // Stage 6, judge: never worse, for the whole building. The refined model is written only when the scan
 // shows it better than the input, judged on every scan point near the building (facade points
 // matched to a wall or not, roof points; street ground excepted), and on each moved wall's own
-// region: a wall with points in front of it must fit them better; a wall without points
+// points: a wall with points in front of it must fit them better; a wall without points
 // may move only on the scan's corner evidence (corners.h).
 //
 // Inputs are in one (local) frame; distances in metres. A point is judged when it lies within
