@@ -1,4 +1,4 @@
-// Stage 4 (paper Sec. 3.2): candidate faces from pairwise plane intersections in a region.
+// Stage 5, selection (paper Sec. 3.2): candidate faces from pairwise plane intersections in a region.
 #include "lodrefine/core/candidates.h"
 
 #include <algorithm>

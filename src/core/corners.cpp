@@ -1,4 +1,4 @@
-// Stage 2b: corners from the scan's extent, see corners.h.
+// Stage 3, matching: corners from the scan's extent, see corners.h.
 #include "lodrefine/core/corners.h"
 
 #include <algorithm>
@@ -14,7 +14,7 @@ namespace {
 
 // Inliers of a facade plane are connected within the RANSAC cluster epsilon; a longer empty
 // stretch along the facade ends it (a gap to a neighbour, or the corner).
-constexpr double kRunGap = 0.5;
+constexpr double kInlierGap = 0.5;
 // Corners closer than this to the scan's end already agree with it (scan spacing ~ cm).
 constexpr double kCornerTolerance = 0.05;
 // The end must be the same in every height band within this: a vertical building edge, not
@@ -43,7 +43,6 @@ constexpr double kMaxCornerCos = 0.707;
 // the facade's plane at its height past the end beyond stray points.
 constexpr double kStrip = 2.0;
 constexpr double kStreetNear = 0.3, kStreetFar = 10.0;
-constexpr double kGroundBand = 0.3;
 constexpr double kStreetGoesOn = 0.5;
 constexpr double kClearInFront = 0.05;
 // A flush neighbour: the facade's outline is read in bands of kHeightBand (m); at least kBands
@@ -65,7 +64,7 @@ double run_end(std::vector<double> t) {
   bool started = false;
   for (double x : t) {
     if (x < 0) continue;
-    if (x - e > kRunGap) break;
+    if (x - e > kInlierGap) break;
     e = std::max(e, x);
     started = true;
   }
@@ -129,7 +128,7 @@ EndStrips end_strips(const PointCloud& cloud, const Plane& facade, const Vec3& o
     const double d = facade.distance(p);  // outwards: the street side
     const bool in_front = d > kStreetNear && d < kStreetFar;
     const bool high = p.z() > za && p.z() < z1;
-    if (in_front && p.z() < ground + kGroundBand) ++(past ? e.street_past : e.street_before);
+    if (in_front && p.z() < ground + kStreetGroundBand) ++(past ? e.street_past : e.street_before);
     if (in_front && high && past) ++e.front_past;
     if (std::abs(d) <= on_plane && high) ++(past ? e.facade_past : e.facade_before);
   }
@@ -273,7 +272,7 @@ std::optional<double> flush_neighbour_edge(const PointCloud& cloud, const Facade
   const int n = int(std::ceil((f.z1 - f.z0) / kHeightBand));
   std::vector<double> own = band_ends(t, f.pz, f.z0, n, uc - reach, uc + reach);
   std::reverse(own.begin(), own.end());
-  if (auto e = one_edge(own, uc + reach - kRunGap)) return e;
+  if (auto e = one_edge(own, uc + reach - kInlierGap)) return e;
   // The taller neighbour's points, positions negated: their start is the largest.
   const double on_plane = on_plane_band(prm), z0 = top + kAboveTop;
   std::vector<double> back, z;
@@ -282,7 +281,7 @@ std::optional<double> flush_neighbour_edge(const PointCloud& cloud, const Facade
       back.push_back(-s * ((p - f.o).dot(f.u) - f.u_mid));
       z.push_back(p.z());
     }
-  const auto e = one_edge(band_ends(back, z, z0, 2 * kBands, -uc - reach, -uc + reach), -uc + reach - kRunGap);
+  const auto e = one_edge(band_ends(back, z, z0, 2 * kBands, -uc - reach, -uc + reach), -uc + reach - kInlierGap);
   if (!e) return std::nullopt;
   return -*e;
 }
@@ -325,7 +324,7 @@ std::optional<CornerMove> corner_at(const Mesh& mesh, const FacadeScan& wall_sca
     // Points of this plane again past the end, short of the corner: the run ended at a gap in
     // the facade (a recessed entrance), not at the building's edge.
     int beyond = 0;
-    for (double x : t) beyond += x > end + kRunGap && x <= s * uc + prm.match_distance;
+    for (double x : t) beyond += x > end + kInlierGap && x <= s * uc + prm.match_distance;
     if (beyond > kStrayPoints) return std::nullopt;
     // The scan must show the corner itself (corners.h): a return onto the side wall where the
     // facade's points end, or an open end on a facade the scan found misplaced.

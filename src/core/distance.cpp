@@ -29,7 +29,7 @@ constexpr double kMinTriangleArea = 1e-12;
 // Slack for the rounding of the bounds that keep a triangle in a search (m, far above it).
 constexpr double kRounding = 1e-9;
 // The cells of a batch of queries (m) and the most a batch's grid holds.
-constexpr double kCell = 1.0;
+constexpr double kBatchCell = 1.0;
 constexpr double kMaxCells = 1 << 22;
 // Meshes of at most this many triangles are searched without the tree (faster for so few).
 constexpr std::size_t kFewTriangles = 128;
@@ -110,7 +110,7 @@ class SurfaceIndex {
   double distance(const Vec3& world, bool want_sign) const { return distance_local(world - origin_, want_sign); }
 
   // The nearest distance for many points at once, and the face nearest() reports: the points
-  // fall into cubic cells of kCell, and each cell keeps only the triangles that can be nearest
+  // fall into cubic cells of kBatchCell, and each cell keeps only the triangles that can be nearest
   // (or tie) anywhere in it.
   std::vector<Nearest> nearest_all(const std::vector<Vec3>& world) const {
     std::vector<Vec3> local;
@@ -213,7 +213,7 @@ class SurfaceIndex {
     return {nearest, tris_[candidates[best]].face};
   }
 
-  // Per cell of kCell, the triangles that can lie within kTieTolerance of the nearest one for
+  // Per cell of kBatchCell, the triangles that can lie within kTieTolerance of the nearest one for
   // some point of the cell: from its centre m (half diagonal h) the nearest triangle is at U,
   // so every point of the cell has one within U + h, and a triangle farther than U + 2h from m
   // is farther than that from every point of the cell.
@@ -224,27 +224,27 @@ class SurfaceIndex {
       if (points.empty()) return;
       const Eigen::AlignedBox3d box = bounding_box(points);
       if (!box.min().allFinite() || !box.max().allFinite()) return;
-      lo_ = (box.min() / kCell).array().floor().matrix();
-      const Eigen::Array3d n = (box.max() / kCell).array().floor() - lo_.array() + 1.0;
+      lo_ = (box.min() / kBatchCell).array().floor().matrix();
+      const Eigen::Array3d n = (box.max() / kBatchCell).array().floor() - lo_.array() + 1.0;
       if (n.prod() > kMaxCells) return;
       n_ = n.cast<long long>();
       slot_.assign(std::size_t(n.prod()), -1);
     }
     // Null for a point outside the grid.
     const std::vector<std::size_t>* of(const Vec3& p) {
-      const Eigen::Array3d c = (p / kCell).array().floor() - lo_.array();
+      const Eigen::Array3d c = (p / kBatchCell).array().floor() - lo_.array();
       if (slot_.empty() || !(c >= 0.0).all() || !(c < n_.cast<double>()).all()) return nullptr;
       const std::size_t cell = std::size_t((c.z() * double(n_.y()) + c.y()) * double(n_.x()) + c.x());
       if (slot_[cell] < 0) {
         slot_[cell] = int(lists_.size());
-        lists_.push_back(candidates((lo_ + c.matrix() + Vec3::Constant(0.5)) * kCell));
+        lists_.push_back(candidates((lo_ + c.matrix() + Vec3::Constant(0.5)) * kBatchCell));
       }
       return &lists_[std::size_t(slot_[cell])];
     }
 
    private:
     std::vector<std::size_t> candidates(const Vec3& m) const {
-      const double h = 0.5 * std::sqrt(3.0) * kCell + kRounding;
+      const double h = 0.5 * std::sqrt(3.0) * kBatchCell + kRounding;
       return index_.within(m, 2 * h + kTieTolerance + kRounding);
     }
     const SurfaceIndex& index_;

@@ -1,4 +1,4 @@
-// Stage 5: never worse, for the whole building (see judge.h).
+// Stage 6, judge: never worse, for the whole building (see judge.h).
 #include "lodrefine/core/judge.h"
 
 #include <algorithm>
@@ -62,17 +62,17 @@ std::string worse_reason(const Judgement::Fit& f, double slack, bool count) {
   return {};
 }
 
-// The wall's region: the points whose nearest face is the wall's, before the move (a face on
+// The wall's points (WallPoints): the points whose nearest face is the wall's, before the move (a face on
 // its old plane within its outline) or after it (a face on its new plane near that outline),
 // and which lie on its old or its new plane (within `on_plane`). The points farther from both
 // stand on other surfaces near the wall (a return, a neighbour, clutter): the building check
 // judges them, and they must not decide whether the wall itself is scanned.
-struct Region {
+struct WallPoints {
   std::vector<char> before, after;  // per face of each mesh: the wall's
   const JudgedWall& wall;
   double on_plane;
 
-  Region(const JudgedWall& w, const Mesh& mb, const Mesh& ma, double margin, double reach, double band)
+  WallPoints(const JudgedWall& w, const Mesh& mb, const Mesh& ma, double margin, double reach, double band)
       : wall(w), on_plane(band) {
     before = faces_on(w, w.from, mb, margin);
     after = faces_on(w, w.to, ma, reach);
@@ -139,10 +139,7 @@ std::vector<Plane> face_planes(const Mesh& m) {
 // object before the wall (a neighbour across an alley, seen past or over); where the face has
 // no points of its own, it is the building's facade stepping forward (a setback's front line).
 constexpr double kColumn = 0.5;  // m; a column's neighbours count too (window gaps up to ~1 m)
-Vec3 horizontal_along(const Plane& f) { return Vec3(-f.n.y(), f.n.x(), 0.0); }
-long long column_of(const Vec3& p, const Plane& f) {
-  return (long long)std::floor(horizontal_along(f).dot(p) / kColumn);
-}
+long long column_of(const Vec3& p, const Plane& f) { return (long long)std::floor(along_wall(f.n).dot(p) / kColumn); }
 
 // One model as the judge sees it: distances to it, its faces' planes and, when facade lines
 // beyond the cap are judged, the columns of each face's own points.
@@ -255,7 +252,7 @@ std::vector<PointFit> judged_points(const Mesh& before, const Mesh& after, const
   const bool facade_lines = reach > cap;
   Eigen::AlignedBox3d box = bounding_box(before.vertices);
   box.extend(bounding_box(after.vertices));
-  const double ground = box.min().z() + kGroundBand;
+  const double ground = box.min().z() + kStreetGroundBand;
   Eigen::AlignedBox3d within_cap = box;  // beyond it only a facade line's points are judged
   within_cap.min() -= Vec3::Constant(cap);
   within_cap.max() += Vec3::Constant(cap);
@@ -319,8 +316,8 @@ Judgement judge_refinement(const Mesh& before, const Mesh& after, const std::vec
   }
   j.building = fit_of(points, changed, [](const PointFit&) { return true; });
   for (const auto& w : walls) {
-    const Region region(w, before, after, prm.match_margin, cap, on_plane_band(detection));
-    j.walls.push_back(fit_of(points, changed, [&](const PointFit& q) { return region.holds(q); }));
+    const WallPoints own(w, before, after, prm.match_margin, cap, on_plane_band(detection));
+    j.walls.push_back(fit_of(points, changed, [&](const PointFit& q) { return own.holds(q); }));
   }
   if (const std::string why = worse_reason(j.building, kRmsSlack, true); !why.empty()) {
     j.ok = false;

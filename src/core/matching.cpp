@@ -1,4 +1,4 @@
-// Stage 2: model-to-surface matching (paper Sec. 3.1).
+// Stage 3, matching: model-to-surface matching (paper Sec. 3.1).
 #include "lodrefine/core/matching.h"
 
 #include <algorithm>

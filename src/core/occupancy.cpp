@@ -16,7 +16,8 @@ void mark_scanned(CellSet& cells, const std::vector<Vec3>& pts, const Frame2& fr
   CellSet occupied;
   for (const auto& p : pts) {
     const Vec2 q = frame(p);
-    const long long i = (long long)std::floor(q.x() / kCell), j = (long long)std::floor(q.y() / kCell);
+    const long long i = (long long)std::floor(q.x() / kOccupancyCell),
+                    j = (long long)std::floor(q.y() / kOccupancyCell);
     if (!occupied.insert(cell_key(i, j)).second) continue;
     for (long long di = -kFill; di <= kFill; ++di)
       for (long long dj = -kFill; dj <= kFill; ++dj) cells.insert(cell_key(i + di, j + dj));
@@ -27,7 +28,7 @@ double scanned_share(const std::vector<Vec2>& poly, const CellSet& cells) {
   if (cells.empty() || poly.empty()) return 0.0;
   long long total = 0, hit = 0;
   for_box_cells(poly, [&](long long i, long long j) {
-    if (!point_in_polygon_2d(Vec2((i + 0.5) * kCell, (j + 0.5) * kCell), poly)) return;
+    if (!point_in_polygon_2d(Vec2((i + 0.5) * kOccupancyCell, (j + 0.5) * kOccupancyCell), poly)) return;
     ++total;
     hit += cells.count(cell_key(i, j));
   });
@@ -35,7 +36,10 @@ double scanned_share(const std::vector<Vec2>& poly, const CellSet& cells) {
   Vec2 c = Vec2::Zero();
   for (const auto& p : poly) c += p;
   c /= double(poly.size());
-  return cells.count(cell_key((long long)std::floor(c.x() / kCell), (long long)std::floor(c.y() / kCell))) ? 1.0 : 0.0;
+  return cells.count(
+             cell_key((long long)std::floor(c.x() / kOccupancyCell), (long long)std::floor(c.y() / kOccupancyCell)))
+             ? 1.0
+             : 0.0;
 }
 
 }  // namespace lodrefine::detail

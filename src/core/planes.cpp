@@ -1,4 +1,4 @@
-// Stage 1. The only translation unit with CGAL's shape detection: keep it that way, it is the
+// Stage 2, planes. The only translation unit with CGAL's shape detection: keep it that way, it is the
 // slowest to compile.
 #include "lodrefine/core/planes.h"
 #include "wall_layers.h"

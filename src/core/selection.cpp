@@ -1,4 +1,4 @@
-// Stage 4b: the binary program, driven through GLPK's C API (CGAL's traits only turn presolve
+// Stage 5, selection: the binary program, driven through GLPK's C API (CGAL's traits only turn presolve
 // on; PolyFit-shaped programs need cuts: measured 13 min -> 0.2 s with MIR cuts).
 #include "lodrefine/core/selection.h"
 

@@ -1,4 +1,4 @@
-// Stage 4a's data for the selection: what each candidate face is (shell_describe.h).
+// Stage 5, selection: the data for the program, what each candidate face is (shell_describe.h).
 #include "shell_describe.h"
 
 #include <algorithm>
@@ -24,12 +24,12 @@ constexpr double kSeeThrough = 3.0;
 // PolyFit's data-fitting term (its compute_confidences' supporting points): the scan points of
 // a candidate's supporting plane that lie within it, each weighted by how well it fits that
 // plane (objective.h: fit_weight within fit_tolerance). Counted
-// as the area they stand for: the scanned area (kCell cells holding a point, over all planes)
+// as the area they stand for: the scanned area (kOccupancyCell cells holding a point, over all planes)
 // over the points, so a candidate explaining its share of an evenly sampled scan is worth about
 // its area, a sparsely sampled one less: PolyFit's share of the points, in the coverage term's
 // units (m²) rather than the box's.
 //
-// Per plane: its points in the plane's frame, their fit weights, and the points in each kCell
+// Per plane: its points in the plane's frame, their fit weights, and the points in each kOccupancyCell
 // cell; and the scanned area each point stands for (m²).
 struct FitPoints {
   std::vector<std::vector<Vec2>> at;
@@ -47,15 +47,16 @@ FitPoints fit_points(const Supports& s, const std::vector<Frame2>& frames, const
   for (int k = 0; k < np; ++k) {
     for (const auto& p : s.points[k]) {
       const Vec2 q = frames[k](p);
-      fp.cells[k][cell_key((long long)std::floor(q.x() / kCell), (long long)std::floor(q.y() / kCell))].push_back(
-          int(fp.at[k].size()));
+      fp.cells[k]
+              [cell_key((long long)std::floor(q.x() / kOccupancyCell), (long long)std::floor(q.y() / kOccupancyCell))]
+                  .push_back(int(fp.at[k].size()));
       fp.at[k].push_back(q);
       fp.weight[k].push_back(fit_weight(s.planes[k].plane.distance(p), tol));
     }
     points += (long long)s.points[k].size();
     occupied += (long long)fp.cells[k].size();
   }
-  if (points > 0) fp.area_per_point = double(occupied) * kCell * kCell / double(points);
+  if (points > 0) fp.area_per_point = double(occupied) * kOccupancyCell * kOccupancyCell / double(points);
   return fp;
 }
 

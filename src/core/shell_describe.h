@@ -1,4 +1,4 @@
-// Internal to core: what the selection's program knows of each candidate (stage 4a,
+// Internal to core: what the selection's program knows of each candidate (stage 5,
 // shell_selection.h), measured on the starting shell and the supports' scan points: in the
 // start, its source, its confidence (objective.h: face_confidence on the occupancy grid), whether
 // evidence reaches it, and the scanned area its supporting points explain (the data-fitting

@@ -18,18 +18,18 @@ namespace {
 constexpr double kRegionMargin = 1.0;
 
 // Where a scanned facade's points run along its horizontal direction `u` (positions along u;
-// gaps shorter than kRunGap are bridged: a window column still has wall above and below).
+// gaps shorter than kWindowGap are bridged: a window column still has wall above and below).
 struct Interval {
   double a, b;
 };
-constexpr double kRunGap = 2 * kCell;  // m
+constexpr double kWindowGap = 2 * kOccupancyCell;  // m
 std::vector<Interval> intervals_along(const std::vector<Vec3>& pts, const Vec3& u) {
   std::vector<double> t;
   for (const auto& p : pts) t.push_back(u.dot(p));
   std::sort(t.begin(), t.end());
   std::vector<Interval> out;
   for (double x : t) {
-    if (out.empty() || x - out.back().b > kRunGap) out.push_back({x, x});
+    if (out.empty() || x - out.back().b > kWindowGap) out.push_back({x, x});
     else out.back().b = x;
   }
   return out;
@@ -72,7 +72,7 @@ bool continues_across_step(const std::vector<Interval>& a, const Interval& span,
 // found once, not per facade tried.
 bool continues_another_across_step(const Mesh& start, const Supports& s, const std::vector<Vec3>& pts, const Vec3& n,
                                    double angle_deg, int self = -1) {
-  const Vec3 u = Vec3(-n.y(), n.x(), 0.0).normalized();
+  const Vec3 u = along_wall(n).normalized();
   const std::vector<Interval> runs = intervals_along(pts, u);
   const Interval span = span_along(start, u);
   for (int k = 0; k < int(s.planes.size()); ++k)
@@ -86,14 +86,14 @@ bool continues_another_across_step(const Mesh& start, const Supports& s, const s
 // the start's span, and past one of its ends only up to where a run crossing that end stops
 // within `reach` (the facade's own corner, a wall the model has short). A run going on past the
 // reach is the facade line running into a neighbour's: the party wall between them is not in the
-// scan, so the model's end stands. A run from the end (within kRunGap of it: a bay's return
+// scan, so the model's end stands. A run from the end (within kWindowGap of it: a bay's return
 // starts at the model's front) counts as crossing it; runs that begin farther past an end (across
 // a gap) are another building's.
 Interval own_extent(const std::vector<Interval>& runs, const Interval& span, double reach) {
   Interval own = span;
   for (const Interval& r : runs) {
-    if (r.a <= span.b + kRunGap && r.b > span.b && r.b <= span.b + reach) own.b = std::max(own.b, r.b);
-    if (r.b >= span.a - kRunGap && r.a < span.a && r.a >= span.a - reach) own.a = std::min(own.a, r.a);
+    if (r.a <= span.b + kWindowGap && r.b > span.b && r.b <= span.b + reach) own.b = std::max(own.b, r.b);
+    if (r.b >= span.a - kWindowGap && r.a < span.a && r.a >= span.a - reach) own.a = std::min(own.a, r.a);
   }
   return own;
 }
@@ -186,7 +186,7 @@ void add_scan_planes(const Mesh& start, const PointCloud& cloud, const std::vect
     Vec3 n(sp.plane.n.x(), sp.plane.n.y(), 0.0);
     if (n.norm() < 1e-9) continue;
     n.normalize();
-    const Vec3 u(-n.y(), n.x(), 0.0);
+    const Vec3 u = along_wall(n);
     Eigen::AlignedBox3d box;  // the start in (u, n, z)
     for (const auto& p : start.vertices) box.extend(Vec3(u.dot(p), n.dot(p), p.z()));
     std::vector<Vec3> inliers;
@@ -220,7 +220,7 @@ void add_step_walls(const Mesh& start, const RefineConfig& prm, Supports& s) {
   for (int j = s.start_planes; j < existing; ++j) {
     const Plane& pj = s.planes[j].plane;
     if (!s.planes[j].from_scan || s.points[j].empty() || !near_vertical(pj, tilt)) continue;
-    const Vec3 u = Vec3(-pj.n.y(), pj.n.x(), 0.0).normalized();
+    const Vec3 u = along_wall(pj.n).normalized();
     const auto [lo, hi] = span_along(start, u);
     std::vector<double> ends;
     for (const auto& r : intervals_along(s.points[j], u)) ends.insert(ends.end(), {r.a, r.b});
@@ -313,7 +313,7 @@ Region building_region(const Mesh& start, const Supports& s, double max_tilt_deg
       break;
     }
   Region r;
-  r.axes.col(0) = Vec3(-n.y(), n.x(), 0.0);
+  r.axes.col(0) = along_wall(n);
   r.axes.col(1) = n;
   r.axes.col(2) = Vec3::UnitZ();
   Eigen::AlignedBox3d box;

@@ -1,4 +1,4 @@
-// The supporting planes of a building's arrangement (stage 4, shell_selection.h): the starting
+// The supporting planes of a building's arrangement (stage 5, selection: shell_selection.h): the starting
 // shell's planes, the scan's facades none of them carries, and the hypothesised walls across the
 // steps of a facade line; and the region the arrangement covers. Internal to core: the
 // selection's and the rebuild's (which adds its holes' planes: hole_planes.h).

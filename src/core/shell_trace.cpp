@@ -1,4 +1,4 @@
-// Stage 4c: see shell_trace.h.
+// Stage 5, selection: the output shell, see shell_trace.h.
 #include "lodrefine/core/shell_trace.h"
 
 #include <algorithm>

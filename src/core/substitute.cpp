@@ -1,4 +1,4 @@
-// Stage 3 (first choice): wall substitution, see substitute.h.
+// Stage 4, substitution: wall substitution, see substitute.h.
 #include "lodrefine/core/substitute.h"
 
 #include "lodrefine/core/repair.h"

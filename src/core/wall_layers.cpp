@@ -1,4 +1,4 @@
-// Stage 1 besides the shape detection: the plane fitted to a point set; a wall seen twice by two
+// Stage 2, planes, besides the shape detection: the plane fitted to a point set; a wall seen twice by two
 // drives is one plane midway; facade planes over only part of a wall's height are relief.
 #include <algorithm>
 #include <cmath>
@@ -244,7 +244,7 @@ std::vector<ModelWall> model_walls(const Mesh& model, double max_tilt_deg) {
     if (poly.size() < 3) continue;
     const Plane pl = polygon_plane(poly);
     if (90.0 - unoriented_angle_deg(pl.n, Vec3::UnitZ()) > max_tilt_deg) continue;
-    ModelWall w{pl, Vec3(-pl.n.y(), pl.n.x(), 0.0).normalized(), 1e300, -1e300, 1e300, -1e300};
+    ModelWall w{pl, along_wall(pl.n).normalized(), 1e300, -1e300, 1e300, -1e300};
     for (const auto& p : poly) w.a = std::min(w.a, w.u.dot(p)), w.b = std::max(w.b, w.u.dot(p));
     for (const auto& p : poly) {
       w.foot = std::min(w.foot, p.z());

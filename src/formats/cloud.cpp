@@ -1,4 +1,5 @@
-// Format dispatch for point clouds: PLY (io) or LAS (las), by content; a cloud of several files.
+// Format dispatch for point clouds by content, through the readers' table (cloud_readers.h); a
+// cloud of several files.
 #include "lodrefine/formats/cloud.h"
 
 #include <fcntl.h>
@@ -14,43 +15,59 @@
 #include <map>
 #include <utility>
 
+#include "cloud_readers.h"
 #include "lodrefine/base/files.h"
-#include "lodrefine/formats/las.h"
-#include "lodrefine/formats/ply.h"
 
 namespace lodrefine {
 
-CloudFormat cloud_format(const std::string& path) {
-  const FileKind kind = sniff_file(path);
-  if (kind == FileKind::Las) return CloudFormat::Las;
-  if (kind == FileKind::Xml || kind == FileKind::Json)
-    throw InputError(path + ": not a PLY or LAS point cloud: the file is " + file_kind_text(kind));
-  return CloudFormat::Ply;  // the PLY reader reports any other content ("not a PLY file")
+namespace {
+
+using detail::cloud_readers;
+using detail::CloudReader;
+
+// "PLY, LAS or LAZ": names in a message.
+std::string or_list(const std::vector<std::string>& names) {
+  std::string out;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    out += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  return out;
 }
 
-namespace {
+// Each reader's first name ("PLY or LAS"); only the classified ones' with `classified`.
+std::string reader_names(bool classified_only = false) {
+  std::vector<std::string> names;
+  for (const CloudReader& r : cloud_readers())
+    if (r.classified || !classified_only) names.push_back(r.names.front());
+  return or_list(names);
+}
+
+// "neither 'ply' nor 'LASF'": the signatures a file's first bytes are not.
+std::string not_any_magic() {
+  const auto& rows = cloud_readers();
+  std::string out = rows.size() == 2 ? "neither " : rows.size() > 2 ? "none of " : "not ";
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    out += (i == 0                 ? ""
+            : rows.size() == 2     ? " nor "
+            : i + 1 == rows.size() ? " or "
+                                   : ", ") +
+           ("'" + rows[i].magic + "'");
+  return out;
+}
+
+// The reader of a cloud file by its first bytes; refuses a city model or JSON with what it is.
+const CloudReader& reader_of(const std::string& path) {
+  const FileKind kind = sniff_file(path);
+  if (const CloudReader* r = detail::cloud_reader(kind)) return *r;
+  if (kind == FileKind::Xml || kind == FileKind::Json)
+    throw InputError(path + ": not a " + reader_names() + " point cloud: the file is " + file_kind_text(kind));
+  return cloud_readers().front();  // it reports any other content ("not a PLY file")
+}
 
 namespace fs = std::filesystem;
 
 std::uint64_t saturated_sum(std::uint64_t a, std::uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
 
-// What a file's header declares: its points, and the points worth reserving room for before
-// reading them. A LAS count is bounded by the file size (checked in the header), a LAZ count
-// only by what its chunks decode to, so beyond a few million points the vector grows as points
-// arrive.
-struct Declared {
-  std::uint64_t points = 0, reserve = 0;
-};
-
-Declared declared(const std::string& path) {
-  constexpr std::uint64_t kReserveLimit = std::uint64_t(1) << 22;
-  if (cloud_format(path) == CloudFormat::Las) {
-    const LasHeader h = read_las_header(path);
-    return {h.point_count, h.compressed ? std::min(h.point_count, kReserveLimit) : h.point_count};
-  }
-  const std::uint64_t n = ply_vertex_count(path);
-  return {n, n};
-}
+detail::DeclaredPoints declared(const std::string& path) { return reader_of(path).declared(path); }
 
 // What a folder entry is, as far as its cloud goes (see cloud_files): a cloud file, one of
 // lodrefine's temporaries (skipped whatever its name), or anything else (said in the fault).
@@ -61,14 +78,19 @@ struct Entry {
   std::string fault;  // what it is when not a cloud, for a refusal or a skip
 };
 
-// Whether an entry's name says it is a cloud file: it ends in .ply, .las or .laz, in any case
-// (".laz" alone too).
+// Whether an entry's name says it is a cloud file: it ends in a reader's name (.ply, .las or
+// .laz), in any case (".laz" alone too).
 bool cloud_name(const fs::path& path) {
   std::string name = path.filename().string();
-  if (name.size() < 4) return false;
-  name = name.substr(name.size() - 4);
   for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return name == ".ply" || name == ".las" || name == ".laz";
+  for (const CloudReader& r : cloud_readers())
+    for (std::string ending : r.names) {
+      for (char& c : ending) c = char(std::tolower(static_cast<unsigned char>(c)));
+      ending.insert(0, ".");
+      if (name.size() >= ending.size() && name.compare(name.size() - ending.size(), ending.size(), ending) == 0)
+        return true;
+    }
+  return false;
 }
 
 // Looks at one entry without reading more than its first bytes; a FIFO or device is never opened.
@@ -93,11 +115,11 @@ Entry inspect(const fs::path& path) {
   const ssize_t n = ::read(fd, head, sizeof head);
   ::close(fd);
   const FileKind kind = sniff_head(std::string(head, n > 0 ? std::size_t(n) : 0));
-  if (kind == FileKind::Ply || kind == FileKind::Las) return {EntryKind::Cloud, ""};
-  return {EntryKind::NoCloud, kind == FileKind::Other
-                                  ? std::string("not a PLY, LAS or LAZ cloud (its first bytes are "
-                                                "neither 'ply' nor 'LASF')")
-                                  : "not a PLY or LAS point cloud: the file is " + file_kind_text(kind)};
+  if (detail::cloud_reader(kind)) return {EntryKind::Cloud, ""};
+  return {EntryKind::NoCloud,
+          kind == FileKind::Other
+              ? "not a " + or_list(cloud_format_names()) + " cloud (its first bytes are " + not_any_magic() + ")"
+              : "not a " + reader_names() + " point cloud: the file is " + file_kind_text(kind)};
 }
 
 bool by_path(const SkippedEntry& a, const SkippedEntry& b) { return a.path < b.path; }
@@ -122,7 +144,7 @@ std::vector<std::string> folder_clouds(const std::string& folder, const std::str
   }
   if (ec) throw InputError(folder + ": cannot list the folder (" + ec.message() + ")");
   if (found.empty())
-    throw InputError(folder + ": no PLY, LAS or LAZ cloud in the " + option + " folder" +
+    throw InputError(folder + ": no " + or_list(cloud_format_names()) + " cloud in the " + option + " folder" +
                      (others.empty()       ? std::string(" (empty)")
                       : others.size() == 1 ? std::string(" (1 other entry)")
                                            : " (" + std::to_string(others.size()) + " other entries)"));
@@ -191,11 +213,12 @@ std::uint64_t cloud_point_count(const std::vector<std::string>& paths) {
 
 void stream_cloud(const std::vector<std::string>& paths, const CloudOptions& options,
                   const std::function<void(const Vec3&)>& on_point, std::vector<CloudFileRead>* read) {
-  std::vector<CloudFormat> formats;
+  std::vector<const CloudReader*> readers;
   for (const std::string& path : paths) {
-    formats.push_back(cloud_format(path));
-    if (formats.back() == CloudFormat::Ply && !options.classes.empty())
-      throw InputError(path + ": a PLY cloud has no classification; --classes needs a LAS cloud");
+    readers.push_back(&reader_of(path));
+    if (!readers.back()->classified && !options.classes.empty())
+      throw InputError(path + ": a " + readers.back()->names.front() +
+                       " cloud has no classification; --classes needs a " + reader_names(true) + " cloud");
     declared(path);  // its header checked: a broken last tile is refused before the first is read
   }
   for (std::size_t i = 0; i < paths.size(); ++i) {
@@ -207,18 +230,15 @@ void stream_cloud(const std::vector<std::string>& paths, const CloudOptions& opt
       on_point(p);
     };
     const auto& visit = file ? counted : on_point;
-    read_naming_memory(paths[i], [&] {
-      if (formats[i] == CloudFormat::Las) stream_las(paths[i], options.classes, visit);
-      else stream_ply(paths[i], visit);
-    });
+    read_naming_memory(paths[i], [&] { readers[i]->stream(paths[i], options.classes, visit); });
   }
 }
 
 PointCloud read_cloud(const std::vector<std::string>& paths, const CloudOptions& options,
                       std::vector<CloudFileRead>* read) {
-  Declared total;
+  detail::DeclaredPoints total;
   for (const std::string& path : paths) {
-    const Declared d = declared(path);
+    const detail::DeclaredPoints d = declared(path);
     total.points = saturated_sum(total.points, d.points);
     total.reserve = saturated_sum(total.reserve, d.reserve);
   }
@@ -264,6 +284,15 @@ std::string classes_text(const std::vector<int>& classes) {
   std::string s;
   for (int c : classes) s += (s.empty() ? "" : ",") + std::to_string(c);
   return s;
+}
+
+const std::vector<std::string>& cloud_format_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const CloudReader& r : cloud_readers()) out.insert(out.end(), r.names.begin(), r.names.end());
+    return out;
+  }();
+  return names;
 }
 
 }  // namespace lodrefine

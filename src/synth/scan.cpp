@@ -113,7 +113,7 @@ ScanWall scan_wall(const Mesh& m, int face, double z0, Rng& r) {
   const auto pts = face_points(m, m.faces[face]);
   const Vec2 n2 = xy(newell_normal(pts)).normalized();
   w.n = Vec3(n2.x(), n2.y(), 0);
-  w.u = Vec3(-n2.y(), n2.x(), 0);
+  w.u = along_wall(w.n);
   w.o = Vec3(pts[0].x(), pts[0].y(), 0);
   w.smin = w.zmin = 1e300, w.smax = w.zmax = -1e300;
   for (const auto& p : pts) {

@@ -182,7 +182,7 @@ SceneWall wall_frame(const std::vector<Vec3>& poly) {
   SceneWall w;
   const Vec3 nn = newell_normal(poly);
   w.n = Vec3(nn.x(), nn.y(), 0).normalized();
-  w.u = Vec3(-w.n.y(), w.n.x(), 0);
+  w.u = along_wall(w.n);
   w.o = poly[0];
   double smin = 1e300;
   for (const auto& p : poly) smin = std::min(smin, (p - w.o).dot(w.u));
@@ -352,7 +352,7 @@ std::vector<FacadeGroup> facade_groups(const Mesh& truth, const std::vector<int>
 // Whether any vertex of the meshes stands in the street strip [front + kPavement, front + depth]
 // in front of the facade, within the drive's extent along it.
 bool street_blocked(const std::vector<const Mesh*>& meshes, const FacadeGroup& g, double s0, double s1, double depth) {
-  const Vec3 u(-g.n.y(), g.n.x(), 0);
+  const Vec3 u = along_wall(g.n);
   for (const Mesh* m : meshes)
     for (const auto& p : m->vertices) {
       const double d = g.n.dot(p) - g.front, s = u.dot(p);
@@ -363,7 +363,7 @@ bool street_blocked(const std::vector<const Mesh*>& meshes, const FacadeGroup& g
 
 // Boxes standing in for the neighbours past the street's ends (each end with a chance of 0.6).
 void add_neighbour_boxes(StreetScene& scene, const FacadeGroup& g, double s0, double s1, double z0, Rng& r) {
-  const Vec3 u(-g.n.y(), g.n.x(), 0);
+  const Vec3 u = along_wall(g.n);
   for (double dir : {-1.0, 1.0}) {
     if (!r.chance(0.6)) continue;
     const double gap = r.chance(0.5) ? r.uniform(0.05, 0.8) : r.uniform(1.5, 4.0);
@@ -377,7 +377,7 @@ void add_neighbour_boxes(StreetScene& scene, const FacadeGroup& g, double s0, do
 
 // The extent [s0, s1] of the building along the street of group g.
 std::pair<double, double> along_street(const Mesh& truth, const FacadeGroup& g) {
-  const Vec3 u(-g.n.y(), g.n.x(), 0);
+  const Vec3 u = along_wall(g.n);
   double s0 = 1e300, s1 = -1e300;
   for (const auto& p : truth.vertices) s0 = std::min(s0, u.dot(p)), s1 = std::max(s1, u.dot(p));
   return {s0, s1};
@@ -429,7 +429,7 @@ VanScan van_scan(const Mesh& truth, const std::vector<int>& street_faces, double
   const auto groups = facade_groups(truth, street_faces);
   for (std::size_t gi = 0; gi < groups.size(); ++gi) {
     const FacadeGroup& g = groups[gi];
-    const Vec3 u(-g.n.y(), g.n.x(), 0);
+    const Vec3 u = along_wall(g.n);
     const auto [s0, s1] = along_street(truth, g);
     bool seen = false;
     for (const auto& lane : lanes) seen |= lane.first.side.dot(-g.n) > kNewStreetCos;

@@ -50,8 +50,8 @@ TEST(OneOutcome, ARepairedHouseIsRepairedAloneInACityAndInTheEvaluation) {
   fs::copy_file(fs::path(dir) / "fan" / "house.obj", b / "coarse.obj");
   fs::copy_file(fs::path(dir) / "cloud.ply", b / "cloud.ply");
 
-  c = run_cli("refine --model " + (b / "coarse.obj").string() + " --cloud " + (b / "cloud.ply").string() +
-                  " --out " + (b / "refined.obj").string() + " --report " + (b / "report.json").string(),
+  c = run_cli("refine --model " + (b / "coarse.obj").string() + " --cloud " + (b / "cloud.ply").string() + " --out " +
+                  (b / "refined.obj").string() + " --report " + (b / "report.json").string(),
               dir);
   ASSERT_EQ(c.exit, 0) << c.err;
   const json alone = load((b / "report.json").string());

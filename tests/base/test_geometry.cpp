@@ -89,3 +89,21 @@ TEST(Geometry, ConvexHullOfManyPointsIsTheHullOfItsCorners) {
   EXPECT_EQ(convex_hull_2d(grid).size(), 4u);
   EXPECT_NEAR(std::abs(signed_area_2d(convex_hull_2d(grid))), 2.9 * 1.9, 1e-12);
 }
+
+TEST(Geometry, AlongWallRunsLeftToRightSeenFromOutside) {
+  // A south wall, counter-clockwise seen from outside (from the south): its bottom edge runs
+  // from the left (x = 0) to the right (x = 4), along +x.
+  const std::vector<Vec3> wall = {{0, 0, 0}, {4, 0, 0}, {4, 0, 3}, {0, 0, 3}};
+  const Vec3 n = newell_normal(wall).normalized();
+  ASSERT_NEAR((n - Vec3(0, -1, 0)).norm(), 0.0, 1e-15);
+  EXPECT_EQ(along_wall(n), Vec3(1, 0, 0));
+  EXPECT_EQ(along_wall(n).dot(wall[1] - wall[0]), 4.0);
+  EXPECT_EQ(along_wall(Vec3(1, 0, 0)), Vec3(0, 1, 0));  // an east wall: along +y
+  // Not normalized: a tilted normal gives its horizontal part's length, a roof's none.
+  EXPECT_EQ(along_wall(Vec3(0.6, 0, 0.8)), Vec3(0, 0.6, 0));
+  EXPECT_EQ(along_wall(Vec3(0, 0, 1)).norm(), 0.0);
+  // Horizontal and perpendicular to the normal.
+  const Vec3 t = Vec3(0.3, -0.5, 0.2).normalized();
+  EXPECT_EQ(along_wall(t).z(), 0.0);
+  EXPECT_NEAR(along_wall(t).dot(t), 0.0, 1e-15);
+}

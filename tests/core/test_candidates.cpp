@@ -1,4 +1,4 @@
-// Stage 3: the candidate arrangement of the supporting planes inside the region.
+// Stage 5, selection: the candidate arrangement of the supporting planes inside the region.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// Stage 2: the model's planar surfaces (model_surfaces), scan planes matched to walls by point
+// Stage 3, matching: the model's planar surfaces (model_surfaces), scan planes matched to walls by point
 // ownership (match_surfaces) and the matched points in front of their walls (points_in_front).
 // Buildings are hand-made closed prisms; scan planes are noise-free grids built directly, or
 // detect_planes on noisy ones.
@@ -172,7 +172,7 @@ TEST(Matching, NonFacadePlanesAreNeverMatched) {
   EXPECT_TRUE(r.rejected.empty()) << joined(r.rejected);
 }
 
-// Stage 1 into stage 2: the front and the right side scanned 0.4 m out with 1 cm noise, plus
+// Stage 2 into stage 3 (planes into matching): the front and the right side scanned 0.4 m out with 1 cm noise, plus
 // the street; each wall gets its own detected plane, the ground none.
 TEST(Matching, DetectedPlanesOfTwoScannedWallsMatchTheirWalls) {
   Scene s(building());

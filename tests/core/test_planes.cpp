@@ -1,4 +1,4 @@
-// Stage 1, detect_planes, with both detectors (Efficient RANSAC, region growing): synthetic scans
+// Stage 2, planes: detect_planes, with both detectors (Efficient RANSAC, region growing): synthetic scans
 // with 1 cm range noise give back their planes (normal,
 // offset, inliers, RMS, hull area, facade flag, vertical snap), the same ones for a fixed seed,
 // through the default voxel thinning and without it; too small or degenerate clouds give none,

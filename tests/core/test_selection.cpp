@@ -1,4 +1,4 @@
-// Stage 4b: face selection by GLPK over the candidate arrangement.
+// Stage 5, selection: face selection by GLPK over the candidate arrangement.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// Stage 4c: the output shell traced on the candidate mesh from the chosen faces.
+// Stage 5, selection: the output shell traced on the candidate mesh from the chosen faces.
 #include <gtest/gtest.h>
 
 #include <CGAL/Polygon_mesh_processing/orientation.h>

@@ -244,3 +244,20 @@ TEST(CloudFiles, OverlapProblemsNameEachFileThatMissesTheModel) {
             "far.ply: cloud x 95010.0..95030.0 y 447005.0..447006.0 does not overlap the city model x "
             "85000.0..85020.0 y 447000.0..447010.0: wrong CRS or tile?");
 }
+
+// The formats the commands' help names are the readers' table's (src/formats/cloud_readers.cpp),
+// each row's names in row order; a folder entry ending in any of them, in any case, is a cloud
+// file of the survey (refused when it holds none).
+TEST(CloudFiles, FormatNamesComeFromTheReadersTable) {
+  EXPECT_EQ(cloud_format_names(), (std::vector<std::string>{"PLY", "LAS", "LAZ"}));
+  EXPECT_EQ(kCloudFormatNames, cloud_format_names());
+  for (const std::string name : {"a.PLY", "b.Las", "c.laz"}) {
+    const std::string dir = temp_path("names_" + name);
+    fs::create_directories(dir);
+    write_text(dir + "/" + name, "not a cloud\n");
+    const std::string why = refusal([&] { cloud_files({dir}); });
+    EXPECT_NE(why.find(name + ": not a PLY, LAS or LAZ cloud (its first bytes are neither 'ply' nor 'LASF')"),
+              std::string::npos)
+        << name << ": " << why;
+  }
+}

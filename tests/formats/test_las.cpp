@@ -84,7 +84,7 @@ TEST(Las, EveryFormatAndVersionReadsBackExactly) {
         EXPECT_EQ(h.record_length, o.record_length);
         EXPECT_EQ(h.point_count, pts.points.size());
         EXPECT_EQ(fs::file_size(path), h.point_offset + pts.points.size() * o.record_length);
-        EXPECT_EQ(cloud_format(path), CloudFormat::Las);
+        EXPECT_EQ(sniff_file(path), FileKind::Las);
         EXPECT_EQ(cloud_point_count(path), pts.points.size());
         const PointCloud back = read_cloud(path);
         ASSERT_EQ(back.points.size(), pts.points.size());
@@ -140,7 +140,7 @@ TEST(Las, PlyAndLasOfOneCloudAgree) {
   const std::string las = temp_path("c.las"), ply = temp_path("c.ply");
   write_las(las, pts, {}, opts(3, 3));
   write_ply(ply, pts);
-  EXPECT_EQ(cloud_format(ply), CloudFormat::Ply);
+  EXPECT_EQ(sniff_file(ply), FileKind::Ply);
   const PointCloud a = read_cloud(las), b = read_cloud(ply);
   ASSERT_EQ(a.points.size(), b.points.size());
   for (std::size_t i = 0; i < a.points.size(); ++i) EXPECT_LT((a.points[i] - b.points[i]).norm(), 1e-9);

@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "synth/perturb.h"
 #include "support/synth_shape_fixtures.h"
+#include "synth/perturb.h"
 
 using namespace lodrefine;
 using namespace lodrefine::synth;

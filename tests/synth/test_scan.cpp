@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "synth/scan.h"
 #include "lodrefine/base/geometry.h"
 #include "support/synth_shape_fixtures.h"
+#include "synth/scan.h"
 
 using namespace lodrefine;
 using namespace lodrefine::synth;

@@ -25,6 +25,12 @@ struct Plane {
   std::pair<Vec3, Vec3> basis() const;
 };
 
+// The horizontal direction along a wall whose outward normal is `n`: n's horizontal part turned
+// +90 degrees about z, so that, seen from outside, it runs from left to right. Not normalized: its
+// length is that of n's horizontal part (1 for a vertical unit normal, less for a tilted one, 0 for
+// a horizontal plane); callers that need a unit vector normalize it.
+inline Vec3 along_wall(const Vec3& n) { return Vec3(-n.y(), n.x(), 0.0); }
+
 // The positions of a face's vertices, in order.
 std::vector<Vec3> face_points(const Mesh& mesh, const Face& face);
 // The mesh moved by `offset` (e.g. into or out of a local frame).

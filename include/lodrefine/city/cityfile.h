@@ -26,6 +26,7 @@
 #include "lodrefine/core/outcome.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/validate.h"
+#include "lodrefine/formats/cityjson_write.h"  // cityjson_solid, cityjson_multisurface
 #include "lodrefine/formats/cloud.h"
 
 namespace lodrefine {
@@ -118,17 +119,5 @@ struct CityRefineSummary {
 CityRefineSummary refine_city(const std::string& model_path, const std::vector<std::string>& cloud_paths,
                               const std::string& out_path, const RefineConfig& params,
                               const CityRefineOptions& options);
-
-// The refined mesh as a CityJSON Solid geometry of LoD `lod` with semantics, its vertices
-// appended to `vertices` quantised by the document's transform (`scale`, `translate`). A face
-// with a provenance (Face::provenance) has it on its semantic surface object as
-// "lodrefine_source" ("model", "scan", "added"), a scan face its coverage as
-// "lodrefine_coverage" (0..1, in hundredths): one surface object per semantic, source and
-// coverage. Faces of no semantic (Semantic::Other) have none (a null value).
-nlohmann::ordered_json cityjson_solid(const Mesh& mesh, const std::string& lod, const Vec3& scale,
-                                      const Vec3& translate, nlohmann::ordered_json& vertices);
-// The same as a MultiSurface (the fins written beside a rebuilt shell: RefineResult::fins).
-nlohmann::ordered_json cityjson_multisurface(const Mesh& mesh, const std::string& lod, const Vec3& scale,
-                                             const Vec3& translate, nlohmann::ordered_json& vertices);
 
 }  // namespace lodrefine

@@ -1,4 +1,4 @@
-// Stage 4 (README's numbering; paper Sec. 3.2): PolyFit-style candidate faces on a CGAL::Surface_mesh. Every
+// Stage 5, selection (paper Sec. 3.2): PolyFit-style candidate faces on a CGAL::Surface_mesh. Every
 // supporting plane, cropped to a convex region, is split by every other plane; the convex pieces
 // are the candidates. As in CGAL's Polygonal_surface_reconstruction (its hypothesis), each plane
 // is one component of the mesh (its pieces share halfedges), a property map gives each face its

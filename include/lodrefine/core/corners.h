@@ -1,4 +1,4 @@
-// Stage 2b: corners from the scan's extent. A scanned facade ends where the building's corner
+// Stage 3, matching: corners from the scan's extent. A scanned facade ends where the building's corner
 // is; when it ends short of the model's corner (or runs on a little past it, then stops), the
 // adjacent wall that was not scanned is misplaced, and moves so that the corner is where the
 // scan says. Evidence must hold over the facade's height (an occluding car or tree does not),
@@ -45,6 +45,11 @@ struct CornerMove {
 // A point within this of a scan plane lies on it (m): the plane's noise band (two RANSAC
 // epsilons), at least the corners' tolerance of 5 cm.
 double on_plane_band(const PlaneEvidence& detection);
+
+// Street ground: points lower than this above the building's foot (m). Corners count them to see
+// the street go on past a facade's end; the judge leaves them out (ground in front of a wall
+// moved inwards would count against a right move).
+constexpr double kStreetGroundBand = 0.3;
 
 std::vector<CornerMove> corner_moves(const Mesh& mesh, const std::vector<ModelSurface>& surfaces,
                                      const std::vector<ScannedWall>& scanned, const PointCloud& cloud,

@@ -1,12 +1,12 @@
-// Stage 5: never worse, for the whole building. The refined model is written only when the scan
+// Stage 6, judge: never worse, for the whole building. The refined model is written only when the scan
 // shows it better than the input, judged on every scan point near the building (facade points
 // matched to a wall or not, roof points; street ground excepted), and on each moved wall's own
-// region: a wall with points in front of it must fit them better; a wall without points
+// points: a wall with points in front of it must fit them better; a wall without points
 // may move only on the scan's corner evidence (corners.h).
 //
 // Inputs are in one (local) frame; distances in metres. A point is judged when it lies within
 // MatchConfig::match_distance of either model (the cap: farther points are another object's) and
-// above the lowest model vertex + kGroundBand (street ground in front of a wall moved inwards
+// above the lowest model vertex + kStreetGroundBand (corners.h: street ground in front of a wall moved inwards
 // would count against a right move), and not a flush neighbour's (JudgedWall::flush_facade). Its
 // distance to each model is capped at match_distance. A scanned facade line farther off is the
 // building's, not another object's, where it stands before none of the face's own points: an
@@ -32,8 +32,6 @@
 #include "lodrefine/core/planes.h"
 
 namespace lodrefine {
-
-constexpr double kGroundBand = 0.3;  // m above the model's lowest vertex
 
 // A wall the refinement moved, described before the move.
 struct JudgedWall {
@@ -69,7 +67,7 @@ struct Judgement {
   std::string detail;                   // one line with the figures of the refusal; empty when ok
   int wall = -1;                        // the refused wall (index into the JudgedWalls) when check is Wall
   Fit building;                         // every judged point
-  std::vector<Fit> walls;               // per JudgedWall, its region
+  std::vector<Fit> walls;               // per JudgedWall, its own points
   // "<check> check: <detail>", the refusal in a reason.
   std::string refusal() const { return check_name(check) + std::string(" check: ") + detail; }
 };
@@ -81,14 +79,14 @@ struct Judgement {
 // - building: refused when the capped RMS of every judged point grows by more than kRmsSlack,
 //   or when more than kWorseShare of the points that changed (by more than
 //   PlaneConfig::ransac_epsilon) got farther;
-// - wall: each moved wall's region (the judged points whose nearest face is the wall, before
+// - wall: each moved wall's own points (the judged points whose nearest face is the wall, before
 //   the move or after it, and that lie on its old or its new plane within on_plane_band,
 //   corners.h) must not grow in RMS by more than kWallRmsSlack (window recesses and clutter on
-//   the wall are in it too, so it is judged on the RMS only); a region with fewer than
+//   the wall are among them, so it is judged on the RMS only); a wall with fewer than
 //   PlaneConfig::ransac_min_points points is unscanned and passes only when the wall moved on
 //   corner evidence. Points nearest the wall but on neither plane stand on other surfaces (a
 //   neighbour, a return): they count for the building, not for whether the wall is scanned.
-// - gain: fewer than kMinGain points got closer and no moved wall's region RMS dropped by
+// - gain: fewer than kMinGain points got closer and no moved wall's own points' RMS dropped by
 //   kMinRmsGain (a move within the scan's noise, e.g. a correct wall refitted a few cm off by
 //   its windows, is no refinement).
 // The building is judged first, then each wall, then the gain. Refuses (never throws) when a

@@ -1,4 +1,4 @@
-// Stage 2: model-to-surface matching. Groups the model's faces into planar surfaces, matches
+// Stage 3, matching: model-to-surface matching. Groups the model's faces into planar surfaces, matches
 // scan planes to wall surfaces and scores the model by Q_model (sum of S_match).
 #pragma once
 #include <string>

@@ -13,26 +13,30 @@ namespace lodrefine {
   X(double, weld_tolerance, 0.01, 0.0, 1.0, "model repair: vertices closer than this are welded (m)") \
   X(double, planarity_tolerance, 0.01, 0.0, 1.0, "validation: max vertex distance from its face plane (m)")
 
-#define LODREFINE_PLANE_PARAMS(X)                                                                                   \
-  X(int, ransac, 1, 0, 1,                                                                                           \
-    "1: planes by CGAL's Efficient RANSAC (the paper's); 0: by region growing on the same points, normals and "     \
-    "thresholds (the same planes on the dev tiles, faster)")                                                        \
-  X(int, seed, 42, 0, 2147483647, "RANSAC random seed (runs are reproducible)")                                     \
-  X(double, ransac_epsilon, 0.03, 0.001, 1.0, "RANSAC: max point-to-plane distance of an inlier (m)")               \
-  X(double, ransac_cluster_epsilon, 0.25, 0.01, 10.0, "RANSAC: max gap between connected inliers (m)")              \
-  X(double, ransac_normal_deg, 25.0, 1.0, 90.0, "RANSAC: max angle between point normal and plane (deg)")           \
-  X(int, ransac_min_points, 150, 3, 100000000, "RANSAC: min inliers of a plane")                                    \
-  X(double, ransac_probability, 0.01, 1e-6, 1.0, "RANSAC: probability to miss the largest shape")                   \
-  X(double, detect_voxel, -1.0, -1.0, 1.0,                                                                          \
-    "plane detection runs on one point per voxel of this size, then takes back every point near its planes (m; 0: " \
-    "all points; negative: sqrt(min_plane_area / (normal_neighbors + 1)), the largest voxel at which the smallest " \
-    "plane "                                                                                                        \
-    "kept still holds a neighbourhood of representatives)")                                                         \
-  X(int, normal_neighbors, 12, 3, 200, "neighbours for PCA normal estimation")                                      \
-  X(double, min_plane_area, 1.0, 0.0, 1e6, "scan planes whose inlier hull is smaller are ignored (m^2)")            \
-  X(double, facade_max_tilt_deg, 10.0, 0.0, 45.0,                                                                   \
-    "scan plane counts as facade if its normal is within this of horizontal (deg)")                                 \
-  X(double, vertical_snap_deg, 1.5, 0.0, 10.0,                                                                      \
+#define LODREFINE_PLANE_PARAMS(X)                                                                                    \
+  X(int, ransac, 1, 0, 1,                                                                                            \
+    "1: planes by CGAL's Efficient RANSAC (the paper's); 0: by region growing on the same points, normals and "      \
+    "thresholds (the same planes on the dev tiles, faster)")                                                         \
+  X(int, seed, 42, 0, 2147483647,                                                                                    \
+    "RANSAC random seed (runs are reproducible); applies only with ransac 1, and changes the planes only where "     \
+    "Efficient RANSAC's random draws decide which planes it finds (a clearly scanned building's come out the same)") \
+  X(double, ransac_epsilon, 0.03, 0.001, 1.0, "RANSAC: max point-to-plane distance of an inlier (m)")                \
+  X(double, ransac_cluster_epsilon, 0.25, 0.01, 10.0, "RANSAC: max gap between connected inliers (m)")               \
+  X(double, ransac_normal_deg, 25.0, 1.0, 90.0, "RANSAC: max angle between point normal and plane (deg)")            \
+  X(int, ransac_min_points, 150, 3, 100000000, "RANSAC: min inliers of a plane")                                     \
+  X(double, ransac_probability, 0.01, 1e-6, 1.0,                                                                     \
+    "RANSAC: probability to miss the largest shape; applies only with ransac 1, and changes the planes only "        \
+    "where the search's length decides which planes it finds (a clearly scanned building's come out the same)")      \
+  X(double, detect_voxel, -1.0, -1.0, 1.0,                                                                           \
+    "plane detection runs on one point per voxel of this size, then takes back every point near its planes (m; 0: "  \
+    "all points; negative: sqrt(min_plane_area / (normal_neighbors + 1)), the largest voxel at which the smallest "  \
+    "plane "                                                                                                         \
+    "kept still holds a neighbourhood of representatives)")                                                          \
+  X(int, normal_neighbors, 12, 3, 200, "neighbours for PCA normal estimation")                                       \
+  X(double, min_plane_area, 1.0, 0.0, 1e6, "scan planes whose inlier hull is smaller are ignored (m^2)")             \
+  X(double, facade_max_tilt_deg, 10.0, 0.0, 45.0,                                                                    \
+    "scan plane counts as facade if its normal is within this of horizontal (deg)")                                  \
+  X(double, vertical_snap_deg, 1.5, 0.0, 10.0,                                                                       \
     "facade planes tilted less than this are refitted exactly vertical (deg)")
 
 #define LODREFINE_MATCH_PARAMS(X)                                                                                      \
@@ -49,20 +53,25 @@ namespace lodrefine {
     "matching: scan points up to this far beyond a wall's outline (in its plane) still belong to it (m)")              \
   X(double, corner_gap, 0.6, 0.0, 100.0,                                                                               \
     "a wall match is rejected if the new corner lies farther than this beyond the adjacent scanned facade's points "   \
-    "and its wall's end in the model (m)")                                                                             \
+    "and its wall's end in the model (m); applies only at a corner between two matched walls")                         \
   X(double, w_normal, 0.5, 0.0, 1.0, "matching score weight of |S_normal|")                                            \
   X(double, w_coverage, 0.5, 0.0, 1.0, "matching score weight of the OBB IoU C_bbox")
 
 #define LODREFINE_SELECTION_PARAMS(X)                                                                               \
   X(double, bbox_expand, 0.1, 0.0, 2.0, "relative expansion of the bounding box on each side")                      \
   X(double, bbox_margin, 1.0, 0.0, 100.0, "absolute expansion of the bounding box on each side (m)")                \
-  X(double, merge_angle_deg, 5.0, 0.0, 30.0, "planes within this angle (and merge_distance) are merged (deg)")      \
-  X(double, merge_distance, 0.05, 0.0, 5.0, "planes closer than this (and within merge_angle_deg) are merged (m)")  \
+  X(double, merge_angle_deg, 5.0, 0.0, 30.0,                                                                        \
+    "planes within this angle (and merge_distance) are merged (deg); applies only where a scan facade lies near a " \
+    "start plane it was not moved onto (a wall kept within change_tolerance, a step)")                              \
+  X(double, merge_distance, 0.05, 0.0, 5.0,                                                                         \
+    "planes closer than this (and within merge_angle_deg) are merged (m); applies only where a scan facade lies "   \
+    "near a start plane it was not moved onto (a wall kept within change_tolerance, a step)")                       \
   X(double, tau_cov, 0.3, 0.0, 1.0, "coverage threshold tau_cov: inflection of the sigmoid coverage cost")          \
   X(double, lambda_coverage, 1.0, 0.0, 1e6, "weight of the coverage term")                                          \
   X(double, lambda_data, 0.1, 0.0, 1e6,                                                                             \
     "weight of the data-fitting term (the scanned area a face's supporting points explain, each weighted by its "   \
-    "fit to the face's plane)")                                                                                     \
+    "fit to the face's plane); applies only where the coverage and complexity terms leave a choice between "        \
+    "scanned candidates (a recess, a step); where they decide every face it changes nothing")                       \
   X(double, lambda_complexity, 0.2, 0.0, 1e6, "weight of the complexity (sharp edge) term")                         \
   X(double, mip_work_limit, 60.0, 0.0, 1e9,                                                                         \
     "GLPK work budget of a face selection (millions of tableau entries: rows + columns per simplex iteration, "     \
@@ -71,7 +80,9 @@ namespace lodrefine {
   X(double, mip_time_limit, 30.0, 0.001, 86400.0,                                                                   \
     "wall-clock safety ceiling of a face selection (s), far above what mip_work_limit takes; results that reach "   \
     "it depend on the machine's load")                                                                              \
-  X(double, mip_gap, 1e-4, 0.0, 1.0, "GLPK relative MIP gap")
+  X(double, mip_gap, 1e-4, 0.0, 1.0,                                                                                \
+    "GLPK relative MIP gap; applies only where the search runs past the root (a program whose relaxation is "       \
+    "not integral there); one solved at its root is the same at any gap")
 
 // S(Config, stage, what the stage does, rows). `stage` names the stage: its Config::stage, the
 // RefineConfig member that holds its config, its CLI help group.

@@ -1,4 +1,4 @@
-// Stage 1: planar primitives of the MLS cloud (CGAL Efficient RANSAC, the paper's, or region
+// Stage 2, planes: planar primitives of the MLS cloud (CGAL Efficient RANSAC, the paper's, or region
 // growing on CGAL's Region_growing; refitted by PCA).
 #pragma once
 #include <vector>

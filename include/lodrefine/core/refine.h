@@ -25,6 +25,8 @@ namespace lodrefine {
 
 // The stages a refinement times (RefineTrace::seconds), in pipeline order; "total" follows
 // them. A building's run stops after any of them (a refusal, nothing to change).
+// The stages in the order refine_building runs them; the README's Method numbers them 1-7 and
+// each stage's header names its number and name (`// Stage 5, selection: ...`).
 enum class RefineStage { Repair, Planes, Matching, Substitution, Selection, Judge, Validation };
 inline constexpr std::array<const char*, 7> kRefineStageNames = {"repair",    "planes", "matching",  "substitution",
                                                                  "selection", "judge",  "validation"};

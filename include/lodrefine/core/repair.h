@@ -1,4 +1,4 @@
-// Turning an exported polygon soup into a clean closed polyhedron: weld, dedupe, fix
+// Stage 1, repair: turning an exported polygon soup into a clean closed polyhedron: weld, dedupe, fix
 // T-junctions, orient consistently outward, fill a missing ground, merge coplanar neighbours.
 #pragma once
 #include <string>

@@ -1,4 +1,4 @@
-// Stage 4b: face selection as a binary program in GLPK (paper Sec. 3.4): the solver driver.
+// Stage 5, selection: face selection as a binary program in GLPK (paper Sec. 3.4): the solver driver.
 // The costs come built (objective.h); here the columns, per edge "selected incident faces = 2 x
 // used" (the region's outside surface a constant incident face on boundary edges), the sharp
 // edges' rows, the warm start, the search and its status.

@@ -1,4 +1,4 @@
-// Stage 4c: the output shell traced on the candidate mesh (candidates.h) from the faces the
+// Stage 5, selection: the output shell traced on the candidate mesh (candidates.h) from the faces the
 // selection chose, as CGAL's Polygonal_surface_reconstruction reads its model off the hypothesis:
 // no geometric weld and no repair pass.
 // - Vertices are the mesh's: a corner of a chosen face is its vertex's point (candidate_props::point,

@@ -1,4 +1,4 @@
-// Stage 3 (first choice): wall substitution. A matched wall takes its scan plane and every
+// Stage 4, substitution: the first choice of starting shell. A matched wall takes its scan plane and every
 // vertex it carries is re-solved against the planes of the other walls at that vertex, at its
 // own height (or, where the scan shows the eave moved with the roof, along the roof's plane).
 // The model keeps its topology, ids and semantics; flat roofs, ridges and the ground keep their

@@ -1,4 +1,4 @@
-// The project's own validator: every model is checked before it is written as refined.
+// Stage 7, validation: the project's own validator; every model is checked before it is written as refined.
 #pragma once
 #include <string>
 #include <vector>

@@ -2,6 +2,9 @@
 #pragma once
 #include <array>
 #include <cmath>
+#include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "lodrefine/base/types.h"
 
@@ -20,5 +23,17 @@ struct CityJsonTransform {
             std::llround((p.z() - translate.z()) / scale.z())};
   }
 };
+
+// The refined mesh as a CityJSON Solid geometry of LoD `lod` with semantics, its vertices
+// appended to `vertices` quantised by the document's transform (`scale`, `translate`). A face
+// with a provenance (Face::provenance) has it on its semantic surface object as
+// "lodrefine_source" ("model", "scan", "added"), a scan face its coverage as
+// "lodrefine_coverage" (0..1, in hundredths): one surface object per semantic, source and
+// coverage. Faces of no semantic (Semantic::Other) have none (a null value).
+nlohmann::ordered_json cityjson_solid(const Mesh& mesh, const std::string& lod, const Vec3& scale,
+                                      const Vec3& translate, nlohmann::ordered_json& vertices);
+// The same as a MultiSurface (the fins written beside a rebuilt shell: RefineResult::fins).
+nlohmann::ordered_json cityjson_multisurface(const Mesh& mesh, const std::string& lod, const Vec3& scale,
+                                             const Vec3& translate, nlohmann::ordered_json& vertices);
 
 }  // namespace lodrefine

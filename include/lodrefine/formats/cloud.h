@@ -13,11 +13,11 @@
 
 namespace lodrefine {
 
-enum class CloudFormat { Ply, Las };
-
-// The cloud formats read_cloud and stream_cloud take, as the commands' help names them (one
-// list: tests/app/test_help.cpp checks every command that reads a cloud names each).
-inline const std::vector<std::string> kCloudFormatNames = {"PLY", "LAS", "LAZ"};
+// The cloud formats read_cloud and stream_cloud take, as the commands' help names them: the
+// readers' table's (src/formats/cloud_readers.cpp; tests/app/test_help.cpp checks every command
+// that reads a cloud names each).
+const std::vector<std::string>& cloud_format_names();
+inline const std::vector<std::string> kCloudFormatNames = cloud_format_names();
 
 inline constexpr std::uint64_t kDefaultMaxPoints = 20000000;
 
@@ -30,9 +30,6 @@ struct CloudOptions {
   // Beyond: InputError.
   std::uint64_t max_points = kDefaultMaxPoints;
 };
-
-// The format of a cloud file by its first bytes; throws InputError for anything else.
-CloudFormat cloud_format(const std::string& path);
 
 // A survey delivered as many files (one per drive, or per tile) is read as one cloud: the files'
 // points one file after another, in the list's order, as if they were one file holding them all
@@ -47,7 +44,7 @@ struct SkippedEntry {
 
 // The cloud files of a command's --cloud (or --tile) values, in reading order. Each value is a
 // file or a folder, expanded in the order given:
-// - a file is taken as named; one that is no cloud is refused when read (cloud_format says what
+// - a file is taken as named; one that is no cloud is refused when read (its reader says what
 //   it is, the PLY reader refuses anything else);
 // - a folder gives its regular files (links to them too) whose content is a cloud (sniff_file:
 //   PLY or LAS/LAZ), sorted by name (byte order). A folder is a survey: an entry named as a
