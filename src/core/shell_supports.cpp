@@ -325,15 +325,11 @@ Region building_region(const Mesh& start, const Supports& s, double max_tilt_deg
   return r;
 }
 
-std::vector<Region> plane_reach(const Mesh& start, const Supports& s, const Region& region, double margin,
-                                const std::vector<Vec3>& also) {
+std::vector<Region> plane_reach(const Mesh& start, const Supports& s, const Region& region, double margin) {
   std::vector<Eigen::AlignedBox3d> box(s.planes.size());  // in the region's axes
   for (std::size_t f = 0; f < start.faces.size(); ++f)
     if (s.face_plane[f] >= 0)
       for (int v : start.faces[f].v) box[s.face_plane[f]].extend(region.axes.transpose() * start.vertices[v]);
-  for (std::size_t k = 0; k < box.size(); ++k)
-    for (const auto& p : also)
-      if (std::abs(s.planes[k].plane.distance(p)) <= kSurfaceDistance) box[k].extend(region.axes.transpose() * p);
   for (std::size_t k = 0; k < s.points.size(); ++k)
     for (const auto& p : s.points[k]) box[k].extend(region.axes.transpose() * p);
   for (std::size_t k = 0; k < box.size(); ++k) {

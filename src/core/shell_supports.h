@@ -56,9 +56,6 @@ Region building_region(const Mesh& start, const Supports& s, double max_tilt_deg
 // scan points, grown by `margin` (the farthest a wall may move); a plane with neither (a
 // hypothesised wall) those of the start and the evidence within `margin` of it. A scanned wall
 // spans the region's height (a street scan sees its lower storeys only).
-// Points of `also` reach every plane they lie on (within kSurfaceDistance): a hole's edges, the
-// plane that closes it.
-std::vector<Region> plane_reach(const Mesh& start, const Supports& s, const Region& region, double margin,
-                                const std::vector<Vec3>& also = {});
+std::vector<Region> plane_reach(const Mesh& start, const Supports& s, const Region& region, double margin);
 
 }  // namespace lodrefine::detail
