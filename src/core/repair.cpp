@@ -488,9 +488,7 @@ Mesh repair_model(const Mesh& soup, double weld_tolerance, RepairReport* report,
 }
 
 int split_warped_faces(Mesh& mesh, double tolerance) {
-  std::set<std::pair<int, int>> edges;
-  for (const auto& f : mesh.faces)
-    for (std::size_t k = 0; k < f.v.size(); ++k) edges.insert(std::minmax(f.v[k], f.v[(k + 1) % f.v.size()]));
+  const EdgeUses edges = edge_uses(mesh.faces);
   std::vector<Face> faces;
   int split = 0;
   for (const auto& f : mesh.faces) {
@@ -510,7 +508,7 @@ int split_warped_faces(Mesh& mesh, double tolerance) {
       for (int k = 0; k < 3; ++k) {
         const int ia = t[k], ib = t[(k + 1) % 3];
         const bool boundary = (ia + 1) % n == ib || (ib + 1) % n == ia;
-        clash = clash || (!boundary && edges.count(std::minmax(f.v[ia], f.v[ib])));
+        clash = clash || (!boundary && edges.count(edge_key(f.v[ia], f.v[ib])));
       }
     if (!clash) {
       for (const auto& t : tris) faces.push_back(with_corners(f, {f.v[t[0]], f.v[t[1]], f.v[t[2]]}));

@@ -1,5 +1,5 @@
 // Where each face of a refined or repaired building comes from (Face::provenance: the model's
-// plane, the scan's, or added to close the shell; core/types.h) and, for the scan's, how much of
+// plane, the scan's, or added to close the shell; base/types.h) and, for the scan's, how much of
 // it the scan covers (Face::coverage). The provenance is carried by the stages themselves (a
 // substitution's moved walls, the selection's supporting planes, shell_trace.h); this module
 // measures the coverage and fills what no stage set.
