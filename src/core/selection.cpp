@@ -76,9 +76,9 @@ double iteration_size(glp_prob* lp) { return double(glp_get_num_rows(lp)) + doub
 // Until the search holds a solution, it may spend this many budgets to find one (no warm start,
 // or GLPK refused it): a building is then kept only when none is found even so. With one budget
 // an upper storey's move is lost (Refine.AnUpperStoreyOverALedgeIsMovedWhereItsSubstitutionFolds)
-// and jobs' selections end differently (CityFile.JobsWriteTheSameBytesWhenSelectionsEndAtTheBudget);
-// ten let hopeless programs of the 2,000-building bench run 15 s. Without a warm start the count under-reads GLPK's
-// time about 5x (presolved program, cut rows): such a search may take ~5 s.
+// and the jobs' selections end elsewhere (CityFile.JobsWriteTheSameBytesWhenSelectionsEndAtTheBudget);
+// ten let hopeless programs of the 2,000-building bench run 15 s. Without a warm start the count
+// under-reads GLPK's time about 5x (presolved program, cut rows): such a search may take ~5 s.
 constexpr double kFirstSolutionBudgets = 4.0;
 
 // The callback's state: the starting point (GLPK's 1-based column values) and what GLPK made of
