@@ -305,8 +305,8 @@ void outdated_walls(const Mesh& current, const MatchResult& mr, const std::vecto
 }
 
 // The starting shell: every move of the plan at once, the model's topology kept, else one wall at
-// a time; none when no wall is outdated or none could be moved. The walls it moved go to plan.moved (and the trace's
-// facades).
+// a time; none when no wall is outdated or none could be moved. The walls it moved go to
+// plan.moved (and the trace's facades).
 std::optional<Mesh> starting_shell(const Mesh& current, MovePlan& plan, const PointCloud& local,
                                    const std::vector<ScanPlane>& planes, const RefineConfig& prm, RefineTrace& trace) {
   plan.moved.clear();
