@@ -17,8 +17,8 @@
 
 #include "commands.h"
 #include "lodrefine/base/files.h"
-#include "lodrefine/core/refine.h"
 #include "lodrefine/eval/eval.h"
+#include "lodrefine/refine/refine.h"
 #include "lodrefine/synth/synth.h"
 #include "lodrefine/tools/polyfit_bench.h"
 #include "options.h"

@@ -16,11 +16,11 @@
 #include "lodrefine/city/crop.h"
 #include "lodrefine/city/in_order_pool.h"
 #include "lodrefine/city/validity.h"
-#include "lodrefine/core/provenance.h"
-#include "lodrefine/core/refine.h"
 #include "lodrefine/formats/citygml.h"
 #include "lodrefine/formats/cityjson.h"
 #include "lodrefine/formats/cityjson_write.h"
+#include "lodrefine/refine/provenance.h"
+#include "lodrefine/refine/refine.h"
 
 namespace lodrefine {
 namespace {

@@ -30,8 +30,8 @@
 #include "lodrefine/core/distance.h"
 #include "lodrefine/core/matching.h"
 #include "lodrefine/core/planes.h"
-#include "lodrefine/core/refine.h"
 #include "lodrefine/core/repair.h"
+#include "lodrefine/refine/refine.h"
 
 namespace lodrefine {
 namespace {

@@ -11,9 +11,9 @@
 
 #include "lodrefine/base/files.h"
 #include "lodrefine/base/geometry.h"
-#include "lodrefine/core/refine.h"
 #include "lodrefine/formats/cloud.h"
 #include "lodrefine/formats/obj.h"
+#include "lodrefine/refine/refine.h"
 #include "lodrefine/tools/run.h"
 
 namespace lodrefine {

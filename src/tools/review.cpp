@@ -11,8 +11,8 @@
 #include "lodrefine/base/files.h"
 #include "lodrefine/base/geometry.h"
 #include "lodrefine/core/distance.h"
-#include "lodrefine/core/refine.h"
 #include "lodrefine/eval/plots.h"
+#include "lodrefine/refine/refine.h"
 
 namespace lodrefine {
 namespace {

@@ -14,11 +14,11 @@
 #include "lodrefine/base/geometry.h"
 #include "lodrefine/city/in_order_pool.h"
 #include "lodrefine/city/refine_report.h"
-#include "lodrefine/core/refine.h"
 #include "lodrefine/core/validate.h"
 #include "lodrefine/eval/plots.h"
 #include "lodrefine/formats/cityjson.h"
 #include "lodrefine/formats/obj.h"
+#include "lodrefine/refine/refine.h"
 
 namespace lodrefine {
 namespace {

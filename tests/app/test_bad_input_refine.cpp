@@ -9,7 +9,7 @@
 // Each case prints a row "| input | what lodrefine says | exit |"; running the suite in one
 // process (lodrefine_app_tests --gtest_filter='BadInput*') prints the whole table at the end.
 // The other commands' bad input: test_bad_input_{refine_files,city,convert,crop,eval}.cpp; the
-// selection solver's faults: tests/core/test_selection_bad_input.cpp.
+// selection solver's faults: tests/refine/test_selection_bad_input.cpp.
 #include <gtest/gtest.h>
 
 #include <fcntl.h>

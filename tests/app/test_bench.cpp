@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "lodrefine/core/refine.h"
+#include "lodrefine/refine/refine.h"
 #include "support/cli_fixtures.h"
 
 using namespace lodrefine;

@@ -7,9 +7,9 @@
 
 #include "lodrefine/base/geometry.h"
 #include "lodrefine/core/params.h"
-#include "lodrefine/core/refine.h"
 #include "lodrefine/core/validate.h"
 #include "lodrefine/eval/eval.h"
+#include "lodrefine/refine/refine.h"
 #include "lodrefine/synth/synth.h"
 
 using namespace lodrefine;

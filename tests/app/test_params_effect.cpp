@@ -12,7 +12,7 @@
 
 #include "lodrefine/city/refine_report.h"
 #include "lodrefine/core/params.h"
-#include "lodrefine/core/refine.h"
+#include "lodrefine/refine/refine.h"
 #include "lodrefine/synth/synth.h"
 
 using namespace lodrefine;

@@ -20,12 +20,12 @@
 #include "lodrefine/base/files.h"
 #include "lodrefine/base/geometry.h"
 #include "lodrefine/core/distance.h"
-#include "lodrefine/core/refine.h"
 #include "lodrefine/core/repair.h"
 #include "lodrefine/core/validate.h"
 #include "lodrefine/formats/cityjson.h"
 #include "lodrefine/formats/obj.h"
 #include "lodrefine/formats/ply.h"
+#include "lodrefine/refine/refine.h"
 #include "support/realdata.h"
 
 using namespace lodrefine;

@@ -17,11 +17,11 @@
 #include "lodrefine/base/geometry.h"
 #include "lodrefine/base/topology.h"
 #include "lodrefine/core/distance.h"
-#include "lodrefine/core/refine.h"
 #include "lodrefine/core/validate.h"
 #include "lodrefine/eval/eval.h"
 #include "lodrefine/formats/cloud.h"
 #include "lodrefine/formats/obj.h"
+#include "lodrefine/refine/refine.h"
 #include "lodrefine/synth/synth.h"
 #include "support/test_paths.h"
 

@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "lodrefine/city/refine_report.h"
-#include "lodrefine/core/refine.h"
+#include "lodrefine/refine/refine.h"
 #include "support/mesh_fixtures.h"
 #include "support/scan_fixtures.h"
 

@@ -5,7 +5,7 @@
 #include <initializer_list>
 
 #include "lodrefine/core/outcome.h"
-#include "lodrefine/core/refine.h"
+#include "lodrefine/refine/refine.h"
 #include "support/mesh_fixtures.h"
 
 using namespace lodrefine;

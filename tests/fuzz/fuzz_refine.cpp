@@ -11,9 +11,9 @@
 
 #include "fuzz_common.h"
 #include "lodrefine/city/refine_report.h"
-#include "lodrefine/core/refine.h"
 #include "lodrefine/formats/obj.h"
 #include "lodrefine/formats/ply.h"
+#include "lodrefine/refine/refine.h"
 
 using namespace lodrefine;
 

@@ -18,7 +18,8 @@ endfunction()
 
 run("install" ${CMAKE_COMMAND} --install ${BUILD} --prefix ${WORK}/prefix)
 foreach(f include/lodrefine/version.h include/lodrefine/base/types.h include/lodrefine/laz/laz_write.h
-          include/lodrefine/formats/obj.h include/lodrefine/core/validate.h include/lodrefine/city/cityfile.h
+          include/lodrefine/formats/obj.h include/lodrefine/core/validate.h include/lodrefine/refine/refine.h
+          include/lodrefine/city/cityfile.h
           include/lodrefine/eval/eval.h include/lodrefine/tools/report.h lib/cmake/lodrefine/lodrefineConfig.cmake
           bin/lodrefine)
   if(NOT EXISTS ${WORK}/prefix/${f})
@@ -32,6 +33,14 @@ run("configure the consumer" ${CMAKE_COMMAND} -S ${SOURCE}/tests/install/consume
     -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${WORK}/prefix -DLODREFINE_WANTED=${VERSION})
 run("build the consumer" ${CMAKE_COMMAND} --build ${WORK}/build)
 run("run the consumer" ${WORK}/build/consumer ${WORK}/box.obj)
+# formats, core and eval link no GLPK: only the selection (refine) and tools do.
+file(GET_RUNTIME_DEPENDENCIES EXECUTABLES ${WORK}/build/consumer RESOLVED_DEPENDENCIES_VAR resolved
+     UNRESOLVED_DEPENDENCIES_VAR unresolved)
+foreach(dep ${resolved} ${unresolved})
+  if(dep MATCHES "glpk")
+    message(FATAL_ERROR "install test: a program linking formats, core and eval loads GLPK (${dep})")
+  endif()
+endforeach()
 message(STATUS "${last_output}")
 if(NOT last_output MATCHES "^lodrefine ${VERSION}:")
   message(FATAL_ERROR "install test: the installed version.h does not say ${VERSION}:\n${last_output}")

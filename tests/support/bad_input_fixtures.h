@@ -1,4 +1,4 @@
-// The bad-input suites (tests/app/test_bad_input_*.cpp, tests/core/test_selection_bad_input.cpp):
+// The bad-input suites (tests/app/test_bad_input_*.cpp, tests/refine/test_selection_bad_input.cpp):
 // the box model and its wall scan as files, running the binary under a time limit, checking
 // what it left behind, and the table of cases. Each case adds a row "| input | what lodrefine
 // says | exit |"; a test binary run as one process (lodrefine_app_tests

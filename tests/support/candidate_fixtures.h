@@ -4,7 +4,7 @@
 #pragma once
 #include <vector>
 
-#include "lodrefine/core/candidates.h"
+#include "lodrefine/refine/candidates.h"
 
 namespace lodrefine::fixtures {
 

@@ -12,7 +12,7 @@
 
 #include "lodrefine/base/geometry.h"
 #include "lodrefine/core/distance.h"
-#include "lodrefine/core/refine.h"
+#include "lodrefine/refine/refine.h"
 
 namespace lodrefine::fixtures {
 

@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "lodrefine/base/geometry.h"
-#include "lodrefine/core/refine.h"
+#include "lodrefine/refine/refine.h"
 #include "lodrefine/synth/synth.h"
 
 using namespace lodrefine;

@@ -4,8 +4,8 @@
 #include <nlohmann/json.hpp>
 
 #include "lodrefine/city/cityfile.h"
-#include "lodrefine/core/refine.h"
 #include "lodrefine/core/validate.h"
+#include "lodrefine/refine/refine.h"
 
 namespace lodrefine {
 
