@@ -123,7 +123,7 @@ void add_start_planes(const Mesh& start, double planarity_tolerance, Supports& s
       if (worst <= kSurfaceDistance && angle <= kSurfaceAngleDeg) k = j;
       else if (worst <= planarity_tolerance && angle < sliver_angle) sliver_of = j, sliver_angle = angle;
     }
-    if (k < 0 && sliver_of >= 0) k = sliver_of, ++s.slivers;
+    if (k < 0 && sliver_of >= 0) k = sliver_of;
     if (k < 0) {
       k = int(s.planes.size());
       s.planes.push_back({surf.plane, surf.sem, false, si});

@@ -21,7 +21,6 @@ struct Supports {
   std::vector<int> face_plane;            // start face -> supporting plane
   std::vector<std::vector<Vec3>> points;  // per supporting plane: its scan points
   int added = 0;
-  int slivers = 0;      // start surfaces on a plane by the planarity tolerance alone (add_start_planes)
   int hole_planes = 0;  // planes no face of the start lies on (add_hole_planes)
 };
 
@@ -33,7 +32,7 @@ inline bool near_vertical(const Plane& pl, double max_tilt_deg) {
 
 // The start's planes, one per set of its surfaces within kSurfaceAngleDeg / kSurfaceDistance
 // (matching.h), largest first; a surface on none of them goes to the one nearest in angle of
-// those its vertices all lie within `planarity_tolerance` (m) of (a sliver: counted in slivers).
+// those its vertices all lie within `planarity_tolerance` (m) of (a sliver).
 // A plane's provenance: the scan's when a start face on it is (a moved wall), added when only
 // added faces lie on it, else the model's.
 void add_start_planes(const Mesh& start, double planarity_tolerance, Supports& s);
