@@ -1,5 +1,5 @@
-// End to end on hand-made buildings with known truth (the generator's richer cases are in
-// test_end_to_end.cpp).
+// End to end on hand-made buildings with known truth, and on two generated hips the starting
+// shell's fallback is pinned by (the generator's richer cases are in test_end_to_end.cpp).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -8,10 +8,12 @@
 #include <random>
 
 #include "lodrefine/base/geometry.h"
+#include "lodrefine/core/distance.h"
 #include "lodrefine/core/params.h"
 #include "lodrefine/core/validate.h"
 #include "lodrefine/refine/candidates.h"
 #include "lodrefine/refine/refine.h"
+#include "lodrefine/synth/synth.h"
 #include "support/mesh_fixtures.h"
 #include "support/scan_fixtures.h"
 
@@ -469,6 +471,37 @@ TEST(Refine, AnUpperStoreyOverALedgeIsMovedWhereItsSubstitutionFolds) {
   EXPECT_EQ(lower, 2);
   EXPECT_NEAR(v.volume, 12 * 8 * 9 - 4 * kStep * 6 - 12 * (kSetback - kOut) * 3, 0.05);
   EXPECT_LT(seconds, 5.0);
+}
+
+// The starting shell's fallback, one wall at a time (refine.cpp's one_wall_at_a_time): generated
+// hips (synth hip seeds 38 and 53) with three scanned walls 0.05-0.75 m out. Moved at once, the
+// shell's faces intersect; moved one at a time, each re-matched on the shell before, all three
+// land on the truth. With the call switched off both hips are kept, every wall where it was: the
+// selection from the input, the moves as its warm start, ends on the input (no candidate changed).
+TEST(Refine, AHipWhoseWallsCannotMoveAtOnceMovesThemOneAtATime) {
+  for (std::uint64_t seed : {38u, 53u}) {
+    const SynthBuilding b = make_building(BuildingType::Hip, seed);
+    SCOPED_TRACE(b.id);
+    const RefineResult r = refine_building(b.coarse, b.cloud, RefineConfig{});
+    ASSERT_TRUE(r.trace.substitution.has_value());
+    EXPECT_FALSE(r.trace.substitution->ok) << "the case is one whose walls cannot move at once";
+    EXPECT_EQ(r.outcome, Outcome::Refined) << r.reason;
+    int scanned = 0;
+    for (const MovedWall& w : b.moved_walls) {
+      if (!w.scanned) continue;
+      ++scanned;
+      const std::vector<Vec3> samples = sample_faces(b.truth, w.truth_faces, 0.25);
+      const auto median_abs = [&](const Mesh& m) {
+        std::vector<double> d = cloud_to_mesh(m, samples);
+        for (double& x : d) x = std::abs(x);
+        std::nth_element(d.begin(), d.begin() + std::ptrdiff_t(d.size() / 2), d.end());
+        return d[d.size() / 2];
+      };
+      EXPECT_GT(median_abs(b.coarse), 0.04) << "truth wall " << w.truth_faces[0] << " is out in the input";
+      EXPECT_LT(median_abs(r.mesh), 0.01) << "truth wall " << w.truth_faces[0];
+    }
+    EXPECT_EQ(scanned, 3);
+  }
 }
 
 TEST(Refine, OutcomeNamesReadBack) {
