@@ -27,6 +27,12 @@ namespace fs = std::filesystem;
 
 // m: city buildings whose box comes this close to the scanned building's stand in its street.
 constexpr double kNeighbourhood = 40.0;
+// The face corners a street's city buildings may hold together: the van's scene (an AABB tree of
+// their triangles, ~150 bytes a corner) is built for each scanned building, so a city stacking
+// buildings each within size_problem's bounds at one spot made memory and time grow without end.
+// 50 buildings at those bounds; a street of LoD2 buildings holds thousands (Delfshaven's largest
+// building 1,916).
+constexpr std::size_t kMaxStreetCorners = 1000000;
 // The dev tiles' crop: the model's box grown by 10 % and 3 m.
 constexpr double kCropRelative = 0.1, kCropAbsolute = 3.0;
 
@@ -177,12 +183,22 @@ std::vector<Mesh> neighbours(const City& city, const Eigen::AlignedBox3d& box, c
   return out;
 }
 
-// The neighbours the van will meet, within the bounds refine holds models to (size_problem: a
-// face of 60,000 vertices made every ray slow): refused, naming the city's building.
-void check_neighbours(const City& city, const Eigen::AlignedBox3d& box, const std::vector<std::size_t>& self) {
-  for (std::size_t i : near_buildings(city, box, self))
-    if (const std::string too_large = size_problem(city.buildings[i].mesh); !too_large.empty())
-      throw InputError(city.path + ": building " + shown_id(city.buildings[i].mesh.id) + ": " + too_large);
+// The neighbours the van will meet, each within the bounds refine holds models to (size_problem:
+// a face of 60,000 vertices made every ray slow), naming the city's building, and together
+// within kMaxStreetCorners, naming the scanned building (`where`).
+void check_neighbours(const City& city, const Eigen::AlignedBox3d& box, const std::vector<std::size_t>& self,
+                      const std::string& where) {
+  std::size_t corners = 0;
+  for (std::size_t i : near_buildings(city, box, self)) {
+    const Mesh& m = city.buildings[i].mesh;
+    if (const std::string too_large = size_problem(m); !too_large.empty())
+      throw InputError(city.path + ": building " + shown_id(m.id) + ": " + too_large);
+    for (const Face& f : m.faces) corners += f.v.size();
+  }
+  if (corners > kMaxStreetCorners)
+    throw InputError(where + ": the --city buildings within " + std::to_string(int(kNeighbourhood)) + " m of it hold " +
+                     std::to_string(corners) + " face corners, more than " + std::to_string(kMaxStreetCorners) +
+                     " (a street of LoD2 buildings holds thousands)");
 }
 
 // The tile's origin, once meta.json is known to be a dev tile's: an origin of three numbers, and
@@ -238,7 +254,7 @@ std::vector<TileBuilding> read_tile(const nlohmann::json& meta, const std::strin
     t.model = read_model(in / "models" / (t.id + ".obj"));
     t.street = street_faces(t.truth, b, where);
     t.self = city_self(city, t.truth, b, where);
-    check_neighbours(city, bounding_box(t.truth.vertices), t.self);
+    check_neighbours(city, bounding_box(t.truth.vertices), t.self, where);
     require_van_rays(van_scan_rays(translated(t.truth, -origin), t.street, opt.van), where);
     out.push_back(std::move(t));
   }

@@ -227,6 +227,41 @@ TEST(BadInputSynth, RescanRefusesAModelOrNeighbourBeyondRefinesBounds) {
           neighbour.exit);
 }
 
+// Neighbours each within those bounds but stacked by the dozen at one spot made the van's scene,
+// built for every scanned building, grow without end: a street holds 1,000,000 face corners at
+// most (53 buildings of 19,024 here, beside A and C: 1,008,320), refused naming the scanned building.
+TEST(BadInputSynth, RescanRefusesAStreetOfMoreThanAMillionCorners) {
+  const std::string dir = temp_dir("synth_rescan_huge_street");
+  const std::string args = rescan_args(dir, "out");
+  json city = json::parse(rescan_fixtures::terrace_city());
+  json shell = city["CityObjects"]["A"]["geometry"][0]["boundaries"][0];
+  json values = city["CityObjects"]["A"]["geometry"][0]["semantics"]["values"][0];
+  for (int ring = 0; ring < 19; ++ring) {  // 19 rings of 1,000 vertices, shared by every copy
+    json r = json::array();
+    for (int k = 0; k < 1000; ++k) {
+      const double t = 2 * M_PI * k / 1000;
+      r.push_back(city["vertices"].size());
+      city["vertices"].push_back(
+          {std::llround((-6 + 3 * std::cos(t)) * 1000), std::llround((4 + 3 * std::sin(t)) * 1000), 100 + 300 * ring});
+    }
+    shell.push_back({r});
+    values.push_back(2);
+  }
+  for (int copy = 0; copy < 53; ++copy) {
+    json b = city["CityObjects"]["A"];
+    b["geometry"][0]["boundaries"][0] = shell;
+    b["geometry"][0]["semantics"]["values"][0] = values;
+    city["CityObjects"]["N" + std::to_string(copy)] = b;
+  }
+  write_text(dir + "/in/city.json", city.dump());
+  const CliRun r = run_cli(args, dir, 60);
+  expect_one_error_line(r,
+                        "meta.json: building \"B\": the --city buildings within 40 m of it hold 1008320 face "
+                        "corners, more than 1000000");
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+  add_row("synth --rescan --city: 53 neighbours of 19,024 corners at one spot", "refused, naming the building", r.exit);
+}
+
 // `synth --tile X/synth_flat_0001/truth.obj --out X` renamed the tile over the truth it had just
 // written; a rescan's --city file where a truth goes was overwritten by it. Both are refused up
 // front, as crop refuses a tile where a building's cloud goes.
