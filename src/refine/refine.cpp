@@ -47,6 +47,7 @@ SubstitutedWall& add_moved(const Mesh& mesh, const std::vector<ModelSurface>& su
   w.wall.to = move.plane;
   w.wall.corner = evidence == Evidence::Corner;
   w.scan_surface = scan_surface;
+  w.input_faces = trace.facades.back().input_faces;
   return w;
 }
 
@@ -75,12 +76,17 @@ std::optional<Mesh> substitute_valid(const Mesh& mesh, const std::vector<ModelSu
   return m;
 }
 
+// Whether surface `s` of `mesh` holds a face descending from one of the input faces `faces`.
+bool holds_any(const Mesh& mesh, const ModelSurface& s, const std::set<int>& faces) {
+  return std::any_of(s.faces.begin(), s.faces.end(), [&](int f) { return faces.count(mesh.faces[f].source) > 0; });
+}
+
 // The starting shell's fallback: one wall at a time, the best-matching outdated one first, each
-// by substitution, re-matching on the new model after each. Returns the model once any wall
-// moved; the walls moved go to `moved`.
+// by substitution, re-matching on the new model after each; a wall holding one of the
+// `refused_faces` stays. Returns the model once any wall moved; the walls moved go to `moved`.
 std::optional<Mesh> one_wall_at_a_time(const Mesh& start, const PointCloud& local, const std::vector<ScanPlane>& planes,
-                                       const RefineConfig& prm, std::vector<SubstitutedWall>& moved,
-                                       RefineTrace& trace) {
+                                       const std::set<int>& refused_faces, const RefineConfig& prm,
+                                       std::vector<SubstitutedWall>& moved, RefineTrace& trace) {
   // Each (scan plane, wall position) is tried once: a wall that would not move is not retried,
   // and the loop ends even when moves undo each other.
   const int max_steps = 4 * int(planes.size()) + 4;
@@ -96,7 +102,7 @@ std::optional<Mesh> one_wall_at_a_time(const Mesh& start, const PointCloud& loca
     const MatchResult mi = match_surfaces(step_mesh, ss, local, planes, prm.match);
     const Match* next = nullptr;
     for (const auto& m : mi.matches) {
-      if (tried.count({m.scan_plane, position(ss[m.surface])}) ||
+      if (tried.count({m.scan_plane, position(ss[m.surface])}) || holds_any(step_mesh, ss[m.surface], refused_faces) ||
           surface_deviation(step_mesh, ss[m.surface], planes[m.scan_plane].plane) <= prm.match.change_tolerance)
         continue;
       if (next == nullptr || m.s_match > next->s_match) next = &m;
@@ -324,7 +330,8 @@ std::optional<Mesh> starting_shell(const Mesh& current, MovePlan& plan, const Po
           c.flush_facade;
   }
   trace.replacements.emplace();
-  if (!refined && !all.empty()) refined = one_wall_at_a_time(current, local, planes, prm, plan.moved, trace);
+  if (!refined && !all.empty())
+    refined = one_wall_at_a_time(current, local, planes, plan.refused_faces, prm, plan.moved, trace);
   return refined;
 }
 
@@ -447,6 +454,25 @@ RefineTrace::Scan scan_summary(const std::vector<ScanPlane>& walls, const std::v
   return s;
 }
 
+// Drops the move of the starting shell's wall `wall` (plan.moved; plan.surfaces are `current`'s)
+// from the plan: its scan move, or for a wall the one-at-a-time fallback moved, its input faces,
+// which the fallback then leaves where they are, and each scan move of a surface holding one.
+// False when nothing is dropped (a corner move, or a wall dropped before).
+bool drop_refused_wall(const Mesh& current, MovePlan& plan, int wall) {
+  const SubstitutedWall& w = plan.moved[std::size_t(wall)];
+  if (w.wall.corner) return false;
+  const std::size_t refused = plan.refused_faces.size(), scan = plan.scan.size();
+  if (w.scan_surface < 0) plan.refused_faces.insert(w.input_faces.begin(), w.input_faces.end());
+  const std::set<int>& faces = plan.refused_faces;
+  plan.scan.erase(std::remove_if(plan.scan.begin(), plan.scan.end(),
+                                 [&](const WallMove& m) {
+                                   return m.surface == w.scan_surface ||
+                                          holds_any(current, plan.surfaces[m.surface], faces);
+                                 }),
+                  plan.scan.end());
+  return plan.refused_faces.size() != refused || plan.scan.size() != scan;
+}
+
 }  // namespace
 
 RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const RefineConfig& prm) {
@@ -505,12 +531,7 @@ RefineResult refine_building(const Mesh& model, const PointCloud& cloud, const R
   // A scan move whose own wall the judge refuses (its points got farther, or it has none: a
   // plane matched that is not the wall's) says nothing of the other walls: it is dropped and the
   // building refined again on theirs.
-  while (refused() && verdict->check == JudgeCheck::Wall) {
-    const int surface = plan.moved[std::size_t(verdict->wall)].scan_surface;
-    const auto dropped =
-        std::remove_if(plan.scan.begin(), plan.scan.end(), [&](const WallMove& m) { return m.surface == surface; });
-    if (surface < 0 || dropped == plan.scan.end()) break;
-    plan.scan.erase(dropped, plan.scan.end());
+  while (refused() && verdict->check == JudgeCheck::Wall && drop_refused_wall(current, plan, verdict->wall)) {
     trace.walls_refused.push_back(verdict->refusal());
     result = again();
   }

@@ -473,6 +473,19 @@ TEST(Refine, AnUpperStoreyOverALedgeIsMovedWhereItsSubstitutionFolds) {
   EXPECT_LT(seconds, 5.0);
 }
 
+namespace {
+
+// The median distance (m) of a generated building's scanned truth wall `w` to `m`, on samples
+// 0.25 m apart.
+double wall_median_distance(const SynthBuilding& b, const MovedWall& w, const Mesh& m) {
+  std::vector<double> d = cloud_to_mesh(m, sample_faces(b.truth, w.truth_faces, 0.25));
+  for (double& x : d) x = std::abs(x);
+  std::nth_element(d.begin(), d.begin() + std::ptrdiff_t(d.size() / 2), d.end());
+  return d[d.size() / 2];
+}
+
+}  // namespace
+
 // The starting shell's fallback, one wall at a time (refine.cpp's one_wall_at_a_time): generated
 // hips (synth hip seeds 38 and 53) with three scanned walls 0.05-0.75 m out. Moved at once, the
 // shell's faces intersect; moved one at a time, each re-matched on the shell before, all three
@@ -490,18 +503,38 @@ TEST(Refine, AHipWhoseWallsCannotMoveAtOnceMovesThemOneAtATime) {
     for (const MovedWall& w : b.moved_walls) {
       if (!w.scanned) continue;
       ++scanned;
-      const std::vector<Vec3> samples = sample_faces(b.truth, w.truth_faces, 0.25);
-      const auto median_abs = [&](const Mesh& m) {
-        std::vector<double> d = cloud_to_mesh(m, samples);
-        for (double& x : d) x = std::abs(x);
-        std::nth_element(d.begin(), d.begin() + std::ptrdiff_t(d.size() / 2), d.end());
-        return d[d.size() / 2];
-      };
-      EXPECT_GT(median_abs(b.coarse), 0.04) << "truth wall " << w.truth_faces[0] << " is out in the input";
-      EXPECT_LT(median_abs(r.mesh), 0.01) << "truth wall " << w.truth_faces[0];
+      EXPECT_GT(wall_median_distance(b, w, b.coarse), 0.04)
+          << "truth wall " << w.truth_faces[0] << " is out in the input";
+      EXPECT_LT(wall_median_distance(b, w, r.mesh), 0.01) << "truth wall " << w.truth_faces[0];
     }
     EXPECT_EQ(scanned, 3);
   }
+}
+
+// A wall the fallback moved that the judge refuses is dropped on its own, as a scan move is: a
+// generated gable (synth gable seed 45) whose fallback moved one wall a second time, onto a plane
+// with none of its points in front. The whole building was kept, its scanned walls 0.19 m out;
+// now that wall's input faces stay and the others move onto the truth.
+TEST(Refine, AWallTheFallbackMovedThatTheJudgeRefusesIsDroppedAlone) {
+  const SynthBuilding b = make_building(BuildingType::Gable, 45);
+  const RefineResult r = refine_building(b.coarse, b.cloud, RefineConfig{});
+  ASSERT_TRUE(r.trace.substitution.has_value());
+  EXPECT_FALSE(r.trace.substitution->ok) << "the case is one whose walls cannot move at once";
+  ASSERT_EQ(r.outcome, Outcome::Refined) << r.reason;
+  ASSERT_EQ(r.trace.walls_refused.size(), 1u);
+  EXPECT_NE(r.trace.walls_refused[0].find("0 scan points in front of it"), std::string::npos)
+      << r.trace.walls_refused[0];
+  double before = 0, after = 0;
+  int scanned = 0;
+  for (const MovedWall& w : b.moved_walls) {
+    if (!w.scanned) continue;
+    ++scanned;
+    before += wall_median_distance(b, w, b.coarse);
+    after += wall_median_distance(b, w, r.mesh);
+  }
+  ASSERT_GT(scanned, 0);
+  EXPECT_GT(before / scanned, 0.15);
+  EXPECT_LT(after / scanned, 0.03);
 }
 
 TEST(Refine, OutcomeNamesReadBack) {

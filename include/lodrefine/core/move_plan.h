@@ -10,9 +10,12 @@
 //   judge (judge_refinement)                   takes  moved (judged_walls)
 //
 // The judge's retries hand the plan on again with fewer moves: without the corners, then
-// without each scan move whose own wall the judge refused (SubstitutedWall::scan_surface names it).
+// without each scan move whose own wall the judge refused (SubstitutedWall::scan_surface names
+// it; a wall the one-at-a-time fallback moved is named by its input faces, which the fallback
+// then leaves where they are: MovePlan::refused_faces).
 // All geometry is in the building's local frame (refine_building's), in metres.
 #pragma once
+#include <set>
 #include <vector>
 
 #include "lodrefine/core/corners.h"
@@ -29,6 +32,7 @@ struct SubstitutedWall {
   // move and for a wall the one-at-a-time fallback moved (that one re-matches on each new shell,
   // so its surfaces are not the plan's).
   int scan_surface = -1;
+  std::set<int> input_faces;  // the input faces (Face::source) it descends from
 };
 
 struct MovePlan {
@@ -40,6 +44,9 @@ struct MovePlan {
   // What the starting shell moved, in order (the scan moves, then the corners; or the fallback's
   // walls one at a time); empty when no starting shell was made.
   std::vector<SubstitutedWall> moved;
+  // Input faces (Face::source) of walls the judge refused: the one-at-a-time fallback moves no
+  // wall holding one of them.
+  std::set<int> refused_faces;
 };
 
 // The judge's input: the walls of `plan.moved`, in order (Judgement::wall indexes both).
