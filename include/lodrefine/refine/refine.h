@@ -23,16 +23,16 @@
 
 namespace lodrefine {
 
-// The stages a refinement times (RefineTrace::seconds), in pipeline order; "total" follows
-// them. A building's run stops after any of them (a refusal, nothing to change).
-// The stages in the order refine_building runs them; the README's Method numbers them 1-7 and
-// each stage's header names its number and name (`// Stage 5, selection: ...`).
+// The stages a refinement times (RefineTrace::seconds), in the order refine_building runs them;
+// "total" follows them. A building's run stops after any of them (a refusal, nothing to change).
+// The README's Method numbers them 1-7, and each stage's header names its number and name
+// (`// Stage 5, selection: ...`).
 enum class RefineStage { Repair, Planes, Matching, Substitution, Selection, Judge, Validation };
 inline constexpr std::array<const char*, 7> kRefineStageNames = {"repair",    "planes", "matching",  "substitution",
                                                                  "selection", "judge",  "validation"};
 inline const char* stage_name(RefineStage stage) { return kRefineStageNames[std::size_t(stage)]; }
 
-// What each stage found, kept for the report (built outside the core: city/refine_report.h).
+// What each stage found, kept for the report (built by city: city/refine_report.h).
 // A record only: the stages hand their results to each other as values (the walls moved:
 // move_plan.h) and never read them back from here. A stage the building did not reach leaves its
 // member empty.

@@ -1,7 +1,6 @@
-// Stage 5, selection (candidates, data term, program, traced shell) for the whole building (paper Sec.
-// 3.2-3.4): one PolyFit-style candidate
-// arrangement over the building and the scan around it, and the GLPK binary selection that
-// decides every face of the output.
+// Stage 5, selection (candidates, data term, program, traced shell) for the whole building
+// (paper Sec. 3.2-3.4): one PolyFit-style candidate arrangement over the building and the scan
+// around it, and the GLPK binary selection that decides every face of the output.
 //
 // Supporting planes: the planes of the starting shell (the substituted or coarse model: roofs,
 // ground, unscanned walls, walls already moved onto their scan planes) and every facade plane
@@ -62,8 +61,8 @@ struct ShellSelection {
 // when the program chose the starting shell unchanged but its pieces do not validate, the result
 // is `start` itself (ok, with that said in `reason`). A start face whose vertices all lie within
 // planarity_tolerance of a larger face's plane, though its own normal is off (a sliver), is a
-// piece of that plane. Never throws
-// for geometry; !ok with the reason when the program has no solution or no valid shell.
+// piece of that plane. Never throws for geometry; !ok with the reason when the program has no
+// solution or no valid shell.
 // `outdated` (move_plan.h; its `surfaces` and `scan` only): walls of `start` the scan puts on
 // another plane that `start` still has where the model put them (no substitution moved them).
 // Its `surfaces` are model_surfaces(start) at their default tolerances, as the matching made them
