@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <memory>
@@ -107,5 +108,40 @@ TEST(InOrderPool, AnErrorInTheWorkStopsThePoolAndIsRethrown) {
                      [&](std::size_t&) { ++given; }),
                  std::runtime_error);
     EXPECT_LE(given, 10u) << jobs;
+  }
+}
+
+// TBB frees a token in flight when the pipeline is cancelled only if it waits in a filter's
+// buffer, not if it sits in a task the cancellation drops: items the pool handed TBB leaked
+// whenever an error stopped it with items still being worked on.
+TEST(InOrderPool, AnErrorFreesEveryItemInFlight) {
+  struct Counted {
+    std::size_t k;
+    std::atomic<int>* alive;
+    Counted(std::size_t k, std::atomic<int>* alive) : k(k), alive(alive) { ++*alive; }
+    ~Counted() { --*alive; }
+  };
+  constexpr int kJobs = 2;
+  constexpr std::size_t kBound = kInOrderItemsPerJob * kJobs;
+  for (int round = 0; round < 20; ++round) {
+    std::atomic<int> alive{0};
+    std::atomic<std::size_t> next{0};
+    EXPECT_THROW(in_order_pool<Counted>(
+                     kJobs,
+                     [&]() -> std::shared_ptr<Counted> {
+                       return next == 4 * kBound ? nullptr : std::make_shared<Counted>(next++, &alive);
+                     },
+                     [&](Counted& item) {
+                       // Item 1 fails once the pool is full, with its successors taken and being
+                       // worked on.
+                       if (item.k == 1) {
+                         while (next < kBound) std::this_thread::yield();
+                         throw std::runtime_error("building 1");
+                       }
+                       std::this_thread::sleep_for(std::chrono::milliseconds(2));
+                     },
+                     [&](Counted&) {}),
+                 std::runtime_error);
+    ASSERT_EQ(alive.load(), 0) << "round " << round << ": items taken and never freed";
   }
 }

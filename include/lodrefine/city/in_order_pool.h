@@ -4,7 +4,9 @@
 #pragma once
 #include <cstddef>
 #include <functional>
+#include <map>
 #include <memory>
+#include <mutex>
 
 #include <tbb/global_control.h>
 #include <tbb/parallel_pipeline.h>
@@ -35,19 +37,32 @@ void in_order_pool(int jobs, const std::function<std::shared_ptr<Item>()>& take,
     }
     return;
   }
-  using Ptr = std::shared_ptr<Item>;
+  // The pool owns the items in flight and TBB passes pointers: when an error cancels the
+  // pipeline, TBB frees only the tokens waiting in a filter's buffer, not those in the tasks it
+  // drops, so items it owned would leak.
+  std::mutex mutex;
+  std::map<std::size_t, std::shared_ptr<Item>> in_flight;
+  std::size_t taken = 0, given = 0;
   tbb::task_arena arena(jobs);
   arena.execute([&] {
     tbb::parallel_pipeline(
         kInOrderItemsPerJob * std::size_t(jobs),
-        tbb::make_filter<void, Ptr>(tbb::filter_mode::serial_in_order, [&](tbb::flow_control& fc) {
-          Ptr item = take();
-          if (!item) fc.stop();
-          return item;
-        }) & tbb::make_filter<Ptr, Ptr>(tbb::filter_mode::parallel, [&](Ptr item) {
+        tbb::make_filter<void, Item*>(tbb::filter_mode::serial_in_order, [&](tbb::flow_control& fc) -> Item* {
+          std::shared_ptr<Item> item = take();
+          if (!item) {
+            fc.stop();
+            return nullptr;
+          }
+          const std::lock_guard<std::mutex> lock(mutex);
+          return in_flight.emplace(taken++, std::move(item)).first->second.get();
+        }) & tbb::make_filter<Item*, Item*>(tbb::filter_mode::parallel, [&](Item* item) {
           work(*item);
           return item;
-        }) & tbb::make_filter<Ptr, void>(tbb::filter_mode::serial_in_order, [&](Ptr item) { give(*item); }));
+        }) & tbb::make_filter<Item*, void>(tbb::filter_mode::serial_in_order, [&](Item* item) {
+          give(*item);
+          const std::lock_guard<std::mutex> lock(mutex);
+          in_flight.erase(given++);
+        }));
   });
 }
 
